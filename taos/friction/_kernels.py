@@ -1,0 +1,187 @@
+"""Scalar friction kernels: the single definition of every friction law.
+
+Each law is two numba-compiled scalar functions over SI floats, written so that the same
+Python source also traces under CasADi (``fn.py_func`` with SX arguments) where the law is
+smooth:
+
+* ``torque(v, z, t_app, p)`` -> friction torque T_f [N m] opposing relative rate ``v``
+  [rad/s], given the internal state ``z`` [rad] and the applied (non-friction) torque
+  ``t_app`` [N m] (used only by the stick-slip law);
+* ``zdot(v, z, p)`` -> dz/dt [rad/s].
+
+``p`` is the packed parameter vector (float64, :data:`NPARAM` slots, see ``SLOT_*``).
+The kernels are dispatched by integer id (:data:`IDS`) inside the time-domain integrator so
+that one compiled integrator serves every law.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# Packed parameter slots (SI units).
+SLOT_TC = 0        # Coulomb (dynamic) torque T_c [N m]
+SLOT_TS = 1        # static (breakaway) torque T_s [N m]
+SLOT_VS = 2        # Stribeck velocity v_s [rad/s]
+SLOT_DELTA = 3     # Stribeck exponent delta [-]
+SLOT_SIGMA0 = 4    # bristle stiffness sigma_0 [N m/rad]
+SLOT_SIGMA1 = 5    # bristle damping sigma_1 [N m s/rad]
+SLOT_SIGMA2 = 6    # viscous damping sigma_2 [N m s/rad]
+SLOT_VD = 7        # vibration velocity amplitude V_d [rad/s]
+SLOT_VEPS = 8      # stick band (switching) or regularisation velocity (smooth) [rad/s]
+SLOT_ALPHA = 9     # Dahl exponent alpha [-]
+SLOT_V1 = 10       # bristle-damping decay velocity v_1 [rad/s] (0: constant sigma_1)
+SLOT_CSTICK = 11   # stick damping c_stick [N m s/rad] (switching law)
+NPARAM = 12
+
+ID_NONE, ID_COULOMB_SWITCHING, ID_COULOMB_SMOOTH, ID_DAHL, ID_LUGRE, ID_MODIFIED_LUGRE = range(6)
+IDS = {
+    "none": ID_NONE,
+    "coulomb-switching": ID_COULOMB_SWITCHING,
+    "coulomb-smooth": ID_COULOMB_SMOOTH,
+    "dahl": ID_DAHL,
+    "lugre": ID_LUGRE,
+    "modified-lugre": ID_MODIFIED_LUGRE,
+}
+
+
+@njit(cache=True)
+def _sign(x):
+    if x > 0.0:
+        return 1.0
+    if x < 0.0:
+        return -1.0
+    return 0.0
+
+
+# --- Coulomb, stick-slip switching (Karnopp 1985) -------------------------------------
+@njit(cache=True)
+def coulomb_switching_torque(v, z, t_app, p):
+    """Karnopp: inside |v| < v_eps the joint sticks and friction balances the applied torque
+    (plus a stick damping c_stick*v that bleeds off the residual rate), up to T_s;
+    outside it slides with T_c sign(v)."""
+    if abs(v) < p[SLOT_VEPS]:
+        t = t_app + p[SLOT_CSTICK] * v
+        ts = max(p[SLOT_TS], p[SLOT_TC])
+        if t > ts:
+            return ts
+        if t < -ts:
+            return -ts
+        return t
+    return p[SLOT_TC] * _sign(v)
+
+
+# --- Coulomb, smooth regularised ------------------------------------------------------
+@njit(cache=True)
+def coulomb_smooth_torque(v, z, t_app, p):
+    """T_f = T_c v / sqrt(v^2 + v_eps^2): algebraic regularisation, C-infinity, slope
+    T_c / v_eps at v = 0."""
+    e = p[SLOT_VEPS]
+    return p[SLOT_TC] * v / math.sqrt(v * v + e * e)
+
+
+# --- Dahl (1968) ----------------------------------------------------------------------
+@njit(cache=True)
+def dahl_zdot(v, z, p):
+    """dz/dt = v * |1 - s|^alpha * sign(1 - s),  s = sigma_0 z sign(v) / T_c."""
+    s = p[SLOT_SIGMA0] * z * _sign(v) / p[SLOT_TC]
+    d = 1.0 - s
+    return v * abs(d) ** p[SLOT_ALPHA] * _sign(d)
+
+
+@njit(cache=True)
+def dahl_torque(v, z, t_app, p):
+    """T_f = sigma_0 z."""
+    return p[SLOT_SIGMA0] * z
+
+
+# --- LuGre (Canudas de Wit et al. 1995) and the modified LuGre --------------------------
+@njit(cache=True)
+def _stribeck(v, p):
+    """G(v) = T_c + (T_s - T_c) exp(-|v/v_s|^delta)."""
+    return p[SLOT_TC] + (p[SLOT_TS] - p[SLOT_TC]) * math.exp(-abs(v / p[SLOT_VS]) ** p[SLOT_DELTA])
+
+
+@njit(cache=True)
+def _abs_v_over_h(v, vd):
+    """|v| / h(v) with h(v) = (2/pi) asin(min(1, |v|/V_d)); equals |v| when V_d = 0.
+
+    Finite at v = 0: the limit is V_d pi / 2."""
+    av = abs(v)
+    if vd <= 0.0 or av >= vd:
+        return av
+    u = av / vd
+    if u < 1e-8:
+        return vd * 0.5 * math.pi  # u / asin(u) -> 1
+    return vd * 0.5 * math.pi * u / math.asin(u)
+
+
+@njit(cache=True)
+def lugre_zdot(v, z, p):
+    """dz/dt = v - sigma_0 z |v| / g(v),  g(v) = G(v) h(v)  (h = 1 for plain LuGre)."""
+    return v - p[SLOT_SIGMA0] * z * _abs_v_over_h(v, p[SLOT_VD]) / _stribeck(v, p)
+
+
+@njit(cache=True)
+def _sigma1(v, p):
+    """sigma_1(v) = sigma_1 exp(-(v/v_1)^2), constant when v_1 = 0 (Canudas 1995, eq. 9)."""
+    v1 = p[SLOT_V1]
+    if v1 > 0.0:
+        return p[SLOT_SIGMA1] * math.exp(-(v / v1) ** 2)
+    return p[SLOT_SIGMA1]
+
+
+@njit(cache=True)
+def lugre_torque(v, z, t_app, p):
+    """T_f = sigma_0 z + sigma_1(v) dz/dt + sigma_2 v."""
+    return p[SLOT_SIGMA0] * z + _sigma1(v, p) * lugre_zdot(v, z, p) + p[SLOT_SIGMA2] * v
+
+
+# --- dispatch -------------------------------------------------------------------------
+@njit(cache=True)
+def torque(fid, v, z, t_app, p):
+    """Friction torque [N m] of law ``fid``."""
+    if fid == ID_NONE:
+        return 0.0
+    if fid == ID_COULOMB_SWITCHING:
+        return coulomb_switching_torque(v, z, t_app, p)
+    if fid == ID_COULOMB_SMOOTH:
+        return coulomb_smooth_torque(v, z, t_app, p)
+    if fid == ID_DAHL:
+        return dahl_torque(v, z, t_app, p)
+    return lugre_torque(v, z, t_app, p)  # LuGre and modified LuGre share the kernel
+
+
+@njit(cache=True)
+def zdot(fid, v, z, p):
+    """Internal-state derivative [rad/s] of law ``fid`` (0 for memoryless laws)."""
+    if fid == ID_DAHL:
+        return dahl_zdot(v, z, p)
+    if fid == ID_LUGRE or fid == ID_MODIFIED_LUGRE:
+        return lugre_zdot(v, z, p)
+    return 0.0
+
+
+@njit(cache=True)
+def prescribed_rate_response(fid, p, v, dt, z0):
+    """Torque history for a prescribed relative-rate history ``v`` sampled every ``dt``.
+
+    The state is advanced by classical RK4 with ``v`` linearly interpolated at the
+    half-step. Returns (torque[n], z[n])."""
+    n = v.shape[0]
+    tq = np.empty(n)
+    zs = np.empty(n)
+    z = z0
+    for k in range(n):
+        zs[k] = z
+        tq[k] = torque(fid, v[k], z, 0.0, p)
+        if k + 1 < n:
+            vm = 0.5 * (v[k] + v[k + 1])
+            k1 = zdot(fid, v[k], z, p)
+            k2 = zdot(fid, vm, z + 0.5 * dt * k1, p)
+            k3 = zdot(fid, vm, z + 0.5 * dt * k2, p)
+            k4 = zdot(fid, v[k + 1], z + dt * k3, p)
+            z = z + dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
+    return tq, zs

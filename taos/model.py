@@ -1,0 +1,279 @@
+"""Model files: TOML parameter sets with units, loaded into frozen SI dataclasses.
+
+A model file (``models/rs25_ambient.toml`` and friends) holds the sections below; every
+physical value is a string with its unit, parsed by pint (:mod:`taos.units`). The keys of
+DESIGN.md are a contract::
+
+    [engine]    mass, inertia_pitch, inertia_yaw, rotational_stiffness, (thrust)
+    [actuator]  moment_arm, piston_area, supply_pressure, oil_bulk_modulus, trapped_volume,
+                piston_mass, piston_damping, loop_gain, valve_natural_frequency,
+                valve_damping_ratio, valve_order, flow_pressure_coefficient, leakage_coefficient
+    [structure] load_stiffness
+    [friction]  model, coulomb_torque and the law's own parameters (taos.friction)
+    [avionics]  quantization_bits, command_range, rounding, crossover_command, crossover_gain
+
+Other sections (``[gimbal]``, ``[geometry]``) belong to the 3-D model and are kept as raw
+tables in :attr:`TvcModel.extra` for it to validate.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+import tomllib
+import types
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+from .avionics import Avionics
+from .errors import InputError
+from .friction import FrictionLaw, friction_from_table
+from .units import to_si
+
+KNOWN_SECTIONS = {"name", "description", "engine", "actuator", "structure", "friction", "avionics",
+                  "gimbal", "geometry"}
+
+
+@dataclass(frozen=True)
+class Engine:
+    """Gimballed engine (rigid body about the gimbal point).
+
+    mass_kg : gimballed mass [kg]; inertia_pitch/yaw_kgm2 : J_n about the gimbal [kg m^2];
+    rotational_stiffness_Nm_per_rad : K_n, feedlines and gravity [N m/rad];
+    thrust_N : thrust pressing the gimbal bearing [N] (0 when hanging).
+    """
+
+    mass_kg: float
+    inertia_pitch_kgm2: float
+    inertia_yaw_kgm2: float
+    rotational_stiffness_Nm_per_rad: float
+    thrust_N: float = 0.0
+
+    def inertia(self, axis: str) -> float:
+        """J_n [kg m^2] about ``axis`` ('pitch' or 'yaw')."""
+        return self.inertia_pitch_kgm2 if axis == "pitch" else self.inertia_yaw_kgm2
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """Mechanical-feedback hydraulic position servo (Merritt, Hydraulic Control Systems, 1967).
+
+    Equations (SI)::
+
+        valve:       q'' + 2 zeta_v w_v q' + w_v^2 q = w_v^2 K_v (x_c - x_p)   (order 2)
+                     q' = w_v (K_v (x_c - x_p) - q)                               (order 1)
+        continuity:  (V_t / 4 beta) P_L' = A q - (K_c + C_l) P_L - A v_p
+        piston:      M_p v_p' = A P_L - F_L - B_p v_p
+
+    q is the valve's no-load flow divided by the piston area [m/s]; K_v = K_q K_fb / A is the
+    position loop gain [1/s].
+    """
+
+    moment_arm_m: float
+    piston_area_m2: float
+    supply_pressure_Pa: float
+    oil_bulk_modulus_Pa: float
+    trapped_volume_m3: float
+    piston_mass_kg: float
+    piston_damping_Ns_per_m: float
+    loop_gain_per_s: float
+    valve_natural_frequency_hz: float
+    valve_damping_ratio: float
+    valve_order: int
+    flow_pressure_coefficient_m3_per_s_Pa: float
+    leakage_coefficient_m3_per_s_Pa: float
+
+    @property
+    def oil_column_stiffness_N_per_m(self) -> float:
+        """K_h = 4 beta A^2 / V_t [N/m] (Merritt eq. 5-56, piston centred)."""
+        return 4.0 * self.oil_bulk_modulus_Pa * self.piston_area_m2 ** 2 / self.trapped_volume_m3
+
+    @property
+    def stall_force_N(self) -> float:
+        """A P_s [N]."""
+        return self.piston_area_m2 * self.supply_pressure_Pa
+
+
+@dataclass(frozen=True)
+class Structure:
+    """Load path outside the actuator position loop: K_L [N/m] (thrust structure, engine,
+    gimbal, actuator case and attachments in series)."""
+
+    load_stiffness_N_per_m: float
+
+
+@dataclass(frozen=True)
+class TvcModel:
+    """One engine, its gimbal friction, actuators and command avionics (SI inside)."""
+
+    name: str
+    engine: Engine
+    actuator: Actuator
+    structure: Structure
+    friction: FrictionLaw
+    avionics: Avionics
+    source: str = "<code>"
+    sha256: str = ""
+    friction_table: Mapping[str, Any] = field(default_factory=lambda: types.MappingProxyType({}),
+                                              compare=False, repr=False)
+    extra: Mapping[str, Any] = field(default_factory=lambda: types.MappingProxyType({}),
+                                     compare=False, repr=False)
+
+    # -- derived figures ------------------------------------------------------------------
+    def load_resonance_hz(self, axis: str = "pitch") -> float:
+        """w_L / 2 pi with w_L = sqrt((K_L R^2 + K_n) / J_n) (seed paper eq. 1) [Hz]."""
+        R = self.actuator.moment_arm_m
+        k = self.structure.load_stiffness_N_per_m * R * R + self.engine.rotational_stiffness_Nm_per_rad
+        return math.sqrt(k / self.engine.inertia(axis)) / (2 * math.pi)
+
+    def breakaway_deflection_rad(self) -> float:
+        """T_c / (K_L R^2) [rad]: load-path deflection that friction holds before the engine moves."""
+        R = self.actuator.moment_arm_m
+        return self.friction.coulomb_torque_Nm / (self.structure.load_stiffness_N_per_m * R * R)
+
+    # -- variants -------------------------------------------------------------------------
+    def with_friction(self, name: str) -> "TvcModel":
+        """The same model with friction law ``name``, keeping the file's torque levels."""
+        table = dict(self.friction_table) or {"coulomb_torque": f"{self.friction.coulomb_torque_Nm} N*m"}
+        law = friction_from_table(table, self.source, model=name)
+        return dataclasses.replace(self, friction=law)
+
+    def replace(self, **changes) -> "TvcModel":
+        """Copy with fields replaced (``dataclasses.replace``)."""
+        return dataclasses.replace(self, **changes)
+
+
+# -- loading ------------------------------------------------------------------------------
+def _need(table: Mapping, key: str, kind: str, src: str, section: str, **checks) -> float:
+    if key not in table:
+        from .units import DIMENSIONS
+        raise InputError(src, f"{section}.{key}", f"a {kind.replace('_', ' ')} with its unit, like "
+                         f"{DIMENSIONS[kind][2]}", got="nothing (key missing)")
+    return to_si(table[key], kind, source=src, field=f"{section}.{key}", **checks)
+
+
+def _section(doc: Mapping, name: str, src: str) -> Mapping:
+    sec = doc.get(name)
+    if not isinstance(sec, Mapping):
+        raise InputError(src, f"[{name}]", f"a [{name}] table", got="nothing (section missing)")
+    return sec
+
+
+def _check_keys(sec: Mapping, allowed: set[str], src: str, section: str) -> None:
+    unknown = sorted(set(sec) - allowed)
+    if unknown:
+        raise InputError(src, f"{section}.{unknown[0]}", "one of " + ", ".join(sorted(allowed)),
+                         got="an unknown key")
+
+
+def parse_engine(doc: Mapping, src: str) -> Engine:
+    s = _section(doc, "engine", src)
+    _check_keys(s, {"mass", "inertia_pitch", "inertia_yaw", "rotational_stiffness", "thrust"}, src, "engine")
+    return Engine(
+        mass_kg=_need(s, "mass", "mass", src, "engine", positive=True),
+        inertia_pitch_kgm2=_need(s, "inertia_pitch", "inertia", src, "engine", positive=True),
+        inertia_yaw_kgm2=_need(s, "inertia_yaw", "inertia", src, "engine", positive=True),
+        rotational_stiffness_Nm_per_rad=_need(s, "rotational_stiffness", "rotational_stiffness", src,
+                                              "engine", nonnegative=True),
+        thrust_N=(to_si(s["thrust"], "force", source=src, field="engine.thrust", nonnegative=True)
+                  if "thrust" in s else 0.0),
+    )
+
+
+_ACTUATOR_FIELDS = {  # key -> (kind, check)
+    "moment_arm": ("length", "positive"),
+    "piston_area": ("area", "positive"),
+    "supply_pressure": ("pressure", "positive"),
+    "oil_bulk_modulus": ("pressure", "positive"),
+    "trapped_volume": ("volume", "positive"),
+    "piston_mass": ("mass", "positive"),
+    "piston_damping": ("damping", "nonnegative"),
+    "loop_gain": ("rate", "positive"),
+    "valve_natural_frequency": ("frequency", "positive"),
+    "valve_damping_ratio": ("dimensionless", "positive"),
+    "flow_pressure_coefficient": ("flow_pressure", "nonnegative"),
+    "leakage_coefficient": ("flow_pressure", "nonnegative"),
+}
+_ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
+                "supply_pressure": "supply_pressure_Pa", "oil_bulk_modulus": "oil_bulk_modulus_Pa",
+                "trapped_volume": "trapped_volume_m3", "piston_mass": "piston_mass_kg",
+                "piston_damping": "piston_damping_Ns_per_m", "loop_gain": "loop_gain_per_s",
+                "valve_natural_frequency": "valve_natural_frequency_hz",
+                "valve_damping_ratio": "valve_damping_ratio",
+                "flow_pressure_coefficient": "flow_pressure_coefficient_m3_per_s_Pa",
+                "leakage_coefficient": "leakage_coefficient_m3_per_s_Pa"}
+
+
+def parse_actuator(doc: Mapping, src: str) -> Actuator:
+    s = _section(doc, "actuator", src)
+    _check_keys(s, set(_ACTUATOR_FIELDS) | {"valve_order"}, src, "actuator")
+    kw = {_ACTUATOR_SI[k]: _need(s, k, kind, src, "actuator", **{chk: True})
+          for k, (kind, chk) in _ACTUATOR_FIELDS.items()}
+    order = s.get("valve_order", 2)
+    if order not in (1, 2) or isinstance(order, bool):
+        raise InputError(src, "actuator.valve_order", "1 or 2", got=repr(order))
+    return Actuator(valve_order=int(order), **kw)
+
+
+def parse_avionics(doc: Mapping, src: str) -> Avionics:
+    s = _section(doc, "avionics", src)
+    _check_keys(s, {"quantization_bits", "command_range", "rounding", "crossover_command",
+                    "crossover_gain"}, src, "avionics")
+    bits = s.get("quantization_bits")
+    if not isinstance(bits, int) or isinstance(bits, bool) or not 0 <= bits <= 32:
+        raise InputError(src, "avionics.quantization_bits", "a whole number of bits from 0 to 32",
+                         got="nothing (key missing)" if bits is None else repr(bits))
+    rng = _need(s, "command_range", "angle", src, "avionics", positive=True)
+    rounding = s.get("rounding")
+    if rounding not in ("truncate", "round"):
+        raise InputError(src, "avionics.rounding", "'truncate' or 'round'",
+                         got="nothing (key missing)" if rounding is None else repr(rounding))
+    cmd = s.get("crossover_command", [])
+    gain = s.get("crossover_gain", [])
+    if not isinstance(cmd, list) or not isinstance(gain, list) or len(cmd) != len(gain):
+        raise InputError(src, "avionics.crossover_gain", "a list as long as crossover_command")
+    amps = tuple(to_si(c, "angle", source=src, field=f"avionics.crossover_command[{i}]", nonnegative=True)
+                 for i, c in enumerate(cmd))
+    gains = tuple(to_si(g, "dimensionless", source=src, field=f"avionics.crossover_gain[{i}]", positive=True)
+                  for i, g in enumerate(gain))
+    if any(b <= a for a, b in zip(amps, amps[1:])):
+        raise InputError(src, "avionics.crossover_command", "strictly increasing command magnitudes")
+    return Avionics(quantization_bits=bits, command_range_rad=rng, rounding=(rounding == "round"),
+                    gain_table_rad=amps, gain_table=gains)
+
+
+def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
+    """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
+
+    Raises :class:`~taos.errors.InputError` (one line: file, field, expectation) on bad input.
+    """
+    p = Path(path)
+    src = str(path)
+    try:
+        raw = p.read_bytes()
+    except OSError as e:
+        raise InputError(src, "(file)", "a readable model file", got=e.strerror) from None
+    try:
+        doc = tomllib.loads(raw.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+    unknown = sorted(set(doc) - KNOWN_SECTIONS)
+    if unknown:
+        raise InputError(src, unknown[0], "a known section (" + ", ".join(sorted(KNOWN_SECTIONS)) + ")",
+                         got="an unknown section")
+    engine = parse_engine(doc, src)
+    actuator = parse_actuator(doc, src)
+    st = _section(doc, "structure", src)
+    _check_keys(st, {"load_stiffness"}, src, "structure")
+    structure = Structure(_need(st, "load_stiffness", "stiffness", src, "structure", positive=True))
+    ftab = _section(doc, "friction", src)
+    law = friction_from_table(ftab, src, model=friction)
+    avionics = parse_avionics(doc, src)
+    extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}
+    return TvcModel(name=str(doc.get("name", p.stem)), engine=engine, actuator=actuator,
+                    structure=structure, friction=law, avionics=avionics, source=src,
+                    sha256=hashlib.sha256(raw).hexdigest(),
+                    friction_table=types.MappingProxyType(dict(ftab)),
+                    extra=types.MappingProxyType(extra))
