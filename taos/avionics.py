@@ -75,7 +75,7 @@ class Avionics:
         return Avionics()
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def apply(c, p):
     """Command path for one value ``c`` [rad] with packed parameters ``p``."""
     lsb = p[1]
@@ -90,18 +90,18 @@ def apply(c, p):
     if n == 0:
         return c
     a = abs(c)
-    amps = p[4:4 + n]
-    gains = p[4 + n:4 + 2 * n]
-    if a <= amps[0]:
-        g = gains[0]
-    elif a >= amps[n - 1]:
-        g = gains[n - 1]
+    ia = 4          # amplitudes p[4 : 4+n], gains p[4+n : 4+2n]
+    ig = 4 + n
+    if a <= p[ia]:
+        g = p[ig]
+    elif a >= p[ia + n - 1]:
+        g = p[ig + n - 1]
     else:
         i = 0
-        while amps[i + 1] < a:
+        while p[ia + i + 1] < a:
             i += 1
-        w = (a - amps[i]) / (amps[i + 1] - amps[i])
-        g = gains[i] + w * (gains[i + 1] - gains[i])
+        w = (a - p[ia + i]) / (p[ia + i + 1] - p[ia + i])
+        g = p[ig + i] + w * (p[ig + i + 1] - p[ig + i])
     return g * c
 
 

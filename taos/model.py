@@ -7,7 +7,8 @@ DESIGN.md are a contract::
     [engine]    mass, inertia_pitch, inertia_yaw, rotational_stiffness, (thrust)
     [actuator]  moment_arm, piston_area, supply_pressure, oil_bulk_modulus, trapped_volume,
                 piston_mass, piston_damping, loop_gain, valve_natural_frequency,
-                valve_damping_ratio, valve_order, flow_pressure_coefficient, leakage_coefficient
+                valve_damping_ratio, valve_order, flow_pressure_coefficient, leakage_coefficient,
+                (pressure_feedback_gain, pressure_feedback_time_constant)
     [structure] load_stiffness
     [friction]  model, coulomb_torque and the law's own parameters (taos.friction)
     [avionics]  quantization_bits, command_range, rounding, crossover_command, crossover_gain
@@ -68,7 +69,10 @@ class Actuator:
         piston:      M_p v_p' = A P_L - F_L - B_p v_p
 
     q is the valve's no-load flow divided by the piston area [m/s]; K_v = K_q K_fb / A is the
-    position loop gain [1/s].
+    position loop gain [1/s]; K_dpf [m/(s Pa)] with time constant tau_dpf [s] is the dynamic
+    pressure feedback that damps the load resonance without softening the static stiffness
+    (a velocity servo with oil compressibility alone gives the load mode negative damping
+    unless K_c > A^2 K_v / K_h).
     """
 
     moment_arm_m: float
@@ -84,6 +88,8 @@ class Actuator:
     valve_order: int
     flow_pressure_coefficient_m3_per_s_Pa: float
     leakage_coefficient_m3_per_s_Pa: float
+    pressure_feedback_gain_m_per_s_Pa: float = 0.0
+    pressure_feedback_time_constant_s: float = 0.0
 
     @property
     def oil_column_stiffness_N_per_m(self) -> float:
@@ -195,6 +201,8 @@ _ACTUATOR_FIELDS = {  # key -> (kind, check)
     "valve_damping_ratio": ("dimensionless", "positive"),
     "flow_pressure_coefficient": ("flow_pressure", "nonnegative"),
     "leakage_coefficient": ("flow_pressure", "nonnegative"),
+    "pressure_feedback_gain": ("velocity_per_pressure", "nonnegative"),
+    "pressure_feedback_time_constant": ("time", "nonnegative"),
 }
 _ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "supply_pressure": "supply_pressure_Pa", "oil_bulk_modulus": "oil_bulk_modulus_Pa",
@@ -203,14 +211,21 @@ _ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "valve_natural_frequency": "valve_natural_frequency_hz",
                 "valve_damping_ratio": "valve_damping_ratio",
                 "flow_pressure_coefficient": "flow_pressure_coefficient_m3_per_s_Pa",
-                "leakage_coefficient": "leakage_coefficient_m3_per_s_Pa"}
+                "leakage_coefficient": "leakage_coefficient_m3_per_s_Pa",
+                "pressure_feedback_gain": "pressure_feedback_gain_m_per_s_Pa",
+                "pressure_feedback_time_constant": "pressure_feedback_time_constant_s"}
 
 
 def parse_actuator(doc: Mapping, src: str) -> Actuator:
     s = _section(doc, "actuator", src)
     _check_keys(s, set(_ACTUATOR_FIELDS) | {"valve_order"}, src, "actuator")
+    optional = {"pressure_feedback_gain", "pressure_feedback_time_constant"}
     kw = {_ACTUATOR_SI[k]: _need(s, k, kind, src, "actuator", **{chk: True})
-          for k, (kind, chk) in _ACTUATOR_FIELDS.items()}
+          for k, (kind, chk) in _ACTUATOR_FIELDS.items() if k not in optional or k in s}
+    if kw.get("pressure_feedback_gain_m_per_s_Pa", 0.0) > 0 and not kw.get(
+            "pressure_feedback_time_constant_s", 0.0) > 0:
+        raise InputError(src, "actuator.pressure_feedback_time_constant",
+                         "a positive time constant when pressure_feedback_gain is set")
     order = s.get("valve_order", 2)
     if order not in (1, 2) or isinstance(order, bool):
         raise InputError(src, "actuator.valve_order", "1 or 2", got=repr(order))

@@ -40,6 +40,7 @@ DIMENSIONS: dict[str, tuple[str, str, str]] = {
     "damping": ("N*s/m", "N*s/m", "'20000 N*s/m'"),
     "rotational_damping": ("N*m*s/rad", "N*m*s/rad", "'1e6 N*m*s/rad'"),
     "flow_pressure": ("m**3/s/Pa", "m**3/s/Pa", "'1e-12 m**3/s/Pa'"),
+    "velocity_per_pressure": ("m/s/Pa", "m/s/Pa", "'4e-8 m/s/Pa'"),
     "dimensionless": ("dimensionless", "1", "'0.95'"),
 }
 

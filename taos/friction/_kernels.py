@@ -4,10 +4,11 @@ Each law is two numba-compiled scalar functions over SI floats, written so that 
 Python source also traces under CasADi (``fn.py_func`` with SX arguments) where the law is
 smooth:
 
-* ``torque(v, z, t_app, p)`` -> friction torque T_f [N m] opposing relative rate ``v``
-  [rad/s], given the internal state ``z`` [rad] and the applied (non-friction) torque
-  ``t_app`` [N m] (used only by the stick-slip law);
-* ``zdot(v, z, p)`` -> dz/dt [rad/s].
+* ``zdot(v, z, p)`` -> dz/dt [rad/s];
+* ``torque(v, z, dz, t_app, p)`` -> friction torque T_f [N m] opposing relative rate ``v``
+  [rad/s], given the internal state ``z`` [rad], its derivative ``dz`` (from ``zdot``, so it
+  is computed once) and the applied (non-friction) torque ``t_app`` [N m] (used only by the
+  stick-slip law).
 
 ``p`` is the packed parameter vector (float64, :data:`NPARAM` slots, see ``SLOT_*``).
 The kernels are dispatched by integer id (:data:`IDS`) inside the time-domain integrator so
@@ -47,7 +48,7 @@ IDS = {
 }
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _sign(x):
     if x > 0.0:
         return 1.0
@@ -57,8 +58,8 @@ def _sign(x):
 
 
 # --- Coulomb, stick-slip switching (Karnopp 1985) -------------------------------------
-@njit(cache=True)
-def coulomb_switching_torque(v, z, t_app, p):
+@njit(cache=True, inline="always")
+def coulomb_switching_torque(v, t_app, p):
     """Karnopp: inside |v| < v_eps the joint sticks and friction balances the applied torque
     (plus a stick damping c_stick*v that bleeds off the residual rate), up to T_s;
     outside it slides with T_c sign(v)."""
@@ -74,8 +75,8 @@ def coulomb_switching_torque(v, z, t_app, p):
 
 
 # --- Coulomb, smooth regularised ------------------------------------------------------
-@njit(cache=True)
-def coulomb_smooth_torque(v, z, t_app, p):
+@njit(cache=True, inline="always")
+def coulomb_smooth_torque(v, p):
     """T_f = T_c v / sqrt(v^2 + v_eps^2): algebraic regularisation, C-infinity, slope
     T_c / v_eps at v = 0."""
     e = p[SLOT_VEPS]
@@ -83,7 +84,7 @@ def coulomb_smooth_torque(v, z, t_app, p):
 
 
 # --- Dahl (1968) ----------------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def dahl_zdot(v, z, p):
     """dz/dt = v * |1 - s|^alpha * sign(1 - s),  s = sigma_0 z sign(v) / T_c."""
     s = p[SLOT_SIGMA0] * z * _sign(v) / p[SLOT_TC]
@@ -91,20 +92,23 @@ def dahl_zdot(v, z, p):
     return v * abs(d) ** p[SLOT_ALPHA] * _sign(d)
 
 
-@njit(cache=True)
-def dahl_torque(v, z, t_app, p):
+@njit(cache=True, inline="always")
+def dahl_torque(z, p):
     """T_f = sigma_0 z."""
     return p[SLOT_SIGMA0] * z
 
 
 # --- LuGre (Canudas de Wit et al. 1995) and the modified LuGre --------------------------
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _stribeck(v, p):
     """G(v) = T_c + (T_s - T_c) exp(-|v/v_s|^delta)."""
-    return p[SLOT_TC] + (p[SLOT_TS] - p[SLOT_TC]) * math.exp(-abs(v / p[SLOT_VS]) ** p[SLOT_DELTA])
+    u = abs(v / p[SLOT_VS])
+    d = p[SLOT_DELTA]
+    e = u * u if d == 2.0 else u ** d
+    return p[SLOT_TC] + (p[SLOT_TS] - p[SLOT_TC]) * math.exp(-e)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _abs_v_over_h(v, vd):
     """|v| / h(v) with h(v) = (2/pi) asin(min(1, |v|/V_d)); equals |v| when V_d = 0.
 
@@ -118,13 +122,13 @@ def _abs_v_over_h(v, vd):
     return vd * 0.5 * math.pi * u / math.asin(u)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lugre_zdot(v, z, p):
     """dz/dt = v - sigma_0 z |v| / g(v),  g(v) = G(v) h(v)  (h = 1 for plain LuGre)."""
     return v - p[SLOT_SIGMA0] * z * _abs_v_over_h(v, p[SLOT_VD]) / _stribeck(v, p)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _sigma1(v, p):
     """sigma_1(v) = sigma_1 exp(-(v/v_1)^2), constant when v_1 = 0 (Canudas 1995, eq. 9)."""
     v1 = p[SLOT_V1]
@@ -133,28 +137,28 @@ def _sigma1(v, p):
     return p[SLOT_SIGMA1]
 
 
-@njit(cache=True)
-def lugre_torque(v, z, t_app, p):
+@njit(cache=True, inline="always")
+def lugre_torque(v, z, dz, p):
     """T_f = sigma_0 z + sigma_1(v) dz/dt + sigma_2 v."""
-    return p[SLOT_SIGMA0] * z + _sigma1(v, p) * lugre_zdot(v, z, p) + p[SLOT_SIGMA2] * v
+    return p[SLOT_SIGMA0] * z + _sigma1(v, p) * dz + p[SLOT_SIGMA2] * v
 
 
 # --- dispatch -------------------------------------------------------------------------
-@njit(cache=True)
-def torque(fid, v, z, t_app, p):
-    """Friction torque [N m] of law ``fid``."""
+@njit(cache=True, inline="always")
+def torque(fid, v, z, dz, t_app, p):
+    """Friction torque [N m] of law ``fid``; ``dz`` is ``zdot(fid, v, z, p)``."""
     if fid == ID_NONE:
         return 0.0
     if fid == ID_COULOMB_SWITCHING:
-        return coulomb_switching_torque(v, z, t_app, p)
+        return coulomb_switching_torque(v, t_app, p)
     if fid == ID_COULOMB_SMOOTH:
-        return coulomb_smooth_torque(v, z, t_app, p)
+        return coulomb_smooth_torque(v, p)
     if fid == ID_DAHL:
-        return dahl_torque(v, z, t_app, p)
-    return lugre_torque(v, z, t_app, p)  # LuGre and modified LuGre share the kernel
+        return dahl_torque(z, p)
+    return lugre_torque(v, z, dz, p)  # LuGre and modified LuGre share the kernel
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def zdot(fid, v, z, p):
     """Internal-state derivative [rad/s] of law ``fid`` (0 for memoryless laws)."""
     if fid == ID_DAHL:
@@ -176,7 +180,7 @@ def prescribed_rate_response(fid, p, v, dt, z0):
     z = z0
     for k in range(n):
         zs[k] = z
-        tq[k] = torque(fid, v[k], z, 0.0, p)
+        tq[k] = torque(fid, v[k], z, zdot(fid, v[k], z, p), 0.0, p)
         if k + 1 < n:
             vm = 0.5 * (v[k] + v[k + 1])
             k1 = zdot(fid, v[k], z, p)

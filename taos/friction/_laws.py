@@ -83,7 +83,9 @@ class FrictionLaw(abc.ABC):
     def __call__(self, v: float, z: float = 0.0, t_app: float = 0.0) -> float:
         """Friction torque [N m] at relative rate ``v`` [rad/s], state ``z`` [rad] and applied
         torque ``t_app`` [N m]."""
-        return float(K.torque(self.fid, float(v), float(z), float(t_app), self.pack()))
+        p = self.pack()
+        dz = K.zdot(self.fid, float(v), float(z), p)
+        return float(K.torque(self.fid, float(v), float(z), dz, float(t_app), p))
 
     def derivative(self, v: float, z: float) -> float:
         """dz/dt [rad/s] (0 for memoryless laws)."""

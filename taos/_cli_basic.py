@@ -1,0 +1,160 @@
+"""``taos info``, ``taos freqresp`` and ``taos simulate``."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import InputError
+from .model import TvcModel, load_model
+from .results import write_json
+
+AXES = ("pitch", "yaw")
+
+
+def parse_float_list(text: str, option: str) -> list[float]:
+    """'0.1,0.5,1' -> [0.1, 0.5, 1.0]; refuses empty, non-numeric, non-positive or non-finite items."""
+    try:
+        vals = [float(s) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise InputError("command line", option, "a comma-separated list of numbers like 0.1,0.5,1",
+                         got=repr(text)) from None
+    if not vals or not all(math.isfinite(v) and v > 0 for v in vals):
+        raise InputError("command line", option, "positive finite numbers", got=repr(text))
+    return vals
+
+
+def model_from_args(args) -> TvcModel:
+    return load_model(args.model, friction=getattr(args, "friction", None))
+
+
+def info_dict(model: TvcModel) -> dict:
+    """Parameters in SI and derived figures (the ``taos info`` JSON)."""
+    from dataclasses import asdict
+
+    from .simplex import load_resonance_from_notch, simplex_state_space
+
+    poles = simplex_state_space(model, "pitch").poles()
+    p = poles[poles.imag >= 0]
+    p = p[np.argsort(np.abs(p))]
+    friction = {"model": model.friction.name, **asdict(model.friction)}
+    av = model.avionics
+    return {
+        "model_file": model.source,
+        "model_sha256": model.sha256,
+        "name": model.name,
+        "load_resonance_hz": model.load_resonance_hz("pitch"),
+        "load_resonance_yaw_hz": model.load_resonance_hz("yaw"),
+        "notch_frequency_hz": load_resonance_from_notch(model, "pitch"),
+        "breakaway_deflection_deg": math.degrees(model.breakaway_deflection_rad()),
+        "oil_column_stiffness_N_per_m": model.actuator.oil_column_stiffness_N_per_m,
+        "load_stiffness_rotational_Nm_per_rad": model.structure.load_stiffness_N_per_m * model.actuator.moment_arm_m ** 2,
+        "stall_force_N": model.actuator.stall_force_N,
+        "avionics_lsb_deg": math.degrees(av.lsb_rad),
+        "linear_modes": [{"freq_hz": float(abs(x) / (2 * math.pi)),
+                          "damping_ratio": float(-x.real / abs(x)) if abs(x) > 0 else 1.0} for x in p],
+        "parameters": {
+            "engine": asdict(model.engine),
+            "actuator": asdict(model.actuator),
+            "structure": asdict(model.structure),
+            "friction": friction,
+            "avionics": {"quantization_bits": av.quantization_bits, "command_range_rad": av.command_range_rad,
+                         "rounding": "round" if av.rounding else "truncate",
+                         "crossover_command_rad": list(av.gain_table_rad), "crossover_gain": list(av.gain_table)},
+        },
+    }
+
+
+def cmd_info(args) -> int:
+    model = model_from_args(args)
+    d = info_dict(model)
+    if args.json:
+        write_json(args.json, d)
+    else:
+        print(f"{d['name']}  ({d['model_file']})")
+        print(f"  load resonance    {d['load_resonance_hz']:.3f} Hz (pitch), notch {d['notch_frequency_hz']:.3f} Hz")
+        print(f"  breakaway defl.   {d['breakaway_deflection_deg']:.4f} deg")
+        print(f"  oil column        {d['oil_column_stiffness_N_per_m']:.4g} N/m")
+        print(f"  friction          {model.friction.name}, {model.friction.coulomb_torque_Nm:.5g} N m")
+        print(f"  avionics LSB      {d['avionics_lsb_deg']:.5f} deg")
+    return 0
+
+
+def cmd_freqresp(args) -> int:
+    from .freqresp import linear_freqresp, sine_dwell_freqresp
+
+    freqs = parse_float_list(args.freq_hz, "--freq-hz")
+    model = model_from_args(args)
+    if args.engine != "simplex":
+        raise InputError("command line", "--engine", "simplex (the 3-D TAOS engine is not in this build)",
+                         got=repr(args.engine))
+    if args.amplitude_deg is None or args.linear:
+        fr = linear_freqresp(model, freqs, args.axis)
+    else:
+        amp = parse_float_list(args.amplitude_deg, "--amplitude-deg")
+        if len(amp) != 1:
+            raise InputError("command line", "--amplitude-deg", "one amplitude in deg", got=args.amplitude_deg)
+        fr = sine_dwell_freqresp(model, freqs, math.radians(amp[0]), args.axis)
+    d = fr.to_dict()
+    d["provenance"].update({"model_file": model.source})
+    if args.json:
+        write_json(args.json, d)
+    else:
+        print(f"{'freq_hz':>9} {'piston dB':>10} {'piston deg':>11} {'engine dB':>10} {'engine deg':>11}")
+        for i, f in enumerate(d["freq_hz"]):
+            print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} "
+                  f"{d['engine']['gain_db'][i]:10.3f} {d['engine']['phase_deg'][i]:11.2f}")
+    if args.plot:
+        from .plotting import save
+        save(fr.plot(resonance_hz=model.load_resonance_hz(args.axis)), args.plot)
+    return 0
+
+
+def cmd_simulate(args) -> int:
+    from .profiles import load_profile
+    from .simulate import simulate
+
+    model = model_from_args(args)
+    profile = load_profile(args.profile)
+    if args.engine != "simplex":
+        raise InputError("command line", "--engine", "simplex (the 3-D TAOS engine is not in this build)",
+                         got=repr(args.engine))
+    if not (args.dt > 0 and math.isfinite(args.dt)):
+        raise InputError("command line", "--dt", "a positive step in seconds", got=repr(args.dt))
+    th = simulate(model, profile, dt_s=args.dt, progress=True)
+    th.to_hdf5(args.out)
+    print(f"wrote {args.out} ({th.t_s.size} samples, {', '.join(th.axes)})")
+    return 0
+
+
+def add_parsers(sub) -> None:
+    def common(p, friction=True):
+        p.add_argument("model", help="model file (TOML), e.g. models/rs25_ambient.toml")
+        if friction:
+            p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels "
+                           "(none, coulomb-switching, coulomb-smooth, dahl, lugre, modified-lugre)")
+        p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
+
+    p = sub.add_parser("info", help="parameters in SI and derived figures")
+    common(p)
+    p.set_defaults(func=cmd_info)
+
+    p = sub.add_parser("freqresp", help="command -> piston and engine frequency response")
+    common(p)
+    p.add_argument("--freq-hz", required=True, help="comma-separated frequencies, e.g. 0.1,0.5,1,2,5")
+    p.add_argument("--amplitude-deg", help="command amplitude for the sine-dwell (nonlinear) response")
+    p.add_argument("--linear", action="store_true", help="exact linear response (no friction, unity avionics)")
+    p.add_argument("--axis", choices=AXES, default="pitch")
+    p.add_argument("--engine", default="simplex", help="engine model: simplex")
+    p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save a Bode plot")
+    p.set_defaults(func=cmd_freqresp)
+
+    p = sub.add_parser("simulate", help="time history of a command profile, to HDF5")
+    p.add_argument("model")
+    p.add_argument("--profile", required=True, help="profile file (TOML), e.g. models/profiles/greenrun_two_axis.toml")
+    p.add_argument("--out", required=True, help="HDF5 file to write")
+    p.add_argument("--engine", default="simplex", help="engine model: simplex")
+    p.add_argument("--friction", help="swap the friction law")
+    p.add_argument("--dt", type=float, default=2e-4, help="integration step [s] (default 2e-4)")
+    p.set_defaults(func=cmd_simulate)

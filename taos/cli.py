@@ -1,0 +1,41 @@
+"""``taos`` command line (DESIGN.md "CLI").
+
+Each subcommand lives in a small module with ``add_parser(subparsers)`` and ``run(args)``;
+register new ones in :data:`COMMANDS`. Bad input exits with status 2 and one line naming
+the file, the field and what was expected; an unstable simulation exits with status 3.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from .errors import InputError, SimulationUnstable
+
+#: subcommand modules, in help order
+COMMANDS = ["taos._cli_basic"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="taos", description="TVC gimbal/actuator simulation (simplex and TAOS)")
+    sub = ap.add_subparsers(dest="command", required=True)
+    for name in COMMANDS:
+        importlib.import_module(name).add_parsers(sub)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except InputError as e:
+        print(f"taos: {e}", file=sys.stderr)
+        return 2
+    except SimulationUnstable as e:
+        print(f"taos: {e}", file=sys.stderr)
+        return 3
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,205 @@
+"""Linear elasticity with scikit-fem, rigid (RBE2-type) interface couplings, Guyan condensation.
+
+Equations (small strain, isotropic, SI)::
+
+    sigma = lambda tr(eps) I + 2 mu eps,   eps = (grad u + grad u^T) / 2
+    lambda = E nu / ((1 + nu)(1 - 2 nu)),  mu = E / (2 (1 + nu))
+    K = int_V eps(v) : sigma(u) dV                                   (stiffness, N/m)
+
+Elements: 20-node serendipity hexahedra (:class:`~skfem.ElementHexS2`, quadratic
+displacement, free of shear locking in bending for the regular meshes built here) on
+27-node quadratic-geometry meshes (:func:`taos.fem.mesh.curved_mesh`).
+
+Interface coupling (RBE2, rigid): every displacement DOF on an interface surface follows
+the rigid motion of a reference point x_ref with 6 DOFs q = (u, theta)::
+
+    u(x) = u_ref + theta x (x - x_ref)
+
+i.e. the interface surface is kinematically rigid, as a stiff bolted flange or a closed,
+stuck bearing contact (NASTRAN RBE2 with all 6 components). This is the kinematic
+transformation u_S = T q.
+
+Static (Guyan 1965) condensation onto the reference DOFs (exact for static loads applied
+at the reference points)::
+
+    K_c = T^T K_SS T - (K_IS T)^T K_II^-1 (K_IS T)
+
+where S are the coupled surface DOFs and I all other (interior) DOFs.
+Reference: R. J. Guyan, "Reduction of stiffness and mass matrices", AIAA J. 3(2), 1965.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+from skfem import Basis, BilinearForm, ElementHexS2, ElementVector, Functional, Mesh
+from skfem.helpers import ddot, sym_grad, trace, eye
+
+
+@dataclass(frozen=True)
+class Material:
+    """Isotropic linear-elastic material.
+
+    youngs_modulus_Pa : E [Pa]; poisson_ratio : nu [-]; density_kg_m3 : rho [kg/m^3].
+    """
+
+    name: str
+    youngs_modulus_Pa: float
+    poisson_ratio: float
+    density_kg_m3: float
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """(lambda, mu) [Pa]."""
+        E, nu = self.youngs_modulus_Pa, self.poisson_ratio
+        return E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+
+    @property
+    def shear_modulus_Pa(self) -> float:
+        """G = E / (2 (1 + nu)) [Pa]."""
+        return self.lame[1]
+
+
+#: Ti-6Al-4V, annealed (MIL-HDBK-5J / MMPDS typical values): E = 113.8 GPa, nu = 0.342,
+#: rho = 4430 kg/m^3. The SSME gimbal bearing is titanium (public).
+TI_6AL_4V = Material("Ti-6Al-4V annealed", 113.8e9, 0.342, 4430.0)
+
+
+@dataclass(frozen=True)
+class Interface:
+    """An interface surface coupled rigidly (RBE2) to a reference point.
+
+    name : label; nodes : mesh vertex indices spanning the surface (a boundary facet is on
+    the interface when all its vertices are); ref_point_m : (3,) reference point [m].
+    """
+
+    name: str
+    nodes: np.ndarray
+    ref_point_m: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ElasticModel:
+    """An assembled FE model: basis, stiffness K [N/m] (csr), and a few counts."""
+
+    basis: Basis
+    K: sp.csr_matrix
+    material: Material
+
+    @property
+    def ndofs(self) -> int:
+        return int(self.K.shape[0])
+
+    @property
+    def nelements(self) -> int:
+        return int(self.basis.mesh.nelements)
+
+
+def assemble_elasticity(mesh: Mesh, material: Material) -> ElasticModel:
+    """Assemble the linear-elastic stiffness matrix of ``mesh`` (coordinates in m)."""
+    lam, mu = material.lame
+    basis = Basis(mesh, ElementVector(ElementHexS2()))
+
+    @BilinearForm
+    def form(u, v, w):
+        eu = sym_grad(u)
+        return ddot(lam * eye(trace(eu), 3) + 2.0 * mu * eu, sym_grad(v))
+
+    K = form.assemble(basis).tocsr()
+    return ElasticModel(basis, K, material)
+
+
+def volume(model: ElasticModel) -> float:
+    """Volume of the meshed body [m^3] (integral of 1 with the element quadrature)."""
+    vb = model.basis.with_element(model.basis.elem.elem) if hasattr(model.basis.elem, "elem") else model.basis
+    return float(Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(vb))
+
+
+def interface_dofs(model: ElasticModel, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """DOFs on the boundary facets spanned by ``nodes``: (dof indices, component 0/1/2)."""
+    mesh = model.basis.mesh
+    bf = mesh.boundary_facets()
+    mask = np.zeros(mesh.p.shape[1], bool)
+    mask[np.asarray(nodes)] = True
+    sel = bf[np.all(mask[mesh.facets[:, bf]], axis=0)]
+    if sel.size == 0:
+        raise ValueError("interface selects no boundary facet")
+    dofs = np.unique(model.basis.get_dofs(facets=sel).all())
+    comp = np.empty(model.ndofs, np.int8)
+    for c, ix in enumerate(model.basis.split_indices()):
+        comp[ix] = c
+    return dofs, comp[dofs]
+
+
+def rigid_transform(locs: np.ndarray, comp: np.ndarray, ref: Sequence[float]) -> np.ndarray:
+    """T (n, 6) with u_dof = T q, q = (ux, uy, uz, rx, ry, rz) of the reference point.
+
+    u = u_ref + theta x r, r = x - x_ref:
+    u_x = ux + ry r_z - rz r_y;  u_y = uy + rz r_x - rx r_z;  u_z = uz + rx r_y - ry r_x.
+    """
+    r = locs - np.asarray(ref, float)[:, None]
+    n = comp.size
+    T = np.zeros((n, 6))
+    T[np.arange(n), comp] = 1.0
+    rx, ry, rz = r
+    cx, cy, cz = comp == 0, comp == 1, comp == 2
+    T[cx, 4], T[cx, 5] = rz[cx], -ry[cx]
+    T[cy, 3], T[cy, 5] = -rz[cy], rx[cy]
+    T[cz, 3], T[cz, 4] = ry[cz], -rx[cz]
+    return T
+
+
+def guyan_condense(model: ElasticModel, interfaces: Sequence[Interface]) -> np.ndarray:
+    """Condense the model onto the 6 DOFs of each interface reference point (RBE2 + Guyan).
+
+    Returns the symmetric (6 m, 6 m) free-free stiffness in SI units (N/m, N/rad, N m/m,
+    N m/rad blocks), DOF order (ux, uy, uz, rx, ry, rz) per reference point, in the order
+    of ``interfaces``.
+    """
+    K = model.K
+    n = model.ndofs
+    m = len(interfaces)
+    rows, cols, vals = [], [], []
+    slave = np.zeros(n, bool)
+    for k, itf in enumerate(interfaces):
+        dofs, comp = interface_dofs(model, itf.nodes)
+        if np.any(slave[dofs]):
+            raise ValueError(f"interface {itf.name} overlaps another interface")
+        slave[dofs] = True
+        T = rigid_transform(model.basis.doflocs[:, dofs], comp, itf.ref_point_m)
+        rr, cc = np.nonzero(T)
+        rows.append(dofs[rr])
+        cols.append(6 * k + cc)
+        vals.append(T[rr, cc])
+    Tfull = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(n, 6 * m))
+    S = np.flatnonzero(slave)
+    interior = np.flatnonzero(~slave)
+    TS = Tfull[S]
+    KSS = (TS.T @ K[S][:, S] @ TS).toarray()
+    KIS_T = (K[interior][:, S] @ TS).toarray()
+    lu = splu(K[interior][:, interior].tocsc(), permc_spec="COLAMD")
+    X = lu.solve(KIS_T)
+    Kc = KSS - KIS_T.T @ X
+    return 0.5 * (Kc + Kc.T)
+
+
+def rigid_body_modes(ref_points: np.ndarray, origin: Sequence[float] = (0.0, 0.0, 0.0)) -> np.ndarray:
+    """(6 m, 6) reference-point motions of the 6 rigid-body motions about ``origin``.
+
+    Column j is the unit translation (j < 3) or unit rotation (j >= 3) of the whole body;
+    a free-free condensed stiffness K satisfies K @ R = 0.
+    """
+    pts = np.atleast_2d(np.asarray(ref_points, float))
+    R = np.zeros((6 * len(pts), 6))
+    for k, p in enumerate(pts):
+        comp = np.array([0, 1, 2])
+        T = rigid_transform((p - np.asarray(origin))[:, None].repeat(3, 1) + np.asarray(origin)[:, None],
+                            comp, origin)
+        R[6 * k:6 * k + 3] = T
+        R[6 * k + 3:6 * k + 6, 3:] = np.eye(3)
+    return R

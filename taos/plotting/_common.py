@@ -1,0 +1,23 @@
+"""Shared plotting helpers: headless backend, PNG/SVG saving, engineering length units."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+from ..results import atomic_write  # noqa: E402
+
+#: selectable length units for piston positions: name -> metres per unit
+LENGTH_UNITS = {"in": 0.0254, "mm": 1e-3, "m": 1.0}
+
+
+def save(fig, path, dpi: int = 120) -> None:
+    """Save a figure as PNG or SVG (by suffix), atomically."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in (".png", ".svg"):
+        from ..errors import InputError
+        raise InputError("command line", "plot path", "a .png or .svg file name", got=str(path))
+    atomic_write(path, lambda p: fig.savefig(p, dpi=dpi, format=suffix[1:]))

@@ -1,0 +1,277 @@
+"""Command profiles: engine-angle commands theta_c(t) [rad] for one or two axes.
+
+Every profile is a frozen dataclass with ``duration_s`` and ``__call__(t) -> rad``. Two-axis
+profiles (:class:`TwoAxis`, :class:`Circular`) return an array of shape (2, n) for
+(pitch, yaw). Profiles load from TOML (``models/profiles/*.toml``) with units::
+
+    name = "..."
+    [pitch]                       # or a top-level type = "circular"
+    type = "sine_dwell"           # step | multi_ramp | sine_dwell | sine_sweep | multisine | sequence
+    amplitude = "0.4 deg"
+    frequency = "1 Hz"
+    cycles = 10
+
+Schroeder phases for multisines: phi_k = -pi k (k - 1) / N (M. R. Schroeder, "Synthesis of
+low-peak-factor signals and binary sequences with low autocorrelation", IEEE Trans. Inf.
+Theory 16 (1970) 85-89).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .units import to_si
+
+
+@dataclass(frozen=True)
+class Step:
+    """theta_c = amplitude for t >= t0 (else 0). Duration ``t0 + hold``."""
+
+    amplitude_rad: float
+    t0_s: float = 0.5
+    hold_s: float = 2.0
+
+    @property
+    def duration_s(self) -> float:
+        return self.t0_s + self.hold_s
+
+    def __call__(self, t):
+        return np.where(np.asarray(t) >= self.t0_s, self.amplitude_rad, 0.0)
+
+
+@dataclass(frozen=True)
+class MultiRamp:
+    """Piecewise-linear ramps through ``levels_rad`` at constant ``rate_rad_s``, holding each
+    level ``hold_s`` (the MPTA-style multi-ramp used to measure Coulomb torque)."""
+
+    levels_rad: tuple[float, ...]
+    rate_rad_s: float
+    hold_s: float = 1.0
+
+    def _knots(self):
+        t, y = [0.0], [0.0]
+        for lv in self.levels_rad:
+            t.append(t[-1] + abs(lv - y[-1]) / self.rate_rad_s)
+            y.append(lv)
+            t.append(t[-1] + self.hold_s)
+            y.append(lv)
+        return np.array(t), np.array(y)
+
+    @property
+    def duration_s(self) -> float:
+        return float(self._knots()[0][-1])
+
+    def __call__(self, t):
+        tk, yk = self._knots()
+        return np.interp(t, tk, yk)
+
+
+@dataclass(frozen=True)
+class SineDwell:
+    """theta_c = A sin(2 pi f t) for a whole number of cycles."""
+
+    amplitude_rad: float
+    frequency_hz: float
+    cycles: int = 10
+
+    @property
+    def duration_s(self) -> float:
+        return self.cycles / self.frequency_hz
+
+    def __call__(self, t):
+        t = np.asarray(t, float)
+        return np.where(t <= self.duration_s, self.amplitude_rad * np.sin(2 * np.pi * self.frequency_hz * t), 0.0)
+
+
+@dataclass(frozen=True)
+class SineSweep:
+    """Logarithmic (or linear) sweep from f0 to f1 over ``duration_s``."""
+
+    amplitude_rad: float
+    f0_hz: float
+    f1_hz: float
+    duration_s: float
+    logarithmic: bool = True
+
+    def __call__(self, t):
+        t = np.asarray(t, float)
+        T = self.duration_s
+        if self.logarithmic:
+            k = math.log(self.f1_hz / self.f0_hz) / T
+            ph = 2 * np.pi * self.f0_hz * (np.exp(k * t) - 1.0) / k
+        else:
+            ph = 2 * np.pi * (self.f0_hz * t + 0.5 * (self.f1_hz - self.f0_hz) / T * t * t)
+        return np.where(t <= T, self.amplitude_rad * np.sin(ph), 0.0)
+
+
+@dataclass(frozen=True)
+class Multisine:
+    """Schroeder-phased sum of sines at ``freqs_hz``, scaled to peak ``amplitude_rad``."""
+
+    amplitude_rad: float
+    freqs_hz: tuple[float, ...]
+    duration_s: float
+
+    def _phases(self):
+        N = len(self.freqs_hz)
+        return np.array([-math.pi * k * (k - 1) / N for k in range(1, N + 1)])
+
+    def _raw(self, t):
+        t = np.asarray(t, float)
+        return sum(np.cos(2 * np.pi * f * t + p) for f, p in zip(self.freqs_hz, self._phases()))
+
+    def __call__(self, t):
+        t = np.asarray(t, float)
+        period = 1.0 / min(self.freqs_hz)
+        peak = np.max(np.abs(self._raw(np.linspace(0, period, 4096))))
+        return np.where(t <= self.duration_s, self.amplitude_rad * self._raw(t) / peak, 0.0)
+
+
+@dataclass(frozen=True)
+class Sequence:
+    """Profiles played one after another."""
+
+    parts: tuple
+
+    @property
+    def duration_s(self) -> float:
+        return float(sum(p.duration_s for p in self.parts))
+
+    def __call__(self, t):
+        t = np.asarray(t, float)
+        out = np.zeros_like(t)
+        t0 = 0.0
+        for p in self.parts:
+            m = (t >= t0) & (t < t0 + p.duration_s)
+            out[m] = p(t[m] - t0)
+            t0 += p.duration_s
+        return out
+
+
+@dataclass(frozen=True)
+class TwoAxis:
+    """Pitch and yaw commanded at the same time (Green Run vectoring)."""
+
+    pitch: object
+    yaw: object
+    name: str = ""
+
+    @property
+    def duration_s(self) -> float:
+        return max(self.pitch.duration_s, self.yaw.duration_s)
+
+    def __call__(self, t):
+        return np.vstack([self.pitch(t), self.yaw(t)])
+
+
+@dataclass(frozen=True)
+class Circular:
+    """Circular gimbal motion: pitch = A sin(2 pi f t), yaw = A cos(2 pi f t) (ramped in over
+    the first cycle so the yaw command starts at zero)."""
+
+    amplitude_rad: float
+    frequency_hz: float
+    cycles: int = 10
+    name: str = ""
+
+    @property
+    def duration_s(self) -> float:
+        return self.cycles / self.frequency_hz
+
+    def __call__(self, t):
+        t = np.asarray(t, float)
+        w = 2 * np.pi * self.frequency_hz
+        ramp = np.clip(t * self.frequency_hz, 0.0, 1.0)
+        on = t <= self.duration_s
+        return np.vstack([np.where(on, self.amplitude_rad * np.sin(w * t), 0.0),
+                          np.where(on, ramp * self.amplitude_rad * np.cos(w * t), 0.0)])
+
+
+def is_two_axis(profile) -> bool:
+    return isinstance(profile, (TwoAxis, Circular))
+
+
+# -- TOML loading -----------------------------------------------------------------------
+def _angle(tab, key, src, sec):
+    if key not in tab:
+        raise InputError(src, f"{sec}.{key}", "an angle with its unit, like '0.4 deg'", got="nothing (key missing)")
+    return to_si(tab[key], "angle", source=src, field=f"{sec}.{key}")
+
+
+def _pos(tab, key, kind, src, sec, example):
+    if key not in tab:
+        raise InputError(src, f"{sec}.{key}", f"a {kind} with its unit, like {example}", got="nothing (key missing)")
+    return to_si(tab[key], kind, source=src, field=f"{sec}.{key}", positive=True)
+
+
+def _int(tab, key, src, sec, default):
+    v = tab.get(key, default)
+    if not isinstance(v, int) or isinstance(v, bool) or v < 1:
+        raise InputError(src, f"{sec}.{key}", "a positive whole number", got=repr(v))
+    return v
+
+
+def profile_from_table(tab: dict, src: str, sec: str):
+    """One single-axis profile from a TOML table."""
+    kind = tab.get("type")
+    if kind == "step":
+        return Step(_angle(tab, "amplitude", src, sec),
+                    to_si(tab.get("start", "0.5 s"), "time", source=src, field=f"{sec}.start", nonnegative=True),
+                    to_si(tab.get("hold", "2 s"), "time", source=src, field=f"{sec}.hold", positive=True))
+    if kind == "multi_ramp":
+        levels = tab.get("levels")
+        if not isinstance(levels, list) or not levels:
+            raise InputError(src, f"{sec}.levels", "a list of angles like ['0.2 deg', '-0.2 deg']")
+        return MultiRamp(tuple(to_si(v, "angle", source=src, field=f"{sec}.levels[{i}]") for i, v in enumerate(levels)),
+                         _pos(tab, "rate", "angular_velocity", src, sec, "'0.5 deg/s'"),
+                         to_si(tab.get("hold", "1 s"), "time", source=src, field=f"{sec}.hold", nonnegative=True))
+    if kind == "sine_dwell":
+        return SineDwell(_angle(tab, "amplitude", src, sec), _pos(tab, "frequency", "frequency", src, sec, "'1 Hz'"),
+                         _int(tab, "cycles", src, sec, 10))
+    if kind == "sine_sweep":
+        return SineSweep(_angle(tab, "amplitude", src, sec), _pos(tab, "start_frequency", "frequency", src, sec, "'0.1 Hz'"),
+                         _pos(tab, "end_frequency", "frequency", src, sec, "'10 Hz'"),
+                         _pos(tab, "duration", "time", src, sec, "'60 s'"), bool(tab.get("logarithmic", True)))
+    if kind == "multisine":
+        fr = tab.get("frequencies")
+        if not isinstance(fr, list) or not fr:
+            raise InputError(src, f"{sec}.frequencies", "a list of frequencies like ['0.5 Hz', '1 Hz']")
+        return Multisine(_angle(tab, "amplitude", src, sec),
+                         tuple(to_si(v, "frequency", source=src, field=f"{sec}.frequencies[{i}]", positive=True)
+                               for i, v in enumerate(fr)),
+                         _pos(tab, "duration", "time", src, sec, "'20 s'"))
+    if kind == "sequence":
+        segs = tab.get("segments")
+        if not isinstance(segs, list) or not segs:
+            raise InputError(src, f"{sec}.segments", "a list of profile tables ([[...segments]])")
+        return Sequence(tuple(profile_from_table(s, src, f"{sec}.segments[{i}]") for i, s in enumerate(segs)))
+    raise InputError(src, f"{sec}.type", "one of step, multi_ramp, sine_dwell, sine_sweep, multisine, sequence",
+                     got=repr(kind))
+
+
+def load_profile(path: str | Path):
+    """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
+    ``[pitch]`` and/or ``[yaw]`` tables (two-axis)."""
+    src = str(path)
+    try:
+        doc = tomllib.loads(Path(path).read_text())
+    except OSError as e:
+        raise InputError(src, "(file)", "a readable profile file", got=e.strerror) from None
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(src, "(file)", "valid TOML", got=str(e)) from None
+    name = str(doc.get("name", Path(path).stem))
+    if doc.get("type") == "circular":
+        return Circular(_angle(doc, "amplitude", src, "profile"), _pos(doc, "frequency", "frequency", src, "profile", "'1 Hz'"),
+                        _int(doc, "cycles", src, "profile", 10), name)
+    if "pitch" in doc or "yaw" in doc:
+        zero = Step(0.0, 0.0, 1e-9)
+        pitch = profile_from_table(doc["pitch"], src, "pitch") if "pitch" in doc else zero
+        yaw = profile_from_table(doc["yaw"], src, "yaw") if "yaw" in doc else zero
+        return TwoAxis(pitch, yaw, name)
+    return profile_from_table(doc, src, "profile")
