@@ -1,0 +1,30 @@
+"""Shared fixtures: the shipped models, paths, and a CLI runner."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = ROOT / "models"
+
+
+@pytest.fixture(scope="session")
+def ambient():
+    from taos.model import load_model
+    return load_model(MODELS / "rs25_ambient.toml")
+
+
+@pytest.fixture(scope="session")
+def hotfire():
+    from taos.model import load_model
+    return load_model(MODELS / "rs25_hotfire.toml")
+
+
+def run_cli(*args, prog="taos", cwd=ROOT):
+    """Run the console script in a subprocess; returns CompletedProcess (text)."""
+    exe = Path(sys.executable).parent / prog
+    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=300)
