@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from .linear import StateSpace
+from .linear import StateSpace, finish, is_symbolic, zeros
 from .model import Actuator
 
 
@@ -38,8 +38,10 @@ def actuator_state_space(act: Actuator) -> StateSpace:
     ----------
     act : Actuator
         Parameters in SI (areas m^2, pressures Pa, volumes m^3, masses kg, gains 1/s,
-        frequencies Hz, flow-pressure coefficients m^3/(s Pa)).
+        frequencies Hz, flow-pressure coefficients m^3/(s Pa)). Fields may be CasADi SX
+        expressions; the matrices are then SX (for exact derivatives in fits).
     """
+    sym = is_symbolic(*(getattr(act, f) for f in act.__dataclass_fields__))
     A = act.piston_area_m2
     wv = 2.0 * math.pi * act.valve_natural_frequency_hz
     zv = act.valve_damping_ratio
@@ -49,17 +51,18 @@ def actuator_state_space(act: Actuator) -> StateSpace:
     M = act.piston_mass_kg
     Bp = act.piston_damping_Ns_per_m
     kd = act.pressure_feedback_gain_m_per_s_Pa
+    has_dpf = sym or kd > 0
     states = ("q_m_s",) + (("qdot_m_s2",) if act.valve_order == 2 else ()) + (
-        "p_load_Pa", "x_p_m", "v_p_m_s") + (("p_filt_Pa",) if kd > 0 else ())
+        "p_load_Pa", "x_p_m", "v_p_m_s") + (("p_filt_Pa",) if has_dpf else ())
     n = len(states)
     ix = {s: i for i, s in enumerate(states)}
-    Am = np.zeros((n, n))
-    Bm = np.zeros((n, 2))
+    Am = zeros((n, n), sym)
+    Bm = zeros((n, 2), sym)
     q, P, x, v = ix["q_m_s"], ix["p_load_Pa"], ix["x_p_m"], ix["v_p_m_s"]
     # valve input u_v = uv_x . state + K_v x_c
-    uv = np.zeros(n)
+    uv = zeros(n, sym)
     uv[x] = -Kv
-    if kd > 0:
+    if has_dpf:
         pf = ix["p_filt_Pa"]
         uv[P] -= kd
         uv[pf] += kd
@@ -85,9 +88,10 @@ def actuator_state_space(act: Actuator) -> StateSpace:
     Am[v, v] = -Bp / M
     Bm[v, 1] = -1.0 / M
     outputs = ("x_p_m", "v_p_m_s", "p_load_Pa", "f_piston_N")
-    C = np.zeros((4, n))
+    C = zeros((4, n), sym)
     C[0, x] = 1.0
     C[1, v] = 1.0
     C[2, P] = 1.0
     C[3, P] = A
-    return StateSpace(Am, Bm, C, np.zeros((4, 2)), states, ("x_c_m", "f_load_N"), outputs)
+    return StateSpace(finish(Am, sym), finish(Bm, sym), finish(C, sym), finish(zeros((4, 2), sym), sym),
+                      states, ("x_c_m", "f_load_N"), outputs)

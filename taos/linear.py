@@ -14,7 +14,10 @@ import scipy.linalg
 
 @dataclass(frozen=True, eq=False)
 class StateSpace:
-    """A continuous-time LTI system with named signals (SI units in the names)."""
+    """A continuous-time LTI system with named signals (SI units in the names).
+
+    The matrices are float arrays, or CasADi SX matrices when the builder was given symbolic
+    parameters (then only the symbolic helpers, e.g. :func:`freqresp_symbolic`, apply)."""
 
     A: np.ndarray
     B: np.ndarray
@@ -28,7 +31,7 @@ class StateSpace:
         n, m, p = len(self.states), len(self.inputs), len(self.outputs)
         for name, M, shape in (("A", self.A, (n, n)), ("B", self.B, (n, m)),
                                ("C", self.C, (p, n)), ("D", self.D, (p, m))):
-            if M.shape != shape:
+            if tuple(M.shape) != shape:
                 raise ValueError(f"{name} has shape {M.shape}, expected {shape}")
 
     def input_index(self, name: str) -> int:
@@ -84,6 +87,32 @@ class StateSpace:
         return [names.index(s) for s in sel]
 
 
+def is_symbolic(*values) -> bool:
+    """True if any value is a CasADi symbol/expression (SX or MX)."""
+    try:
+        import casadi as ca
+    except ImportError:  # pragma: no cover - casadi is a dependency
+        return False
+    return any(isinstance(v, (ca.SX, ca.MX)) for v in values)
+
+
+def zeros(shape, symbolic: bool) -> np.ndarray:
+    """A float array, or an object array that can hold CasADi expressions."""
+    return np.zeros(shape, dtype=object if symbolic else float)
+
+
+def finish(M: np.ndarray, symbolic: bool):
+    """Turn a matrix built by :func:`zeros` into a float ndarray or a CasADi SX matrix.
+
+    This is how the model builders (actuator, simplex) serve both numeric analysis and
+    CasADi fits from one definition of the equations."""
+    if not symbolic:
+        return M
+    import casadi as ca
+    M2 = M if M.ndim == 2 else M.reshape(-1, 1)
+    return ca.blockcat([[ca.SX(v) if not isinstance(v, (ca.SX, ca.MX)) else v for v in row] for row in M2.tolist()])
+
+
 def gain_db(h) -> np.ndarray:
     """20 log10 |h| [dB]."""
     return 20.0 * np.log10(np.abs(h))
@@ -95,3 +124,37 @@ def phase_deg(h, unwrap: bool = True) -> np.ndarray:
     if unwrap:
         ph = np.unwrap(ph, axis=0)
     return np.degrees(ph)
+
+
+def balancing_scale(ss: StateSpace) -> np.ndarray:
+    """Diagonal state scaling s (x = diag(s) x') that balances a numeric A (LAPACK gebal)."""
+    _, (sc, _perm) = scipy.linalg.matrix_balance(np.asarray(ss.A, float), permute=False, separate=True)
+    return sc
+
+
+def freqresp_symbolic(ss: StateSpace, w_rad_s: float, input_name: str, output_name: str,
+                      scale: np.ndarray | None = None):
+    """Real and imaginary parts of H(j w) for a (possibly CasADi-symbolic) state space.
+
+    Solves the real 2n system [[-A, -w I], [w I, -A]] [x_r; x_i] = [B; 0] so CasADi (which has
+    no complex type) can differentiate the response exactly. ``scale`` (from
+    :func:`balancing_scale` of a nominal numeric model) rescales the states first: states in Pa
+    and m otherwise cost the solve several digits. Returns (re, im)."""
+    import casadi as ca
+
+    A = ca.SX(ss.A) if not isinstance(ss.A, (ca.SX, ca.MX)) else ss.A
+    B = ss.B[:, ss.input_index(input_name)]
+    C = ss.C[ss.output_index(output_name), :]
+    if scale is not None:
+        S = ca.diag(ca.DM(scale))
+        Si = ca.diag(ca.DM(1.0 / np.asarray(scale)))
+        A = Si @ A @ S
+        B = Si @ B
+        C = C @ S
+    D = ss.D[ss.output_index(output_name), ss.input_index(input_name)]
+    n = len(ss.states)
+    eye = ca.SX.eye(n)
+    M = ca.vertcat(ca.horzcat(-A, -w_rad_s * eye), ca.horzcat(w_rad_s * eye, -A))
+    rhs = ca.vertcat(B, ca.SX.zeros(n, 1))
+    x = ca.solve(M, rhs)
+    return C @ x[:n] + D, C @ x[n:]

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .actuator import actuator_state_space
-from .linear import StateSpace
+from .linear import StateSpace, finish, is_symbolic, zeros
 from .model import TvcModel
 
 #: Outputs of the simplex linear block, in order.
@@ -57,40 +57,50 @@ def simplex_state_space(model: TvcModel, axis: str = "pitch") -> StateSpace:
 
     Inputs: ``command_rad`` (engine-angle command after the avionics), ``friction_torque_Nm``.
     Outputs: :data:`SIMPLEX_OUTPUTS`. States: the actuator states, ``theta_rad``, ``omega_rad_s``.
+    Parameters may be CasADi SX expressions (fits); the matrices are then SX.
     """
     act = actuator_state_space(model.actuator)
     R = model.actuator.moment_arm_m
     KL = model.structure.load_stiffness_N_per_m
     Kn = model.engine.rotational_stiffness_Nm_per_rad
     J = model.engine.inertia(axis)
+    sym = is_symbolic(act.A, R, KL, Kn, J)
+    if sym:  # work on object arrays holding SX scalars
+        import casadi as ca
+        obj = lambda M: np.array([[M[i, j] for j in range(M.shape[1])] for i in range(M.shape[0])],  # noqa: E731
+                                 dtype=object)
+        actA, actB, actC = (obj(ca.SX(M)) for M in (act.A, act.B, act.C))
+    else:
+        actA, actB, actC = act.A, act.B, act.C
     na = len(act.states)
     n = na + 2
     ith, iom = na, na + 1
-    cxp = act.C[act.output_index("x_p_m")]
+    cxp = actC[act.output_index("x_p_m")]
     # load force F_L = K_L (x_p - R theta) as a row over the full state
-    fl = np.zeros(n)
-    fl[:na] = KL * cxp
+    fl = zeros(n, sym)
+    fl[:na] = [KL * c for c in cxp]   # element-wise: also for CasADi scalars
     fl[ith] = -KL * R
-    A = np.zeros((n, n))
-    A[:na, :na] = act.A
-    A[:na, :] += np.outer(act.B[:, act.input_index("f_load_N")], fl)
+    A = zeros((n, n), sym)
+    A[:na, :na] = actA
+    bf = actB[:, act.input_index("f_load_N")]
+    A[:na, :] += np.array([[b * f for f in fl] for b in bf], dtype=A.dtype)
     A[ith, iom] = 1.0
-    applied = R * fl
+    applied = np.array([R * f for f in fl], dtype=fl.dtype)
     applied[ith] -= Kn
-    A[iom, :] = applied / J
-    B = np.zeros((n, 2))
-    B[:na, 0] = act.B[:, act.input_index("x_c_m")] * R
+    A[iom, :] = [a / J for a in applied]
+    B = zeros((n, 2), sym)
+    B[:na, 0] = [b * R for b in actB[:, act.input_index("x_c_m")]]
     B[iom, 1] = -1.0 / J
-    C = np.zeros((len(SIMPLEX_OUTPUTS), n))
+    C = zeros((len(SIMPLEX_OUTPUTS), n), sym)
     C[0, :na] = cxp
     C[1, ith] = 1.0
     C[2, iom] = 1.0
     C[3] = applied
     C[4] = fl
-    C[5, :na] = act.C[act.output_index("p_load_Pa")]
+    C[5, :na] = actC[act.output_index("p_load_Pa")]
     states = tuple(act.states) + ("theta_rad", "omega_rad_s")
-    return StateSpace(A, B, C, np.zeros((C.shape[0], 2)), states,
-                      ("command_rad", "friction_torque_Nm"), SIMPLEX_OUTPUTS)
+    return StateSpace(finish(A, sym), finish(B, sym), finish(C, sym), finish(zeros((C.shape[0], 2), sym), sym),
+                      states, ("command_rad", "friction_torque_Nm"), SIMPLEX_OUTPUTS)
 
 
 def simplex_plant(model: TvcModel, axis: str = "pitch") -> LurePlant:
