@@ -145,6 +145,12 @@ class FrictionLaw(abc.ABC):
         """Range checks beyond the unit parse; raise :class:`InputError`."""
 
 
+def coulomb_describing_function(coulomb_torque_Nm: float, rate_amplitude: float) -> complex:
+    """4 T_c / (pi V): fundamental of T_c sign(V sin wt) over V [N m s/rad] (relay describing
+    function, Gelb & Vander Velde, Multiple-Input Describing Functions, 1968)."""
+    return complex(4.0 * coulomb_torque_Nm / (math.pi * rate_amplitude), 0.0)
+
+
 @dataclass(frozen=True)
 class NoFriction(FrictionLaw):
     """No gimbal friction: T_f = 0."""
@@ -183,7 +189,7 @@ class CoulombSwitching(FrictionLaw):
         return self.coulomb_torque_Nm * np.sign(np.asarray(v, float))
 
     def describing_function(self, rate_amplitude):
-        return complex(4.0 * self.coulomb_torque_Nm / (math.pi * rate_amplitude), 0.0)
+        return coulomb_describing_function(self.coulomb_torque_Nm, rate_amplitude)
 
     def validate(self, source, section="friction"):
         if not self.stick_velocity_rad_s > 0:
@@ -211,7 +217,7 @@ class CoulombSmooth(FrictionLaw):
 
     def describing_function(self, rate_amplitude):
         # exact for v_eps -> 0; the regularisation changes it by O((v_eps/V)^2)
-        return complex(4.0 * self.coulomb_torque_Nm / (math.pi * rate_amplitude), 0.0)
+        return coulomb_describing_function(self.coulomb_torque_Nm, rate_amplitude)
 
     def validate(self, source, section="friction"):
         if not self.regularization_velocity_rad_s > 0:
@@ -264,6 +270,8 @@ class LuGre(FrictionLaw):
     name: ClassVar[str] = "lugre"
     fid: ClassVar[int] = K.ID_LUGRE
     has_state: ClassVar[bool] = True
+    #: plain LuGre divides by g(v) = G(v): the static level must be positive
+    requires_static_torque: ClassVar[bool] = True
 
     static_torque_Nm: float = 0.0
     stribeck_velocity_rad_s: float = 1e-3
@@ -303,7 +311,7 @@ class LuGre(FrictionLaw):
                              f"a positive rotational stiffness for the {self.name} law")
         if not self.stribeck_velocity_rad_s > 0:
             raise InputError(source, f"{section}.stribeck_velocity", "a positive angular velocity")
-        if not self.static_torque_Nm > 0:
+        if self.requires_static_torque and not self.static_torque_Nm > 0:
             raise InputError(source, f"{section}.static_torque", "a positive torque")
 
 
@@ -326,6 +334,7 @@ class ModifiedLuGre(LuGre):
 
     name: ClassVar[str] = "modified-lugre"
     fid: ClassVar[int] = K.ID_MODIFIED_LUGRE
+    requires_static_torque: ClassVar[bool] = False
 
     vibration_velocity_rad_s: float = 0.0
 
@@ -336,12 +345,6 @@ class ModifiedLuGre(LuGre):
             return np.ones_like(v)
         return (2.0 / math.pi) * np.arcsin(np.minimum(1.0, v / vd))
 
-    def validate(self, source, section="friction"):
-        if not self.bristle_stiffness_Nm_per_rad > 0:
-            raise InputError(source, f"{section}.bristle_stiffness",
-                             f"a positive rotational stiffness for the {self.name} law")
-        if not self.stribeck_velocity_rad_s > 0:
-            raise InputError(source, f"{section}.stribeck_velocity", "a positive angular velocity")
 
 
 #: Registry: model name -> class (the names are a contract, DESIGN.md).
