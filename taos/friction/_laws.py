@@ -270,8 +270,6 @@ class LuGre(FrictionLaw):
     name: ClassVar[str] = "lugre"
     fid: ClassVar[int] = K.ID_LUGRE
     has_state: ClassVar[bool] = True
-    #: plain LuGre divides by g(v) = G(v): the static level must be positive
-    requires_static_torque: ClassVar[bool] = True
 
     static_torque_Nm: float = 0.0
     stribeck_velocity_rad_s: float = 1e-3
@@ -311,7 +309,7 @@ class LuGre(FrictionLaw):
                              f"a positive rotational stiffness for the {self.name} law")
         if not self.stribeck_velocity_rad_s > 0:
             raise InputError(source, f"{section}.stribeck_velocity", "a positive angular velocity")
-        if self.requires_static_torque and not self.static_torque_Nm > 0:
+        if not self.static_torque_Nm > 0:  # g(0) = T_s: the bristle relaxation divides by it
             raise InputError(source, f"{section}.static_torque", "a positive torque")
 
 
@@ -334,7 +332,6 @@ class ModifiedLuGre(LuGre):
 
     name: ClassVar[str] = "modified-lugre"
     fid: ClassVar[int] = K.ID_MODIFIED_LUGRE
-    requires_static_torque: ClassVar[bool] = False
 
     vibration_velocity_rad_s: float = 0.0
 
