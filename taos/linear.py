@@ -52,8 +52,8 @@ class StateSpace:
         """Exact frequency response H(j w) = C (j w I - A)^-1 B + D.
 
         Returns an array of shape (n_freq, n_out, n_in) for the selected signals (all by
-        default); a single name selects a single signal and drops that axis. Uses a Hessenberg
-        reduction of the balanced A (Laub 1981).
+        default); a single name selects a single signal and drops that axis. Balances A first
+        (the states mix Pa and m).
         """
         f = np.atleast_1d(np.asarray(freq_hz, float))
         ii = self._sel(inputs, self.inputs)
@@ -61,11 +61,10 @@ class StateSpace:
         B = self.B[:, ii]
         C = self.C[oo, :]
         D = self.D[np.ix_(oo, ii)]
-        # diagonal balancing (states mix Pa and m), then Hessenberg form
-        Ab, (sc, _perm) = scipy.linalg.matrix_balance(self.A, permute=False, separate=True)
-        H, Q = scipy.linalg.hessenberg(Ab, calc_q=True)
-        Bq = Q.T @ (B / sc[:, None])
-        Cq = (C * sc[None, :]) @ Q
+        # diagonal balancing: the states mix Pa and m
+        H, (sc, _perm) = scipy.linalg.matrix_balance(self.A, permute=False, separate=True)
+        Bq = B / sc[:, None]
+        Cq = C * sc[None, :]
         n = self.A.shape[0]
         out = np.empty((f.size, len(oo), len(ii)), complex)
         eye = np.eye(n)

@@ -1,0 +1,337 @@
+"""MASV analyses: 8x8 frequency responses, notches, coupling, closed-loop eigenvalues, loop
+margins with the other loops closed, and the structural modes near the actuator bandwidth.
+
+Conventions: command -> piston is x_p,i / (R_i theta_c,j) and command -> engine is
+theta_i / theta_c,j (dimensionless; element [f, i, j] is output i for command j). Gains are
+reported in dB with a floor of -400 dB (an exactly zero coupling, e.g. on a rigid structure).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.optimize
+
+from taos.freqresp import FrequencyResponse
+from taos.linear import phase_deg
+from taos.simplex import simplex_state_space
+
+from .system import MasvSystem, build_system
+
+GAIN_FLOOR = 1e-20   # |h| floor for dB (-400 dB)
+
+
+def _db(h) -> np.ndarray:
+    return 20.0 * np.log10(np.maximum(np.abs(h), GAIN_FLOOR))
+
+
+def band_grid(system: MasvSystem, n: int = 400) -> np.ndarray:
+    """Log grid over the configuration's band of interest [Hz]."""
+    c = system.config
+    return np.logspace(math.log10(c.band_low_hz), math.log10(c.band_high_hz), n)
+
+
+@dataclass(frozen=True, eq=False)
+class MasvFrequencyResponse:
+    """All eight command -> piston and command -> engine responses, (F, n_act, n_act) complex."""
+
+    freq_hz: np.ndarray
+    actuators: tuple[str, ...]
+    piston: np.ndarray
+    engine: np.ndarray
+    provenance: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The ``masv freqresp`` JSON: gain_db/phase_deg indexed [output][command][freq]."""
+        def part(h):
+            return {"gain_db": np.moveaxis(_db(h), 0, -1).tolist(),
+                    "phase_deg": np.moveaxis(phase_deg(h), 0, -1).tolist()}
+        return {"freq_hz": [float(f) for f in self.freq_hz], "actuators": list(self.actuators),
+                "piston": part(self.piston), "engine": part(self.engine), "provenance": self.provenance}
+
+    def index(self, name: str) -> int:
+        return self.actuators.index(name)
+
+    def diagonal(self, name: str) -> FrequencyResponse:
+        """Actuator ``name``'s own command -> piston/engine response as a taos FrequencyResponse."""
+        k = self.index(name)
+        return FrequencyResponse(self.freq_hz, self.piston[:, k, k], self.engine[:, k, k], None,
+                                 engine_model="masv", provenance=dict(self.provenance))
+
+    def plot(self, kind: str = "engine", **kwargs):
+        """8x8 gain grid (thin call into :mod:`masv.plotting`)."""
+        from . import plotting
+        return plotting.plot_gain_grid(self, kind=kind, **kwargs)
+
+
+def frequency_response(system: MasvSystem, freq_hz) -> MasvFrequencyResponse:
+    """Exact linear 8x8 responses by block elimination (:meth:`MasvSystem.frf`)."""
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    xp, th = system.frf(f)
+    piston = xp / system.moment_arms_m[None, :, None]
+    cfg = system.config
+    return MasvFrequencyResponse(f, system.actuator_names, piston, th,
+                                 {"config_file": cfg.source, "config_sha256": cfg.sha256,
+                                  "n_modes": int(system.omega_rad_s.size), "method": "block elimination"})
+
+
+# -- notches ----------------------------------------------------------------------------------
+def notch_frequencies(system: MasvSystem, n_grid: int = 400) -> dict[str, dict]:
+    """Each actuator's notch (minimum of its own |x_p / (R theta_c)| in the band), refined with a
+    bounded scalar search, beside the rigid-structure simplex notch sqrt((K_L R^2+K_n)/J)/2pi."""
+    f = band_grid(system, n_grid)
+    xp, _ = system.frf(f)
+    out = {}
+    for k, name in enumerate(system.actuator_names):
+        g = np.abs(xp[:, k, k])
+        i = int(np.argmin(g))
+        lo, hi = np.log10(f[max(i - 1, 0)]), np.log10(f[min(i + 1, f.size - 1)])
+
+        def gk(lf, k=k):
+            return abs(system.frf([10 ** lf])[0][0, k, k])
+        r = scipy.optimize.minimize_scalar(gk, bounds=(lo, hi), method="bounded", options={"xatol": 1e-7})
+        a = system.config.actuators[k]
+        model = system.config.engine(a.engine).model
+        out[name] = {"notch_hz": float(10 ** r.x),
+                     "depth_db": float(_db(r.fun / system.moment_arms_m[k])),
+                     "simplex_load_resonance_hz": model.load_resonance_hz(a.axis)}
+    return out
+
+
+# -- coupling ---------------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class CouplingResult:
+    """Peak gains over the band [dB]: ``engine_peak_db[i, j]`` = max |theta_i / theta_c,j|,
+    ``piston_peak_db[i, j]`` = max |x_p,i / (R_i theta_c,j)|, at ``engine_peak_hz``/
+    ``piston_peak_hz``. Off-diagonal pairs on different engines are engine-to-engine coupling,
+    on the same engine axis-to-axis coupling."""
+
+    actuators: tuple[str, ...]
+    engines: tuple[str, ...]
+    band_hz: tuple[float, float]
+    engine_peak_db: np.ndarray
+    engine_peak_hz: np.ndarray
+    piston_peak_db: np.ndarray
+    piston_peak_hz: np.ndarray
+
+    def _strongest(self, same_engine: bool, kind: str = "engine") -> dict | None:
+        P = self.engine_peak_db if kind == "engine" else self.piston_peak_db
+        H = self.engine_peak_hz if kind == "engine" else self.piston_peak_hz
+        best = None
+        n = len(self.actuators)
+        for i in range(n):
+            for j in range(n):
+                if i == j or (self.engines[i] == self.engines[j]) != same_engine:
+                    continue
+                if best is None or P[i, j] > best[2]:
+                    best = (i, j, P[i, j])
+        if best is None:
+            return None
+        i, j, v = best
+        return {"command": self.actuators[j], "response": self.actuators[i], "gain_db": float(v),
+                "freq_hz": float(H[i, j])}
+
+    @property
+    def strongest_engine_to_engine(self) -> dict | None:
+        return self._strongest(False)
+
+    @property
+    def strongest_axis_to_axis(self) -> dict | None:
+        return self._strongest(True)
+
+    def to_dict(self) -> dict:
+        return {"band_hz": list(self.band_hz), "actuators": list(self.actuators),
+                "engine_peak_db": self.engine_peak_db.tolist(), "engine_peak_hz": self.engine_peak_hz.tolist(),
+                "piston_peak_db": self.piston_peak_db.tolist(), "piston_peak_hz": self.piston_peak_hz.tolist(),
+                "strongest_engine_to_engine": self.strongest_engine_to_engine,
+                "strongest_axis_to_axis": self.strongest_axis_to_axis,
+                "strongest_engine_to_engine_piston": self._strongest(False, "piston"),
+                "strongest_axis_to_axis_piston": self._strongest(True, "piston")}
+
+    def plot(self, **kwargs):
+        from . import plotting
+        return plotting.plot_coupling_matrix(self, **kwargs)
+
+
+def coupling(system: MasvSystem, n_freq: int = 400) -> CouplingResult:
+    """Peak coupling gains over the band of interest (see :class:`CouplingResult`)."""
+    fr = frequency_response(system, band_grid(system, n_freq))
+    ge, gp = _db(fr.engine), _db(fr.piston)
+    ie, ip = np.argmax(ge, axis=0), np.argmax(gp, axis=0)
+    cfg = system.config
+    return CouplingResult(fr.actuators, tuple(a.engine for a in cfg.actuators), (cfg.band_low_hz, cfg.band_high_hz),
+                          ge.max(axis=0), fr.freq_hz[ie], gp.max(axis=0), fr.freq_hz[ip])
+
+
+# -- closed-loop eigenvalues ------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class ClosedLoopEigen:
+    """Eigenvalues [1/s] of the whole model with all eight position loops closed."""
+
+    eigenvalues: np.ndarray
+
+    @property
+    def stable(self) -> bool:
+        return bool(np.all(self.eigenvalues.real < 0))
+
+    @property
+    def max_real_per_s(self) -> float:
+        return float(self.eigenvalues.real.max())
+
+    def least_damped(self, n: int = 10) -> list[dict]:
+        """The n oscillatory eigenvalues of lowest damping ratio (freq_hz, damping_ratio)."""
+        p = self.eigenvalues[self.eigenvalues.imag > 0]
+        z = -p.real / np.abs(p)
+        o = np.argsort(z)[:n]
+        return [{"freq_hz": float(abs(p[i]) / (2 * math.pi)), "damping_ratio": float(z[i])} for i in o]
+
+    def to_dict(self) -> dict:
+        return {"stable": self.stable, "max_real_per_s": self.max_real_per_s, "least_damped": self.least_damped()}
+
+
+def closed_loop_eigenvalues(system: MasvSystem) -> ClosedLoopEigen:
+    return ClosedLoopEigen(system.state_space().poles())
+
+
+# -- loop margins -----------------------------------------------------------------------------
+@dataclass(frozen=True)
+class LoopMargin:
+    """Margins of one actuator's position loop broken at its piston-position feedback with the
+    other seven closed. L = T / (1 - T) with T = x_p / x_c (the valve sees K_v (x_c - x_p), so
+    x_c and x_p enter the loop at the same summing point). ``gain_margin_db`` is the smallest
+    -20 log|L| where L crosses the negative real axis (inf if it never does)."""
+
+    actuator: str
+    gain_margin_db: float
+    phase_crossover_hz: float | None
+    phase_margin_deg: float
+    gain_crossover_hz: float | None
+
+    def to_dict(self) -> dict:
+        return {"actuator": self.actuator,
+                "gain_margin_db": None if math.isinf(self.gain_margin_db) else self.gain_margin_db,
+                "phase_crossover_hz": self.phase_crossover_hz, "phase_margin_deg": self.phase_margin_deg,
+                "gain_crossover_hz": self.gain_crossover_hz}
+
+
+def _crossing(x, y0, y1):
+    """Fraction t in [0, 1] where the linear interpolation y0 + t (y1 - y0) is zero."""
+    return y0 / (y0 - y1) if y0 != y1 else 0.0
+
+
+def margins_from_loop(name: str, f: np.ndarray, L: np.ndarray) -> LoopMargin:
+    """Gain and phase margins of loop transfer L sampled on ascending f (linear interpolation in
+    log f between samples)."""
+    lf = np.log10(f)
+    gm, fgm = math.inf, None
+    im, re = L.imag, L.real
+    for i in range(f.size - 1):
+        if im[i] == 0.0 or im[i] * im[i + 1] < 0:
+            t = _crossing(None, im[i], im[i + 1])
+            r = re[i] + t * (re[i + 1] - re[i])
+            if r < 0:
+                g = -20 * math.log10(-r)
+                if g < gm:
+                    gm, fgm = g, float(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
+    mag = np.log10(np.abs(L))
+    pm, fpm = math.inf, None
+    for i in range(f.size - 1):
+        if mag[i] >= 0 > mag[i + 1] or mag[i] < 0 <= mag[i + 1]:
+            t = _crossing(None, mag[i], mag[i + 1])
+            Li = L[i] + t * (L[i + 1] - L[i])
+            p = math.degrees(np.angle(Li))
+            m = ((180.0 + p) + 180.0) % 360.0 - 180.0
+            if m < pm:
+                pm, fpm = m, float(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
+    return LoopMargin(name, float(gm), fgm, float(pm), fpm)
+
+
+def loop_margins(system: MasvSystem, f_lo_hz: float = 0.01, f_hi_hz: float = 1000.0,
+                 n: int = 3000) -> tuple[LoopMargin, ...]:
+    """Margins of every actuator's position loop with the other loops closed (:class:`LoopMargin`)."""
+    f = np.logspace(math.log10(f_lo_hz), math.log10(f_hi_hz), n)
+    xp, _ = system.frf(f)
+    out = []
+    for k, name in enumerate(system.actuator_names):
+        T = xp[:, k, k] / system.moment_arms_m[k]
+        out.append(margins_from_loop(name, f, T / (1.0 - T)))
+    return tuple(out)
+
+
+# -- modes near the actuator bandwidth --------------------------------------------------------
+def actuator_bandwidth_hz(model, axis: str = "pitch") -> float:
+    """-3 dB frequency [Hz] of the rigid-structure simplex command -> engine response."""
+    ss = simplex_state_space(model, axis)
+    f = np.logspace(-1, 2.5, 2000)
+    g = _db(ss.freqresp(f, "command_rad", "theta_rad"))
+    i = int(np.argmax(g < -3.0))
+    if g[i] >= -3.0:
+        return float(f[-1])
+    t = _crossing(None, g[i - 1] + 3.0, g[i] + 3.0)
+    return float(10 ** (math.log10(f[i - 1]) + t * (math.log10(f[i]) - math.log10(f[i - 1]))))
+
+
+@dataclass(frozen=True, eq=False)
+class ModeParticipation:
+    """Modes within [bandwidth / factor, bandwidth * factor]. For each mode i and actuator k:
+    ``phi_e[i, k]`` the mode's elongation shape along the line of action [m/sqrt(kg)] and
+    ``compliance_ratio[i, k]`` = K_L,k phi_e^2 / w_i^2, the static compliance the mode adds in
+    series with the load path relative to 1/K_L (0.1 = 10 % softer load path)."""
+
+    bandwidth_hz: float
+    factor: float
+    actuators: tuple[str, ...]
+    mode_index: np.ndarray
+    freq_hz: np.ndarray
+    damping_ratio: np.ndarray
+    phi_e: np.ndarray
+    compliance_ratio: np.ndarray
+    n_modes_total: int
+
+    def to_dict(self) -> dict:
+        return {"bandwidth_hz": self.bandwidth_hz, "band_hz": [self.bandwidth_hz / self.factor,
+                                                               self.bandwidth_hz * self.factor],
+                "n_modes_total": self.n_modes_total, "actuators": list(self.actuators),
+                "modes": [{"mode": int(self.mode_index[i]) + 1, "freq_hz": float(self.freq_hz[i]),
+                           "damping_ratio": float(self.damping_ratio[i]),
+                           "phi_e_m_per_sqrt_kg": self.phi_e[i].tolist(),
+                           "compliance_ratio": self.compliance_ratio[i].tolist(),
+                           "max_compliance_ratio": float(self.compliance_ratio[i].max())}
+                          for i in range(self.freq_hz.size)]}
+
+
+def modes_near_bandwidth(system: MasvSystem, factor: float = 2.0) -> ModeParticipation:
+    """Structural modes near the actuator bandwidth (median of the actuators' simplex -3 dB
+    frequencies) and their participation at the actuator attach points."""
+    cfg = system.config
+    bws = [actuator_bandwidth_hz(cfg.engine(a.engine).model, a.axis) for a in cfg.actuators]
+    bw = float(np.median(bws))
+    fz = system.omega_rad_s / (2 * math.pi)
+    sel = np.nonzero((fz >= bw / factor) & (fz <= bw * factor))[0]
+    na = system.n_actuators
+    KL = np.array([cfg.engine(a.engine).model.structure.load_stiffness_N_per_m for a in cfg.actuators])
+    pe = system.phi_c[:na, sel].T
+    ratio = KL[None] * pe ** 2 / system.omega_rad_s[sel, None] ** 2
+    return ModeParticipation(bw, factor, system.actuator_names, sel, fz[sel], system.zeta[sel], pe, ratio,
+                             int(fz.size))
+
+
+def structure_effect(system: MasvSystem) -> dict:
+    """Loop margins with the structure and on a rigid structure, and their differences: does the
+    structure (its local modes near the actuator bandwidth) degrade any actuator loop?"""
+    from .structure import rigid_structure
+    st = system.config.structure
+    rigid = build_system(system.config, rigid_structure(st.node_names, st.node_xyz_m))
+    with_s, without = loop_margins(system), loop_margins(rigid)
+    rows = []
+    for a, b in zip(with_s, without):
+        rows.append({"actuator": a.actuator, "with_structure": a.to_dict(), "rigid": b.to_dict(),
+                     "delta_phase_margin_deg": a.phase_margin_deg - b.phase_margin_deg,
+                     "delta_gain_margin_db": (a.gain_margin_db - b.gain_margin_db)
+                     if math.isfinite(a.gain_margin_db) and math.isfinite(b.gain_margin_db) else None})
+    return {"loops": rows,
+            "worst_phase_margin_deg": min(m.phase_margin_deg for m in with_s),
+            "worst_gain_margin_db": min(m.gain_margin_db for m in with_s),
+            "largest_phase_margin_loss_deg": max(-r["delta_phase_margin_deg"] for r in rows)}

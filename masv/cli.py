@@ -1,0 +1,134 @@
+"""``masv`` command line: modes, 8x8 frequency responses, coupling and loop margins.
+
+    masv modes CONFIG [--factor 2] [--json PATH]
+    masv freqresp CONFIG --freq-hz 0.5,1,2,5 [--json PATH] [--plot GRID.png]
+    masv coupling CONFIG [--json PATH] [--plot MATRIX.png]
+
+Bad input exits with status 2 and one line naming the file, the field and what was expected.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from taos._cli_basic import parse_float_list
+from taos.errors import InputError
+from taos.results import package_version, write_json
+
+from . import analysis as an
+from .config import load_config
+from .system import build_system
+
+
+def _system(args):
+    return build_system(load_config(args.config))
+
+
+def _prov(cfg) -> dict:
+    return {"config_file": cfg.source, "config_sha256": cfg.sha256, "modes_file": cfg.structure.source,
+            "n_modes": cfg.structure.n_modes, "taos_version": package_version()}
+
+
+def cmd_modes(args) -> int:
+    if not (args.factor > 1 and math.isfinite(args.factor)):
+        raise InputError("command line", "--factor", "a number above 1", got=repr(args.factor))
+    s = _system(args)
+    mp = an.modes_near_bandwidth(s, args.factor)
+    st = s.config.structure
+    d = {"n_modes": st.n_modes, "freq_hz": st.freq_hz.tolist(), "damping_ratio": st.damping_ratio.tolist(),
+         "near_bandwidth": mp.to_dict(), "provenance": _prov(s.config)}
+    if args.json:
+        write_json(args.json, d)
+    else:
+        print(f"{st.n_modes} modes ({st.source}); actuator bandwidth {mp.bandwidth_hz:.2f} Hz; "
+              f"{mp.freq_hz.size} modes in {mp.bandwidth_hz / args.factor:.2f}-{mp.bandwidth_hz * args.factor:.2f} Hz")
+        print(f"{'mode':>5} {'freq_hz':>9} {'zeta':>7} {'max K_L phi^2/w^2':>18}  strongest actuator")
+        for i in range(mp.freq_hz.size):
+            k = int(mp.compliance_ratio[i].argmax())
+            print(f"{mp.mode_index[i] + 1:5d} {mp.freq_hz[i]:9.3f} {mp.damping_ratio[i]:7.4f} "
+                  f"{mp.compliance_ratio[i, k]:18.4g}  {mp.actuators[k]}")
+    return 0
+
+
+def cmd_freqresp(args) -> int:
+    freqs = parse_float_list(args.freq_hz, "--freq-hz")
+    s = _system(args)
+    fr = an.frequency_response(s, freqs)
+    d = fr.to_dict()
+    d["provenance"].update(_prov(s.config))
+    if args.json:
+        write_json(args.json, d)
+    else:
+        print(f"{'freq_hz':>9} " + " ".join(f"{a[-12:]:>13}" for a in fr.actuators) + "   (own piston gain dB)")
+        for i, f in enumerate(fr.freq_hz):
+            print(f"{f:9.4g} " + " ".join(f"{d['piston']['gain_db'][k][k][i]:13.3f}" for k in range(len(fr.actuators))))
+    if args.plot:
+        from .plotting import save
+        save(fr.plot(kind=args.kind), args.plot)
+    return 0
+
+
+def cmd_coupling(args) -> int:
+    s = _system(args)
+    c = an.coupling(s)
+    eig = an.closed_loop_eigenvalues(s)
+    d = {"coupling": c.to_dict(), "notches": an.notch_frequencies(s), "closed_loop": eig.to_dict(),
+         "margins": an.structure_effect(s), "provenance": _prov(s.config)}
+    if args.json:
+        write_json(args.json, d)
+    else:
+        print(f"closed loop: {'stable' if eig.stable else 'UNSTABLE'} (max Re {eig.max_real_per_s:.4g} 1/s)")
+        for name, n in d["notches"].items():
+            print(f"  notch {name:>18}: {n['notch_hz']:.3f} Hz (simplex {n['simplex_load_resonance_hz']:.3f} Hz)")
+        for r in d["margins"]["loops"]:
+            w, g = r["with_structure"], r["rigid"]
+            print(f"  loop  {r['actuator']:>18}: PM {w['phase_margin_deg']:.1f} deg (rigid {g['phase_margin_deg']:.1f}), "
+                  f"GM {w['gain_margin_db'] if w['gain_margin_db'] is None else round(w['gain_margin_db'], 1)} dB")
+        for k in ("strongest_engine_to_engine", "strongest_axis_to_axis"):
+            v = d["coupling"][k]
+            if v:
+                print(f"  {k}: {v['command']} -> {v['response']} {v['gain_db']:.1f} dB at {v['freq_hz']:.2f} Hz")
+    if args.plot:
+        from .plotting import save
+        save(c.plot(), args.plot)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="masv", description="MASV: four engines, eight actuators, thrust-structure modes")
+    sub = ap.add_subparsers(dest="command", required=True)
+
+    def common(p):
+        p.add_argument("config", help="MASV configuration (TOML), e.g. models/masv/core_stage.toml")
+        p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
+
+    p = sub.add_parser("modes", help="structural modes near the actuator bandwidth and their participation")
+    common(p)
+    p.add_argument("--factor", type=float, default=2.0, help="band: bandwidth / factor .. bandwidth * factor")
+    p.set_defaults(func=cmd_modes)
+    p = sub.add_parser("freqresp", help="8x8 command -> piston and command -> engine responses")
+    common(p)
+    p.add_argument("--freq-hz", required=True, help="comma-separated frequencies, e.g. 0.5,1,2,5")
+    p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save the gain grid")
+    p.add_argument("--kind", choices=("engine", "piston"), default="engine", help="gain grid of engine or piston")
+    p.set_defaults(func=cmd_freqresp)
+    p = sub.add_parser("coupling", help="notches, coupling peaks, closed-loop stability, loop margins")
+    common(p)
+    p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save the peak-coupling matrix")
+    p.set_defaults(func=cmd_coupling)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except InputError as e:
+        print(f"masv: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
