@@ -1,0 +1,190 @@
+"""Bode plots of command -> piston and command -> engine responses (families by amplitude).
+
+Layout: 2 x 2 axes, left column command -> piston (gain, phase), right column command ->
+engine angle (gain, phase); frequency [Hz] on a log axis, gain [dB], phase [deg].
+
+Piston gain: with ``moment_arm_m`` R given, the plotted quantity is x_p / theta_c in
+``length_unit`` per deg, i.e. 20 log10(|H_p| R (pi/180) / unit) [dB re 1 unit/deg], where
+H_p = x_p / (R theta_c) is the stored dimensionless gain; without R it is H_p itself [dB].
+Engine gain theta / theta_c [dB]. Markers: the notch of the command -> piston gain (the load
+resonance seen by the actuator, paper eq. 1 and sec. 2.2) and a vertical line at the load
+resonance w_L = sqrt((K_L R^2 + K_n) / J_n) / 2 pi when ``resonance_hz`` is given.
+
+Artists carry ``gid`` tags so tests and tools can find them: "response" (one curve per
+response per panel), "data" (measured points), "notch", "load-resonance".
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._common import LENGTH_UNITS  # noqa: F401  (sets the Agg backend)
+from ..errors import InputError
+
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def _check_unit(length_unit: str) -> float:
+    if length_unit not in LENGTH_UNITS:
+        raise InputError("plot", "length_unit", f"one of {', '.join(LENGTH_UNITS)}", got=repr(length_unit))
+    return LENGTH_UNITS[length_unit]
+
+
+def piston_scale(length_unit: str, moment_arm_m: float | None) -> tuple[float, str]:
+    """(factor, label): factor turns the stored x_p/(R theta_c) into the plotted quantity."""
+    unit_m = _check_unit(length_unit)
+    if moment_arm_m is None:
+        return 1.0, "x_p / (R θ_c)"
+    return moment_arm_m * math.pi / 180.0 / unit_m, f"x_p / θ_c [{length_unit}/deg]"
+
+
+def gain_db(h) -> np.ndarray:
+    return 20.0 * np.log10(np.maximum(np.abs(h), 1e-300))
+
+
+def phase_deg(h, freq_hz=None, ref=None) -> np.ndarray:
+    """Unwrapped phase [deg]; with ``ref`` = (freq_hz, phase_deg) of a dense reference curve,
+    each point is shifted by the multiple of 360 deg that brings it nearest the reference
+    (sparse sine-dwell points cannot be unwrapped on their own)."""
+    ph = np.degrees(np.unwrap(np.angle(h)))
+    if ref is not None and freq_hz is not None and np.size(ref[0]) > 1:
+        r = np.interp(np.log10(freq_hz), np.log10(ref[0]), ref[1])
+        ph = ph - 360.0 * np.round((ph - r) / 360.0)
+    return ph
+
+
+def response_label(fr) -> str:
+    if fr.amplitude_rad is None:
+        return "linear"
+    return f"{math.degrees(fr.amplitude_rad):.3g} deg ({fr.friction_model})"
+
+
+def notch_frequency_hz(fr) -> float:
+    """Frequency of the deepest interior local minimum of |piston| on the response's grid,
+    refined by a parabola in log f through the three points around it [Hz]; NaN if the gain
+    has no interior minimum (no notch in the band)."""
+    f = np.asarray(fr.freq_hz, float)
+    g = gain_db(fr.piston)
+    if f.size < 3:
+        return float("nan")
+    inner = np.flatnonzero((g[1:-1] < g[:-2]) & (g[1:-1] < g[2:])) + 1
+    if inner.size == 0:
+        return float("nan")
+    k = int(inner[np.argmin(g[inner])])
+    x = np.log10(f[k - 1:k + 2])
+    a, b, _ = np.polyfit(x, g[k - 1:k + 2], 2)
+    return float(10 ** np.clip(-b / (2 * a), x[0], x[2])) if a > 0 else float(f[k])
+
+
+def reference_response(responses):
+    """The response used for the notch and for phase alignment: linear first, then densest."""
+    return max(responses, key=lambda r: (r.amplitude_rad is None, np.size(r.freq_hz)))
+
+
+def new_bode_figure(title: str | None = None, piston_label: str = "x_p / (R θ_c)"):
+    fig, ax = plt.subplots(2, 2, figsize=(11, 7), sharex=True, constrained_layout=True)
+    ax[0, 0].set_title("command → piston")
+    ax[0, 1].set_title("command → engine angle")
+    ax[0, 0].set_ylabel(f"gain [dB]  ({piston_label})")
+    ax[0, 1].set_ylabel("gain [dB]  (θ / θ_c)")
+    ax[1, 0].set_ylabel("phase [deg]")
+    ax[1, 1].set_ylabel("phase [deg]")
+    for a in ax.flat:
+        a.set_xscale("log")
+        a.grid(True, which="both", alpha=0.3)
+    for a in ax[1]:
+        a.set_xlabel("frequency [Hz]")
+    if title:
+        fig.suptitle(title)
+    return fig, ax
+
+
+def draw_response(ax, fr, scale: float, *, color, label: str, gid: str = "response", marker=None,
+                  linestyle="-", ref=None):
+    """Draw one response on a 2 x 2 Bode axes array; ``ref`` = reference response for phase
+    alignment (see :func:`phase_deg`)."""
+    f = np.asarray(fr.freq_hz, float)
+    if marker is None:
+        marker = None if fr.amplitude_rad is None and f.size > 12 else "o"
+    kw = dict(color=color, marker=marker, markersize=4, linestyle=linestyle, gid=gid)
+    ax[0, 0].plot(f, gain_db(np.asarray(fr.piston) * scale), label=label, **kw)
+    rp = re = None
+    if ref is not None and ref is not fr:
+        rf = np.asarray(ref.freq_hz, float)
+        rp, re = (rf, phase_deg(ref.piston)), (rf, phase_deg(ref.engine))
+    ax[1, 0].plot(f, phase_deg(fr.piston, f, rp), **kw)
+    ax[0, 1].plot(f, gain_db(fr.engine), label=label, **kw)
+    ax[1, 1].plot(f, phase_deg(fr.engine, f, re), **kw)
+
+
+def mark_resonance(ax, resonance_hz: float, color="0.3", label_prefix: str = "") -> None:
+    for i, a in enumerate(ax.flat):
+        a.axvline(resonance_hz, color=color, linestyle="--", linewidth=1, gid="load-resonance",
+                  label=(f"{label_prefix}load resonance {resonance_hz:.2f} Hz" if i == 0 else None))
+
+
+def mark_notch(ax, fr, notch_hz: float, scale: float, color="k", label_prefix: str = "") -> None:
+    """Marker on the piston gain at ``notch_hz`` (gain interpolated on the response in log f)."""
+    f = np.asarray(fr.freq_hz, float)
+    g = gain_db(np.asarray(fr.piston) * scale)
+    y = float(np.interp(math.log10(notch_hz), np.log10(f), g))
+    ax[0, 0].plot([notch_hz], [y], marker="v", markersize=10, color=color, linestyle="none", gid="notch",
+                  label=f"{label_prefix}notch {notch_hz:.2f} Hz")
+
+
+def plot_freqresp(responses, resonance_hz: float | None = None, length_unit: str = "in", *,
+                  moment_arm_m: float | None = None, notch_hz: float | None | bool = None,
+                  title: str | None = None, data=None, data_label: str = "data"):
+    """Bode families of ``responses`` (list of :class:`~taos.freqresp.FrequencyResponse`).
+
+    Parameters
+    ----------
+    responses : list of FrequencyResponse
+        One curve each (linear: black line; sine dwell: one colour per amplitude, markers).
+    resonance_hz : float, optional
+        Load resonance [Hz]: a dashed vertical line on every panel.
+    length_unit : {'in', 'mm', 'm'}
+        Piston length unit when ``moment_arm_m`` is given.
+    moment_arm_m : float, optional
+        Moment arm R [m]; turns the piston gain into length_unit/deg.
+    notch_hz : float, optional
+        Notch frequency [Hz] to mark on the piston gain. None: located on the densest
+        response's grid (:func:`notch_frequency_hz`); False: no marker.
+    title : str, optional
+    data : list of FrequencyResponse, optional
+        Measured points drawn as open circles (gid "data"), labelled ``data_label``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    responses = list(responses)
+    if not responses:
+        raise InputError("plot", "responses", "at least one frequency response", got="none")
+    scale, plabel = piston_scale(length_unit, moment_arm_m)
+    ref = reference_response(responses)
+    fig, ax = new_bode_figure(title, plabel)
+    amps = sorted({fr.amplitude_rad for fr in responses if fr.amplitude_rad is not None})
+    cmap = plt.get_cmap("viridis")
+    for fr in responses:
+        if fr.amplitude_rad is None:
+            color = "k"
+        else:
+            color = cmap(0.15 + 0.7 * amps.index(fr.amplitude_rad) / max(1, len(amps) - 1))
+        draw_response(ax, fr, scale, color=color, label=response_label(fr), ref=ref)
+    for fr in data or []:
+        draw_response(ax, fr, scale, color="tab:red", label=f"{data_label} {response_label(fr)}", gid="data",
+                      marker="o", linestyle="none", ref=ref)
+        for line in ax[0, 0].lines[-1:] + ax[0, 1].lines[-1:] + ax[1, 0].lines[-1:] + ax[1, 1].lines[-1:]:
+            line.set_markerfacecolor("none")
+    if resonance_hz is not None:
+        mark_resonance(ax, resonance_hz)
+    if notch_hz is not False:
+        nf = notch_frequency_hz(ref) if notch_hz is None else float(notch_hz)
+        if math.isfinite(nf):
+            mark_notch(ax, ref, nf, scale)
+    ax[0, 0].legend(fontsize=8, loc="best")
+    ax[0, 1].legend(fontsize=8, loc="best")
+    return fig

@@ -1,0 +1,372 @@
+"""The Green Run report (``taos greenrun MODEL --out DIR``).
+
+Runs the two-axis Green Run profile (default ``models/profiles/greenrun_two_axis.toml``: pitch
+and yaw commanded at the same time at different frequencies, 0.4 deg up to 7 Hz and 0.8 deg up
+to 14 Hz, paper sec. 3.2) through the simplex model (:func:`taos.simulate.simulate`), and
+computes per axis:
+
+* the exact linear response (:func:`taos.freqresp.linear_freqresp`) on a log grid, its piston
+  notch (:func:`taos.simplex.load_resonance_from_notch`) and the load resonance
+  w_L = sqrt((K_L R^2 + K_n) / J_n) (paper eq. 1);
+* sine-dwell responses at the profile's amplitudes and frequencies
+  (:func:`taos.freqresp.sine_dwell_grid`);
+* the response read off the two-axis run itself, as the test was analysed: for each dwell
+  segment of the profile a least-squares fit y = a sin(w t') + b cos(w t') + c over its last
+  two whole cycles, H = (a + j b) / A (piston as x_p / (R theta_c)).
+
+Writes ``DIR/index.html`` (self-contained: plots inline as base64 PNG, a summary table, the
+meshcat 3-D animation inline in an ``iframe srcdoc``), ``DIR/greenrun.h5`` (the run plus the
+responses under ``/freqresp``) and ``DIR/summary.json``. The folder is built in a temporary
+folder beside DIR and renamed into place, so a failure leaves nothing half-written.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import io
+import json
+import math
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from .errors import InputError
+from .profiles import Sequence, SineDwell, TwoAxis, load_profile
+
+DEFAULT_PROFILE = Path(__file__).resolve().parents[1] / "models" / "profiles" / "greenrun_two_axis.toml"
+AXES = ("pitch", "yaw")
+
+
+# -- analysis ---------------------------------------------------------------------------------
+
+def dwell_segments(profile) -> list[tuple[float, SineDwell]]:
+    """(start time [s], SineDwell) of each sine-dwell part of a single-axis profile."""
+    parts = profile.parts if isinstance(profile, Sequence) else (profile,)
+    out, t0 = [], 0.0
+    for p in parts:
+        if isinstance(p, SineDwell):
+            out.append((t0, p))
+        t0 += p.duration_s
+    return out
+
+
+def run_dwell_response(t_s, command_amp_rad: float, freq_hz: float, t0_s: float, cycles: int, y,
+                       fit_cycles: int = 2) -> complex:
+    """Fundamental of ``y`` relative to A sin(w (t - t0)) over the segment's last whole cycles."""
+    m = min(fit_cycles, max(1, cycles - 1))
+    w = 2 * math.pi * freq_hz
+    lo, hi = t0_s + (cycles - m) / freq_hz, t0_s + cycles / freq_hz
+    sel = (t_s >= lo) & (t_s < hi)
+    tt = t_s[sel] - t0_s
+    X = np.column_stack([np.sin(w * tt), np.cos(w * tt), np.ones_like(tt)])
+    (a, b, _), *_ = np.linalg.lstsq(X, y[sel], rcond=None)
+    return complex(a, b) / command_amp_rad
+
+
+def run_responses(th, profile, moment_arm_m: float) -> dict:
+    """{axis: FrequencyResponse-like dict arrays} read off the two-axis run's dwell segments."""
+    from .freqresp import FrequencyResponse
+
+    out = {}
+    for k, ax in enumerate(th.axes):
+        segs = dwell_segments(getattr(profile, ax)) if isinstance(profile, TwoAxis) else dwell_segments(profile)
+        if not segs:
+            continue
+        rows = []
+        for t0, s in segs:
+            hp = run_dwell_response(th.t_s, s.amplitude_rad, s.frequency_hz, t0, s.cycles, th.piston_m[k]) / moment_arm_m
+            he = run_dwell_response(th.t_s, s.amplitude_rad, s.frequency_hz, t0, s.cycles, th.engine_rad[k])
+            rows.append((s.amplitude_rad, s.frequency_hz, hp, he))
+        out[ax] = [FrequencyResponse(np.array([r[1] for r in rows if r[0] == a]),
+                                     np.array([r[2] for r in rows if r[0] == a]),
+                                     np.array([r[3] for r in rows if r[0] == a]), a, ax,
+                                     friction_model=th.provenance.get("friction_model", "?"),
+                                     provenance={"method": "two-axis run, dwell segments"})
+                   for a in sorted({r[0] for r in rows})]
+    return out
+
+
+# -- helpers ---------------------------------------------------------------------------------
+
+def _png(fig) -> str:
+    import matplotlib.pyplot as plt
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    plt.close(fig)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _h(x) -> str:
+    return html.escape(str(x))
+
+
+def _db(h) -> float:
+    return 20 * math.log10(max(abs(h), 1e-300))
+
+
+def _deg(h) -> float:
+    return math.degrees(math.atan2(h.imag, h.real))
+
+
+def _write_h5(path: Path, th, linear: dict, dwell: dict, run: dict) -> None:
+    th.to_hdf5(path)
+    with h5py.File(path, "a") as h5:
+        g = h5.create_group("freqresp")
+        g.attrs["piston_definition"] = "x_p / (R theta_c), complex"
+        g.attrs["engine_definition"] = "theta / theta_c, complex"
+        for ax in linear:
+            a = g.create_group(ax)
+            a.create_dataset("linear/freq_hz", data=linear[ax].freq_hz)
+            a.create_dataset("linear/piston", data=linear[ax].piston)
+            a.create_dataset("linear/engine", data=linear[ax].engine)
+            d = dwell[ax]
+            a.create_dataset("sine_dwell/freq_hz", data=d["freq_hz"])
+            a.create_dataset("sine_dwell/amplitude_rad", data=d["amplitude_rad"])
+            a.create_dataset("sine_dwell/piston", data=d["piston"])
+            a.create_dataset("sine_dwell/engine", data=d["engine"])
+            for fr in run.get(ax, []):
+                r = a.create_group(f"run_dwell/{math.degrees(fr.amplitude_rad):.3g}deg")
+                r.attrs["amplitude_rad"] = fr.amplitude_rad
+                r.create_dataset("freq_hz", data=fr.freq_hz)
+                r.create_dataset("piston", data=fr.piston)
+                r.create_dataset("engine", data=fr.engine)
+
+
+# -- the report -------------------------------------------------------------------------------
+
+def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, friction: str | None = None,
+                    progress: bool = True, dt_s: float = 2e-4, view_angle_scale: float = 5.0,
+                    view_fps: float = 100.0) -> Path:
+    """Build the Green Run report folder ``out_dir`` (see the module docstring); returns its path.
+
+    Parameters
+    ----------
+    model_path : str or Path
+        Model file (TOML).
+    out_dir : str or Path
+        Report folder; replaced as a whole when the new one is complete.
+    profile_path : str or Path, optional
+        Two-axis profile; default the notional Green Run profile.
+    friction : str, optional
+        Swap the model's friction law (keeping its torque levels).
+    progress : bool
+        tqdm progress bar on standard error.
+    dt_s : float
+        Integration step [s].
+    view_angle_scale : float
+        Engine-angle exaggeration of the embedded 3-D view [-].
+    view_fps : float
+        Keyframe rate of the embedded 3-D view [1/s].
+    """
+    from tqdm import tqdm
+
+    from ._cli_basic import info_dict
+    from .freqresp import FrequencyResponse, linear_freqresp, sine_dwell_grid
+    from .model import load_model
+    from .plotting import bode, timehist
+    from .simplex import load_resonance_from_notch
+    from .simulate import simulate
+    from .viewer import offline_html
+
+    out = Path(out_dir)
+    # bad input fails here, before any progress output: one line, nothing written
+    model = load_model(model_path, friction=friction)
+    ppath = DEFAULT_PROFILE if profile_path is None else Path(profile_path)
+    profile = load_profile(ppath)
+    if not isinstance(profile, TwoAxis):
+        raise InputError(str(ppath), "(profile)", "a two-axis profile with [pitch] and [yaw] tables",
+                         got=type(profile).__name__)
+    info = info_dict(model)
+    R = model.actuator.moment_arm_m
+    steps = ["simulate", "linear response", "sine dwell", "plots", "3-D view", "write"]
+    bar = tqdm(total=len(steps), desc="greenrun", unit="step", file=sys.stderr, disable=not progress)
+
+    def step(name):
+        bar.set_postfix_str(name)
+
+    try:
+        step("simulate")
+        th = simulate(model, profile, dt_s=dt_s)
+        bar.update()
+
+        step("linear response")
+        f_lin = np.logspace(-1, math.log10(30.0), 240)
+        linear = {ax: linear_freqresp(model, f_lin, ax) for ax in AXES}
+        notch = {ax: load_resonance_from_notch(model, ax) for ax in AXES}
+        wl = {ax: model.load_resonance_hz(ax) for ax in AXES}
+        bar.update()
+
+        step("sine dwell")
+        dwell, dwell_fr = {}, {}
+        for ax in AXES:
+            segs = dwell_segments(getattr(profile, ax))
+            amps = sorted({s.amplitude_rad for _, s in segs})
+            freqs = sorted({s.frequency_hz for _, s in segs})
+            if not segs:
+                dwell[ax] = {"freq_hz": np.zeros(0), "amplitude_rad": np.zeros(0),
+                             "piston": np.zeros((0, 0), complex), "engine": np.zeros((0, 0), complex)}
+                dwell_fr[ax] = []
+                continue
+            p, e = sine_dwell_grid(model, amps, freqs, ax, dt_max_s=dt_s)
+            dwell[ax] = {"freq_hz": np.array(freqs), "amplitude_rad": np.array(amps), "piston": p, "engine": e}
+            dwell_fr[ax] = [FrequencyResponse(np.array(freqs), p[i], e[i], a, ax, friction_model=model.friction.name)
+                            for i, a in enumerate(amps)]
+        run = run_responses(th, profile, R)
+        bar.update()
+
+        step("plots")
+        figs = {}
+        for ax in AXES:
+            figs[f"bode_{ax}"] = _png(bode.plot_freqresp(
+                [linear[ax]] + dwell_fr[ax], resonance_hz=wl[ax], notch_hz=notch[ax], length_unit="in",
+                moment_arm_m=R, data=run.get(ax), data_label="two-axis run", title=f"{ax}: command → piston and engine ({model.name})"))
+        figs["timehist"] = _png(timehist.plot_timehistory(th, "in", "deg"))
+        figs["timehist_zoom"] = _png(timehist.plot_timehistory(
+            th, "in", "deg", t_range_s=(0.0, 4.0), title="first 4 s (0.4 deg dwell, stick-slip onset)"))
+        bar.update()
+
+        step("3-D view")
+        view = offline_html(th, angle_scale=view_angle_scale, fps=view_fps)
+        bar.update()
+
+        step("write")
+        summary = _summary(model, info, th, notch, wl, dwell, run, ppath)
+        page = _page(model, summary, figs, view, view_angle_scale, dwell, run)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+        try:
+            (tmp / "index.html").write_text(page, encoding="utf-8")
+            (tmp / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
+            _write_h5(tmp / "greenrun.h5", th, linear, dwell, run)
+            os.chmod(tmp, 0o755)
+            for f in tmp.iterdir():
+                os.chmod(f, 0o644)
+            old = None
+            if out.exists():
+                old = out.parent / f".{out.name}.old.{os.getpid()}"
+                os.replace(out, old)
+            os.replace(tmp, out)
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        bar.update()
+    finally:
+        bar.close()
+    return out
+
+
+def _summary(model, info, th, notch, wl, dwell, run, ppath) -> dict:
+    from .units import from_si
+
+    fr = model.friction
+    dw = {}
+    for ax, d in dwell.items():
+        dw[ax] = [{"amplitude_deg": math.degrees(a), "freq_hz": float(f),
+                   "piston_gain_db": _db(d["piston"][i, j]), "piston_phase_deg": _deg(d["piston"][i, j]),
+                   "engine_gain_db": _db(d["engine"][i, j]), "engine_phase_deg": _deg(d["engine"][i, j])}
+                  for i, a in enumerate(d["amplitude_rad"]) for j, f in enumerate(d["freq_hz"])]
+    rn = {ax: [{"amplitude_deg": math.degrees(r.amplitude_rad), "freq_hz": float(f),
+                "piston_gain_db": _db(r.piston[j]), "engine_gain_db": _db(r.engine[j]),
+                "engine_phase_deg": _deg(r.engine[j])}
+               for r in rs for j, f in enumerate(r.freq_hz)] for ax, rs in run.items()}
+    return {
+        "model_file": str(model.source), "model_name": model.name, "model_sha256": model.sha256,
+        "profile_file": str(ppath), "profile": th.provenance.get("profile", ""),
+        "friction_model": fr.name, "package_version": th.provenance.get("package_version", ""),
+        "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "load_resonance_hz": {ax: wl[ax] for ax in wl}, "notch_frequency_hz": notch,
+        "breakaway_deflection_deg": info["breakaway_deflection_deg"],
+        "load_stiffness_N_per_m": model.structure.load_stiffness_N_per_m,
+        "load_stiffness_lbf_per_in": from_si(model.structure.load_stiffness_N_per_m, "N/m", "lbf/in"),
+        "load_stiffness_rotational_Nm_per_rad": info["load_stiffness_rotational_Nm_per_rad"],
+        "oil_column_stiffness_N_per_m": info["oil_column_stiffness_N_per_m"],
+        "coulomb_torque_Nm": fr.coulomb_torque_Nm,
+        "coulomb_torque_in_lbf": from_si(fr.coulomb_torque_Nm, "N*m", "in*lbf"),
+        "moment_arm_m": model.actuator.moment_arm_m, "stall_force_N": info["stall_force_N"],
+        "avionics_lsb_deg": info["avionics_lsb_deg"],
+        "run": {"duration_s": float(th.t_s[-1]), "samples": int(th.t_s.size),
+                "peak_engine_deg": {ax: float(np.degrees(np.max(np.abs(th.engine_rad[k])))) for k, ax in enumerate(th.axes)},
+                "peak_piston_in": {ax: float(np.max(np.abs(th.piston_m[k])) / 0.0254) for k, ax in enumerate(th.axes)},
+                "peak_friction_torque_Nm": {ax: float(np.max(np.abs(th.friction_torque_Nm[k]))) for k, ax in enumerate(th.axes)},
+                "peak_load_force_N": {ax: float(np.max(np.abs(th.load_force_N[k]))) for k, ax in enumerate(th.axes)}},
+        "sine_dwell": dw, "run_dwell": rn,
+    }
+
+
+_CSS = """body{font:14px/1.45 system-ui,sans-serif;margin:24px auto;max-width:1150px;color:#1d1f23}
+h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccd}
+table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #ccd;padding:3px 8px;text-align:right}
+th{background:#eef}td:first-child,th:first-child{text-align:left}img{max-width:100%}
+.note{color:#555;font-size:12px}iframe{width:100%;height:620px;border:1px solid #ccd}"""
+
+
+def _page(model, s, figs, view, scale, dwell, run) -> str:
+    rows = [
+        ("load resonance w_L (pitch / yaw)", f"{s['load_resonance_hz']['pitch']:.3f} / {s['load_resonance_hz']['yaw']:.3f} Hz"),
+        ("piston notch, linear (pitch / yaw)", f"{s['notch_frequency_hz']['pitch']:.3f} / {s['notch_frequency_hz']['yaw']:.3f} Hz"),
+        ("load stiffness K_L", f"{s['load_stiffness_lbf_per_in']:,.0f} lbf/in ({s['load_stiffness_N_per_m']:.4g} N/m)"),
+        ("K_L R^2", f"{s['load_stiffness_rotational_Nm_per_rad']:.4g} N m/rad"),
+        ("oil-column stiffness", f"{s['oil_column_stiffness_N_per_m']:.4g} N/m"),
+        ("friction law, Coulomb torque", f"{_h(s['friction_model'])}, {s['coulomb_torque_in_lbf']:,.0f} in lbf ({s['coulomb_torque_Nm']:.4g} N m)"),
+        ("breakaway deflection T_f / (K_L R^2)", f"{s['breakaway_deflection_deg']:.4f} deg"),
+        ("moment arm R, stall force", f"{s['moment_arm_m']:.3g} m, {s['stall_force_N']:.4g} N"),
+        ("avionics LSB", f"{s['avionics_lsb_deg']:.5f} deg"),
+    ]
+    r = s["run"]
+    for ax in r["peak_engine_deg"]:
+        rows.append((f"run peaks, {ax}: engine / piston / T_f / F_L",
+                     f"{r['peak_engine_deg'][ax]:.3f} deg / {r['peak_piston_in'][ax]:.4f} in / "
+                     f"{r['peak_friction_torque_Nm'][ax]:.4g} N m / {r['peak_load_force_N'][ax]:.4g} N"))
+    table = "".join(f"<tr><td>{_h(a)}</td><td>{b}</td></tr>" for a, b in rows)
+    dwell_tables = []
+    for ax, items in s["sine_dwell"].items():
+        runmap = {(round(x["amplitude_deg"], 6), x["freq_hz"]): x for x in s["run_dwell"].get(ax, [])}
+        trs = []
+        for x in items:
+            rr = runmap.get((round(x["amplitude_deg"], 6), x["freq_hz"]))
+            run_cells = (f"<td>{rr['engine_gain_db']:.2f}</td><td>{rr['engine_phase_deg']:.1f}</td>" if rr
+                         else "<td>–</td><td>–</td>")
+            trs.append(f"<tr><td>{x['freq_hz']:g}</td><td>{x['amplitude_deg']:.2g}</td>"
+                       f"<td>{x['piston_gain_db']:.2f}</td><td>{x['piston_phase_deg']:.1f}</td>"
+                       f"<td>{x['engine_gain_db']:.2f}</td><td>{x['engine_phase_deg']:.1f}</td>{run_cells}</tr>")
+        dwell_tables.append(
+            f"<h3>{_h(ax)}</h3><table><tr><th>freq [Hz]</th><th>amplitude [deg]</th><th>piston gain [dB]</th>"
+            f"<th>piston phase [deg]</th><th>engine gain [dB]</th><th>engine phase [deg]</th>"
+            f"<th>run: engine gain [dB]</th><th>run: engine phase [deg]</th></tr>{''.join(trs)}</table>")
+    srcdoc = view.replace("&", "&amp;").replace('"', "&quot;")
+    return f"""<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>Green Run report: {_h(model.name)}</title><style>{_CSS}</style></head>
+<body>
+<h1>Green Run two-axis vectoring: {_h(model.name)}</h1>
+<p>Model <code>{_h(s['model_file'])}</code> (sha256 {_h(s['model_sha256'][:12])}…), profile
+<code>{_h(s['profile_file'])}</code> ({_h(s['profile'])}), friction <b>{_h(s['friction_model'])}</b>,
+simplex model, taos {_h(s['package_version'])}, {_h(s['created_utc'])}.</p>
+<h2>Summary</h2><table>{table}</table>
+<h2>3-D view</h2>
+<p class="note">Engine angle exaggerated ×{scale:g}; load-path deflection x_p − Rθ exaggerated as shown in the legend. Play, pause,
+time and speed (timeScale) are under “Open Controls” → Animations.</p>
+<iframe title="3-D gimbal animation" srcdoc="{srcdoc}"></iframe>
+<h2>Frequency response: pitch</h2>
+<img alt="pitch Bode plot" src="{figs['bode_pitch']}">
+<h2>Frequency response: yaw</h2>
+<img alt="yaw Bode plot" src="{figs['bode_yaw']}">
+<p class="note">Lines: exact linear response (no friction, unity avionics). Dashed/markers: sine-dwell
+describing function at the profile amplitudes (friction and avionics included). Open circles: the
+response read off the two-axis run, dwell by dwell (last two cycles). Triangle: the linear
+command → piston notch; dashed vertical: load resonance w_L = sqrt((K_L R² + K_n)/J_n).
+Piston gain is x_p/θ_c in in/deg.</p>
+<h2>Sine-dwell points</h2>{''.join(dwell_tables)}
+<h2>Time history</h2>
+<img alt="time history" src="{figs['timehist']}">
+<img alt="time history, first 4 s" src="{figs['timehist_zoom']}">
+</body></html>
+"""

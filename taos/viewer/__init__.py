@@ -1,0 +1,110 @@
+"""3-D gimbal view of a recorded run (meshcat): live on loopback, or one offline HTML file.
+
+>>> th = TimeHistory.from_hdf5("run.h5")                          # doctest: +SKIP
+>>> write_html(th, "run.html", angle_scale=5)                     # doctest: +SKIP
+>>> serve(th)          # prints the URL, blocks until Ctrl-C      # doctest: +SKIP
+
+Modules: :mod:`.geometry` (display geometry, meshes), :mod:`.kinematics` (run -> poses and
+colours), :mod:`.base` (backend interface), :mod:`.meshcat_backend` (meshcat).
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from pathlib import Path
+
+from ..errors import InputError
+from ..results import atomic_write
+from .base import BaseVisualizer
+from .geometry import GimbalGeometry
+from .kinematics import ViewerFrames, viewer_frames
+from .meshcat_backend import MeshcatVisualizer, OfflineWindow, legend_html, live_visualizer
+
+__all__ = ["BaseVisualizer", "GimbalGeometry", "MeshcatVisualizer", "OfflineWindow", "ViewerFrames",
+           "load_run", "offline_html", "serve", "viewer_frames", "write_html"]
+
+
+def load_run(path):
+    """Read a ``taos simulate`` HDF5 run; InputError (one line) if it is not one."""
+    from ..simulate import TimeHistory
+
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(str(path), "file", "an existing HDF5 run written by taos simulate", got="no such file")
+    try:
+        th = TimeHistory.from_hdf5(p)
+    except (OSError, KeyError, ValueError) as e:
+        raise InputError(str(path), "HDF5 layout", "a run written by taos simulate (t_s, <axis>/engine_rad, ...)",
+                         got=type(e).__name__ + ": " + str(e).splitlines()[0]) from None
+    import numpy as np
+    t = th.t_s
+    if t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise InputError(str(path), "t_s", "finite, increasing sample times", got=f"{t.size} samples")
+    for name in ("engine_rad", "piston_m", "friction_torque_Nm", "load_force_N"):
+        if not np.all(np.isfinite(getattr(th, name))):
+            raise InputError(str(path), name, "finite values", got="NaN or inf")
+    return th
+
+
+def _title(th) -> str:
+    prov = th.provenance or {}
+    return f"TAOS gimbal view: {prov.get('model_name', 'run')} / {prov.get('profile', '')}".rstrip(" /")
+
+
+def offline_html(th, *, angle_scale: float = 1.0, deflection_scale: float | None = None, fps: float = 100.0,
+                 paused_at_s: float | None = None, geometry: GimbalGeometry | None = None) -> str:
+    """Self-contained HTML (meshcat viewer + scene + animation) of run ``th``.
+
+    ``angle_scale`` and ``deflection_scale`` exaggerate the engine angle and the load-path
+    deflection (see :mod:`taos.viewer.kinematics`); ``fps`` is the keyframe rate [1/s];
+    ``paused_at_s`` opens the page paused at that time [s] (else it plays; ``?t=`` in the URL
+    also selects a time)."""
+    fr = viewer_frames(th, geometry, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps)
+    v = MeshcatVisualizer(geometry or GimbalGeometry(moment_arm_m=float(th.moment_arm_m)),
+                          window=OfflineWindow(title=_title(th), legend_html=legend_html(fr)))
+    v.load_scene()
+    v.play(fr, autoplay=paused_at_s is None)
+    return v.static_html(paused_at_s=paused_at_s)
+
+
+def write_html(th, path, **kwargs) -> None:
+    """Write :func:`offline_html` to ``path`` atomically."""
+    text = offline_html(th, **kwargs)
+    atomic_write(path, lambda p: Path(p).write_text(text, encoding="utf-8"))
+
+
+def serve(th, *, angle_scale: float = 1.0, deflection_scale: float | None = None, fps: float = 100.0,
+          on_ready=print, stop: threading.Event | None = None) -> int:
+    """Serve the animated run on 127.0.0.1 until SIGINT/SIGTERM (or ``stop`` is set).
+
+    Calls ``on_ready(url)`` once the scene is loaded; returns 0 after shutting the server down."""
+    fr = viewer_frames(th, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps)
+    vis, proc = live_visualizer(GimbalGeometry(moment_arm_m=float(th.moment_arm_m)))
+    stop = stop or threading.Event()
+    old = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            old[sig] = signal.signal(sig, lambda *a: stop.set())
+    try:
+        vis.load_scene()
+        vis.play(fr, autoplay=True)
+        on_ready(vis.url())
+        while not stop.wait(0.2):
+            if proc.poll() is not None:
+                raise RuntimeError(f"meshcat server exited ({proc.returncode})")
+    finally:
+        for sig, h in old.items():
+            signal.signal(sig, h)
+        if proc.poll() is None:
+            proc.terminate()
+            try:
+                proc.wait(5)
+            except Exception:
+                proc.kill()
+                proc.wait()
+        try:
+            vis.window.zmq_socket.close(linger=0)
+        except Exception:
+            pass
+    return 0
