@@ -62,14 +62,6 @@ class RevolvedMesh:
         return np.flatnonzero((self.node_i == i) & (self.node_j >= j0) & (self.node_j <= j1))
 
 
-def _grid_lines(breaks: Sequence[float] | int, divs: Sequence[int]) -> tuple[np.ndarray, list[int]]:
-    """Subdivide consecutive zones uniformly; return the parameter of each grid line."""
-    idx = [0]
-    for d in divs:
-        idx.append(idx[-1] + int(d))
-    return np.asarray(idx), idx
-
-
 def revolve_meridian(r_breaks: Sequence[float], r_divs: Sequence[int],
                      key_lines: Sequence[KeyLine], z_divs: Sequence[int],
                      blocks: Sequence[Sequence[bool]], n_theta: int) -> RevolvedMesh:
@@ -87,7 +79,6 @@ def revolve_meridian(r_breaks: Sequence[float], r_divs: Sequence[int],
     r_breaks = np.asarray(r_breaks, float)
     if r_breaks[0] <= 0.0 or np.any(np.diff(r_breaks) <= 0):
         raise ValueError("r_breaks must be positive and increasing")
-    nra, nzb = len(r_divs), len(z_divs)
     # radial grid lines
     r_nodes = [r_breaks[0]]
     r_lines = [0]

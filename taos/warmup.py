@@ -1,0 +1,30 @@
+"""Compile and cache the numba kernels once (``python -m taos.warmup``; run by ``make``).
+
+The integrator kernels take tens of seconds to compile on a cold cache; doing it at install
+time keeps the first ``taos greenrun`` and the test suite's first simulation fast.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+
+def main() -> None:
+    from .freqresp import sine_dwell_grid
+    from .model import load_model
+    from .profiles import SineDwell
+    from .simulate import simulate
+
+    t0 = time.perf_counter()
+    root = Path(__file__).resolve().parents[1]
+    model = load_model(root / "models" / "rs25_hotfire.toml")
+    simulate(model, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
+    sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1)
+    model.friction.response([0.0, 0.1], 1e-3)
+    print(f"taos: numba kernels compiled and cached in {time.perf_counter() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
