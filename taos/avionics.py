@@ -75,7 +75,7 @@ class Avionics:
         return Avionics()
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def apply(c, p):
     """Command path for one value ``c`` [rad] with packed parameters ``p``."""
     lsb = p[1]
