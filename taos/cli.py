@@ -14,7 +14,7 @@ import sys
 from .errors import InputError, SimulationUnstable
 
 #: subcommand modules, in help order
-COMMANDS = ["taos._cli_basic", "taos._cli_view"]
+COMMANDS = ["taos._cli_basic", "taos._cli_view", "taos._cli_data"]
 
 
 def build_parser() -> argparse.ArgumentParser:

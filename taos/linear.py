@@ -131,29 +131,34 @@ def balancing_scale(ss: StateSpace) -> np.ndarray:
     return sc
 
 
-def freqresp_symbolic(ss: StateSpace, w_rad_s: float, input_name: str, output_name: str,
-                      scale: np.ndarray | None = None):
+def freqresp_symbolic(ss: StateSpace, w_rad_s: float, inputs, outputs, scale: np.ndarray | None = None):
     """Real and imaginary parts of H(j w) for a (possibly CasADi-symbolic) state space.
 
-    Solves the real 2n system [[-A, -w I], [w I, -A]] [x_r; x_i] = [B; 0] so CasADi (which has
-    no complex type) can differentiate the response exactly. ``scale`` (from
-    :func:`balancing_scale` of a nominal numeric model) rescales the states first: states in Pa
-    and m otherwise cost the solve several digits. Returns (re, im)."""
+    Solves the real 2n system [[-A, -w I], [w I, -A]] [X_r; X_i] = [B; 0] once for all the
+    selected inputs, so CasADi (which has no complex type) can differentiate the response
+    exactly. ``inputs``/``outputs`` are a name (the result is then a scalar in that direction)
+    or a list of names (an n_out x n_in SX matrix). ``scale`` (from :func:`balancing_scale` of a
+    nominal numeric model) rescales the states first: states in Pa and m otherwise cost the
+    solve several digits. Returns (re, im)."""
     import casadi as ca
 
+    ii = [ss.input_index(inputs)] if isinstance(inputs, str) else [ss.input_index(n) for n in inputs]
+    oo = [ss.output_index(outputs)] if isinstance(outputs, str) else [ss.output_index(n) for n in outputs]
     A = ca.SX(ss.A) if not isinstance(ss.A, (ca.SX, ca.MX)) else ss.A
-    B = ss.B[:, ss.input_index(input_name)]
-    C = ss.C[ss.output_index(output_name), :]
+    B = ca.horzcat(*[ss.B[:, i] for i in ii])
+    C = ca.vertcat(*[ss.C[o, :] for o in oo])
+    D = ca.SX(len(oo), len(ii))
+    for a, o in enumerate(oo):
+        for b, i in enumerate(ii):
+            D[a, b] = ss.D[o, i]
     if scale is not None:
         S = ca.diag(ca.DM(scale))
         Si = ca.diag(ca.DM(1.0 / np.asarray(scale)))
         A = Si @ A @ S
         B = Si @ B
         C = C @ S
-    D = ss.D[ss.output_index(output_name), ss.input_index(input_name)]
     n = len(ss.states)
     eye = ca.SX.eye(n)
     M = ca.vertcat(ca.horzcat(-A, -w_rad_s * eye), ca.horzcat(w_rad_s * eye, -A))
-    rhs = ca.vertcat(B, ca.SX.zeros(n, 1))
-    x = ca.solve(M, rhs)
-    return C @ x[:n] + D, C @ x[n:]
+    x = ca.solve(M, ca.vertcat(B, ca.SX.zeros(n, len(ii))))
+    return C @ x[:n, :] + D, C @ x[n:, :]

@@ -1,8 +1,7 @@
 """Scalar friction kernels: the single definition of every friction law.
 
-Each law is two numba-compiled scalar functions over SI floats, written so that the same
-Python source also traces under CasADi (``fn.py_func`` with SX arguments) where the law is
-smooth:
+Each law is two numba-compiled scalar functions over SI floats (the branches and ``math``
+calls make them numeric only; fits use describing functions of these laws instead):
 
 * ``zdot(v, z, p)`` -> dz/dt [rad/s];
 * ``torque(v, z, dz, t_app, p)`` -> friction torque T_f [N m] opposing relative rate ``v``

@@ -1,0 +1,157 @@
+"""``taos estimate``, ``taos fit`` and ``taos compare``: the test-data workflow (seed paper
+secs. 2.2 and 4): estimate responses from vectoring records, fit model parameters with
+CasADi, and compare two conditions (ambient vs hot fire) side by side."""
+
+from __future__ import annotations
+
+import math
+import sys
+
+from .errors import InputError
+from .results import write_json
+
+AXES = ("pitch", "yaw")
+
+
+def _estimate(path, args):
+    from .data import load_test_data
+    from .estimate import estimate
+
+    data = load_test_data(path)
+    axes = None if args.axis in (None, "both") else (args.axis,)
+    if axes and axes[0] not in data.axes:
+        raise InputError(str(path), f"{axes[0]}_command", f"a {axes[0]} axis in the data", got=", ".join(data.axes))
+    kw = {"axes": axes}
+    if getattr(args, "nperseg", None):
+        kw["nperseg"] = args.nperseg
+    return data, estimate(data, method=args.method, **kw)
+
+
+def _parse_start(items, model) -> dict:
+    from .fit_model import PARAMETERS
+    from .units import to_si
+
+    out = {}
+    for it in items or []:
+        if "=" not in it:
+            raise InputError("command line", "--start", "NAME=VALUE with a unit, like load_stiffness='150000 lbf/in'",
+                             got=repr(it))
+        k, v = (s.strip() for s in it.split("=", 1))
+        if k not in PARAMETERS:
+            raise InputError("command line", "--start", "a name from " + ", ".join(PARAMETERS), got=repr(k))
+        p = PARAMETERS[k]
+        out[k] = to_si(v if p.kind != "dimensionless" else float(v), p.kind, source="command line",
+                       field=f"--start {k}", positive=True)
+    return out
+
+
+def cmd_estimate(args) -> int:
+    data, responses = _estimate(args.data, args)
+    d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
+         "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
+         "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict() for r in responses]}
+    if args.json:
+        write_json(args.json, d)
+    else:
+        for r in responses:
+            print(f"{r.axis} ({r.method}), {len(r)} points")
+            print(f"{'freq_hz':>9} {'amp_deg':>8} {'piston dB':>10} {'deg':>8} {'coh':>6}")
+            for k in range(len(r)):
+                h = r.piston_m_per_rad[k] / 0.0254 * math.pi / 180
+                print(f"{r.freq_hz[k]:9.4g} {math.degrees(r.amplitude_rad[k]):8.3g} {20 * math.log10(abs(h)):10.3f} "
+                      f"{math.degrees(math.atan2(h.imag, h.real)):8.2f} {r.coherence_piston[k]:6.3f}")
+    return 0
+
+
+def cmd_fit(args) -> int:
+    from .fit import fit_frequency_response
+    from .model import load_model
+
+    model = load_model(args.model, friction=args.friction)
+    free = [s.strip() for s in args.free.split(",") if s.strip()]
+    start = _parse_start(args.start, model)
+    responses, labels = [], []
+    for path in args.data:                       # read and validate everything before any output
+        _, rs = _estimate(path, args)
+        responses += rs
+        labels.append(str(path))
+    res = fit_frequency_response(model, responses, free, start=start, starts=args.starts,
+                                 use_engine=not args.no_engine, min_coherence=args.min_coherence,
+                                 correct=None if not args.no_correction else False)
+    d = res.to_dict()
+    d["model_file"] = model.source
+    if args.out_model:
+        res.write_model(args.out_model, data_label=", ".join(labels))
+        d["fitted_model_file"] = str(args.out_model)
+    if args.plot:
+        from .plotting import save
+        save(res.plot(), args.plot)
+    if args.json:
+        write_json(args.json, d)
+    out = sys.stderr if args.json == "-" else sys.stdout
+    print(res.table(), file=out)
+    if args.out_model:
+        print(f"wrote {args.out_model}", file=out)
+    return 0
+
+
+def cmd_compare(args) -> int:
+    from .compare import compare_models, write_comparison
+    from .model import load_model
+
+    ma = load_model(args.model_a)
+    mb = load_model(args.model_b)
+    da, db = (), ()
+    if args.data:
+        _, da = _estimate(args.data[0], args)
+        _, db = _estimate(args.data[1], args)
+    labels = tuple(args.labels.split(",")) if args.labels else None
+    if labels is not None and len(labels) != 2:
+        raise InputError("command line", "--labels", "two labels like ambient,'hot fire'", got=args.labels)
+    cmp = compare_models(ma, mb, da, db, labels)
+    out = write_comparison(cmp, args.out, json_path=args.json)
+    stream = sys.stderr if args.json == "-" else sys.stdout
+    print(cmp.table(), file=stream)
+    print(f"wrote {out}/ (table.txt, comparison.json, piston_side_by_side.png, bode_overlay.png)", file=stream)
+    return 0
+
+
+def add_parsers(sub) -> None:
+    def est_opts(p):
+        p.add_argument("--method", choices=("auto", "dwell", "h1"), default="auto",
+                       help="sine-dwell correlation or H1 (Welch) estimate; auto: dwell if the commands are dwells")
+        p.add_argument("--axis", choices=AXES + ("both",), default="both")
+        p.add_argument("--nperseg", type=int, help="H1 segment length in samples")
+
+    p = sub.add_parser("estimate", help="frequency responses estimated from a vectoring record (CSV/HDF5)")
+    p.add_argument("data", help="time-history file (.csv with 'signal [unit]' header or sidecar .toml, or .h5)")
+    est_opts(p)
+    p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
+    p.set_defaults(func=cmd_estimate)
+
+    p = sub.add_parser("fit", help="fit model parameters to test data (CasADi/IPOPT)")
+    p.add_argument("data", nargs="+", help="time-history file(s), e.g. models/data/greenrun_hotfire_synthetic.csv")
+    p.add_argument("--model", required=True, help="model file whose other values are held")
+    p.add_argument("--free", required=True, help="comma-separated parameters, e.g. load_stiffness,coulomb_torque")
+    p.add_argument("--friction", help="swap the friction law before fitting (keeps the file's torque levels)")
+    p.add_argument("--start", action="append", metavar="NAME=VALUE",
+                   help="start value with unit, e.g. --start 'load_stiffness=150000 lbf/in' (repeatable)")
+    p.add_argument("--starts", type=int, default=3, help="number of starts (default 3)")
+    p.add_argument("--no-engine", action="store_true", help="fit the piston responses only")
+    p.add_argument("--no-correction", action="store_true", help="skip the time-domain defect correction")
+    p.add_argument("--min-coherence", type=float, default=0.5)
+    p.add_argument("--out-model", metavar="TOML", help="write the fitted model file here")
+    p.add_argument("--plot", metavar="PNG_OR_SVG", help="save data vs fit and residuals")
+    p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
+    est_opts(p)
+    p.set_defaults(func=cmd_fit)
+
+    p = sub.add_parser("compare", help="two model conditions side by side (e.g. ambient vs hot fire)")
+    p.add_argument("model_a")
+    p.add_argument("model_b")
+    p.add_argument("--data", nargs=2, metavar=("A_DATA", "B_DATA"), help="test data of each condition")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--labels", help="two labels, comma-separated (default: the model names)")
+    p.add_argument("--json", metavar="PATH", help="also write the comparison JSON here ('-' for standard output)")
+    est_opts(p)
+    p.set_defaults(func=cmd_compare)

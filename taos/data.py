@@ -1,0 +1,343 @@
+"""Test data import: vectoring time histories from CSV or HDF5, validated, in SI.
+
+What the Green Run team had (seed paper sec. 2): FCS pitch and yaw commands, piston
+positions, and engine angles from string pots that carry an unknown constant offset (no
+absolute reference). :func:`load_test_data` reads such a record into :class:`TestData`.
+
+Signals (canonical names, unit kind)::
+
+    time [time], pitch_command, yaw_command [angle], pitch_piston, yaw_piston [length],
+    pitch_engine, yaw_engine [angle]
+
+CSV layout: optional leading ``#`` lines holding TOML metadata (``# condition = "hot fire"``,
+``# engine_angle_reference = "relative"``, ``# synthetic = true``), then a header row whose
+columns are ``signal [unit]`` (``pitch_command [deg]``), then numbers. Or any column names
+with a sidecar TOML beside the file (``run.csv`` + ``run.toml``)::
+
+    condition = "ambient"
+    engine_angle_reference = "relative"     # or "absolute"
+    [columns]
+    t = {signal = "time", unit = "s"}
+    cmd_p = {signal = "pitch_command", unit = "deg"}
+
+HDF5: a ``taos simulate`` :class:`~taos.simulate.TimeHistory` file (``/t_s``, ``/<axis>/...``,
+engine angles absolute), or root datasets named by signal with a ``unit`` attribute and the
+metadata as root attributes.
+
+Validation: time strictly increasing (reversed or repeated samples are refused), every value
+finite, all columns the same length, at least 16 samples, every axis with a command has its
+piston; engine angles for all commanded axes or none. Irregular sampling (spread of the
+sample interval above 0.1 % of its median) is resampled by linear interpolation onto the
+median interval (``resampled`` says so). Errors are one line: ``InputError(file, column,
+expected, got)``; nothing is written by reading.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .results import atomic_write
+from .units import Q_
+
+AXES = ("pitch", "yaw")
+#: canonical signal name -> (unit kind, SI unit, example unit)
+SIGNALS = {
+    "time": ("time", "s", "'s'"),
+    "pitch_command": ("angle", "rad", "'deg'"),
+    "yaw_command": ("angle", "rad", "'deg'"),
+    "pitch_piston": ("length", "m", "'in'"),
+    "yaw_piston": ("length", "m", "'in'"),
+    "pitch_engine": ("angle", "rad", "'deg'"),
+    "yaw_engine": ("angle", "rad", "'deg'"),
+}
+MIN_SAMPLES = 16
+IRREGULAR_TOL = 1e-3
+
+
+@dataclass(frozen=True, eq=False)
+class TestData:
+    """A validated vectoring record (SI; arrays (n_axes, n)).
+
+    ``engine_rad`` is None when no engine angles were recorded; ``engine_absolute`` False means
+    the engine angles carry an unknown constant offset (string pots), so their DC level (the
+    0 Hz engine gain) is unobservable. ``condition`` ("ambient", "hot fire", ...) and
+    ``synthetic`` come from the file's metadata.
+    """
+
+    __test__ = False  # not a pytest class
+
+    source: str
+    t_s: np.ndarray
+    axes: tuple[str, ...]
+    command_rad: np.ndarray
+    piston_m: np.ndarray
+    engine_rad: np.ndarray | None
+    engine_absolute: bool = False
+    condition: str = ""
+    synthetic: bool = False
+    resampled: bool = False
+    metadata: dict = field(default_factory=dict)
+
+    @property
+    def sample_rate_hz(self) -> float:
+        return float(1.0 / np.median(np.diff(self.t_s)))
+
+    def axis_index(self, axis: str) -> int:
+        if axis not in self.axes:
+            raise InputError(self.source, f"{axis}_command", f"a {axis} command column", got="none")
+        return self.axes.index(axis)
+
+    def to_csv(self, path, digits: int = 8, piston_unit: str = "in", angle_unit: str = "deg") -> None:
+        """Write this record as CSV with a TOML-comment header and ``signal [unit]`` columns
+        (atomically)."""
+        pf = float(Q_(1.0, "m").to(piston_unit).magnitude)
+        af = float(Q_(1.0, "rad").to(angle_unit).magnitude)
+        cols, names = [self.t_s], ["time [s]"]
+        for i, ax in enumerate(self.axes):
+            cols.append(self.command_rad[i] * af)
+            names.append(f"{ax}_command [{angle_unit}]")
+            cols.append(self.piston_m[i] * pf)
+            names.append(f"{ax}_piston [{piston_unit}]")
+            if self.engine_rad is not None:
+                cols.append(self.engine_rad[i] * af)
+                names.append(f"{ax}_engine [{angle_unit}]")
+        meta = {"condition": self.condition, "synthetic": self.synthetic,
+                "engine_angle_reference": "absolute" if self.engine_absolute else "relative",
+                **{k: v for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool))}}
+        buf = io.StringIO()
+        for k, v in meta.items():
+            buf.write(f"# {k} = {_toml_value(v)}\n")
+        buf.write(",".join(names) + "\n")
+        np.savetxt(buf, np.column_stack(cols), delimiter=",", fmt=f"%.{digits}g")
+        text = buf.getvalue()
+        atomic_write(path, lambda p: p.write_text(text))
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v)
+    return '"' + str(v).replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def unit_factor(unit: str, signal: str, source: str, column: str) -> float:
+    """SI factor of ``unit`` for ``signal`` (e.g. 'deg' for an angle -> pi/180)."""
+    kind, si, example = SIGNALS[signal]
+    try:
+        q = Q_(1.0, unit)
+        ok = q.dimensionality == Q_(1.0, si).dimensionality
+    except Exception:  # pint raises several error types for unknown units
+        ok = False
+    if not ok:
+        raise InputError(source, column, f"a {kind} unit like {example}", got=repr(unit))
+    return float(q.to(si).magnitude)
+
+
+def _split_header(name: str) -> tuple[str, str | None]:
+    """'pitch_command [deg]' -> ('pitch_command', 'deg')."""
+    name = name.strip()
+    if name.endswith("]") and "[" in name:
+        base, unit = name[:-1].split("[", 1)
+        return base.strip(), unit.strip()
+    return name, None
+
+
+def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
+    """Returns (metadata, {signal: array SI}, {signal: column label})."""
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(src, "(file)", "a readable CSV text file", got=getattr(e, "strerror", None) or str(e)) from None
+    lines = text.splitlines()
+    meta_lines, k = [], 0
+    while k < len(lines) and (lines[k].startswith("#") or not lines[k].strip()):
+        meta_lines.append(lines[k].lstrip("#").strip())
+        k += 1
+    if k >= len(lines):
+        raise InputError(src, "(header)", "a header row of column names like 'time [s],pitch_command [deg],...'",
+                         got="no rows")
+    try:
+        meta = tomllib.loads("\n".join(meta_lines))
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(src, "(# metadata)", "TOML 'key = value' comment lines", got=str(e).splitlines()[0]) from None
+    header = [h.strip() for h in lines[k].split(",")]
+    sidecar = path.with_suffix(".toml")
+    mapping: dict[str, tuple[str, str]] = {}
+    if sidecar.exists():
+        try:
+            side = tomllib.loads(sidecar.read_text())
+        except (OSError, tomllib.TOMLDecodeError) as e:
+            raise InputError(str(sidecar), "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+        cols = side.pop("columns", {})
+        meta.update(side)
+        for col, spec in cols.items():
+            if not isinstance(spec, dict) or "signal" not in spec or "unit" not in spec:
+                raise InputError(str(sidecar), f"columns.{col}", "a table {signal = '...', unit = '...'}", got=repr(spec))
+            if spec["signal"] not in SIGNALS:
+                raise InputError(str(sidecar), f"columns.{col}.signal", "one of " + ", ".join(SIGNALS),
+                                 got=repr(spec["signal"]))
+            if col not in header:
+                raise InputError(src, col, f"a column named {col!r} (from {sidecar.name})", got="no such column")
+            mapping[col] = (spec["signal"], str(spec["unit"]))
+    else:
+        for h in header:
+            base, unit = _split_header(h)
+            if base in SIGNALS:
+                if unit is None:
+                    raise InputError(src, h, f"a unit in brackets like '{base} [{SIGNALS[base][2][1:-1]}]'",
+                                     got="no unit")
+                mapping[h] = (base, unit)
+    body = "\n".join(lines[k + 1:])
+    try:
+        arr = np.genfromtxt(io.StringIO(body), delimiter=",", dtype=float, ndmin=2, invalid_raise=True)
+    except ValueError as e:
+        raise InputError(src, "(rows)", f"{len(header)} comma-separated numbers per row", got=str(e).splitlines()[0]) from None
+    if arr.size == 0:
+        arr = np.zeros((0, len(header)))
+    if arr.shape[1] != len(header):
+        raise InputError(src, "(rows)", f"{len(header)} columns as in the header", got=f"{arr.shape[1]}")
+    out, labels = {}, {}
+    for col, (sig, unit) in mapping.items():
+        j = header.index(col)
+        f = unit_factor(unit, sig, src, col)
+        x = arr[:, j]
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:
+            raise InputError(src, col, "finite numbers in every row",
+                             got=f"{lines[k + 1 + bad[0]].split(',')[j].strip() or 'an empty cell'!s} "
+                                 f"at data row {bad[0] + 1}")
+        if sig in out:
+            raise InputError(src, col, f"one column for {sig}", got="a second one")
+        out[sig] = x * f
+        labels[sig] = col
+    return meta, out, labels
+
+
+def _read_hdf5(path: Path, src: str) -> tuple[dict, dict, dict]:
+    import h5py
+
+    try:
+        h5 = h5py.File(path, "r")
+    except OSError as e:
+        raise InputError(src, "(file)", "a readable HDF5 file", got=str(e).splitlines()[0]) from None
+    with h5:
+        meta = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
+        out, labels = {}, {}
+        if "axes" in h5.attrs and "t_s" in h5:  # a taos simulate TimeHistory
+            axes = str(h5.attrs["axes"]).split(",")
+            out["time"] = np.asarray(h5["t_s"][()], float)
+            labels["time"] = "/t_s"
+            for ax in axes:
+                for sig, name in (("command", "command_rad"), ("piston", "piston_m"), ("engine", "engine_rad")):
+                    key = f"{ax}/{name}"
+                    if key not in h5:
+                        raise InputError(src, "/" + key, "a dataset of the taos simulate layout", got="missing")
+                    out[f"{ax}_{sig}"] = np.asarray(h5[key][()], float)
+                    labels[f"{ax}_{sig}"] = "/" + key
+            meta.setdefault("engine_angle_reference", "absolute")
+            meta.setdefault("synthetic", True)
+            meta = {k: v for k, v in meta.items() if k not in ("axes", "moment_arm_m")}
+        else:
+            for sig in SIGNALS:
+                if sig in h5:
+                    ds = h5[sig]
+                    unit = ds.attrs.get("unit")
+                    if unit is None:
+                        raise InputError(src, "/" + sig, "a 'unit' attribute like " + SIGNALS[sig][2], got="none")
+                    unit = unit.decode() if isinstance(unit, bytes) else str(unit)
+                    out[sig] = np.asarray(ds[()], float).ravel() * unit_factor(unit, sig, src, "/" + sig)
+                    labels[sig] = "/" + sig
+    for sig, x in out.items():
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:
+            raise InputError(src, labels[sig], "finite numbers in every sample", got=f"{x[bad[0]]} at sample {bad[0]}")
+    return meta, out, labels
+
+
+def load_test_data(path, *, resample: bool = True) -> TestData:
+    """Read and validate a vectoring record (CSV or HDF5, see the module docstring).
+
+    Parameters
+    ----------
+    path : str | Path
+        ``.csv`` (with ``signal [unit]`` headers or a sidecar ``.toml``) or ``.h5``/``.hdf5``.
+    resample : bool
+        Resample irregular time stamps onto the median interval (else refuse them).
+    """
+    p = Path(path)
+    src = str(path)
+    if not p.exists():
+        raise InputError(src, "(file)", "an existing data file", got="no such file")
+    if p.suffix.lower() in (".h5", ".hdf5"):
+        meta, sig, labels = _read_hdf5(p, src)
+    elif p.suffix.lower() in (".csv", ".txt"):
+        meta, sig, labels = _read_csv(p, src)
+    else:
+        raise InputError(src, "(file)", "a .csv or .h5 file", got=repr(p.suffix))
+    if "time" not in sig:
+        raise InputError(src, "time", "a time column like 'time [s]'", got="none")
+    t = sig["time"]
+    n = t.size
+    for s, x in sig.items():
+        if x.size != n:
+            raise InputError(src, labels[s], f"{n} samples like the time column", got=str(x.size))
+    if n < MIN_SAMPLES:
+        raise InputError(src, labels["time"], f"at least {MIN_SAMPLES} samples", got=str(n))
+    dt = np.diff(t)
+    bad = np.flatnonzero(dt <= 0)
+    if bad.size:
+        i = bad[0]
+        raise InputError(src, labels["time"], "strictly increasing time",
+                         got=f"{t[i + 1]:.9g} s after {t[i]:.9g} s at sample {i + 1}")
+    axes = tuple(ax for ax in AXES if f"{ax}_command" in sig)
+    if not axes:
+        raise InputError(src, "pitch_command", "a pitch_command or yaw_command column", got="none")
+    for ax in axes:
+        if f"{ax}_piston" not in sig:
+            raise InputError(src, f"{ax}_piston", f"a piston position column for the commanded {ax} axis",
+                             got="none")
+    has_engine = [f"{ax}_engine" in sig for ax in axes]
+    if any(has_engine) and not all(has_engine):
+        missing = axes[has_engine.index(False)]
+        raise InputError(src, f"{missing}_engine", "engine angles for every commanded axis or none", got="none")
+    ref = str(meta.get("engine_angle_reference", "relative"))
+    if ref not in ("relative", "absolute"):
+        raise InputError(src, "engine_angle_reference", "'relative' or 'absolute'", got=repr(ref))
+    resampled = False
+    med = float(np.median(dt))
+    if (dt.max() - dt.min()) > IRREGULAR_TOL * med:
+        if not resample:
+            raise InputError(src, labels["time"], f"a regular sample interval (spread below {IRREGULAR_TOL:.0e})",
+                             got=f"intervals from {dt.min():.6g} s to {dt.max():.6g} s")
+        tn = t[0] + med * np.arange(int(math.floor((t[-1] - t[0]) / med)) + 1)
+        sig = {s: (tn if s == "time" else np.interp(tn, t, x)) for s, x in sig.items()}
+        t = tn
+        resampled = True
+    stack = lambda kind: np.vstack([sig[f"{ax}_{kind}"] for ax in axes])  # noqa: E731
+    return TestData(source=src, t_s=t, axes=axes, command_rad=stack("command"), piston_m=stack("piston"),
+                    engine_rad=stack("engine") if all(has_engine) else None,
+                    engine_absolute=(ref == "absolute"), condition=str(meta.get("condition", "")),
+                    synthetic=bool(meta.get("synthetic", False)), resampled=resampled,
+                    metadata={k: v for k, v in meta.items()
+                              if k not in ("condition", "synthetic", "engine_angle_reference")})
+
+
+def from_time_history(th, *, engine_offset_rad=None, condition: str = "", source: str = "<simulation>",
+                      synthetic: bool = True) -> TestData:
+    """A :class:`TestData` view of a :class:`~taos.simulate.TimeHistory` (engine angles
+    absolute unless an ``engine_offset_rad`` per axis is added, which makes them relative)."""
+    eng = np.asarray(th.engine_rad, float)
+    if engine_offset_rad is not None:
+        eng = eng + np.asarray(engine_offset_rad, float).reshape(-1, 1)
+    return TestData(source=source, t_s=np.asarray(th.t_s, float), axes=tuple(th.axes),
+                    command_rad=np.asarray(th.command_rad, float), piston_m=np.asarray(th.piston_m, float),
+                    engine_rad=eng, engine_absolute=engine_offset_rad is None, condition=condition,
+                    synthetic=synthetic, metadata={})

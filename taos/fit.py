@@ -1,0 +1,432 @@
+"""Fit model parameters to measured frequency responses with CasADi (seed paper secs. 2.2, 4).
+
+Method (:func:`fit_frequency_response`):
+
+1. Residuals. For each measured point (axis, w, command amplitude A) and each response
+   (command -> piston, and command -> engine where measured) the log-complex error
+   ln(H_model / H_data) = ln|H_m / H_d| + j arg(H_m / H_d), each part divided by the point's
+   1-sigma relative error (from the estimator; floored at ``sigma_floor``). The logarithm
+   weights the notch (where |H| is small) as much as the rest and keeps gain and phase in
+   one scale. Points below ``min_coherence`` are dropped. The engine DC gain is never used
+   (unobservable without an absolute engine reference; the estimators return no 0 Hz point).
+2. Model. :mod:`taos.fit_model`: the linear simplex block with CasADi parameters (the one
+   definition of the dynamics), exact responses by :func:`taos.linear.freqresp_symbolic`, and
+   describing functions for the avionics and friction (closed form for Coulomb, exact
+   periodic Dahl loop for Dahl/LuGre, with the amplitude as an implicit NLP variable).
+3. NLP. ``ca.nlpsol('s', 'ipopt', ...)`` minimises 0.5 sum r^2 over the scaled parameters
+   s = p / p_start (bounds from physics: every fitted quantity is positive, held within
+   [lo, hi] times its start, see :data:`taos.fit_model.PARAMETERS`) and the implicit
+   amplitudes, with exact first and second derivatives (SX). ``starts`` multiple starts
+   (the start values, then log-uniform draws within a factor of 2), best objective kept.
+4. Defect correction (when the model has friction): the describing function neglects
+   harmonics, so the surrogate is corrected against the time-domain sine dwell of the full
+   nonlinear model (:func:`taos.freqresp.sine_dwell_grid`) at the current estimate:
+   c_k = H_sim / H_surrogate, data H_d / c_k refitted, until the parameters change by less
+   than ``correction_tol`` (a fixed point where the *simulated* responses match the data to
+   first order; noise-free data from the model class are recovered exactly).
+5. Statistics. Jacobian J of the residuals with respect to the parameters along the
+   implicit-amplitude manifold (implicit function theorem), covariance
+   s^2 (J^T J)^-1 with s^2 = 2 cost / (m - p) (or the stated sigmas when
+   ``absolute_sigma``), standard errors and the correlation matrix; confidence intervals with
+   Student's t. (Gauss-Newton statistics: first order in the noise.)
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import re
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .estimate import MeasuredResponse
+from .fit_model import PARAMETERS, build_surrogate, check_free, solve_implicit
+from .model import TvcModel, load_model
+from .results import atomic_write
+from .units import from_si
+
+
+@dataclass(frozen=True, eq=False)
+class FitResult:
+    """Result of a fit: values in SI (``values``) and in engineering units (``table()``)."""
+
+    model: TvcModel
+    initial: TvcModel
+    names: tuple[str, ...]
+    values: np.ndarray
+    start_values: np.ndarray
+    std_errors: np.ndarray
+    correlation: np.ndarray
+    cost: float
+    n_residuals: int
+    sigma2: float
+    data: tuple[MeasuredResponse, ...]
+    fitted_piston: tuple[np.ndarray, ...]
+    fitted_engine: tuple[np.ndarray | None, ...]
+    notch_hz: dict
+    load_resonance_hz: dict
+    corrections: int = 0
+    starts: int = 1
+    wall_s: float = 0.0
+    method: str = "casadi-ipopt"
+    absolute_sigma: bool = False
+    history: list = field(default_factory=list)
+
+    @property
+    def dof(self) -> int:
+        return max(1, self.n_residuals - len(self.names))
+
+    def units(self) -> list[str]:
+        return [PARAMETERS[n].unit for n in self.names]
+
+    def eng(self, i: int, value: float | None = None) -> float:
+        """Parameter ``i`` (or ``value``) in its engineering unit."""
+        p = PARAMETERS[self.names[i]]
+        v = self.values[i] if value is None else value
+        return v if not p.unit else from_si(v, _si_unit(p.kind), p.unit)
+
+    def confidence_interval(self, level: float = 0.95) -> np.ndarray:
+        """(n, 2) two-sided interval [SI] with Student's t on ``dof`` degrees of freedom."""
+        import scipy.stats
+        q = scipy.stats.t.ppf(0.5 + level / 2, self.dof) if not self.absolute_sigma else \
+            scipy.stats.norm.ppf(0.5 + level / 2)
+        return np.column_stack([self.values - q * self.std_errors, self.values + q * self.std_errors])
+
+    def to_dict(self) -> dict:
+        ci = self.confidence_interval(0.95)
+        return {
+            "parameters": {n: {"value_si": float(self.values[i]), "std_error_si": float(self.std_errors[i]),
+                               "start_si": float(self.start_values[i]), "ci95_si": ci[i].tolist(),
+                               "unit": PARAMETERS[n].unit or "1", "value": self.eng(i),
+                               "std_error": abs(self.eng(i, self.values[i] + self.std_errors[i]) - self.eng(i)),
+                               "si_unit": _si_unit(PARAMETERS[n].kind)}
+                           for i, n in enumerate(self.names)},
+            "correlation": self.correlation.tolist(),
+            "cost": self.cost, "n_residuals": self.n_residuals, "dof": self.dof,
+            "residual_rms": math.sqrt(2 * self.cost / self.n_residuals),
+            "notch_frequency_hz": self.notch_hz, "load_resonance_hz": self.load_resonance_hz,
+            "breakaway_deflection_deg": math.degrees(self.model.breakaway_deflection_rad()),
+            "friction_model": self.model.friction.name, "defect_corrections": self.corrections,
+            "starts": self.starts, "wall_s": self.wall_s, "method": self.method,
+            "data": [{"source": d.source, "axis": d.axis, "method": d.method, "points": len(d),
+                      "condition": d.condition, "engine_dc_observable": d.engine_dc_observable} for d in self.data],
+        }
+
+    def table(self) -> str:
+        lines = [f"{'parameter':24s} {'start':>14s} {'fitted':>14s} {'std error':>12s}  unit"]
+        for i, n in enumerate(self.names):
+            se = abs(self.eng(i, self.values[i] + self.std_errors[i]) - self.eng(i))
+            lines.append(f"{n:24s} {self.eng(i, self.start_values[i]):14.6g} {self.eng(i):14.6g} {se:12.3g}  "
+                         f"{PARAMETERS[n].unit or '-'}")
+        for ax, v in self.notch_hz.items():
+            lines.append(f"notch ({ax}) {v:.4f} Hz, load resonance {self.load_resonance_hz[ax]:.4f} Hz")
+        lines.append(f"residual rms {math.sqrt(2 * self.cost / self.n_residuals):.3g} (sigma units), "
+                     f"{self.n_residuals} residuals, {self.corrections} defect corrections, {self.wall_s:.2f} s")
+        return "\n".join(lines)
+
+    def plot(self, **kwargs):
+        """Data vs fitted model and normalised residuals (:mod:`taos.plotting.fit`)."""
+        from .plotting import fit as pf
+        return pf.plot_fit(self, **kwargs)
+
+    def write_model(self, path, data_label: str = "") -> None:
+        write_fitted_model(self, path, data_label)
+
+
+def _si_unit(kind: str) -> str:
+    from .units import DIMENSIONS
+    return DIMENSIONS[kind][1]
+
+
+# -- the problem ---------------------------------------------------------------------------
+@dataclass(eq=False)
+class FitProblem:
+    """A built NLP for one model, free set and point layout; data enter as NLP parameters,
+    so repeated fits (noise studies, defect corrections, multiple starts) reuse the solver."""
+
+    model: TvcModel
+    free: tuple[str, ...]
+    axes: np.ndarray
+    freq_hz: np.ndarray
+    amp_rad: np.ndarray
+
+    def __post_init__(self):
+        import casadi as ca
+
+        self.params = check_free(self.model, self.free)
+        self.sur = build_surrogate(self.model, self.params, self.axes, self.freq_hz, self.amp_rad)
+        npar, nu, m = len(self.params), self.sur.n_u, self.freq_hz.size
+        s = ca.SX.sym("s", npar)
+        u = ca.SX.sym("u", nu)
+        P = ca.SX.sym("P", 6 * m)
+        xr, xi, er, ei, g = self.sur.fn(s, u)
+        dr, di, Er, Ei, wx, we = (P[i * m:(i + 1) * m] for i in range(6))
+
+        def logerr(hr, hi, drr, dii):
+            num_r = hr * drr + hi * dii
+            num_i = hi * drr - hr * dii
+            return 0.5 * ca.log((hr ** 2 + hi ** 2) / (drr ** 2 + dii ** 2)), ca.atan2(num_i, num_r)
+
+        lx, px = logerr(xr, xi, dr, di)
+        le, pe = logerr(er, ei, Er, Ei)
+        r = ca.vertcat(wx * lx, wx * px, we * le, we * pe)
+        x = ca.vertcat(s, u)
+        self.r_fn = ca.Function("r", [s, u, P], [r])
+        self.jac_fn = ca.Function("J", [s, u, P], [ca.jacobian(r, s), ca.jacobian(r, u),
+                                                   ca.jacobian(g, s), ca.jacobian(g, u)])
+        nlp = {"x": x, "p": P, "f": 0.5 * ca.sumsqr(r), "g": g}
+        opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-10,
+                "ipopt.acceptable_iter": 5, "ipopt.acceptable_tol": 1e-7, "ipopt.max_iter": 200}
+        self.solver = ca.nlpsol("s", "ipopt", nlp, opts)
+        self.lbx = np.concatenate([[p.lo for p in self.params], np.full(nu, -30.0)])
+        self.ubx = np.concatenate([[p.hi for p in self.params], np.full(nu, 6.0)])
+
+    @property
+    def p_ref(self) -> np.ndarray:
+        return self.sur.p_ref
+
+    def surrogate(self, s, u=None):
+        """Numeric surrogate responses (hx [m/rad], he) at scaled parameters s."""
+        u = solve_implicit(self.sur, s) if u is None else u
+        xr, xi, er, ei, _ = self.sur.fn(s, u)
+        return (np.asarray(xr).ravel() + 1j * np.asarray(xi).ravel(),
+                np.asarray(er).ravel() + 1j * np.asarray(ei).ravel())
+
+    def solve(self, P, s0) -> tuple[np.ndarray, np.ndarray, float]:
+        s0 = np.clip(np.asarray(s0, float), self.lbx[:len(self.params)], self.ubx[:len(self.params)])
+        u0 = solve_implicit(self.sur, s0)
+        res = self.solver(x0=np.concatenate([s0, u0]), p=P, lbx=self.lbx, ubx=self.ubx, lbg=0, ubg=0)
+        x = np.asarray(res["x"]).ravel()
+        return x[:len(self.params)], x[len(self.params):], float(res["f"])
+
+    def jacobian(self, s, u, P) -> np.ndarray:
+        """dr/ds along g(s, u) = 0: J_s - J_u (dg/du)^-1 dg/ds."""
+        Jrs, Jru, Jgs, Jgu = (np.asarray(v) for v in self.jac_fn(s, u, P))
+        if Jru.size:
+            Jrs = Jrs - Jru @ np.linalg.solve(Jgu, Jgs)
+        return Jrs
+
+
+def _stack_points(data, use_engine: bool, min_coherence: float, sigma_floor: float):
+    axes, f, A, hx, he, wx, we = [], [], [], [], [], [], []
+    for d in data:
+        ok = d.coherence_piston >= min_coherence
+        for k in np.flatnonzero(ok & (d.freq_hz > 0)):
+            axes.append(d.axis)
+            f.append(d.freq_hz[k])
+            A.append(d.amplitude_rad[k])
+            hx.append(d.piston_m_per_rad[k])
+            wx.append(1.0 / max(d.sigma_piston[k], sigma_floor))
+            if use_engine and d.engine is not None and d.coherence_engine[k] >= min_coherence:
+                he.append(d.engine[k])
+                we.append(1.0 / max(d.sigma_engine[k], sigma_floor))
+            else:
+                he.append(1.0 + 0j)
+                we.append(0.0)
+    if not f:
+        raise InputError(data[0].source if data else "data", "coherence",
+                         f"points with coherence >= {min_coherence}", got="none")
+    return (np.array(axes), np.array(f), np.array(A), np.array(hx), np.array(he), np.array(wx), np.array(we))
+
+
+def _pack(hx, he, wx, we):
+    return np.concatenate([hx.real, hx.imag, he.real, he.imag, wx, we])
+
+
+def _apply(model: TvcModel, names, values) -> TvcModel:
+    for n, v in zip(names, values):
+        model = PARAMETERS[n].set(model, float(v))
+    return model
+
+
+def simulate_points(model: TvcModel, axes, freq_hz, amp_rad) -> tuple[np.ndarray, np.ndarray]:
+    """Sine-dwell responses of the full nonlinear model at the points (hx [m/rad], he)."""
+    from .freqresp import sine_dwell_grid
+    hx = np.empty(freq_hz.size, complex)
+    he = np.empty(freq_hz.size, complex)
+    R = model.actuator.moment_arm_m
+    for ax in np.unique(axes):
+        for a in np.unique(amp_rad[axes == ax]):
+            idx = np.flatnonzero((axes == ax) & (amp_rad == a))
+            p, e = sine_dwell_grid(model, [a], freq_hz[idx], str(ax))
+            hx[idx] = p[0] * R
+            he[idx] = e[0]
+    return hx, he
+
+
+def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = None, starts: int = 3,
+                           seed: int = 0, use_engine: bool = True, min_coherence: float = 0.5,
+                           sigma_floor: float = 1e-3, correct: bool | None = None, max_corrections: int = 6,
+                           correction_tol: float = 1e-4, absolute_sigma: bool = False,
+                           problem: FitProblem | None = None) -> FitResult:
+    """Fit ``free`` parameters of ``model`` to measured responses (module docstring).
+
+    Parameters
+    ----------
+    model : TvcModel
+        The model whose other values are held (its friction law decides the surrogate).
+    data : list of MeasuredResponse
+        From :mod:`taos.estimate` (or synthetic).
+    free : list of str
+        Names from :data:`taos.fit_model.PARAMETERS`.
+    start : dict name -> SI value, optional
+        Start values (default: the model's).
+    starts : int
+        Number of starts (the first at the start values).
+    correct : bool, optional
+        Defect correction against the time-domain sine dwell (default: when the model has
+        friction).
+    problem : FitProblem, optional
+        A built problem to reuse (same model, free set and points).
+    """
+    t0 = time.perf_counter()
+    data = tuple(data)
+    free = tuple(free)
+    m0 = _apply(model, list((start or {}).keys()), list((start or {}).values()))
+    axes, f, A, hx, he, wx, we = _stack_points(data, use_engine, min_coherence, sigma_floor)
+    prob = problem or FitProblem(m0, free, axes, f, A)
+    P = _pack(hx, he, wx, we)
+    rng = np.random.default_rng(seed)
+    best = None
+    npar = len(free)
+    for k in range(max(1, starts)):
+        s0 = np.ones(npar) if k == 0 else np.exp(rng.uniform(-math.log(2), math.log(2), npar))
+        s, u, cost = prob.solve(P, s0)
+        if best is None or cost < best[2] - 1e-12 * abs(best[2]):
+            best = (s, u, cost)
+    s, u, cost = best
+    fam = prob.sur.family
+    if correct is None:
+        correct = fam != "none"
+    ncorr = 0
+    history = [s * prob.p_ref]
+    if correct:
+        for _ in range(max_corrections):
+            mfit = _apply(m0, free, s * prob.p_ref)
+            sx, se = simulate_points(mfit, axes, f, A)
+            gx, ge = prob.surrogate(s, u)
+            cx, ce = sx / gx, np.where(np.abs(ge) > 0, se / np.where(ge == 0, 1, ge), 1.0)
+            P = _pack(hx / cx, he / np.where(we > 0, ce, 1.0), wx, we)
+            s_new, u, cost = prob.solve(P, s)
+            ncorr += 1
+            history.append(s_new * prob.p_ref)
+            done = np.max(np.abs(s_new / s - 1)) < correction_tol
+            s = s_new
+            if done:
+                break
+    r = np.asarray(prob.r_fn(s, u, P)).ravel()
+    J = prob.jacobian(s, u, P)
+    keep = np.any(J != 0, axis=1) | (r != 0)
+    nres = int(np.count_nonzero(np.concatenate([wx, wx, we, we]) > 0))
+    sigma2 = 1.0 if absolute_sigma else 2 * cost / max(1, nres - npar)
+    JtJ = J[keep].T @ J[keep]
+    cov_s = sigma2 * np.linalg.pinv(JtJ)
+    se_s = np.sqrt(np.clip(np.diag(cov_s), 0, None))
+    d = np.where(se_s > 0, se_s, 1.0)
+    corr = cov_s / np.outer(d, d)
+    values = s * prob.p_ref
+    mfit = _apply(m0, free, values)
+    gx, ge = prob.surrogate(s, u)
+    if correct:
+        gx, ge = gx * cx, ge * ce
+    fitted_p, fitted_e, pos = [], [], 0
+    for dset in data:
+        n = int(np.count_nonzero((dset.coherence_piston >= min_coherence) & (dset.freq_hz > 0)))
+        fitted_p.append(gx[pos:pos + n])
+        fitted_e.append(ge[pos:pos + n] if dset.engine is not None else None)
+        pos += n
+    from .simplex import load_resonance_from_notch
+    ax_set = sorted(set(map(str, axes)))
+    return FitResult(model=mfit, initial=m0, names=free, values=values, start_values=prob.p_ref.copy(),
+                     std_errors=se_s * prob.p_ref, correlation=corr, cost=cost, n_residuals=nres, sigma2=sigma2,
+                     data=tuple(dset.select((dset.coherence_piston >= min_coherence) & (dset.freq_hz > 0))
+                                for dset in data),
+                     fitted_piston=tuple(fitted_p), fitted_engine=tuple(fitted_e),
+                     notch_hz={a: load_resonance_from_notch(mfit, a) for a in ax_set},
+                     load_resonance_hz={a: mfit.load_resonance_hz(a) for a in ax_set}, corrections=ncorr,
+                     starts=max(1, starts), wall_s=time.perf_counter() - t0, absolute_sigma=absolute_sigma,
+                     history=history)
+
+
+# -- writing the fitted model ------------------------------------------------------------------
+def _fmt_value(p, v_si: float) -> str:
+    if not p.unit:
+        return f"{v_si:.6g}"
+    return f'"{from_si(v_si, _si_unit(p.kind), p.unit):.6g} {p.unit}"'
+
+
+def fitted_model_text(result: FitResult, data_label: str = "") -> str:
+    """The model file of ``result.initial`` with the fitted values replaced and commented."""
+    src = result.initial.source
+    try:
+        lines = Path(src).read_text().splitlines()
+    except OSError as e:
+        raise InputError(src, "(file)", "the model file the fit started from", got=e.strerror) from None
+    stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    label = data_label or ", ".join(sorted({d.source for d in result.data}))
+    todo = {}
+    for i, n in enumerate(result.names):
+        p = PARAMETERS[n]
+        se = abs(result.eng(i, result.values[i] + result.std_errors[i]) - result.eng(i))
+        note = f"# fitted by taos fit ({label}, {stamp}): {result.eng(i):.6g} +- {se:.3g} {p.unit or ''} (1-sigma)"
+        if n == "avionics_gain":
+            g = result.model.avionics.gain_table
+            todo[(p.section, p.toml_key)] = (f"crossover_gain = [{', '.join(f'{x:.6g}' for x in g)}]  "
+                                             + note.replace("fitted by", "scaled by the gain fitted by"))
+            if len(result.initial.avionics.gain_table) == 0:
+                todo[(p.section, "crossover_command")] = 'crossover_command = ["0 deg"]  # added by taos fit'
+        else:
+            todo[(p.section, p.toml_key)] = f"{p.toml_key} = {_fmt_value(p, result.values[i])}  {note}"
+    file_law = str(result.initial.friction_table.get("model", result.initial.friction.name))
+    if result.initial.friction.name != file_law:
+        todo[("friction", "model")] = (f'model = "{result.initial.friction.name}"  # law used by the fit '
+                                       f'(--friction; the file had "{file_law}")')
+    out, section, done = [], "", set()
+    header = re.compile(r"^\s*\[([A-Za-z0-9_.]+)\]\s*(#.*)?$")
+
+    def flush(sec):
+        for (s, key), line in todo.items():
+            if s == sec and (s, key) not in done:
+                out.append(line)
+                done.add((s, key))
+
+    for line in lines:
+        mh = header.match(line)
+        if mh:
+            flush(section)
+            section = mh.group(1)
+        else:
+            mk = re.match(r"^\s*([A-Za-z0-9_]+)\s*=", line)
+            if mk and (section, mk.group(1)) in todo:
+                out.append(todo[(section, mk.group(1))])
+                done.add((section, mk.group(1)))
+                continue
+            if mk and section == "" and mk.group(1) == "name":
+                out.append(f'name = "{result.initial.name} (fitted)"')
+                continue
+        out.append(line)
+    flush(section)
+    missing = [k for k in todo if k not in done]
+    if missing:
+        raise InputError(src, f"[{missing[0][0]}]", "the section of a fitted value", got="no such section")
+    head = [f"# Model fitted by taos fit on {stamp} to {label}; values marked '# fitted' were estimated."]
+    return "\n".join(head + out) + "\n"
+
+
+def write_fitted_model(result: FitResult, path, data_label: str = "") -> None:
+    """Write the fitted model file (TOML with units, fitted values commented), atomically,
+    after checking that it loads back to the fitted values."""
+    text = fitted_model_text(result, data_label)
+
+    def write(tmp: Path):
+        tmp.write_text(text)
+        back = load_model(tmp)
+        for i, n in enumerate(result.names):
+            got = PARAMETERS[n].get(back) if n != "avionics_gain" else None
+            if got is not None and not math.isclose(got, result.values[i], rel_tol=1e-5):
+                raise RuntimeError(f"written {n} reads back as {got}, not {result.values[i]}")
+    atomic_write(path, write)

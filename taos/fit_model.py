@@ -1,0 +1,333 @@
+"""What a fit can change, and the CasADi describing-function surrogate it is fitted through.
+
+Free parameters (:data:`PARAMETERS`, names for ``taos fit --free``): load stiffness, friction
+levels, servo gains, engine properties and the avionics gain. Each maps to one field of the
+model dataclasses (SI) and one key of the model file (written back with its unit).
+
+Surrogate of the amplitude-dependent sine-dwell response (one point: axis, frequency w,
+command amplitude A). The linear simplex block (:func:`taos.simplex.simplex_state_space`,
+built with CasADi SX parameters, the one definition of the dynamics) gives, exactly and
+differentiably (:func:`taos.linear.freqresp_symbolic`), the four responses from command c and
+friction torque T to piston x_p and engine rate omega: G_xc, G_xT, G_wc, G_wT. The command
+path is the describing function of the avionics (quantiser and crossover gain, a static map:
+its fundamental computed numerically from :class:`taos.avionics.Avionics` itself), times the
+free ``avionics_gain`` k: C = k N_av(A) A. The friction element is replaced by its describing
+function from engine rate to torque, T = N(V) Omega at rate amplitude V:
+
+* Coulomb (both forms): N = 4 T_c / (pi V). The loop Omega = G_wc C + G_wT N Omega gives
+  |V - a G_wT| = |G_wc C| with a = 4 T_c / pi, solved in closed form:
+  V = a Re G_wT + sqrt(|G_wc C|^2 - a^2 (Im G_wT)^2), and V = 0 (engine held, the load path
+  takes the whole piston motion) when that is not positive: smoothed for the NLP.
+* Dahl with exponent 1, and LuGre/modified LuGre through their Dahl core (T_s = T_c,
+  sigma_1 = 0, h = 1: then LuGre *is* Dahl, plus sigma_2 v): the periodic hysteresis loop
+  under theta = X sin(psi) is exact, T_up = T_c - (T_c + T_top) exp(-beta (1 + sin psi)) with
+  beta = sigma_0 X / T_c, T_top = T_c tanh(beta), and its fundamental is integrated by
+  64-point Gauss-Legendre quadrature: N_x = (2/pi) int T_up (sin psi + j cos psi) dpsi / X,
+  N = N_x / (j w) + sigma_2. The amplitude X solves the implicit loop equation
+  ln(w X) + ln|1 - G_wT N| - ln|G_wc C| = 0, which the NLP carries as constraints with
+  u = ln(X / X_lin) as variables.
+
+Then Omega = G_wc C / (1 - G_wT N), x_p = G_xc C + G_xT N Omega, theta = Omega / (j w), and the
+responses are x_p / (A) [m/rad] and theta / A. The DF neglects harmonics (the engine rate is
+not sinusoidal while friction holds it); :mod:`taos.fit` removes that bias by defect
+correction against the time-domain sine dwell of the full nonlinear model.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .errors import InputError
+from .friction import CoulombSmooth, CoulombSwitching, Dahl, LuGre, NoFriction
+from .model import TvcModel
+from .linear import freqresp_symbolic
+
+
+@dataclass(frozen=True)
+class FitParam:
+    """A fittable model value: CLI name, model-file place, unit, accessor and setter."""
+
+    name: str
+    section: str
+    toml_key: str
+    kind: str
+    unit: str
+    get: Callable[[TvcModel], float]
+    set: Callable[[TvcModel, object], TvcModel]
+    lo: float = 0.05   # bounds: [lo, hi] times the start value (positive quantities)
+    hi: float = 20.0
+
+
+def _rep(part: str, fieldname: str):
+    def setter(m, v):
+        return dataclasses.replace(m, **{part: dataclasses.replace(getattr(m, part), **{fieldname: v})})
+    return setter
+
+
+def _get(part: str, fieldname: str):
+    return lambda m: float(getattr(getattr(m, part), fieldname))
+
+
+def _avionics_set(m, k):
+    av = m.avionics
+    if isinstance(k, (int, float)):
+        if av.gain_table:
+            av = dataclasses.replace(av, gain_table=tuple(g * k for g in av.gain_table))
+        else:
+            av = dataclasses.replace(av, gain_table_rad=(0.0,), gain_table=(float(k),))
+        return dataclasses.replace(m, avionics=av)
+    return m  # symbolic: applied in the surrogate's command path
+
+
+def _p(name, section, key, part, fld, kind, unit, **kw):
+    return FitParam(name, section, key, kind, unit, _get(part, fld), _rep(part, fld), **kw)
+
+
+#: name -> FitParam
+PARAMETERS: dict[str, FitParam] = {p.name: p for p in (
+    _p("load_stiffness", "structure", "load_stiffness", "structure", "load_stiffness_N_per_m", "stiffness", "lbf/in"),
+    _p("coulomb_torque", "friction", "coulomb_torque", "friction", "coulomb_torque_Nm", "torque", "in*lbf"),
+    _p("bristle_stiffness", "friction", "bristle_stiffness", "friction", "bristle_stiffness_Nm_per_rad",
+       "rotational_stiffness", "N*m/rad", lo=1e-3, hi=1e3),
+    _p("viscous_damping", "friction", "viscous_damping", "friction", "viscous_damping_Nms_per_rad",
+       "rotational_damping", "N*m*s/rad", lo=1e-3, hi=1e3),
+    _p("loop_gain", "actuator", "loop_gain", "actuator", "loop_gain_per_s", "rate", "1/s"),
+    _p("pressure_feedback_gain", "actuator", "pressure_feedback_gain", "actuator",
+       "pressure_feedback_gain_m_per_s_Pa", "velocity_per_pressure", "m/s/Pa"),
+    _p("valve_natural_frequency", "actuator", "valve_natural_frequency", "actuator", "valve_natural_frequency_hz",
+       "frequency", "Hz"),
+    _p("piston_damping", "actuator", "piston_damping", "actuator", "piston_damping_Ns_per_m", "damping", "N*s/m"),
+    _p("rotational_stiffness", "engine", "rotational_stiffness", "engine", "rotational_stiffness_Nm_per_rad",
+       "rotational_stiffness", "N*m/rad", lo=1e-3, hi=1e3),
+    _p("inertia_pitch", "engine", "inertia_pitch", "engine", "inertia_pitch_kgm2", "inertia", "kg*m**2", lo=0.2, hi=5),
+    _p("inertia_yaw", "engine", "inertia_yaw", "engine", "inertia_yaw_kgm2", "inertia", "kg*m**2", lo=0.2, hi=5),
+    FitParam("avionics_gain", "avionics", "crossover_gain", "dimensionless", "", lambda m: 1.0, _avionics_set,
+             lo=0.5, hi=1.5),
+)}
+
+
+def friction_family(model: TvcModel) -> str:
+    """'none', 'coulomb' or 'dahl' (the surrogate used for the model's friction law)."""
+    law = model.friction
+    if isinstance(law, NoFriction):
+        return "none"
+    if isinstance(law, (CoulombSwitching, CoulombSmooth)):
+        return "coulomb"
+    if isinstance(law, Dahl):
+        if law.dahl_exponent != 1.0:
+            raise InputError(model.source, "friction.dahl_exponent", "1 for fits (closed-form Dahl loop)",
+                             got=repr(law.dahl_exponent))
+        return "dahl"
+    if isinstance(law, LuGre):
+        return "dahl"
+    raise InputError(model.source, "friction.model", "a law the fit supports", got=law.name)
+
+
+def check_free(model: TvcModel, names) -> list[FitParam]:
+    """Validate ``--free`` names against the model; returns the FitParams."""
+    fam = friction_family(model)
+    out = []
+    for n in names:
+        if n not in PARAMETERS:
+            raise InputError("command line", "--free", "names from " + ", ".join(PARAMETERS), got=repr(n))
+        p = PARAMETERS[n]
+        if p.section == "friction":
+            ok = {"none": (), "coulomb": ("coulomb_torque",),
+                  "dahl": ("coulomb_torque", "bristle_stiffness") + (("viscous_damping",)
+                                                                     if isinstance(model.friction, LuGre) else ())}[fam]
+            if n not in ok:
+                raise InputError("command line", "--free", f"friction parameters of the {model.friction.name} law "
+                                 f"({', '.join(ok) or 'none: choose --friction'})", got=repr(n))
+        if n == "pressure_feedback_gain" and model.actuator.pressure_feedback_time_constant_s <= 0:
+            raise InputError(model.source, "actuator.pressure_feedback_time_constant",
+                             "a positive time constant to fit pressure_feedback_gain")
+        if n in [q.name for q in out]:
+            raise InputError("command line", "--free", "each name once", got=repr(n))
+        out.append(p)
+    if not out:
+        raise InputError("command line", "--free", "at least one parameter name", got="none")
+    return out
+
+
+def avionics_df(model: TvcModel, amplitude_rad: float, n: int = 4096) -> complex:
+    """Describing function of the command avionics at ``amplitude_rad`` (fundamental of
+    avionics(A sin psi) over A sin psi, from the avionics kernel itself)."""
+    if amplitude_rad <= 0 or not math.isfinite(amplitude_rad):
+        return 1.0 + 0j
+    psi = (np.arange(n) + 0.5) * 2 * np.pi / n
+    y = model.avionics(amplitude_rad * np.sin(psi))
+    a = 2 * np.mean(y * np.sin(psi))
+    b = 2 * np.mean(y * np.cos(psi))
+    return complex(a, b) / amplitude_rad
+
+
+# -- complex arithmetic on (re, im) pairs of SX ------------------------------------------------
+def _cm(a, b):
+    return (a[0] * b[0] - a[1] * b[1], a[0] * b[1] + a[1] * b[0])
+
+
+def _cd(a, b):
+    d = b[0] * b[0] + b[1] * b[1]
+    return ((a[0] * b[0] + a[1] * b[1]) / d, (a[1] * b[0] - a[0] * b[1]) / d)
+
+
+def _ca(a, b):
+    return (a[0] + b[0], a[1] + b[1])
+
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(64)
+
+
+def dahl_df_x(tc, sigma0, X):
+    """Dahl (exponent 1) describing function from engine angle to torque [N m/rad] at angle
+    amplitude X [rad], as (re, im); SX or float arguments (module docstring)."""
+    import casadi as ca
+    psi = 0.5 * math.pi * _GL_X
+    w = 0.5 * math.pi * _GL_W
+    beta = sigma0 * X / tc
+    ttop = tc * ca.tanh(beta)
+    a = 0
+    b = 0
+    for p, wi in zip(psi, w):
+        tu = tc - (tc + ttop) * ca.exp(-beta * (1 + math.sin(p)))
+        a = a + wi * tu * math.sin(p)
+        b = b + wi * tu * math.cos(p)
+    return (2 / math.pi) * a / X, (2 / math.pi) * b / X
+
+
+@dataclass(frozen=True, eq=False)
+class Surrogate:
+    """CasADi function ``fn(s, u) -> (hx_re, hx_im, he_re, he_im, g)`` over the points.
+
+    ``s`` are the free parameters over their reference values (p = p_ref s); ``u`` the
+    implicit amplitude variables (ln(X / X_lin), Dahl family only; empty otherwise); ``g`` the
+    implicit loop residuals. hx is x_p / theta_c [m/rad], he theta / theta_c."""
+
+    fn: object
+    g_fn: object
+    params: tuple[FitParam, ...]
+    p_ref: np.ndarray
+    n_u: int
+    family: str
+    axes: np.ndarray
+    freq_hz: np.ndarray
+    amp_rad: np.ndarray
+
+
+def build_surrogate(model: TvcModel, params, axes, freq_hz, amp_rad) -> Surrogate:
+    """Symbolic surrogate responses at points (axes[k], freq_hz[k], amp_rad[k])."""
+    import casadi as ca
+
+    from .linear import balancing_scale
+    from .simplex import simplex_state_space
+
+    params = tuple(params)
+    fam = friction_family(model)
+    p_ref = np.array([p.get(model) for p in params])
+    s = ca.SX.sym("s", len(params))
+    msym = model
+    kav = 1.0
+    for i, p in enumerate(params):
+        v = p_ref[i] * s[i]
+        if p.name == "avionics_gain":
+            kav = s[i]
+        else:
+            msym = p.set(msym, v)
+    law = msym.friction
+    axes = np.asarray(axes)
+    f = np.asarray(freq_hz, float)
+    A = np.asarray(amp_rad, float)
+    m = f.size
+    n_u = m if fam == "dahl" else 0
+    u = ca.SX.sym("u", n_u)
+    out = {k: [] for k in ("xr", "xi", "er", "ei", "g")}
+    cache = {}
+    lin = {}
+    if fam == "dahl":  # numeric linear command -> rate at the start values (amplitude scale)
+        for ax in set(map(str, axes)):
+            lin[ax] = simplex_state_space(model, ax).freqresp(f, "command_rad", "omega_rad_s")
+    for k in range(m):
+        ax = str(axes[k])
+        if ax not in cache:
+            cache[ax] = (simplex_state_space(msym, ax), balancing_scale(simplex_state_space(model, ax)))
+        ss, sc = cache[ax]
+        w = 2 * math.pi * f[k]
+        G = freqresp_symbolic_2x2(ss, w, sc)
+        Gxc, Gxt = G["command_rad", "x_p_m"], G["friction_torque_Nm", "x_p_m"]
+        Gwc, Gwt = G["command_rad", "omega_rad_s"], G["friction_torque_Nm", "omega_rad_s"]
+        nav = avionics_df(model, A[k]) if math.isfinite(A[k]) else 1.0 + 0j
+        C = (kav * nav.real, kav * nav.imag)  # command phasor per unit A
+        Aeff = A[k] if math.isfinite(A[k]) else 1e-2
+        if fam == "none":
+            N = (0.0, 0.0)
+            Om = _cm(Gwc, C)
+        elif fam == "coulomb":
+            a = 4 * law.coulomb_torque_Nm / math.pi / Aeff   # per unit A (phasors per unit command)
+            gc2 = (Gwc[0] ** 2 + Gwc[1] ** 2) * (C[0] ** 2 + C[1] ** 2)
+            disc = gc2 - a * a * Gwt[1] ** 2
+            dsm = 1e-8 * gc2
+            root = ca.sqrt(0.5 * (disc + ca.sqrt(disc * disc + dsm * dsm)))
+            raw = a * Gwt[0] + root
+            eps = 1e-4 * ca.sqrt(gc2)
+            V = 0.5 * (raw + ca.sqrt(raw * raw + eps * eps))
+            den = (V - a * Gwt[0], -a * Gwt[1])
+            Om = _cd(_cm((V, 0.0), _cm(Gwc, C)), den)
+            N = (a / V, 0.0)
+        else:  # dahl family
+            Xlin = Aeff * abs(lin[ax][k] * nav) / w
+            X = Xlin * ca.exp(u[k])
+            nx = dahl_df_x(law.coulomb_torque_Nm, law.bristle_stiffness_Nm_per_rad, X)
+            # T = N Omega per unit... N in rate form: N_x / (j w) + sigma_2
+            s2 = law.viscous_damping_Nms_per_rad if isinstance(law, LuGre) else 0.0
+            N = (nx[1] / w + s2, -nx[0] / w)
+            one_m = (1 - (Gwt[0] * N[0] - Gwt[1] * N[1]), -(Gwt[0] * N[1] + Gwt[1] * N[0]))
+            Om = _cd(_cm(Gwc, C), one_m)
+            # per unit A: Omega amplitude w X / Aeff
+            lhs = ca.log(w * X / Aeff) + 0.5 * ca.log(one_m[0] ** 2 + one_m[1] ** 2)
+            rhs = 0.5 * ca.log((Gwc[0] ** 2 + Gwc[1] ** 2) * (C[0] ** 2 + C[1] ** 2))
+            out["g"].append(lhs - rhs)
+        Hx = _ca(_cm(Gxc, C), _cm(Gxt, _cm(N, Om)))
+        He = (Om[1] / w, -Om[0] / w)
+        out["xr"].append(Hx[0])
+        out["xi"].append(Hx[1])
+        out["er"].append(He[0])
+        out["ei"].append(He[1])
+    vc = lambda L: ca.vertcat(*L) if L else ca.SX(0, 1)  # noqa: E731
+    fn = ca.Function("surrogate", [s, u], [vc(out["xr"]), vc(out["xi"]), vc(out["er"]), vc(out["ei"]), vc(out["g"])],
+                     ["s", "u"], ["hx_re", "hx_im", "he_re", "he_im", "g"])
+    g_fn = ca.Function("g", [s, u], [vc(out["g"])])
+    return Surrogate(fn, g_fn, params, p_ref, n_u, fam, axes, f, A)
+
+
+def freqresp_symbolic_2x2(ss, w_rad_s: float, scale):
+    """(re, im) of the four responses {command_rad, friction_torque_Nm} -> {x_p_m,
+    omega_rad_s} at w from one balanced real solve with two right-hand sides
+    (:func:`taos.linear.freqresp_symbolic`), which quarters the expression graph of the fit."""
+    ins = ("command_rad", "friction_torque_Nm")
+    outs = ("x_p_m", "omega_rad_s")
+    re, im = freqresp_symbolic(ss, w_rad_s, list(ins), list(outs), scale=scale)
+    return {(i, o): (re[b, a], im[b, a]) for a, i in enumerate(ins) for b, o in enumerate(outs)}
+
+
+def solve_implicit(sur: Surrogate, s, u0=None, iters: int = 60) -> np.ndarray:
+    """Solve g(s, u) = 0 for u (each g_k depends on u_k only), by safeguarded bisection in
+    u over [-30, 6] refined by Newton steps. Returns u."""
+    if sur.n_u == 0:
+        return np.zeros(0)
+    G = sur.g_fn
+    lo = np.full(sur.n_u, -30.0)
+    hi = np.full(sur.n_u, 6.0)
+    glo = np.asarray(G(s, lo)).ravel()
+    for _ in range(iters):
+        mid = 0.5 * (lo + hi)
+        gm = np.asarray(G(s, mid)).ravel()
+        same = np.sign(gm) == np.sign(glo)
+        lo = np.where(same, mid, lo)
+        glo = np.where(same, gm, glo)
+        hi = np.where(same, hi, mid)
+    return 0.5 * (lo + hi)
