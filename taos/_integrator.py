@@ -171,7 +171,10 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, amp, freq, 
                 out[o, 2] += s
         z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
                             k1, k2, k3, k4, xt)
-        if not math.isfinite(z) or not math.isfinite(x[0]):
+        ok = math.isfinite(z)
+        for i in range(n):
+            ok = ok and math.isfinite(x[i])
+        if not ok:
             return k + 1
     for o in range(ny):
         out[o, 0] *= 2.0 / n_meas

@@ -14,7 +14,7 @@ import sys
 from .errors import InputError, SimulationUnstable
 
 #: subcommand modules, in help order
-COMMANDS = ["taos._cli_basic", "taos._cli_view", "taos._cli_data"]
+COMMANDS = ["taos._cli_basic", "taos._cli_view", "taos._cli_data", "taos._cli_lco"]
 
 
 def build_parser() -> argparse.ArgumentParser:

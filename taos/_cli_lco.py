@@ -1,0 +1,86 @@
+"""``taos lco``: describing-function limit-cycle prediction of the flight-control loop and its
+time-domain confirmation (DESIGN.md "CLI"; seed paper sections 3.1-3.2)."""
+
+from __future__ import annotations
+
+import math
+
+from .errors import InputError
+from .results import write_json
+
+
+def cmd_lco(args) -> int:
+    from .flight import load_flight
+    from .lco import analyse_lco
+    from .model import Structure, load_model
+    from .units import to_si
+
+    flight = load_flight(args.flight)
+    model = load_model(args.model, friction=args.friction)
+    if args.load_stiffness:
+        k = to_si(args.load_stiffness, "stiffness", source="command line", field="--load-stiffness", positive=True)
+        model = model.replace(structure=Structure(k))
+    if not (args.duration > 0 and math.isfinite(args.duration)):
+        raise InputError("command line", "--duration", "a positive time in seconds", got=repr(args.duration))
+    from ._cli_basic import parse_float_list
+
+    amps = None if not args.amplitudes_deg else [math.radians(a) for a in
+                                                 parse_float_list(args.amplitudes_deg, "--amplitudes-deg")]
+    freqs = None if not args.freq_hz else parse_float_list(args.freq_hz, "--freq-hz")
+    for name, v in (("--amplitudes-deg", amps), ("--freq-hz", freqs)):
+        if v is not None and len(v) < 2:
+            raise InputError("command line", name, "at least two values for the describing-function grid")
+    rep = analyse_lco(flight, model, axis=args.axis, duration_s=args.duration, avionics=args.avionics,
+                      amplitudes_rad=amps, freq_hz=freqs,
+                      window_s=min(120.0, 0.5 * args.duration), time_domain=not args.no_time_domain)
+    d = rep.to_dict()
+    d["avionics"] = args.avionics
+    if args.plot or args.plot_df or args.plot_time:
+        from .plotting import save
+        if args.plot:
+            save(rep.plot(), args.plot)
+        if args.plot_df:
+            save(rep.prediction.df.plot(), args.plot_df)
+        if args.plot_time and rep.history is not None:
+            save(rep.history.plot(), args.plot_time)
+    if args.df_out:
+        rep.prediction.df.to_hdf5(args.df_out)
+    if args.json:
+        write_json(args.json, d)
+    else:
+        td = d["time_domain"] or {}
+        if d["lco"]:
+            print(f"LCO predicted: command {d['amplitude_deg']:.4f} deg (engine {d['engine_amplitude_deg']:.4f} deg) "
+                  f"at {d['frequency_hz']:.4f} Hz, {'stable' if d['stable'] else 'unstable'}")
+        else:
+            print(f"no LCO predicted; remaining margin {d['margin_db']:.2f} dB")
+        if td:
+            if td["lco"]:
+                print(f"time domain:   command {td['amplitude_deg']:.4f} deg (engine {td['engine_amplitude_deg']:.4f} deg) "
+                      f"at {td['frequency_hz']:.4f} Hz")
+            else:
+                print(f"time domain:   no sustained oscillation (final {td['final_amplitude_deg']:.2g} deg)")
+    return 0
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser("lco", help="flight-control limit cycle: describing-function prediction and time domain")
+    p.add_argument("model", help="TVC model file, e.g. models/rs25_flight.toml")
+    p.add_argument("--flight", required=True, help="flight file, e.g. models/flight/core_stage.toml")
+    p.add_argument("--friction", help="swap the friction law (none, coulomb-switching, coulomb-smooth, dahl, "
+                   "lugre, modified-lugre), keeping the file's torque levels")
+    p.add_argument("--axis", choices=("pitch", "yaw"), help="vehicle axis (default: the flight file's)")
+    p.add_argument("--load-stiffness", help="override the load stiffness, e.g. '205000 lbf/in'")
+    p.add_argument("--avionics", choices=("bounding", "model"), default="bounding",
+                   help="bounding: the paper's -1 dB gain (default); model: the file's quantisation and crossover curve")
+    p.add_argument("--amplitudes-deg", help="describing-function command amplitudes, e.g. 0.01,0.03,0.1,0.3,1 "
+                   "(default 11 from 0.01 to 1 deg)")
+    p.add_argument("--freq-hz", help="describing-function frequencies (default 10 from 0.03 to 2 Hz)")
+    p.add_argument("--duration", type=float, default=300.0, help="time-domain run [s] (default 300)")
+    p.add_argument("--no-time-domain", action="store_true", help="prediction only")
+    p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
+    p.add_argument("--plot", metavar="PNG_OR_SVG", help="Nichols chart with the predicted LCO")
+    p.add_argument("--plot-df", metavar="PNG_OR_SVG", help="describing-function gain/phase families")
+    p.add_argument("--plot-time", metavar="PNG_OR_SVG", help="engine-angle time history")
+    p.add_argument("--df-out", metavar="HDF5", help="save the describing-function map")
+    p.set_defaults(func=cmd_lco)
