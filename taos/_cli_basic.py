@@ -11,6 +11,7 @@ from .model import TvcModel, load_model
 from .results import write_json
 
 AXES = ("pitch", "yaw")
+ENGINES = ("simplex", "taos")
 
 
 def parse_float_list(text: str, option: str) -> list[float]:
@@ -86,16 +87,19 @@ def cmd_freqresp(args) -> int:
 
     freqs = parse_float_list(args.freq_hz, "--freq-hz")
     model = model_from_args(args)
-    if args.engine != "simplex":
-        raise InputError("command line", "--engine", "simplex (the 3-D TAOS engine is not in this build)",
-                         got=repr(args.engine))
-    if args.amplitude_deg is None or args.linear:
-        fr = linear_freqresp(model, freqs, args.axis)
-    else:
+    amp_rad = None
+    if args.amplitude_deg is not None and not args.linear:
         amp = parse_float_list(args.amplitude_deg, "--amplitude-deg")
         if len(amp) != 1:
             raise InputError("command line", "--amplitude-deg", "one amplitude in deg", got=args.amplitude_deg)
-        fr = sine_dwell_freqresp(model, freqs, math.radians(amp[0]), args.axis)
+        amp_rad = math.radians(amp[0])
+    if args.engine == "taos":
+        from .taos3d import taos_freqresp, taos_model
+        fr = taos_freqresp(taos_model(model), freqs, amp_rad, args.axis, cross=args.cross)
+    elif amp_rad is None:
+        fr = linear_freqresp(model, freqs, args.axis)
+    else:
+        fr = sine_dwell_freqresp(model, freqs, amp_rad, args.axis)
     d = fr.to_dict()
     d["provenance"].update({"model_file": model.source})
     if args.json:
@@ -117,12 +121,13 @@ def cmd_simulate(args) -> int:
 
     model = model_from_args(args)
     profile = load_profile(args.profile)
-    if args.engine != "simplex":
-        raise InputError("command line", "--engine", "simplex (the 3-D TAOS engine is not in this build)",
-                         got=repr(args.engine))
     if not (args.dt > 0 and math.isfinite(args.dt)):
         raise InputError("command line", "--dt", "a positive step in seconds", got=repr(args.dt))
-    th = simulate(model, profile, dt_s=args.dt, progress=True)
+    if args.engine == "taos":
+        from .taos3d import simulate_taos, taos_model
+        th = simulate_taos(taos_model(model), profile, dt_s=args.dt)
+    else:
+        th = simulate(model, profile, dt_s=args.dt, progress=True)
     th.to_hdf5(args.out)
     print(f"wrote {args.out} ({th.t_s.size} samples, {', '.join(th.axes)})")
     return 0
@@ -146,7 +151,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--amplitude-deg", help="command amplitude for the sine-dwell (nonlinear) response")
     p.add_argument("--linear", action="store_true", help="exact linear response (no friction, unity avionics)")
     p.add_argument("--axis", choices=AXES, default="pitch")
-    p.add_argument("--engine", default="simplex", help="engine model: simplex")
+    p.add_argument("--engine", choices=ENGINES, default="simplex",
+                   help="simplex (planar) or taos (3-D, two actuators, compliant two-half gimbal)")
+    p.add_argument("--cross", action="store_true", help="with --engine taos: the other axis' response")
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save a Bode plot")
     p.set_defaults(func=cmd_freqresp)
 
@@ -154,7 +161,7 @@ def add_parsers(sub) -> None:
     p.add_argument("model")
     p.add_argument("--profile", required=True, help="profile file (TOML), e.g. models/profiles/greenrun_two_axis.toml")
     p.add_argument("--out", required=True, help="HDF5 file to write")
-    p.add_argument("--engine", default="simplex", help="engine model: simplex")
+    p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
     p.add_argument("--friction", help="swap the friction law")
     p.add_argument("--dt", type=float, default=2e-4, help="integration step [s] (default 2e-4)")
     p.set_defaults(func=cmd_simulate)

@@ -92,3 +92,19 @@ def test_freqresp_bad_frequency_list(tmp_path):
     out = tmp_path / "f.json"
     r = run_cli("freqresp", MODELS / "rs25_ambient.toml", "--freq-hz", "1,abc", "--json", out)
     assert r.returncode == 2 and "--freq-hz" in r.stderr and not out.exists()
+
+
+def test_engine_taos_on_the_command_line(tmp_path):
+    """--engine taos: the 3-D model's linear response has the hot-fire notch, and simulate writes
+    the 3-D extras (bearing slip, gimbal-half deflections) beside the common arrays."""
+    r = run_cli("freqresp", MODELS / "rs25_hotfire.toml", "--freq-hz", "1,6.93,10", "--engine", "taos", "--json", "-")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["piston"]["gain_db"][1] < d["piston"]["gain_db"][0] - 20
+    out = tmp_path / "t.h5"
+    r = run_cli("simulate", MODELS / "rs25_hotfire.toml", "--engine", "taos", "--profile",
+                MODELS / "profiles" / "circular.toml", "--out", out)
+    assert r.returncode == 0, r.stderr
+    with h5py.File(out) as h5:
+        assert h5.attrs["engine"] == "taos" and "bearing_slip_rad" in h5["taos"]
+        assert np.all(np.isfinite(h5["yaw/engine_rad"][()]))

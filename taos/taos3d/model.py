@@ -1,0 +1,341 @@
+"""TAOS model definition: engine mass properties (Pinocchio), actuator geometry, gimbal halves.
+
+Frame (the gimbal frame, shared with ``fem_data`` and :mod:`taos.viewer`): origin O at the
+bearing centre, z along the engine axis from the engine towards the thrust structure (the
+engine hangs along -z), x pitch-lateral, y yaw-lateral. Pitch is a rotation about +y, yaw a
+rotation about -x; the pitch actuator works in the x-z plane, the yaw actuator in the y-z
+plane. Engine angles are the pitch/yaw components of the engine's rotation vector.
+
+Model-file tables read here (the loader keeps them raw in ``TvcModel.extra``)::
+
+    [gimbal]    friction_coefficient  mu [-], bearing friction coefficient
+                bearing_radius        r_b [m], effective friction radius of the spherical seat
+                stiffness_file        fem_data .npz with K_upper, K_lower (path relative to the
+                                      model file)
+                line_load_stiffness   (optional) actuator-line stiffness outside the gimbal [N/m];
+                                      default [structure] load_stiffness
+    [geometry]  pitch_structure_attach, pitch_engine_attach, yaw_structure_attach,
+                yaw_engine_attach     [x, y, z] attach points [m] (engine points at zero angle)
+                engine_cg             [x, y, z] engine centre of mass [m]
+                engine_roll_inertia   engine inertia about its own axis through the c.g. [kg m^2]
+
+Engine inertia: pitch/yaw inertias about O are ``[engine] inertia_pitch/inertia_yaw`` (the
+same J_n as the planar model), so the inertia about the c.g. is J_n - m (distance to the
+axis)^2; the roll inertia comes from ``engine_roll_inertia``.
+
+Bearing normal load N: the thrust when firing, the engine weight m g0 when hanging. The
+friction torque level is T_c = mu N r_b; the planar law's torque-like parameters are scaled by
+lambda = T_c / T_c,file (:mod:`taos.taos3d.friction3d`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..model import TvcModel, load_model
+from ..units import to_si
+
+G0 = 9.80665  # standard gravity [m/s^2]
+AXES = ("pitch", "yaw")
+#: bearing rotation axes in the gimbal frame: pitch about +y, yaw about -x
+PITCH_AXIS = np.array([0.0, 1.0, 0.0])
+YAW_AXIS = np.array([-1.0, 0.0, 0.0])
+GIMBAL_KEYS = {"friction_coefficient", "bearing_radius", "stiffness_file", "line_load_stiffness"}
+GEOMETRY_KEYS = {"pitch_structure_attach", "pitch_engine_attach", "yaw_structure_attach",
+                 "yaw_engine_attach", "engine_cg", "engine_roll_inertia"}
+
+
+@dataclass(frozen=True)
+class GimbalParams:
+    """Bearing friction scaling and the FEM stiffness source (SI)."""
+
+    friction_coefficient: float
+    bearing_radius_m: float
+    stiffness_file: str | None = None
+    line_load_stiffness_N_per_m: float | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class ActuatorGeometry:
+    """Attach points [m] in the gimbal frame (rows: pitch, yaw) and engine mass layout."""
+
+    structure_attach_m: np.ndarray
+    engine_attach_m: np.ndarray
+    engine_cg_m: np.ndarray
+    engine_roll_inertia_kgm2: float
+
+    def moment_arm_m(self, i: int) -> float:
+        """|E x u| [m]: moment arm of actuator ``i`` about O at zero engine angle."""
+        u = self.line_of_action(i)
+        return float(np.linalg.norm(np.cross(self.engine_attach_m[i], u)))
+
+    def line_of_action(self, i: int) -> np.ndarray:
+        """Unit vector from the structure attach point to the engine attach point."""
+        d = self.engine_attach_m[i] - self.structure_attach_m[i]
+        return d / np.linalg.norm(d)
+
+    def rotation_axis(self, i: int) -> np.ndarray:
+        """Unit axis n about which engine rotation extends actuator ``i`` (n ~ E x u)."""
+        a = np.cross(self.engine_attach_m[i], self.line_of_action(i))
+        return a / np.linalg.norm(a)
+
+
+@dataclass(frozen=True, eq=False)
+class TaosModel:
+    """One engine on a two-half compliant gimbal with two actuators (SI).
+
+    ``base`` is the planar model (actuator, avionics, friction law, K_L, K_n, J_n);
+    ``K_upper``/``K_lower`` (6, 6) are the halves' stiffness at O in DOF order
+    (ux, uy, uz, rx, ry, rz) [N/m, N/rad, N m/m, N m/rad]; ``friction_scale`` is lambda.
+    """
+
+    base: TvcModel
+    gimbal: GimbalParams
+    geometry: ActuatorGeometry
+    K_upper: np.ndarray
+    K_lower: np.ndarray
+    stiffness_source: str = "<code>"
+
+    # -- derived -------------------------------------------------------------------------
+    @property
+    def normal_load_N(self) -> float:
+        """Bearing normal load N [N]: thrust if firing, else the engine weight m g0."""
+        e = self.base.engine
+        return e.thrust_N if e.thrust_N > 0 else e.mass_kg * G0
+
+    @property
+    def coulomb_torque_Nm(self) -> float:
+        """T_c = mu N r_b [N m]."""
+        g = self.gimbal
+        return g.friction_coefficient * self.normal_load_N * g.bearing_radius_m
+
+    @property
+    def friction_scale(self) -> float:
+        """lambda = mu N r_b / T_c,file (1 when the file's law has no torque level)."""
+        tc = self.base.friction.coulomb_torque_Nm
+        return self.coulomb_torque_Nm / tc if tc > 0 else 1.0
+
+    @property
+    def line_load_stiffness_N_per_m(self) -> float:
+        k = self.gimbal.line_load_stiffness_N_per_m
+        return self.base.structure.load_stiffness_N_per_m if k is None else k
+
+    @property
+    def chain_stiffness(self) -> np.ndarray:
+        """K_s = (K_upper^-1 + K_lower^-1)^-1: the two halves in series at O (6, 6)."""
+        C = np.linalg.inv(self.K_upper) + np.linalg.inv(self.K_lower)
+        K = np.linalg.inv(C)
+        return 0.5 * (K + K.T)
+
+    @property
+    def bearing_selection(self) -> np.ndarray:
+        """S (6, 2): chain DOFs released by the bearing (pitch, yaw rotations)."""
+        S = np.zeros((6, 2))
+        S[3:, 0] = PITCH_AXIS
+        S[3:, 1] = YAW_AXIS
+        return S
+
+    @property
+    def engine_inertia_cg(self) -> np.ndarray:
+        """Engine inertia about its c.g. in the gimbal frame [kg m^2] (3, 3)."""
+        e = self.base.engine
+        c = self.geometry.engine_cg_m
+        m = e.mass_kg
+        # about O: I_O = I_c + m (|c|^2 I - c c^T); pitch (y) and yaw (x) from the file
+        shift = m * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
+        Ic = np.diag([e.inertia_yaw_kgm2 - shift[0, 0], e.inertia_pitch_kgm2 - shift[1, 1],
+                      self.geometry.engine_roll_inertia_kgm2])
+        return Ic
+
+    def with_friction(self, name: str) -> "TaosModel":
+        return replace(self, base=self.base.with_friction(name))
+
+    def replace(self, **changes) -> "TaosModel":
+        return replace(self, **changes)
+
+
+# -- Pinocchio ---------------------------------------------------------------------------
+def engine_pin_model(tm: TaosModel):
+    """Pinocchio model of the engine: one free-flyer joint at O (gimbal frame), the engine
+    body (mass, c.g., inertia), operational frames at the actuator attach points; gravity
+    off (its restoring torque is inside K_n, as in the planar model)."""
+    import pinocchio as pin
+
+    m = pin.Model()
+    m.gravity = pin.Motion.Zero()
+    jid = m.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "engine")
+    m.appendBodyToJoint(jid, pin.Inertia(tm.base.engine.mass_kg, np.array(tm.geometry.engine_cg_m, float),
+                                         tm.engine_inertia_cg), pin.SE3.Identity())
+    for i, ax in enumerate(AXES):
+        m.addFrame(pin.Frame(f"{ax}_attach", jid, 0, pin.SE3(np.eye(3), tm.geometry.engine_attach_m[i]),
+                             pin.FrameType.OP_FRAME))
+    return m
+
+
+def spatial_inertia(tm: TaosModel) -> np.ndarray:
+    """6x6 spatial inertia of the engine at its joint frame (Pinocchio, linear first)."""
+    return np.array(engine_pin_model(tm).inertias[1].matrix())
+
+
+# -- validation and loading --------------------------------------------------------------
+def _vec3(tab, key, src, sec):
+    v = tab.get(key)
+    if not isinstance(v, list) or len(v) != 3:
+        raise InputError(src, f"{sec}.{key}", "a list of three lengths like ['0.8 m', '0 m', '-0.55 m']",
+                         got="nothing (key missing)" if v is None else repr(v))
+    return np.array([to_si(x, "length", source=src, field=f"{sec}.{key}[{i}]") for i, x in enumerate(v)])
+
+
+def _table(model: TvcModel, name: str, keys: set[str]) -> dict:
+    tab = model.extra.get(name)
+    if not isinstance(tab, dict):
+        raise InputError(model.source, f"[{name}]", f"a [{name}] table for the TAOS engine model",
+                         got="nothing (section missing)")
+    unknown = sorted(set(tab) - keys)
+    if unknown:
+        raise InputError(model.source, f"{name}.{unknown[0]}", "one of " + ", ".join(sorted(keys)),
+                         got="an unknown key")
+    return tab
+
+
+def parse_gimbal(model: TvcModel) -> GimbalParams:
+    """Validate ``[gimbal]`` (InputError on a missing key, wrong unit or bad range)."""
+    src = model.source
+    g = _table(model, "gimbal", GIMBAL_KEYS)
+    for k in ("friction_coefficient", "bearing_radius"):
+        if k not in g:
+            raise InputError(src, f"gimbal.{k}", "a value (mu like 0.08; radius like '0.11 m')",
+                             got="nothing (key missing)")
+    mu = to_si(g["friction_coefficient"], "dimensionless", source=src, field="gimbal.friction_coefficient",
+               nonnegative=True)
+    rb = to_si(g["bearing_radius"], "length", source=src, field="gimbal.bearing_radius", positive=True)
+    path = None
+    if "stiffness_file" in g:
+        if not isinstance(g["stiffness_file"], str):
+            raise InputError(src, "gimbal.stiffness_file", "a path string", got=repr(g["stiffness_file"]))
+        path = str((Path(src).parent / g["stiffness_file"]).resolve())
+    kl = None
+    if "line_load_stiffness" in g:
+        kl = to_si(g["line_load_stiffness"], "stiffness", source=src, field="gimbal.line_load_stiffness",
+                   positive=True)
+    return GimbalParams(mu, rb, path, kl)
+
+
+def parse_geometry(model: TvcModel) -> ActuatorGeometry:
+    """Validate ``[geometry]``: moment arms equal [actuator] moment_arm within 1 %, the two
+    actuators turn the engine about roughly orthogonal axes (within 30 deg) near the gimbal
+    pitch/yaw axes, and the engine's c.g. inertia is positive and physical."""
+    src = model.source
+    t = _table(model, "geometry", GEOMETRY_KEYS)
+    S = np.vstack([_vec3(t, f"{ax}_structure_attach", src, "geometry") for ax in AXES])
+    E = np.vstack([_vec3(t, f"{ax}_engine_attach", src, "geometry") for ax in AXES])
+    cg = _vec3(t, "engine_cg", src, "geometry")
+    if "engine_roll_inertia" not in t:
+        raise InputError(src, "geometry.engine_roll_inertia", "an inertia like '2000 kg*m**2'",
+                         got="nothing (key missing)")
+    roll = to_si(t["engine_roll_inertia"], "inertia", source=src, field="geometry.engine_roll_inertia",
+                 positive=True)
+    geo = ActuatorGeometry(S, E, cg, roll)
+    R = model.actuator.moment_arm_m
+    for i, ax in enumerate(AXES):
+        if np.linalg.norm(E[i] - S[i]) <= 0:
+            raise InputError(src, f"geometry.{ax}_engine_attach", "a point apart from the structure attach point")
+        arm = geo.moment_arm_m(i)
+        if abs(arm - R) > 0.01 * R:
+            raise InputError(src, f"geometry.{ax}_engine_attach",
+                             f"attach points giving a moment arm of {R:.4g} m ([actuator] moment_arm) within 1 %",
+                             got=f"{arm:.4g} m")
+        ref = PITCH_AXIS if i == 0 else YAW_AXIS
+        if np.dot(geo.rotation_axis(i), ref) < math.cos(math.radians(30)):
+            raise InputError(src, f"geometry.{ax}_engine_attach",
+                             f"a line of action that turns the engine about the {ax} axis "
+                             f"({'+y' if i == 0 else '-x'}) within 30 deg, extending with a positive angle")
+    tmp = TaosModel(model, GimbalParams(0.0, 1.0), geo, np.eye(6), np.eye(6))
+    Ic = np.diag(tmp.engine_inertia_cg)
+    if np.any(Ic <= 0) or Ic[0] + Ic[1] < Ic[2] or Ic[1] + Ic[2] < Ic[0] or Ic[0] + Ic[2] < Ic[1]:
+        raise InputError(src, "geometry.engine_cg",
+                         "a c.g. and roll inertia giving a physical inertia about the c.g. "
+                         "(positive, triangle inequality)", got=f"principal inertias {Ic.round(1).tolist()} kg m^2")
+    return geo
+
+
+def check_stiffness(K, src: str, field: str) -> np.ndarray:
+    """A 6x6 symmetric positive-definite stiffness, else InputError."""
+    K = np.asarray(K, float)
+    if K.shape != (6, 6) or not np.all(np.isfinite(K)):
+        raise InputError(src, field, "a finite 6x6 stiffness matrix", got=f"shape {K.shape}")
+    if not np.allclose(K, K.T, rtol=1e-6, atol=1e-9 * np.abs(K).max()):
+        raise InputError(src, field, "a symmetric stiffness matrix",
+                         got=f"max asymmetry {np.abs(K - K.T).max():.3g}")
+    K = 0.5 * (K + K.T)
+    if np.linalg.eigvalsh(K).min() <= 0:
+        raise InputError(src, field, "a positive-definite stiffness matrix (halves held at one face)",
+                         got=f"smallest eigenvalue {np.linalg.eigvalsh(K).min():.3g}")
+    return K
+
+
+def load_stiffness_file(path: str) -> tuple[np.ndarray, np.ndarray]:
+    """(K_upper, K_lower) from a fem_data .npz (through ``taos.fem.load_gimbal_stiffness`` when
+    that loader exists, else the npz keys directly), validated."""
+    if not Path(path).is_file():
+        raise InputError(path, "(file)", "a gimbal stiffness file (.npz with K_upper, K_lower)",
+                         got="no such file")
+    try:
+        from ..fem import load_gimbal_stiffness  # type: ignore[attr-defined]
+        data = load_gimbal_stiffness(path)
+        get = (lambda k: getattr(data, k)) if not isinstance(data, dict) else data.__getitem__
+        Ku, Kl = get("K_upper"), get("K_lower")
+    except ImportError:
+        with np.load(path) as z:
+            if "K_upper" not in z or "K_lower" not in z:
+                raise InputError(path, "K_upper", "arrays K_upper and K_lower", got=", ".join(z.files)) from None
+            Ku, Kl = z["K_upper"], z["K_lower"]
+    return check_stiffness(Ku, path, "K_upper"), check_stiffness(Kl, path, "K_lower")
+
+
+def taos_model(model: TvcModel, K_upper=None, K_lower=None) -> TaosModel:
+    """Build the TAOS model from a loaded model file; ``K_upper``/``K_lower`` override the
+    ``[gimbal] stiffness_file`` (for synthetic or scaled matrices)."""
+    gim = parse_gimbal(model)
+    geo = parse_geometry(model)
+    if K_upper is None or K_lower is None:
+        if gim.stiffness_file is None:
+            raise InputError(model.source, "gimbal.stiffness_file",
+                             "a fem_data .npz path (or matrices passed in code)", got="nothing (key missing)")
+        Ku, Kl = load_stiffness_file(gim.stiffness_file)
+        src = gim.stiffness_file
+    else:
+        Ku = check_stiffness(K_upper, "<code>", "K_upper")
+        Kl = check_stiffness(K_lower, "<code>", "K_lower")
+        src = "<code>"
+    return TaosModel(model, gim, geo, Ku, Kl, src)
+
+
+def load_taos_model(path, friction: str | None = None, K_upper=None, K_lower=None) -> TaosModel:
+    """Load a model file (with ``[gimbal]`` and ``[geometry]``) as a TAOS model."""
+    return taos_model(load_model(path, friction=friction), K_upper, K_lower)
+
+
+def beam_half_stiffness(axial_N_per_m: float, shear_N_per_m: float, bending_Nm_per_rad: float,
+                        torsion_Nm_per_rad: float, length_m: float) -> np.ndarray:
+    """Synthetic 6x6 stiffness of a short elastic post at its free end (clamped at distance
+    ``length_m`` along z), Euler-Bernoulli bending coupling with shear flexibility; for tests
+    and for running without FEM files. Lateral: 1/k = L^3/(3EI) + 1/k_shear."""
+    EI = bending_Nm_per_rad * length_m
+    L = length_m
+    # flexibility of the tip (lateral u, rotation r) for bending in one plane
+    F = np.array([[L ** 3 / (3 * EI) + 1.0 / shear_N_per_m, L ** 2 / (2 * EI)],
+                  [L ** 2 / (2 * EI), L / EI]])
+    Kb = np.linalg.inv(F)
+    K = np.zeros((6, 6))
+    K[2, 2] = axial_N_per_m
+    K[5, 5] = torsion_Nm_per_rad
+    # x-z plane: ux with ry (a +ux tip shift with the root below pairs with +ry)
+    K[np.ix_([0, 4], [0, 4])] = Kb * np.array([[1, 1], [1, 1]])
+    K[np.ix_([1, 3], [1, 3])] = Kb * np.array([[1, -1], [-1, 1]])
+    return K

@@ -1,0 +1,275 @@
+"""TAOS simulation, linearisation and frequency responses.
+
+* :func:`simulate_taos` runs a command profile (one or two axes) -> :class:`TaosTimeHistory`
+  (the arrays of :class:`taos.simulate.TimeHistory` for pitch and yaw, plus ``extra``: bearing
+  slip, chain wrench, gimbal-half deflections, engine-point translation); HDF5 adds a
+  ``/taos`` group.
+* :func:`taos_freqresp` gives command -> piston / engine responses per axis (and cross-axis):
+  exact linear (friction off: Jacobian of the compiled right-hand side, central differences
+  in tangent coordinates) or amplitude-dependent by sine dwell (compiled, parallel).
+* :func:`two_axis_dwell` measures one axis' response while the other runs its own sine
+  (the Green Run dither of paper sec. 5.1).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import h5py
+import numpy as np
+
+from ..actuator import actuator_state_space
+from ..errors import SimulationUnstable
+from ..freqresp import FrequencyResponse, settle_time_s
+from ..linear import StateSpace
+from ..profiles import is_two_axis
+from ..results import atomic_write, write_provenance
+from ..simulate import SolverSettings, TimeHistory, provenance
+from . import dynamics as _dy
+from . import friction3d as _f3
+from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
+
+DEFAULT_DT_S = 2e-4
+
+
+@dataclass(frozen=True, eq=False)
+class Packed:
+    """Arrays the compiled kernels take (see :func:`pack`)."""
+
+    P: tuple
+    fid: int
+    fp: np.ndarray
+    avp: np.ndarray
+    n_state: int
+    n_act: int
+
+
+def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
+    """Pack a TAOS model for :mod:`taos.taos3d.dynamics` (SI arrays)."""
+    f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+    Y = spatial_inertia(tm)
+    Ks = tm.chain_stiffness
+    S = tm.bearing_selection
+    Kphi = S.T @ Ks @ S
+    Kc = np.linalg.inv(Kphi)
+    G = Kc @ S.T @ Ks
+    act = actuator_state_space(tm.base.actuator)
+    geo = tm.geometry
+    L0 = [float(np.linalg.norm(geo.engine_attach_m[i] - geo.structure_attach_m[i])) for i in range(2)]
+    sc = np.array([tm.line_load_stiffness_N_per_m, tm.base.actuator.moment_arm_m,
+                   tm.base.engine.rotational_stiffness_Nm_per_rad, L0[0], L0[1]])
+    P = (f64(Y), f64(np.linalg.inv(Y)), f64(Ks), f64(G), f64(Kc), f64(S), f64(geo.structure_attach_m),
+         f64(geo.engine_attach_m), f64(act.A), f64(act.B[:, act.input_index("x_c_m")]),
+         f64(act.B[:, act.input_index("f_load_N")]), f64(act.C[act.output_index("x_p_m")]),
+         f64(np.vstack([PITCH_AXIS, YAW_AXIS])), f64(sc))
+    law = tm.base.friction
+    fp = _f3.scale_params(law.pack(), tm.friction_scale)
+    av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
+    na = act.A.shape[0]
+    return Packed(P, law.fid, fp, av.pack(), _dy.N_BODY + 2 * na, na)
+
+
+def rest_state(pk: Packed) -> np.ndarray:
+    x = np.zeros(pk.n_state)
+    x[6] = 1.0
+    return x
+
+
+@dataclass(frozen=True, eq=False)
+class TaosTimeHistory(TimeHistory):
+    """:class:`~taos.simulate.TimeHistory` (axes pitch and yaw) plus ``extra`` arrays:
+    ``bearing_slip_rad`` (2, n), ``chain_wrench`` (6, n) [N, N m] at O, ``upper_deflection``
+    and ``lower_deflection`` (6, n) = K^-1 W [m, rad], ``engine_point_m`` (3, n)."""
+
+    extra: dict = field(default_factory=dict)
+
+    def to_hdf5(self, path) -> None:
+        """As the planar history, plus the ``/taos`` group with ``extra``."""
+        def write(tmp):
+            with h5py.File(tmp, "w") as h5:
+                h5.create_dataset("t_s", data=self.t_s)
+                h5.attrs["axes"] = ",".join(self.axes)
+                h5.attrs["moment_arm_m"] = self.moment_arm_m
+                write_provenance(h5, self.provenance)
+                for i, ax in enumerate(self.axes):
+                    g = h5.create_group(ax)
+                    for name in self.ARRAYS:
+                        g.create_dataset(name, data=getattr(self, name)[i], compression="gzip")
+                g = h5.create_group("taos")
+                for k, v in self.extra.items():
+                    g.create_dataset(k, data=v, compression="gzip")
+        atomic_write(path, write)
+
+
+def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int = 1,
+                pk: Packed | None = None) -> np.ndarray:
+    """Integrate the two-axis command samples ``cmd`` (n + 1, 2) [rad] every ``dt_s`` [s]
+    from rest; returns the records (n_rec, len(dynamics.REC))."""
+    pk = pack(tm) if pk is None else pk
+    cmd = np.ascontiguousarray(cmd, dtype=np.float64)
+    nrec = (cmd.shape[0] - 1) // record_every + 1
+    out = np.empty((nrec, len(_dy.REC)))
+    status = _dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(6), cmd, dt_s,
+                           record_every, out)
+    if status >= 0:
+        raise SimulationUnstable(status * dt_s, f"TAOS, {tm.base.friction.name} friction, dt = {dt_s} s")
+    return out
+
+
+def simulate_taos(tm: TaosModel, profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
+                  duration_s: float | None = None) -> TaosTimeHistory:
+    """Run ``profile`` (a single-axis profile drives pitch; two-axis drives both) through the
+    TAOS model from rest; ``dt_s`` integration step [s]; ``duration_s`` default the profile's
+    duration plus 1 s."""
+    T = (profile.duration_s + 1.0) if duration_s is None else duration_s
+    n = int(math.ceil(T / dt_s))
+    t = np.arange(n + 1) * dt_s
+    c = np.atleast_2d(profile(t))
+    cmd = np.zeros((n + 1, 2))
+    cmd[:, : c.shape[0]] = c.T if is_two_axis(profile) else c[:1].T
+    out = run_samples(tm, cmd, dt_s, record_every)
+    col = {k: i for i, k in enumerate(_dy.REC)}
+    two = lambda a, b: np.vstack([out[:, col[a]], out[:, col[b]]])  # noqa: E731
+    W = out[:, [col[k] for k in ("w_fx", "w_fy", "w_fz", "w_mx", "w_my", "w_mz")]].T
+    extra = {"bearing_slip_rad": two("phi_pitch", "phi_yaw"), "chain_wrench": W,
+             "upper_deflection": np.linalg.solve(tm.K_upper, W), "lower_deflection": np.linalg.solve(tm.K_lower, W),
+             "engine_point_m": out[:, [col["px"], col["py"], col["pz"]]].T}
+    solver = SolverSettings(method="rk4 + backward-Euler bearing", dt_s=dt_s, record_every=record_every)
+    prov = provenance(tm.base, solver, engine="taos", profile=getattr(profile, "name", type(profile).__name__),
+                      stiffness_source=tm.stiffness_source, friction_scale=tm.friction_scale,
+                      bearing_coulomb_torque_Nm=tm.coulomb_torque_Nm)
+    return TaosTimeHistory(
+        t_s=t[::record_every], axes=AXES, moment_arm_m=tm.base.actuator.moment_arm_m, provenance=prov,
+        command_rad=cmd[::record_every].T.copy(), command_avionics_rad=two("u_pitch", "u_yaw"),
+        piston_m=two("xp_pitch", "xp_yaw"), engine_rad=two("theta_pitch", "theta_yaw"),
+        friction_torque_Nm=two("tf_pitch", "tf_yaw"), friction_state_rad=two("z_pitch", "z_yaw"),
+        load_force_N=two("fl_pitch", "fl_yaw"), extra=extra)
+
+
+# -- linearisation -----------------------------------------------------------------------
+def _state_from_tangent(pk: Packed, y: np.ndarray) -> np.ndarray:
+    """Full state from tangent coordinates y = (dp (3), dr (3), v (6), actuators)."""
+    x = np.empty(pk.n_state)
+    x[:3] = y[:3]
+    r = y[3:6]
+    a = np.linalg.norm(r)
+    s = 0.5 if a < 1e-12 else math.sin(a / 2) / a
+    x[3:6] = s * r
+    x[6] = math.cos(a / 2)
+    x[7:] = y[6:]
+    return x
+
+
+def linear_state_space(tm: TaosModel) -> StateSpace:
+    """Linearisation about rest with friction off (T = 0, bearing free): states (dp, dr, v,
+    actuators) in tangent coordinates; inputs ``command_pitch_rad``, ``command_yaw_rad``
+    (after the avionics, unity here); outputs x_p and theta per axis."""
+    pk = pack(tm, ideal_avionics=True)
+    n = pk.n_state - 1
+    aux = np.empty(12)
+    dx = np.empty(pk.n_state)
+
+    def f(y, u):
+        x = _state_from_tangent(pk, y)
+        _dy.rhs(x, 0.0, 0.0, u[0], u[1], pk.P, dx, aux)
+        out = np.empty(n)
+        out[:3] = y[6:9]          # dp/dt = v_lin at rest
+        out[3:6] = y[9:12]        # dr/dt = omega at rest
+        out[6:] = dx[7:]
+        return out, np.array([aux[10], aux[11]])
+
+    y0 = np.zeros(n)
+    u0 = np.zeros(2)
+    A = np.empty((n, n))
+    C = np.zeros((4, n))
+    h = np.full(n, 1e-6)
+    na = pk.n_act
+    act = actuator_state_space(tm.base.actuator)
+    scale = np.array([1e6 if s.endswith("Pa") else 1.0 for s in act.states])
+    h[12:] = np.tile(scale * 1e-6, 2)
+    for j in range(n):
+        yp, ym = y0.copy(), y0.copy()
+        yp[j] += h[j]
+        ym[j] -= h[j]
+        fp, gp = f(yp, u0)
+        fm, gm = f(ym, u0)
+        A[:, j] = (fp - fm) / (2 * h[j])
+        C[2:, j] = (gp - gm) / (2 * h[j])
+    B = np.empty((n, 2))
+    for j in range(2):
+        up, um = u0.copy(), u0.copy()
+        up[j] += 1e-6
+        um[j] -= 1e-6
+        B[:, j] = (f(y0, up)[0] - f(y0, um)[0]) / 2e-6
+    cxp = pk.P[11]
+    C[0, 12:12 + na] = cxp
+    C[1, 12 + na:12 + 2 * na] = cxp
+    states = tuple(f"{k}" for k in ("px", "py", "pz", "rx", "ry", "rz", "vx", "vy", "vz", "wx", "wy", "wz")) + \
+        tuple(f"pitch_{s}" for s in act.states) + tuple(f"yaw_{s}" for s in act.states)
+    return StateSpace(A, B, C, np.zeros((4, 2)), states, ("command_pitch_rad", "command_yaw_rad"),
+                      ("x_p_pitch_m", "x_p_yaw_m", "theta_pitch_rad", "theta_yaw_rad"))
+
+
+def taos_freqresp(tm: TaosModel, freq_hz, amplitude_rad: float | None = None, axis: str = "pitch",
+                  cross: bool = False, *, dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2,
+                  measure_cycles: int = 2, settle_s: float | None = None,
+                  min_steps_per_cycle: int = 64) -> FrequencyResponse:
+    """Command -> piston (x_p / (R theta_c)) and command -> engine (theta / theta_c) of the
+    TAOS model, commanding ``axis``; ``cross=True`` reports the other axis' outputs (the
+    kinematic and friction cross-coupling). ``amplitude_rad`` None: exact linear response
+    (friction off, unity avionics); else sine dwell from rest with friction and avionics."""
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    i = AXES.index(axis)
+    o = 1 - i if cross else i
+    R = tm.base.actuator.moment_arm_m
+    label = f"{axis}->{AXES[o]}" if cross else axis
+    if amplitude_rad is None:
+        ss = linear_state_space(tm)
+        h = ss.freqresp(f, ss.inputs[i], [ss.outputs[o], ss.outputs[2 + o]])
+        return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, label, engine_model="taos", friction_model="none",
+                                 provenance={"model_sha256": tm.base.sha256, "method": "linear (taos)"})
+    amps = np.zeros((f.size, 2))
+    amps[:, i] = amplitude_rad
+    freqs = np.zeros((f.size, 2))
+    freqs[:, i] = f
+    res = _dwell(tm, amps, freqs, f, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle)
+    h = (res[:, :, 0] + 1j * res[:, :, 1]) / amplitude_rad
+    return FrequencyResponse(f, h[:, o] / R, h[:, 2 + o], float(amplitude_rad), label, engine_model="taos",
+                             friction_model=tm.base.friction.name,
+                             provenance={"model_sha256": tm.base.sha256, "method": "sine-dwell (taos)",
+                                         "dt_max_s": dt_max_s, "friction_scale": tm.friction_scale})
+
+
+def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle):
+    pk = pack(tm)
+    ts = settle_time_s(tm.base, "pitch") if settle_s is None else settle_s
+    fmeas = np.asarray(fmeas, float)
+    npc = np.maximum(np.ceil(1.0 / (fmeas * dt_max_s)), min_steps_per_cycle).astype(np.int64)
+    dts = 1.0 / (fmeas * npc)
+    nset = (np.maximum(settle_cycles, np.ceil(ts * fmeas)) * npc).astype(np.int64)
+    nmeas = (measure_cycles * npc).astype(np.int64)
+    out = np.zeros((fmeas.size, 4, 3))
+    status = np.full(fmeas.size, -1, np.int64)
+    _dy.dwell_batch(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.ascontiguousarray(amps, float),
+                    np.ascontiguousarray(freqs, float), fmeas, dts, nset, nmeas, out, status)
+    bad = np.flatnonzero(status >= 0)
+    if bad.size:
+        b = bad[0]
+        raise SimulationUnstable(status[b] * dts[b], f"TAOS sine dwell at {fmeas[b]:.3g} Hz")
+    return out
+
+
+def two_axis_dwell(tm: TaosModel, amplitude_rad, freq_hz, *, measure_axis: str = "pitch",
+                   dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
+                   settle_s: float | None = None, min_steps_per_cycle: int = 64):
+    """Pitch and yaw sines at once (rows of ``amplitude_rad``/``freq_hz`` (n, 2) [rad, Hz]);
+    returns (piston, engine) complex gains of ``measure_axis`` at its own frequency (n,).
+    Whole measured cycles of both sines need commensurate frequencies."""
+    amps = np.atleast_2d(np.asarray(amplitude_rad, float))
+    freqs = np.atleast_2d(np.asarray(freq_hz, float))
+    i = AXES.index(measure_axis)
+    res = _dwell(tm, amps, freqs, freqs[:, i], dt_max_s, settle_cycles, measure_cycles, settle_s,
+                 min_steps_per_cycle)
+    h = (res[:, :, 0] + 1j * res[:, :, 1]) / amps[:, i][:, None]
+    return h[:, i] / tm.base.actuator.moment_arm_m, h[:, 2 + i]
