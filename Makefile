@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/taos greenrun $(DEMO_MODEL) --out $(DEMO_OUT)
+	$(BIN)/taos greenrun $(DEMO_MODEL) --engine taos --out $(DEMO_OUT)
 	@echo "Green Run report: $(DEMO_OUT)/index.html"
 
 # The browser tests need Debian's chromium; install it when missing (root, as in CI).

@@ -41,7 +41,7 @@ def cmd_greenrun(args) -> int:
     from .report import greenrun_report
 
     out = greenrun_report(args.model, args.out, profile_path=args.profile, friction=args.friction,
-                          progress=not args.quiet)
+                          engine=args.engine, progress=not args.quiet)
     print(f"wrote {out / 'index.html'} and {out / 'greenrun.h5'}")
     return 0
 
@@ -64,6 +64,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--out", default="out/greenrun", help="report folder (default out/greenrun)")
     p.add_argument("--profile", default=None, help="profile (default models/profiles/greenrun_two_axis.toml)")
     p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels")
+    p.add_argument("--engine", choices=("simplex", "taos"), default="simplex",
+                   help="simplex (planar) or taos (3-D engine, FEM gimbal halves)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_greenrun)
 

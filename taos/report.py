@@ -142,8 +142,8 @@ def _write_h5(path: Path, th, linear: dict, dwell: dict, run: dict) -> None:
 # -- the report -------------------------------------------------------------------------------
 
 def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, friction: str | None = None,
-                    progress: bool = True, dt_s: float = 2e-4, view_angle_scale: float = 5.0,
-                    view_fps: float = 100.0) -> Path:
+                    engine: str = "simplex", progress: bool = True, dt_s: float = 2e-4,
+                    view_angle_scale: float = 5.0, view_fps: float = 100.0) -> Path:
     """Build the Green Run report folder ``out_dir`` (see the module docstring); returns its path.
 
     Parameters
@@ -156,6 +156,9 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
         Two-axis profile; default the notional Green Run profile.
     friction : str, optional
         Swap the model's friction law (keeping its torque levels).
+    engine : str
+        ``"simplex"`` (planar, one model per axis) or ``"taos"`` (3-D: both axes on one engine,
+        FEM two-half gimbal, spherical-bearing friction; :mod:`taos.taos3d`).
     progress : bool
         tqdm progress bar on standard error.
     dt_s : float
@@ -185,6 +188,21 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
                          got=type(profile).__name__)
     info = info_dict(model)
     R = model.actuator.moment_arm_m
+    if engine == "taos":
+        from .taos3d import simulate_taos, taos_freqresp, taos_model
+        tm = taos_model(model)
+        run_sim = lambda: simulate_taos(tm, profile, dt_s=dt_s)  # noqa: E731
+        lin_fr = lambda f, ax: taos_freqresp(tm, f, None, ax)  # noqa: E731
+
+        def dwell_fr_of(amps, freqs, ax):
+            frs = [taos_freqresp(tm, freqs, a, ax) for a in amps]
+            return np.array([fr.piston for fr in frs]), np.array([fr.engine for fr in frs])
+    elif engine == "simplex":
+        run_sim = lambda: simulate(model, profile, dt_s=dt_s)  # noqa: E731
+        lin_fr = lambda f, ax: linear_freqresp(model, f, ax)  # noqa: E731
+        dwell_fr_of = lambda amps, freqs, ax: sine_dwell_grid(model, amps, freqs, ax, dt_max_s=dt_s)  # noqa: E731
+    else:
+        raise InputError("command line", "--engine", "simplex or taos", got=repr(engine))
     steps = ["simulate", "linear response", "sine dwell", "plots", "3-D view", "write"]
     bar = tqdm(total=len(steps), desc="greenrun", unit="step", file=sys.stderr, disable=not progress)
 
@@ -193,13 +211,20 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
 
     try:
         step("simulate")
-        th = simulate(model, profile, dt_s=dt_s)
+        th = run_sim()
         bar.update()
 
         step("linear response")
         f_lin = np.logspace(-1, math.log10(30.0), 240)
-        linear = {ax: linear_freqresp(model, f_lin, ax) for ax in AXES}
-        notch = {ax: load_resonance_from_notch(model, ax) for ax in AXES}
+        linear = {ax: lin_fr(f_lin, ax) for ax in AXES}
+        if engine == "taos":  # the notch of the 3-D response, refined on a fine grid around the coarse one
+            notch = {}
+            for ax in AXES:
+                k = int(np.argmin(np.abs(linear[ax].piston)))
+                ff = np.linspace(f_lin[max(k - 1, 0)], f_lin[min(k + 1, f_lin.size - 1)], 201)
+                notch[ax] = float(ff[np.argmin(np.abs(lin_fr(ff, ax).piston))])
+        else:
+            notch = {ax: load_resonance_from_notch(model, ax) for ax in AXES}
         wl = {ax: model.load_resonance_hz(ax) for ax in AXES}
         bar.update()
 
@@ -214,7 +239,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
                              "piston": np.zeros((0, 0), complex), "engine": np.zeros((0, 0), complex)}
                 dwell_fr[ax] = []
                 continue
-            p, e = sine_dwell_grid(model, amps, freqs, ax, dt_max_s=dt_s)
+            p, e = dwell_fr_of(amps, freqs, ax)
             dwell[ax] = {"freq_hz": np.array(freqs), "amplitude_rad": np.array(amps), "piston": p, "engine": e}
             dwell_fr[ax] = [FrequencyResponse(np.array(freqs), p[i], e[i], a, ax, friction_model=model.friction.name)
                             for i, a in enumerate(amps)]
@@ -281,7 +306,8 @@ def _summary(model, info, th, notch, wl, dwell, run, ppath) -> dict:
     return {
         "model_file": str(model.source), "model_name": model.name, "model_sha256": model.sha256,
         "profile_file": str(ppath), "profile": th.provenance.get("profile", ""),
-        "friction_model": fr.name, "package_version": th.provenance.get("package_version", ""),
+        "friction_model": fr.name, "engine_model": th.provenance.get("engine", "simplex"),
+        "package_version": th.provenance.get("package_version", ""),
         "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "load_resonance_hz": {ax: wl[ax] for ax in wl}, "notch_frequency_hz": notch,
         "breakaway_deflection_deg": info["breakaway_deflection_deg"],
@@ -349,7 +375,7 @@ def _page(model, s, figs, view, scale, dwell, run) -> str:
 <h1>Green Run two-axis vectoring: {_h(model.name)}</h1>
 <p>Model <code>{_h(s['model_file'])}</code> (sha256 {_h(s['model_sha256'][:12])}…), profile
 <code>{_h(s['profile_file'])}</code> ({_h(s['profile'])}), friction <b>{_h(s['friction_model'])}</b>,
-simplex model, taos {_h(s['package_version'])}, {_h(s['created_utc'])}.</p>
+{_h(s['engine_model'])} engine model, taos {_h(s['package_version'])}, {_h(s['created_utc'])}.</p>
 <h2>Summary</h2><table>{table}</table>
 <h2>3-D view</h2>
 <p class="note">Engine angle exaggerated ×{scale:g}; load-path deflection x_p − Rθ exaggerated as shown in the legend. Play, pause,

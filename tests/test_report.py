@@ -113,3 +113,15 @@ def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypa
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml", "gr"]  # no temp folder left
     r = run_cli("greenrun", bad, "--out", tmp_path / "new", cwd=ROOT)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "new").exists()
+
+
+def test_greenrun_with_the_3d_engine(tmp_path):
+    """taos greenrun --engine taos: the report is built from the 3-D model and says so."""
+    import json as _json
+
+    from taos.report import greenrun_report
+
+    out = greenrun_report(MODELS / "rs25_hotfire.toml", tmp_path / "gr", engine="taos", progress=False)
+    s = _json.loads((out / "summary.json").read_text())
+    assert s["engine_model"] == "taos"
+    assert "taos engine model" in (out / "index.html").read_text()
