@@ -7,7 +7,7 @@
   generic BilinearForm (``skfem.models.elasticity.linear_elasticity``) against the vectorised
   assembly of taos.fem.elasticity, and the agreement of the two matrices.
 
-Writes benchmarks/RESULTS_fem.md (``--out`` to change).
+Prints a Markdown table for benchmarks/RESULTS.md (``--out FILE`` also writes it).
 Usage: python benchmarks/bench_fem_rebuild.py [--coarse] [--out PATH]
 """
 
@@ -59,7 +59,8 @@ def peer_assembly(h: float = 0.03, n_theta: int = 8) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--coarse", action="store_true")
-    ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "RESULTS_fem.md")
+    ap.add_argument("--out", type=Path, default=None,
+                    help="also write the table here (default: print only; paste into benchmarks/RESULTS.md)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
@@ -102,7 +103,8 @@ def main(argv=None) -> int:
         f"Speed-up x{peer['peer_s'] / peer['ours_s']:.0f}; matrices agree to max|dK|/max|K| = {peer['rel_diff']:.1e}.",
         "",
     ]
-    args.out.write_text("\n".join(lines))
+    if args.out is not None:
+        args.out.write_text("\n".join(lines))
     print("\n".join(lines))
     return 0
 

@@ -1,4 +1,4 @@
-"""TAOS speed and physics figures (writes nothing; paste the output into RESULTS_taos.md).
+"""TAOS speed and physics figures (writes nothing; paste the output into benchmarks/RESULTS.md).
 
 Run:  .venv/bin/python benchmarks/bench_taos.py [--naive-seconds 0.05]
 
