@@ -122,12 +122,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    try:
-        return int(args.func(args) or 0)
-    except InputError as e:
-        print(f"masv: {e}", file=sys.stderr)
-        return 2
+    from taos.cli import run
+    return run(build_parser(), argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -29,7 +29,6 @@ Engine positions in the core-stage layout are the gimbal nodes' coordinates in t
 from __future__ import annotations
 
 import hashlib
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
@@ -37,7 +36,7 @@ from typing import Mapping
 import numpy as np
 
 from taos.errors import InputError
-from taos.model import TvcModel, load_model
+from taos.model import TvcModel, load_model, read_toml
 from taos.units import to_si
 
 from .structure import DEFAULT_DAMPING_RATIO, ModalStructure, load_modes, rigid_structure
@@ -196,14 +195,7 @@ def load_config(path) -> MasvConfig:
     """
     p = Path(path)
     src = str(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as e:
-        raise InputError(src, "(file)", "a readable MASV configuration file", got=e.strerror) from None
-    try:
-        doc = tomllib.loads(raw.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
-        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+    raw, doc = read_toml(p, "a readable MASV configuration file")
     unknown = sorted(set(doc) - {"name", "description", "structure", "band", "engine", "actuator"})
     if unknown:
         raise InputError(src, unknown[0], "one of name, description, structure, band, engine, actuator",

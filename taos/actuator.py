@@ -25,8 +25,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from .linear import StateSpace, finish, is_symbolic, zeros
 from .model import Actuator
 

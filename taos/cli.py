@@ -25,16 +25,21 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+def run(parser: argparse.ArgumentParser, argv: list[str] | None) -> int:
+    """Parse and dispatch; bad input -> one line and exit 2, an unstable run -> exit 3."""
+    args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
     except InputError as e:
-        print(f"taos: {e}", file=sys.stderr)
+        print(f"{parser.prog}: {e}", file=sys.stderr)
         return 2
     except SimulationUnstable as e:
-        print(f"taos: {e}", file=sys.stderr)
+        print(f"{parser.prog}: {e}", file=sys.stderr)
         return 3
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run(build_parser(), argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
@@ -48,7 +47,7 @@ import scipy.signal
 
 from .errors import InputError
 from .linear import StateSpace
-from .model import TvcModel
+from .model import TvcModel, read_toml
 from .simplex import LurePlant, simplex_state_space
 from .units import Q_
 
@@ -200,13 +199,7 @@ def load_flight(path: str | Path) -> FlightModel:
     """Load a flight file (``models/flight/core_stage.toml``); :class:`InputError` on bad input."""
     p = Path(path)
     src = str(path)
-    try:
-        raw = p.read_bytes()
-        doc = tomllib.loads(raw.decode("utf-8"))
-    except OSError as e:
-        raise InputError(src, "(file)", "a readable flight file", got=e.strerror) from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
-        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+    raw, doc = read_toml(p, "a readable flight file")
     unknown = set(doc) - {"name", "description", "axis", "tvc_model", "vehicle", "fcs"}
     if unknown:
         raise InputError(src, sorted(unknown)[0], "a known section (name, description, axis, tvc_model, "

@@ -259,6 +259,20 @@ def parse_avionics(doc: Mapping, src: str) -> Avionics:
                     gain_table_rad=amps, gain_table=gains)
 
 
+def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
+    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it cannot
+    be read (``what`` says what was expected, e.g. "a readable model file") or is not TOML."""
+    src = str(path)
+    try:
+        raw = Path(path).read_bytes()
+    except OSError as e:
+        raise InputError(src, "(file)", what, got=e.strerror) from None
+    try:
+        return raw, tomllib.loads(raw.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+
+
 def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
 
@@ -266,14 +280,7 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     """
     p = Path(path)
     src = str(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as e:
-        raise InputError(src, "(file)", "a readable model file", got=e.strerror) from None
-    try:
-        doc = tomllib.loads(raw.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
-        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+    raw, doc = read_toml(p, "a readable model file")
     unknown = sorted(set(doc) - KNOWN_SECTIONS)
     if unknown:
         raise InputError(src, unknown[0], "a known section (" + ", ".join(sorted(KNOWN_SECTIONS)) + ")",

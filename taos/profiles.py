@@ -19,7 +19,6 @@ Theory 16 (1970) 85-89).
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -258,13 +257,10 @@ def profile_from_table(tab: dict, src: str, sec: str):
 def load_profile(path: str | Path):
     """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
     ``[pitch]`` and/or ``[yaw]`` tables (two-axis)."""
+    from .model import read_toml
+
     src = str(path)
-    try:
-        doc = tomllib.loads(Path(path).read_text())
-    except OSError as e:
-        raise InputError(src, "(file)", "a readable profile file", got=e.strerror) from None
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(src, "(file)", "valid TOML", got=str(e)) from None
+    _, doc = read_toml(path, "a readable profile file")
     name = str(doc.get("name", Path(path).stem))
     if doc.get("type") == "circular":
         return Circular(_angle(doc, "amplitude", src, "profile"), _pos(doc, "frequency", "frequency", src, "profile", "'1 Hz'"),

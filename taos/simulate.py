@@ -119,7 +119,11 @@ class TimeHistory:
                     g = h5.create_group(ax)
                     for name in self.ARRAYS:
                         g.create_dataset(name, data=getattr(self, name)[i], compression="gzip")
+                self._write_extra(h5)
         atomic_write(path, write)
+
+    def _write_extra(self, h5: h5py.File) -> None:
+        """Hook for subclasses that record more (the 3-D model's ``/taos`` group)."""
 
     @classmethod
     def from_hdf5(cls, path) -> "TimeHistory":

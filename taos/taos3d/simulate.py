@@ -16,7 +16,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import h5py
 import numpy as np
 
 from ..actuator import actuator_state_space
@@ -24,7 +23,6 @@ from ..errors import SimulationUnstable
 from ..freqresp import FrequencyResponse, settle_time_s
 from ..linear import StateSpace
 from ..profiles import is_two_axis
-from ..results import atomic_write, write_provenance
 from ..simulate import SolverSettings, TimeHistory, provenance
 from . import dynamics as _dy
 from . import friction3d as _f3
@@ -84,22 +82,11 @@ class TaosTimeHistory(TimeHistory):
 
     extra: dict = field(default_factory=dict)
 
-    def to_hdf5(self, path) -> None:
-        """As the planar history, plus the ``/taos`` group with ``extra``."""
-        def write(tmp):
-            with h5py.File(tmp, "w") as h5:
-                h5.create_dataset("t_s", data=self.t_s)
-                h5.attrs["axes"] = ",".join(self.axes)
-                h5.attrs["moment_arm_m"] = self.moment_arm_m
-                write_provenance(h5, self.provenance)
-                for i, ax in enumerate(self.axes):
-                    g = h5.create_group(ax)
-                    for name in self.ARRAYS:
-                        g.create_dataset(name, data=getattr(self, name)[i], compression="gzip")
-                g = h5.create_group("taos")
-                for k, v in self.extra.items():
-                    g.create_dataset(k, data=v, compression="gzip")
-        atomic_write(path, write)
+    def _write_extra(self, h5) -> None:
+        """The ``/taos`` group with ``extra`` (the rest as the planar history)."""
+        g = h5.create_group("taos")
+        for k, v in self.extra.items():
+            g.create_dataset(k, data=v, compression="gzip")
 
 
 def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int = 1,
