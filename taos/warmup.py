@@ -23,6 +23,10 @@ def main() -> None:
     simulate(model, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
     sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1)
     model.friction.response([0.0, 0.1], 1e-3)
+    from .taos3d import simulate_taos, taos_freqresp, taos_model
+    tm = taos_model(model)
+    simulate_taos(tm, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
+    taos_freqresp(tm, [10.0], math.radians(0.4))
     print(f"taos: numba kernels compiled and cached in {time.perf_counter() - t0:.0f} s")
 
 
