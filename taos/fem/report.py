@@ -82,7 +82,7 @@ def readme_text(s: dict) -> str:
     a("* **hanging** (ambient): the engine weight opens the seat; the ball hangs by its shoulder on the socket's")
     a("  retaining lip (annulus r = 0.095..0.110 m), so load goes round through the shoulder, the lip (plate")
     a("  bending) and the socket skirt. The retaining parts are sized for the engine weight only: root bending")
-    a(f"  stress at 1 g is {st['lip'] / 1e6:.0f} MPa in the 6 mm lip and {st['shoulder'] / 1e6:.0f} MPa in the 8 mm shoulder")
+    a(f"  stress at 1 g is {st['lip'] / 1e6:.0f} MPa in the {(geom.lip_top - geom.lip_bottom) * 1e3:.0f} mm lip and {st['shoulder'] / 1e6:.0f} MPa in the {(geom.shoulder_top - geom.lip_top) * 1e3:.0f} mm shoulder")
     a("  (Ti-6Al-4V yield about 880 MPa).")
     a("")
     a("### Hanging vs thrust-loaded (finest mesh), bearing-point diagonal with the bolted face held")
