@@ -21,7 +21,8 @@ def cmd_view(args) -> int:
     kw = dict(angle_scale=_positive(args.angle_scale, "--angle-scale"),
               deflection_scale=(None if args.deflection_scale is None
                                 else _positive(args.deflection_scale, "--deflection-scale")),
-              fps=_positive(args.fps, "--fps"))
+              fps=_positive(args.fps, "--fps"),
+              gimbal_scale=(None if args.gimbal_scale is None else _positive(args.gimbal_scale, "--gimbal-scale")))
     if args.html:
         if args.paused_at is not None and not (0 <= args.paused_at <= th.t_s[-1]):
             raise InputError("command line", "--paused-at", f"a time in [0, {th.t_s[-1]:g}] s", got=repr(args.paused_at))
@@ -56,6 +57,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--deflection-scale", type=float, default=None,
                    help="load-path deflection exaggeration, x_p - R theta (default: automatic, "
                         "peak drawn near 0.15 m; shown in the page legend)")
+    p.add_argument("--gimbal-scale", type=float, default=None,
+                   help="3-D (--engine taos) runs: gimbal-half deflection exaggeration (default: automatic, "
+                        "peak drawn near 3 cm)")
     p.add_argument("--fps", type=float, default=100.0, help="keyframes per second of run time (default 100)")
     p.set_defaults(func=cmd_view)
 

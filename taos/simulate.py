@@ -132,7 +132,12 @@ class TimeHistory:
             arrays = {n: np.vstack([h5[ax][n][()] for ax in axes]) for n in cls.ARRAYS}
             prov = {k: v for k, v in h5.attrs.items() if k not in ("axes", "moment_arm_m")}
             return cls(t_s=h5["t_s"][()], axes=axes, moment_arm_m=float(h5.attrs["moment_arm_m"]),
-                       provenance=prov, **arrays)
+                       provenance=prov, **arrays, **cls._read_extra(h5))
+
+    @classmethod
+    def _read_extra(cls, h5: h5py.File) -> dict:
+        """Hook for subclasses: extra constructor arguments read from the file."""
+        return {}
 
 
 def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:

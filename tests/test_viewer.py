@@ -253,3 +253,27 @@ def test_live_view_serves_on_loopback_renders_and_stops_on_sigint(tmp_path):
     for c in children:
         stat = Path(f"/proc/{c}/stat")
         assert not stat.exists() or stat.read_text().split()[2] == "Z", f"server {c} still running"
+
+
+def test_3d_run_draws_gimbal_half_deflections(tmp_path):
+    """A TAOS run file carries the gimbal halves' deflections; the viewer moves the upper half by
+    g u_upper and the engine (with the lower half) by g (u_upper + u_lower)."""
+    import math
+
+    from taos.profiles import Circular
+    from taos.taos3d import load_taos_model, simulate_taos
+    from taos.viewer import load_run, offline_html, viewer_frames
+
+    models = Path(__file__).resolve().parents[1] / "models"
+    th = simulate_taos(load_taos_model(models / "rs25_hotfire.toml"), Circular(math.radians(0.4), 2.0, 2))
+    path = tmp_path / "t.h5"
+    th.to_hdf5(path)
+    back = load_run(path)
+    assert set(back.extra) >= {"upper_deflection", "lower_deflection"}
+    fr = viewer_frames(back, gimbal_scale=500.0, fps=1e9)
+    uu = np.asarray(back.extra["upper_deflection"])[:3]
+    ul = np.asarray(back.extra["lower_deflection"])[:3]
+    np.testing.assert_allclose(fr.upper_gimbal_m, 500.0 * uu.T, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(fr.engine_offset_m, 500.0 * (uu + ul).T, rtol=1e-9, atol=1e-12)
+    assert np.max(np.abs(fr.engine_offset_m)) > 1e-4
+    assert "gimbal-half deflection &times;" in offline_html(back)

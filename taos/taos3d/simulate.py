@@ -88,6 +88,11 @@ class TaosTimeHistory(TimeHistory):
         for k, v in self.extra.items():
             g.create_dataset(k, data=v, compression="gzip")
 
+    @classmethod
+    def _read_extra(cls, h5) -> dict:
+        g = h5["taos"]
+        return {"extra": {k: g[k][()] for k in g}}
+
 
 def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int = 1,
                 pk: Packed | None = None) -> np.ndarray:

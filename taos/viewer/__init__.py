@@ -33,7 +33,15 @@ def load_run(path):
     if not p.is_file():
         raise InputError(str(path), "file", "an existing HDF5 run written by taos simulate", got="no such file")
     try:
-        th = TimeHistory.from_hdf5(p)
+        import h5py
+
+        with h5py.File(p, "r") as h5:
+            three_d = "taos" in h5
+        if three_d:
+            from ..taos3d.simulate import TaosTimeHistory
+            th = TaosTimeHistory.from_hdf5(p)
+        else:
+            th = TimeHistory.from_hdf5(p)
     except (OSError, KeyError, ValueError) as e:
         raise InputError(str(path), "HDF5 layout", "a run written by taos simulate (t_s, <axis>/engine_rad, ...)",
                          got=type(e).__name__ + ": " + str(e).splitlines()[0]) from None
@@ -53,14 +61,17 @@ def _title(th) -> str:
 
 
 def offline_html(th, *, angle_scale: float = 1.0, deflection_scale: float | None = None, fps: float = 100.0,
-                 paused_at_s: float | None = None, geometry: GimbalGeometry | None = None) -> str:
+                 paused_at_s: float | None = None, geometry: GimbalGeometry | None = None,
+                 gimbal_scale: float | None = None) -> str:
     """Self-contained HTML (meshcat viewer + scene + animation) of run ``th``.
 
-    ``angle_scale`` and ``deflection_scale`` exaggerate the engine angle and the load-path
-    deflection (see :mod:`taos.viewer.kinematics`); ``fps`` is the keyframe rate [1/s];
+    ``angle_scale``, ``deflection_scale`` and ``gimbal_scale`` exaggerate the engine angle, the
+    load-path deflection and (3-D runs) the gimbal halves' deflections (see
+    :mod:`taos.viewer.kinematics`); ``fps`` is the keyframe rate [1/s];
     ``paused_at_s`` opens the page paused at that time [s] (else it plays; ``?t=`` in the URL
     also selects a time)."""
-    fr = viewer_frames(th, geometry, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps)
+    fr = viewer_frames(th, geometry, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps,
+                       gimbal_scale=gimbal_scale)
     v = MeshcatVisualizer(geometry or GimbalGeometry(moment_arm_m=float(th.moment_arm_m)),
                           window=OfflineWindow(title=_title(th), legend_html=legend_html(fr)))
     v.load_scene()
@@ -75,11 +86,12 @@ def write_html(th, path, **kwargs) -> None:
 
 
 def serve(th, *, angle_scale: float = 1.0, deflection_scale: float | None = None, fps: float = 100.0,
-          on_ready=print, stop: threading.Event | None = None) -> int:
+          on_ready=print, stop: threading.Event | None = None, gimbal_scale: float | None = None) -> int:
     """Serve the animated run on 127.0.0.1 until SIGINT/SIGTERM (or ``stop`` is set).
 
     Calls ``on_ready(url)`` once the scene is loaded; returns 0 after shutting the server down."""
-    fr = viewer_frames(th, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps)
+    fr = viewer_frames(th, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps,
+                       gimbal_scale=gimbal_scale)
     vis, proc = live_visualizer(GimbalGeometry(moment_arm_m=float(th.moment_arm_m)))
     stop = stop or threading.Event()
     old = {}

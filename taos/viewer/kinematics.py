@@ -9,9 +9,11 @@ K_L with F_L = K_L (x_p - R theta) (DESIGN.md "Physics"); its deflection is
 delta = x_p - R theta [m]. It is drawn at the structure-side attach point, which is pushed
 back along the actuator line by k delta (k = ``deflection_scale``); the actuator spans that
 point and the engine clevis, so the drawn rod stroke is |C - S'| - L0 ~ s R theta + k delta,
-equal to the recorded piston position x_p when s = k = 1 (tested). The gimbal halves are
-drawn rigid (the planar model has no separate gimbal compliance): the lower half turns with
-the engine, the upper half stays with the structure.
+equal to the recorded piston position x_p when s = k = 1 (tested). The lower half turns with
+the engine, the upper half stays with the structure. For a 3-D TAOS run (which records the
+halves' deflections u_upper, u_lower = K^-1 W [m]) the upper half is drawn displaced by
+g u_upper and the engine (with the lower half) by g (u_upper + u_lower), g =
+``gimbal_scale``; the planar model has no separate gimbal compliance, so its halves stay put.
 
 Colours: friction state per axis from the friction rate and torque: *stuck* where the engine
 rate |d theta/dt| < ``stick_rate_rad_s`` while friction carries torque
@@ -60,6 +62,9 @@ class ViewerFrames:
     force_fraction: np.ndarray      # (2, n) F_L / max |F_L| in [-1, 1]
     angle_scale: float
     deflection_scale: float
+    upper_gimbal_m: np.ndarray | None = None   # (n, 3) displayed upper-half translation (3-D runs)
+    engine_offset_m: np.ndarray | None = None  # (n, 3) displayed engine/lower-half translation
+    gimbal_scale: float = 0.0                  # gimbal-half deflection exaggeration (0: none drawn)
 
     def gimbal_rgb(self) -> np.ndarray:
         """(n, 3) colour of the gimbal halves: stuck if any axis is stuck."""
@@ -115,9 +120,13 @@ def auto_deflection_scale(peak_deflection_m: float) -> float:
     return float(min(max(nice, 1.0), 1000.0))
 
 
+#: displayed peak gimbal-half deflection [m] when that exaggeration is chosen automatically
+AUTO_GIMBAL_M = 0.03
+
+
 def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: float = 1.0,
                   deflection_scale: float | None = None, fps: float = 100.0,
-                  stick_rate_rad_s: float = 1.75e-3) -> ViewerFrames:
+                  stick_rate_rad_s: float = 1.75e-3, gimbal_scale: float | None = None) -> ViewerFrames:
     """Poses and colours for the 3-D view of run ``th`` (see the module docstring).
 
     Parameters
@@ -135,6 +144,9 @@ def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: fl
         Keyframe rate [1/s]; never above the recorded sample rate.
     stick_rate_rad_s : float
         Engine-rate threshold below which friction that carries torque counts as stuck [rad/s].
+    gimbal_scale : float, optional
+        Gimbal-half deflection exaggeration g [-] for 3-D runs; default: the peak drawn near
+        3 cm (1-2-5 steps).
     """
     g = geometry or GimbalGeometry(moment_arm_m=float(th.moment_arm_m))
     t = np.asarray(th.t_s, float)
@@ -159,6 +171,16 @@ def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: fl
     if deflection_scale is None:
         deflection_scale = auto_deflection_scale(float(np.max(np.abs(delta))))
 
+    extra = getattr(th, "extra", None) or {}
+    upper = engine_off = None
+    if "upper_deflection" in extra and "lower_deflection" in extra:
+        uu = interp(np.asarray(extra["upper_deflection"], float)[:3])
+        ul = interp(np.asarray(extra["lower_deflection"], float)[:3])
+        if gimbal_scale is None:
+            peak = float(np.max(np.linalg.norm(uu + ul, axis=0)))
+            gimbal_scale = auto_deflection_scale(peak * AUTO_DEFLECTION_M / AUTO_GIMBAL_M)
+        upper = (gimbal_scale * uu).T
+        engine_off = (gimbal_scale * (uu + ul)).T
     rot = engine_rotation(angle_scale * theta[0], angle_scale * theta[1])
     S = np.empty((2, tk.size, 3))
     C = np.empty((2, tk.size, 3))
@@ -166,7 +188,7 @@ def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: fl
     stroke = np.empty((2, tk.size))
     for i, ax in enumerate(AXES):
         s0, c0 = g.structure_attach_m(ax), g.engine_attach_m(ax)
-        C[i] = rot.apply(c0)
+        C[i] = rot.apply(c0) + (0.0 if engine_off is None else engine_off)
         u = C[i] - s0
         u /= np.linalg.norm(u, axis=1)[:, None]
         S[i] = s0 - u * (deflection_scale * delta[i])[:, None]
@@ -179,4 +201,6 @@ def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: fl
     return ViewerFrames(t_s=tk, engine_quat_xyzw=rot.as_quat(), engine_rad=theta, piston_m=xp,
                         deflection_m=delta, structure_attach_m=S, clevis_m=C, actuator_quat_xyzw=Q,
                         stroke_m=stroke, stuck=stuck, force_fraction=np.clip(ff, -1, 1),
-                        angle_scale=float(angle_scale), deflection_scale=float(deflection_scale))
+                        angle_scale=float(angle_scale), deflection_scale=float(deflection_scale),
+                        upper_gimbal_m=upper, engine_offset_m=engine_off,
+                        gimbal_scale=float(gimbal_scale or 0.0))

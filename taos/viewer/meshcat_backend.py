@@ -167,7 +167,9 @@ def legend_html(frames: ViewerFrames | None) -> str:
     sw = lambda rgb: f'<i style="background:#{_rgb_int(rgb):06x}"></i>'  # noqa: E731
     from .kinematics import PULL_RGB, PUSH_RGB, STUCK_RGB
     scale = "" if frames is None else (f"engine angle &times;{frames.angle_scale:g}, "
-                                       f"load-path deflection &times;{frames.deflection_scale:g}<br>")
+                                       f"load-path deflection &times;{frames.deflection_scale:g}"
+                                       + (f", gimbal-half deflection &times;{frames.gimbal_scale:g}"
+                                          if frames.gimbal_scale else "") + "<br>")
     return (scale + f"gimbal friction:{sw(STUCK_RGB)}stuck{sw(SLIP_RGB)}slipping &nbsp; "
             f"actuator load:{sw(PUSH_RGB)}push{sw(PULL_RGB)}pull{sw(IDLE_RGB)}none")
 
@@ -218,7 +220,10 @@ class MeshcatVisualizer(BaseVisualizer):
     # -- one frame -----------------------------------------------------------------------
     def display(self, frames: ViewerFrames, i: int) -> None:
         v = self.vis
-        v[NODES["engine"]].set_transform(_pose(frames.engine_quat_xyzw[i], (0, 0, 0)))
+        eo = (0, 0, 0) if frames.engine_offset_m is None else frames.engine_offset_m[i]
+        v[NODES["engine"]].set_transform(_pose(frames.engine_quat_xyzw[i], eo))
+        if frames.upper_gimbal_m is not None:
+            v[NODES["upper_gimbal"]].set_transform(_translation(frames.upper_gimbal_m[i]))
         for k, ax in enumerate(AXES):
             q = frames.actuator_quat_xyzw[k, i]
             v[actuator_node(ax, "body")].set_transform(_pose(q, frames.structure_attach_m[k, i]))
@@ -238,7 +243,12 @@ class MeshcatVisualizer(BaseVisualizer):
             anim.clips[self.vis[node].path] = AnimationClip(tracks=tr, fps=1, name="default")
 
         colour = lambda node: node + "/<object>"  # noqa: E731  (the mesh itself carries the material)
-        clip(NODES["engine"], quaternion=("quaternion", frames.engine_quat_xyzw))
+        if frames.engine_offset_m is None:
+            clip(NODES["engine"], quaternion=("quaternion", frames.engine_quat_xyzw))
+        else:  # 3-D run: the gimbal halves' deflections move the engine and the upper half
+            clip(NODES["engine"], quaternion=("quaternion", frames.engine_quat_xyzw),
+                 position=("vector3", frames.engine_offset_m))
+            clip(NODES["upper_gimbal"], position=("vector3", frames.upper_gimbal_m))
         grgb = frames.gimbal_rgb()
         for node in (NODES["lower_gimbal"], NODES["upper_gimbal"]):
             anim.clips[self.vis[colour(node)].path] = AnimationClip(
