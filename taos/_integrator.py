@@ -55,6 +55,15 @@ def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, dx):
 
 
 @njit(cache=True, fastmath=_FM, inline="always")
+def _finite(x, z):
+    """True if the friction state and every linear state are finite."""
+    ok = math.isfinite(z)
+    for i in range(x.shape[0]):
+        ok = ok and math.isfinite(x[i])
+    return ok
+
+
+@njit(cache=True, fastmath=_FM, inline="always")
 def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
               k1, k2, k3, k4, xt):
     """Advance (x, z) by one step in place; return (z_new, T_f, u) at the step start."""
@@ -119,10 +128,7 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, x0, z0, r
             break
         z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
                             k1, k2, k3, k4, xt)
-        ok = math.isfinite(z)
-        for i in range(n):
-            ok = ok and math.isfinite(x[i])
-        if not ok:
+        if not _finite(x, z):
             return k + 1
     return -1
 
@@ -171,10 +177,7 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, amp, freq, 
                 out[o, 2] += s
         z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
                             k1, k2, k3, k4, xt)
-        ok = math.isfinite(z)
-        for i in range(n):
-            ok = ok and math.isfinite(x[i])
-        if not ok:
+        if not _finite(x, z):
             return k + 1
     for o in range(ny):
         out[o, 0] *= 2.0 / n_meas

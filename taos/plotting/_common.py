@@ -21,3 +21,13 @@ def save(fig, path, dpi: int = 120) -> None:
         from ..errors import InputError
         raise InputError("command line", "plot path", "a .png or .svg file name", got=str(path))
     atomic_write(path, lambda p: fig.savefig(p, dpi=dpi, format=suffix[1:]))
+
+
+def finish_bode_axes(ax) -> None:
+    """Log frequency axes with grids on a 2-row (gain, phase) grid of Bode axes; x labels on
+    the phase row."""
+    for a in ax.flat:
+        a.set_xscale("log")
+        a.grid(True, which="both", alpha=0.3)
+    for a in ax[1]:
+        a.set_xlabel("frequency [Hz]")

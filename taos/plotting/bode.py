@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._common import LENGTH_UNITS  # noqa: F401  (sets the Agg backend)
+from ._common import LENGTH_UNITS, finish_bode_axes  # (importing _common also sets the Agg backend)
 from ..errors import InputError
 
 import matplotlib.pyplot as plt  # noqa: E402
@@ -91,11 +91,7 @@ def new_bode_figure(title: str | None = None, piston_label: str = "x_p / (R θ_c
     ax[0, 1].set_ylabel("gain [dB]  (θ / θ_c)")
     ax[1, 0].set_ylabel("phase [deg]")
     ax[1, 1].set_ylabel("phase [deg]")
-    for a in ax.flat:
-        a.set_xscale("log")
-        a.grid(True, which="both", alpha=0.3)
-    for a in ax[1]:
-        a.set_xlabel("frequency [Hz]")
+    finish_bode_axes(ax)
     if title:
         fig.suptitle(title)
     return fig, ax

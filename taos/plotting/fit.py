@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ._common import LENGTH_UNITS  # noqa: F401  (sets the Agg backend)
+from ._common import finish_bode_axes  # (importing _common also sets the Agg backend)
 
 import matplotlib.pyplot as plt  # noqa: E402
 
@@ -148,11 +148,7 @@ def plot_compare_side_by_side(cmp, axis: str = "pitch"):
         ax[0, k].legend(fontsize=7)
     ax[0, 0].set_ylabel("gain [dB re 1 in/deg]")
     ax[1, 0].set_ylabel("phase [deg]")
-    for a in ax.flat:
-        a.set_xscale("log")
-        a.grid(True, which="both", alpha=0.3)
-    for a in ax[1]:
-        a.set_xlabel("frequency [Hz]")
+    finish_bode_axes(ax)
     return fig
 
 
