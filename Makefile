@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
-	$(BIN)/python -m taos.warmup
+	$(BIN)/python -m taos.cli.warmup
 	touch $(STAMP)
 
 demo: $(STAMP)

@@ -15,7 +15,7 @@ import time
 import numpy as np
 import scipy.integrate
 
-from taos.describing import describing_function_map
+from taos.flight.describing import describing_function_map
 from taos.freqresp import settle_time_s
 from taos.model import load_model
 from taos.simplex import simplex_plant

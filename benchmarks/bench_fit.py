@@ -28,9 +28,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from taos.estimate import MeasuredResponse  # noqa: E402
-from taos.fit import FitProblem, _pack, _stack_points, fit_frequency_response  # noqa: E402
-from taos.fit_model import solve_implicit  # noqa: E402
+from taos.identify.estimate import MeasuredResponse  # noqa: E402
+from taos.identify.fit import FitProblem, _pack, _stack_points, fit_frequency_response  # noqa: E402
+from taos.identify.surrogate import solve_implicit  # noqa: E402
 from taos.freqresp import sine_dwell_grid  # noqa: E402
 from taos.model import load_model  # noqa: E402
 from taos.units import to_si  # noqa: E402
@@ -71,7 +71,7 @@ def main(argv=None) -> int:
     start = dict(zip(FREE, start_vals))
     m0 = truth
     for n, v in start.items():
-        from taos.fit_model import PARAMETERS
+        from taos.identify.surrogate import PARAMETERS
         m0 = PARAMETERS[n].set(m0, float(v))
 
     rows = []

@@ -13,7 +13,7 @@ import argparse
 import math
 import sys
 
-from taos._cli_basic import parse_float_list
+from taos.cli.basic import parse_float_list
 from taos.errors import InputError
 from taos.results import package_version, write_json
 

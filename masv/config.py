@@ -37,6 +37,7 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.model import TvcModel, load_model, read_toml
+from taos.shipped import resolve
 from taos.units import to_si
 
 from .structure import DEFAULT_DAMPING_RATIO, ModalStructure, load_modes, rigid_structure
@@ -193,8 +194,8 @@ def load_config(path) -> MasvConfig:
     Raises InputError (one line: file, field, expectation) on any bad value, including the
     referenced taos model files and the modal file.
     """
-    p = Path(path)
-    src = str(path)
+    p = resolve(path, "masv")
+    src = str(p)
     raw, doc = read_toml(p, "a readable MASV configuration file")
     unknown = sorted(set(doc) - {"name", "description", "structure", "band", "engine", "actuator"})
     if unknown:

@@ -35,7 +35,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from taos.data import from_time_history  # noqa: E402
+from taos.identify.data import from_time_history  # noqa: E402
 from taos.model import load_model  # noqa: E402
 from taos.profiles import load_profile  # noqa: E402
 from taos.simulate import simulate  # noqa: E402

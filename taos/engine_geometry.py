@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-ROOT = Path(__file__).resolve().parent.parent
+from taos.shipped import models_dir
+
 
 
 @dataclass(frozen=True)
@@ -141,9 +142,10 @@ def engine_mass_properties(meshes: dict[str, trimesh.Trimesh] | None = None,
     return combine([mesh_mass_properties(meshes[k], masses[k]) for k in masses])
 
 
-def load_part_meshes(directory: Path = ROOT / "models" / "meshes") -> dict[str, trimesh.Trimesh]:
+def load_part_meshes(directory: Path | None = None) -> dict[str, trimesh.Trimesh]:
     """Read the shipped meshes models/meshes/rs25_{powerhead,nozzle}.stl."""
-    return {k: trimesh.load_mesh(Path(directory) / f"rs25_{k}.stl") for k in ("powerhead", "nozzle")}
+    directory = models_dir() / "meshes" if directory is None else Path(directory)
+    return {k: trimesh.load_mesh(directory / f"rs25_{k}.stl") for k in ("powerhead", "nozzle")}
 
 
 def build_engine_model(props: MassProperties | None = None):

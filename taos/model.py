@@ -31,6 +31,7 @@ from typing import Any, Mapping
 from .avionics import Avionics
 from .errors import InputError
 from .friction import FrictionLaw, friction_from_table
+from .shipped import resolve
 from .units import to_si
 
 KNOWN_SECTIONS = {"name", "description", "engine", "actuator", "structure", "friction", "avionics",
@@ -278,8 +279,8 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
 
     Raises :class:`~taos.errors.InputError` (one line: file, field, expectation) on bad input.
     """
-    p = Path(path)
-    src = str(path)
+    p = resolve(path, "model")
+    src = str(p)
     raw, doc = read_toml(p, "a readable model file")
     unknown = sorted(set(doc) - KNOWN_SECTIONS)
     if unknown:

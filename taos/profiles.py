@@ -258,7 +258,9 @@ def load_profile(path: str | Path):
     """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
     ``[pitch]`` and/or ``[yaw]`` tables (two-axis)."""
     from .model import read_toml
+    from .shipped import resolve
 
+    path = resolve(path, "profile")
     src = str(path)
     _, doc = read_toml(path, "a readable profile file")
     name = str(doc.get("name", Path(path).stem))

@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from taos.compare import compare_models
-from taos.estimate import MeasuredResponse
+from taos.identify.compare import compare_models
+from taos.identify.estimate import MeasuredResponse
 
 from .conftest import MODELS, run_cli
 

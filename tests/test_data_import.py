@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from taos.data import load_test_data
+from taos.identify.data import load_test_data
 from taos.errors import InputError
 
 from .conftest import MODELS, run_cli

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from taos.describing import (DescribingFunctionMap, describing_function_map, rigid_coulomb_engine_response,
+from taos.flight.describing import (DescribingFunctionMap, describing_function_map, rigid_coulomb_engine_response,
                              rigid_limit_model)
 from taos.freqresp import linear_freqresp
 from taos.model import load_model

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import scipy.signal as ss
 
-from taos.data import TestData
-from taos.estimate import detect_dwells, estimate_dwells, estimate_h1
+from taos.identify.data import TestData
+from taos.identify.estimate import detect_dwells, estimate_dwells, estimate_h1
 
 from .conftest import MODELS
 

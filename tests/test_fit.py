@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from taos.estimate import MeasuredResponse
-from taos.fit import FitProblem, fit_frequency_response
+from taos.identify.estimate import MeasuredResponse
+from taos.identify.fit import FitProblem, fit_frequency_response
 from taos.freqresp import linear_freqresp, sine_dwell_grid
 from taos.model import load_model
 from taos.simplex import load_resonance_from_notch
@@ -98,7 +98,7 @@ def test_standard_errors_cover_the_truth_at_the_stated_confidence():
 
 def test_surrogate_describing_functions_equal_the_friction_kernels(hotfire):
     """Closed-form Dahl loop (quadrature) and Coulomb DF vs the numba friction kernels."""
-    from taos.fit_model import dahl_df_x
+    from taos.identify.surrogate import dahl_df_x
 
     dahl = hotfire.with_friction("dahl").friction
     for V, f in ((0.01, 1.0), (0.05, 2.0), (0.3, 5.0)):
@@ -136,8 +136,8 @@ def test_demo_datasets_reproduce_the_paper_direction_hot_fire_stiffer(tmp_path):
                 "--start", "load_stiffness=160000 lbf/in", "--json", "-", "--out-model", tmp_path / "amb.toml")
     assert r.returncode == 0, r.stderr
     d_amb = json.loads(r.stdout)
-    from taos.data import load_test_data
-    from taos.estimate import estimate
+    from taos.identify.data import load_test_data
+    from taos.identify.estimate import estimate
     model = load_model(MODELS / "rs25_hotfire.toml")
     res_hot = fit_frequency_response(model, estimate(load_test_data(hot)), ["load_stiffness", "coulomb_torque"],
                                      start={"load_stiffness": 160000 * LBF_IN, "coulomb_torque": 100000 * INLBF})

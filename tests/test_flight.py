@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from taos.errors import InputError
-from taos.flight import fcs_filter_tf, flight_plant, load_flight, loop_freqresp, margins
+from taos.flight.vehicle import fcs_filter_tf, flight_plant, load_flight, loop_freqresp, margins
 from taos.freqresp import linear_freqresp
 from taos.model import load_model
 

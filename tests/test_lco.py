@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from taos.flight import load_flight
-from taos.lco import analyse_lco
+from taos.flight.vehicle import load_flight
+from taos.flight.lco import analyse_lco
 from taos.model import Structure, load_model
 
 from .conftest import MODELS, run_cli

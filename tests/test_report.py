@@ -86,7 +86,7 @@ def test_report_opens_offline_with_the_3d_view_drawn(report, tmp_path):
 
 
 def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypatch):
-    import taos.report as rep
+    import taos.cli.report as rep
     from taos.errors import InputError
 
     out = tmp_path / "gr"
@@ -119,7 +119,7 @@ def test_greenrun_with_the_3d_engine(tmp_path):
     """taos greenrun --engine taos: the report is built from the 3-D model and says so."""
     import json as _json
 
-    from taos.report import greenrun_report
+    from taos.cli.report import greenrun_report
 
     out = greenrun_report(MODELS / "rs25_hotfire.toml", tmp_path / "gr", engine="taos", progress=False)
     s = _json.loads((out / "summary.json").read_text())

@@ -9,7 +9,7 @@ import numpy as np
 
 
 def plot_df_map(df, which: str = "engine", title: str | None = None, ax=None):
-    """Gain [dB] and phase [deg] of ``df`` (a :class:`taos.describing.DescribingFunctionMap`)
+    """Gain [dB] and phase [deg] of ``df`` (a :class:`taos.flight.describing.DescribingFunctionMap`)
     against frequency [Hz], one curve per command amplitude. Returns the figure."""
     if ax is None:
         fig, (ag, ap) = plt.subplots(2, 1, sharex=True, figsize=(7, 6))

@@ -38,7 +38,7 @@ def _ph(h, ref_f=None, ref_ph=None, f=None):
 
 
 def plot_fit(result, title: str | None = None):
-    """Data vs fitted model and residuals of a :class:`taos.fit.FitResult`."""
+    """Data vs fitted model and residuals of a :class:`taos.identify.fit.FitResult`."""
     from ..freqresp import linear_freqresp
 
     has_e = any(e is not None for e in result.fitted_engine)
@@ -105,12 +105,12 @@ def plot_fit(result, title: str | None = None):
 
 
 def PARAM_UNIT(name: str) -> str:  # noqa: N802
-    from ..fit_model import PARAMETERS
+    from taos.identify.surrogate import PARAMETERS
     return PARAMETERS[name].unit
 
 
 def _curves(cmp, k, axis):
-    from ..compare import model_curves
+    from taos.identify.compare import model_curves
     amps = [a for d in cmp.data[k] if d.axis == axis for a in d.amplitude_rad]
     return model_curves(cmp.models[k], axis, amps)
 

@@ -11,7 +11,7 @@ import numpy as np
 
 def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
     """Nichols chart (phase [deg] vs gain [dB]) of L0 N(A, .) at several command amplitudes of
-    ``pred`` (a :class:`taos.lco.LcoPrediction`), the loop without friction (L0 alone), the
+    ``pred`` (a :class:`taos.flight.lco.LcoPrediction`), the loop without friction (L0 alone), the
     critical point (-180 deg, 0 dB) and the predicted limit cycles. Returns the figure."""
     fig, ax = (plt.subplots(figsize=(7, 6)) if ax is None else (ax.figure, ax))
     df = pred.df
@@ -47,7 +47,7 @@ def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
 
 
 def plot_flight_histories(histories, labels=None, ax=None):
-    """Engine angle [deg] against time [s] for one or more :class:`taos.lco.FlightHistory`."""
+    """Engine angle [deg] against time [s] for one or more :class:`taos.flight.lco.FlightHistory`."""
     fig, ax = (plt.subplots(figsize=(8, 4)) if ax is None else (ax.figure, ax))
     for i, h in enumerate(histories):
         lab = labels[i] if labels else f"{h.friction_model}, K_L = {h.load_stiffness_N_per_m / 175.1268:.0f} lbf/in"

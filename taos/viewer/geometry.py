@@ -23,8 +23,10 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from taos.shipped import models_dir
+
 #: repository folder with engine meshes (optional)
-MESH_DIR = Path(__file__).resolve().parents[2] / "models" / "meshes"
+MESH_DIR = models_dir() / "meshes"
 MESH_SUFFIXES = (".stl", ".obj", ".ply", ".glb")
 
 

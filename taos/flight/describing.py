@@ -24,12 +24,12 @@ from dataclasses import dataclass, field
 import h5py
 import numpy as np
 
-from .freqresp import sine_dwell_grid
-from .linear import StateSpace
-from .model import Structure, TvcModel
-from .results import atomic_write, package_version, write_json, write_provenance
-from .simplex import simplex_state_space
-from .simulate import DEFAULT_DT_S
+from taos.freqresp import sine_dwell_grid
+from taos.linear import StateSpace
+from taos.model import Structure, TvcModel
+from taos.results import atomic_write, package_version, write_json, write_provenance
+from taos.simplex import simplex_state_space
+from taos.simulate import DEFAULT_DT_S
 
 #: gain floor [dB] below which the engine is taken as stuck (phase is then borrowed from the
 #: nearest amplitude at which it moves; the gain itself is kept, floored here)
@@ -140,7 +140,7 @@ class DescribingFunctionMap:
 
     def plot(self, **kwargs):
         """Gain and phase families, one curve per amplitude (:mod:`taos.plotting.describing`)."""
-        from .plotting import describing
+        from taos.plotting import describing
         return describing.plot_df_map(self, **kwargs)
 
 

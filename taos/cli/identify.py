@@ -7,15 +7,15 @@ from __future__ import annotations
 import math
 import sys
 
-from .errors import InputError
-from .results import write_json
+from taos.errors import InputError
+from taos.results import write_json
 
 AXES = ("pitch", "yaw")
 
 
 def _estimate(path, args):
-    from .data import load_test_data
-    from .estimate import estimate
+    from taos.identify.data import load_test_data
+    from taos.identify.estimate import estimate
 
     data = load_test_data(path)
     axes = None if args.axis in (None, "both") else (args.axis,)
@@ -28,8 +28,8 @@ def _estimate(path, args):
 
 
 def _parse_start(items, model) -> dict:
-    from .fit_model import PARAMETERS
-    from .units import to_si
+    from taos.identify.surrogate import PARAMETERS
+    from taos.units import to_si
 
     out = {}
     for it in items or []:
@@ -64,8 +64,8 @@ def cmd_estimate(args) -> int:
 
 
 def cmd_fit(args) -> int:
-    from .fit import fit_frequency_response
-    from .model import load_model
+    from taos.identify.fit import fit_frequency_response
+    from taos.model import load_model
 
     model = load_model(args.model, friction=args.friction)
     free = [s.strip() for s in args.free.split(",") if s.strip()]
@@ -84,7 +84,7 @@ def cmd_fit(args) -> int:
         res.write_model(args.out_model, data_label=", ".join(labels))
         d["fitted_model_file"] = str(args.out_model)
     if args.plot:
-        from .plotting import save
+        from taos.plotting import save
         save(res.plot(), args.plot)
     if args.json:
         write_json(args.json, d)
@@ -96,8 +96,8 @@ def cmd_fit(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    from .compare import compare_models, write_comparison
-    from .model import load_model
+    from taos.identify.compare import compare_models, write_comparison
+    from taos.model import load_model
 
     ma = load_model(args.model_a)
     mb = load_model(args.model_b)

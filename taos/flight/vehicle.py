@@ -45,11 +45,12 @@ from typing import Mapping
 import numpy as np
 import scipy.signal
 
-from .errors import InputError
-from .linear import StateSpace
-from .model import TvcModel, read_toml
-from .simplex import LurePlant, simplex_state_space
-from .units import Q_
+from taos.errors import InputError
+from taos.linear import StateSpace
+from taos.model import TvcModel, read_toml
+from taos.shipped import resolve
+from taos.simplex import LurePlant, simplex_state_space
+from taos.units import Q_
 
 #: vehicle + FCS block signals
 VF_INPUTS = ("delta_rad", "delta_rate_rad_s")
@@ -197,8 +198,8 @@ def _parse(table: Mapping, keys: dict, src: str, section: str) -> dict:
 
 def load_flight(path: str | Path) -> FlightModel:
     """Load a flight file (``models/flight/core_stage.toml``); :class:`InputError` on bad input."""
-    p = Path(path)
-    src = str(path)
+    p = resolve(path, "flight")
+    src = str(p)
     raw, doc = read_toml(p, "a readable flight file")
     unknown = set(doc) - {"name", "description", "axis", "tvc_model", "vehicle", "fcs"}
     if unknown:

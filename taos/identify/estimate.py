@@ -34,8 +34,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .data import TestData
-from .errors import InputError
+from taos.identify.data import TestData
+from taos.errors import InputError
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,7 +77,7 @@ class MeasuredResponse:
 
     def to_freqresp(self, moment_arm_m: float):
         """As a :class:`~taos.freqresp.FrequencyResponse` (piston x_p / (R theta_c)) for plots."""
-        from .freqresp import FrequencyResponse
+        from taos.freqresp import FrequencyResponse
         amps = self.amplitude_rad[np.isfinite(self.amplitude_rad)]
         amp = float(np.median(amps)) if amps.size else None
         eng = self.engine if self.engine is not None else np.full(self.freq_hz.shape, np.nan + 0j)

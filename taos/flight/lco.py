@@ -2,8 +2,8 @@
 time-domain confirmation (seed paper sections 3.1-3.2, figures 6-8).
 
 Prediction (harmonic balance, Gelb & Vander Velde 1968, ch. 2): with the loop L0(j w) broken
-at the TVC command (:func:`taos.flight.loop_freqresp`) and the TVC's describing function
-N(A, w) (:class:`taos.describing.DescribingFunctionMap`), a limit cycle of command amplitude A
+at the TVC command (:func:`taos.flight.vehicle.loop_freqresp`) and the TVC's describing function
+N(A, w) (:class:`taos.flight.describing.DescribingFunctionMap`), a limit cycle of command amplitude A
 and frequency w satisfies
 
     L0(j w) N(A, w) = -1,  i.e.  20 log10|L0 N| = 0 dB  and  arg(L0 N) = -180 deg (mod 360).
@@ -14,7 +14,7 @@ U + j V = 1 + L0 N, the cycle is stable if dU/dA dV/dw - dU/dw dV/dA > 0 (deriva
 central differences on the interpolated map). Without a cycle the remaining margin is the
 smallest gain margin of L0 N(A, .) over the map's amplitudes.
 
-Time domain: the closed flight loop (:func:`taos.flight.flight_plant`) with the nonlinear
+Time domain: the closed flight loop (:func:`taos.flight.vehicle.flight_plant`) with the nonlinear
 simplex TVC, from a small initial attitude error, integrated by the compiled RK4 kernel;
 the settled oscillation of the FCS command (the describing function's input) and of the
 engine angle is measured over the final window by a least-squares fit of the fundamental at
@@ -29,12 +29,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.optimize
 
-from .avionics import Avionics
-from .describing import DescribingFunctionMap, describing_function_map
-from .flight import FlightModel, Margins, flight_plant, loop_freqresp, margins
-from .model import TvcModel
-from .results import atomic_write, package_version, write_provenance
-from .simulate import DEFAULT_DT_S, integrate_plant
+from taos.avionics import Avionics
+from taos.flight.describing import DescribingFunctionMap, describing_function_map
+from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
+from taos.model import TvcModel
+from taos.results import atomic_write, package_version, write_provenance
+from taos.simulate import DEFAULT_DT_S, integrate_plant
 
 DEG = math.pi / 180.0
 #: default describing-function grid for the flight loop: command amplitudes [deg], frequencies [Hz]
@@ -119,7 +119,7 @@ class LcoPrediction:
     def plot(self, **kwargs):
         """Nichols chart of L0 N at several amplitudes with the critical point and the predicted
         cycle (:mod:`taos.plotting.nichols`, the paper's figure 6)."""
-        from .plotting import nichols
+        from taos.plotting import nichols
         return nichols.plot_lco_nichols(self, **kwargs)
 
 
@@ -229,7 +229,7 @@ class FlightHistory:
 
     def plot(self, **kwargs):
         """Time histories (:mod:`taos.plotting.nichols`)."""
-        from .plotting import nichols
+        from taos.plotting import nichols
         return nichols.plot_flight_histories([self], **kwargs)
 
 

@@ -1,4 +1,4 @@
-"""Compile and cache the numba kernels once (``python -m taos.warmup``; run by ``make``).
+"""Compile and cache the numba kernels once (``python -m taos.cli.warmup``; run by ``make``).
 
 The integrator kernels take tens of seconds to compile on a cold cache; doing it at install
 time keeps the first ``taos greenrun`` and the test suite's first simulation fast.
@@ -8,22 +8,20 @@ from __future__ import annotations
 
 import math
 import time
-from pathlib import Path
 
 
 def main() -> None:
-    from .freqresp import sine_dwell_grid
-    from .model import load_model
-    from .profiles import SineDwell
-    from .simulate import simulate
+    from taos.freqresp import sine_dwell_grid
+    from taos.model import load_model
+    from taos.profiles import SineDwell
+    from taos.simulate import simulate
 
     t0 = time.perf_counter()
-    root = Path(__file__).resolve().parents[1]
-    model = load_model(root / "models" / "rs25_hotfire.toml")
+    model = load_model("rs25_hotfire")
     simulate(model, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
     sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1)
     model.friction.response([0.0, 0.1], 1e-3)
-    from .taos3d import simulate_taos, taos_freqresp, taos_model
+    from taos.taos3d import simulate_taos, taos_freqresp, taos_model
     tm = taos_model(model)
     simulate_taos(tm, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
     taos_freqresp(tm, [10.0], math.radians(0.4))

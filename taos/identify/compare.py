@@ -7,7 +7,7 @@ tell the conditions apart: the load resonance w_L = sqrt((K_L R^2 + K_n) / J_n) 
 (paper eq. 1) per axis, the notch of the linear command -> piston response
 (:func:`taos.simplex.load_resonance_from_notch`), and the friction breakaway deflection
 T_c / (K_L R^2). With test data (time-history files) each condition's responses are
-estimated (:func:`taos.estimate.estimate`) and the plots overlay them on the model curves:
+estimated (:func:`taos.identify.estimate.estimate`) and the plots overlay them on the model curves:
 the exact linear response and the time-domain sine dwell of the full model at the data's
 command amplitudes.
 """
@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .model import TvcModel
-from .units import from_si
+from taos.model import TvcModel
+from taos.units import from_si
 
 
 @dataclass(frozen=True)
@@ -81,12 +81,12 @@ class Comparison:
 
     def plot_side_by_side(self, **kw):
         """Figure 2 of the paper: command -> piston gain and phase, A left, B right."""
-        from .plotting import fit as pf
+        from taos.plotting import fit as pf
         return pf.plot_compare_side_by_side(self, **kw)
 
     def plot_overlay(self, **kw):
         """Figure 11 style: both conditions' piston and engine Bode curves overlaid, with data."""
-        from .plotting import fit as pf
+        from taos.plotting import fit as pf
         return pf.plot_compare_overlay(self, **kw)
 
 
@@ -119,8 +119,8 @@ def _numeric_fields(obj) -> dict:
 def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
                    labels: tuple[str, str] | None = None) -> Comparison:
     """The comparison table of two models (module docstring); ``data_a``/``data_b`` are
-    lists of :class:`~taos.estimate.MeasuredResponse` shown on the plots."""
-    from .simplex import load_resonance_from_notch
+    lists of :class:`~taos.identify.estimate.MeasuredResponse` shown on the plots."""
+    from taos.simplex import load_resonance_from_notch
 
     labels = labels or (model_a.name, model_b.name)
     rows: list[Row] = []
@@ -156,8 +156,8 @@ def write_comparison(cmp: Comparison, out_dir, json_path: str | None = None) -> 
     """Write ``table.txt``, ``comparison.json``, ``piston_side_by_side.png`` (paper fig. 2) and
     ``bode_overlay.png`` (fig. 11 style) into ``out_dir``: built in a temporary folder beside
     it and renamed into place, so a failure leaves nothing half-written."""
-    from .plotting import save
-    from .results import write_json
+    from taos.plotting import save
+    from taos.results import write_json
 
     out = Path(out_dir)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -189,7 +189,7 @@ def write_comparison(cmp: Comparison, out_dir, json_path: str | None = None) -> 
 
 def model_curves(model: TvcModel, axis: str, amplitudes_rad, f_lo: float = 0.3, f_hi: float = 20.0, n: int = 24):
     """(dense linear FrequencyResponse, [sine-dwell FrequencyResponse per amplitude]) for plots."""
-    from .freqresp import linear_freqresp, sine_dwell_freqresp
+    from taos.freqresp import linear_freqresp, sine_dwell_freqresp
 
     f = np.geomspace(f_lo, f_hi, 300)
     lin = linear_freqresp(model, f, axis)

@@ -37,10 +37,11 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .errors import InputError
-from .profiles import Sequence, SineDwell, TwoAxis, load_profile
+from taos.errors import InputError
+from taos.profiles import Sequence, SineDwell, TwoAxis, load_profile
+from taos.shipped import models_dir
 
-DEFAULT_PROFILE = Path(__file__).resolve().parents[1] / "models" / "profiles" / "greenrun_two_axis.toml"
+DEFAULT_PROFILE = models_dir() / "profiles" / "greenrun_two_axis.toml"
 AXES = ("pitch", "yaw")
 
 
@@ -72,7 +73,7 @@ def run_dwell_response(t_s, command_amp_rad: float, freq_hz: float, t0_s: float,
 
 def run_responses(th, profile, moment_arm_m: float) -> dict:
     """{axis: FrequencyResponse-like dict arrays} read off the two-axis run's dwell segments."""
-    from .freqresp import FrequencyResponse
+    from taos.freqresp import FrequencyResponse
 
     out = {}
     for k, ax in enumerate(th.axes):
@@ -170,13 +171,13 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     """
     from tqdm import tqdm
 
-    from ._cli_basic import info_dict
-    from .freqresp import FrequencyResponse, linear_freqresp, sine_dwell_grid
-    from .model import load_model
-    from .plotting import bode, timehist
-    from .simplex import load_resonance_from_notch
-    from .simulate import simulate
-    from .viewer import offline_html
+    from taos.cli.basic import info_dict
+    from taos.freqresp import FrequencyResponse, linear_freqresp, sine_dwell_grid
+    from taos.model import load_model
+    from taos.plotting import bode, timehist
+    from taos.simplex import load_resonance_from_notch
+    from taos.simulate import simulate
+    from taos.viewer import offline_html
 
     out = Path(out_dir)
     # bad input fails here, before any progress output: one line, nothing written
@@ -189,7 +190,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     info = info_dict(model)
     R = model.actuator.moment_arm_m
     if engine == "taos":
-        from .taos3d import simulate_taos, taos_freqresp, taos_model
+        from taos.taos3d import simulate_taos, taos_freqresp, taos_model
         tm = taos_model(model)
         run_sim = lambda: simulate_taos(tm, profile, dt_s=dt_s)  # noqa: E731
         lin_fr = lambda f, ax: taos_freqresp(tm, f, None, ax)  # noqa: E731
@@ -290,7 +291,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
 
 
 def _summary(model, info, th, notch, wl, dwell, run, ppath) -> dict:
-    from .units import from_si
+    from taos.units import from_si
 
     fr = model.friction
     dw = {}

@@ -29,7 +29,7 @@ function from engine rate to torque, T = N(V) Omega at rate amplitude V:
 
 Then Omega = G_wc C / (1 - G_wT N), x_p = G_xc C + G_xT N Omega, theta = Omega / (j w), and the
 responses are x_p / (A) [m/rad] and theta / A. The DF neglects harmonics (the engine rate is
-not sinusoidal while friction holds it); :mod:`taos.fit` removes that bias by defect
+not sinusoidal while friction holds it); :mod:`taos.identify.fit` removes that bias by defect
 correction against the time-domain sine dwell of the full nonlinear model.
 """
 
@@ -42,10 +42,10 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import InputError
-from .friction import CoulombSmooth, CoulombSwitching, Dahl, LuGre, NoFriction
-from .model import TvcModel
-from .linear import freqresp_symbolic
+from taos.errors import InputError
+from taos.friction import CoulombSmooth, CoulombSwitching, Dahl, LuGre, NoFriction
+from taos.model import TvcModel
+from taos.linear import freqresp_symbolic
 
 
 @dataclass(frozen=True)
@@ -223,8 +223,8 @@ def build_surrogate(model: TvcModel, params, axes, freq_hz, amp_rad) -> Surrogat
     """Symbolic surrogate responses at points (axes[k], freq_hz[k], amp_rad[k])."""
     import casadi as ca
 
-    from .linear import balancing_scale
-    from .simplex import simplex_state_space
+    from taos.linear import balancing_scale
+    from taos.simplex import simplex_state_space
 
     params = tuple(params)
     fam = friction_family(model)

@@ -9,13 +9,13 @@ Method (:func:`fit_frequency_response`):
    weights the notch (where |H| is small) as much as the rest and keeps gain and phase in
    one scale. Points below ``min_coherence`` are dropped. The engine DC gain is never used
    (unobservable without an absolute engine reference; the estimators return no 0 Hz point).
-2. Model. :mod:`taos.fit_model`: the linear simplex block with CasADi parameters (the one
+2. Model. :mod:`taos.identify.surrogate`: the linear simplex block with CasADi parameters (the one
    definition of the dynamics), exact responses by :func:`taos.linear.freqresp_symbolic`, and
    describing functions for the avionics and friction (closed form for Coulomb, exact
    periodic Dahl loop for Dahl/LuGre, with the amplitude as an implicit NLP variable).
 3. NLP. ``ca.nlpsol('s', 'ipopt', ...)`` minimises 0.5 sum r^2 over the scaled parameters
    s = p / p_start (bounds from physics: every fitted quantity is positive, held within
-   [lo, hi] times its start, see :data:`taos.fit_model.PARAMETERS`) and the implicit
+   [lo, hi] times its start, see :data:`taos.identify.surrogate.PARAMETERS`) and the implicit
    amplitudes, with exact first and second derivatives (SX). ``starts`` multiple starts
    (the start values, then log-uniform draws within a factor of 2), best objective kept.
 4. Defect correction (when the model has friction): the describing function neglects
@@ -42,12 +42,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .estimate import MeasuredResponse
-from .fit_model import PARAMETERS, build_surrogate, check_free, solve_implicit
-from .model import TvcModel, load_model
-from .results import atomic_write
-from .units import from_si
+from taos.errors import InputError
+from taos.identify.estimate import MeasuredResponse
+from taos.identify.surrogate import PARAMETERS, build_surrogate, check_free, solve_implicit
+from taos.model import TvcModel, load_model
+from taos.results import atomic_write
+from taos.units import from_si
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,7 +130,7 @@ class FitResult:
 
     def plot(self, **kwargs):
         """Data vs fitted model and normalised residuals (:mod:`taos.plotting.fit`)."""
-        from .plotting import fit as pf
+        from taos.plotting import fit as pf
         return pf.plot_fit(self, **kwargs)
 
     def write_model(self, path, data_label: str = "") -> None:
@@ -138,7 +138,7 @@ class FitResult:
 
 
 def _si_unit(kind: str) -> str:
-    from .units import DIMENSIONS
+    from taos.units import DIMENSIONS
     return DIMENSIONS[kind][1]
 
 
@@ -245,7 +245,7 @@ def _apply(model: TvcModel, names, values) -> TvcModel:
 
 def simulate_points(model: TvcModel, axes, freq_hz, amp_rad) -> tuple[np.ndarray, np.ndarray]:
     """Sine-dwell responses of the full nonlinear model at the points (hx [m/rad], he)."""
-    from .freqresp import sine_dwell_grid
+    from taos.freqresp import sine_dwell_grid
     hx = np.empty(freq_hz.size, complex)
     he = np.empty(freq_hz.size, complex)
     R = model.actuator.moment_arm_m
@@ -270,9 +270,9 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
     model : TvcModel
         The model whose other values are held (its friction law decides the surrogate).
     data : list of MeasuredResponse
-        From :mod:`taos.estimate` (or synthetic).
+        From :mod:`taos.identify.estimate` (or synthetic).
     free : list of str
-        Names from :data:`taos.fit_model.PARAMETERS`.
+        Names from :data:`taos.identify.surrogate.PARAMETERS`.
     start : dict name -> SI value, optional
         Start values (default: the model's).
     starts : int
@@ -339,7 +339,7 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
         fitted_p.append(gx[pos:pos + n])
         fitted_e.append(ge[pos:pos + n] if dset.engine is not None else None)
         pos += n
-    from .simplex import load_resonance_from_notch
+    from taos.simplex import load_resonance_from_notch
     ax_set = sorted(set(map(str, axes)))
     return FitResult(model=mfit, initial=m0, names=free, values=values, start_values=prob.p_ref.copy(),
                      std_errors=se_s * prob.p_ref, correlation=corr, cost=cost, n_residuals=nres, sigma2=sigma2,

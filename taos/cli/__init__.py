@@ -11,10 +11,10 @@ import argparse
 import importlib
 import sys
 
-from .errors import InputError, SimulationUnstable
+from taos.errors import InputError, SimulationUnstable
 
 #: subcommand modules, in help order
-COMMANDS = ["taos._cli_basic", "taos._cli_view", "taos._cli_data", "taos._cli_lco"]
+COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco"]
 
 
 def build_parser() -> argparse.ArgumentParser:

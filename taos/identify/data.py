@@ -42,9 +42,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .results import atomic_write
-from .units import Q_
+from taos.errors import InputError
+from taos.results import atomic_write
+from taos.units import Q_
 
 AXES = ("pitch", "yaw")
 #: canonical signal name -> (unit kind, SI unit, example unit)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import sys
 
-from .errors import InputError
+from taos.errors import InputError
 
 
 def _positive(value: float, option: str) -> float:
@@ -15,7 +15,7 @@ def _positive(value: float, option: str) -> float:
 
 
 def cmd_view(args) -> int:
-    from .viewer import load_run, serve, write_html
+    from taos.viewer import load_run, serve, write_html
 
     th = load_run(args.run)
     kw = dict(angle_scale=_positive(args.angle_scale, "--angle-scale"),
@@ -39,7 +39,7 @@ def cmd_view(args) -> int:
 
 
 def cmd_greenrun(args) -> int:
-    from .report import greenrun_report
+    from taos.cli.report import greenrun_report
 
     out = greenrun_report(args.model, args.out, profile_path=args.profile, friction=args.friction,
                           engine=args.engine, progress=not args.quiet)
@@ -75,5 +75,5 @@ def add_parsers(sub) -> None:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    from .cli import main
+    from taos.cli import main
     sys.exit(main())

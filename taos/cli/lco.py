@@ -5,15 +5,15 @@ from __future__ import annotations
 
 import math
 
-from .errors import InputError
-from .results import write_json
+from taos.errors import InputError
+from taos.results import write_json
 
 
 def cmd_lco(args) -> int:
-    from .flight import load_flight
-    from .lco import analyse_lco
-    from .model import Structure, load_model
-    from .units import to_si
+    from taos.flight.vehicle import load_flight
+    from taos.flight.lco import analyse_lco
+    from taos.model import Structure, load_model
+    from taos.units import to_si
 
     flight = load_flight(args.flight)
     model = load_model(args.model, friction=args.friction)
@@ -22,7 +22,7 @@ def cmd_lco(args) -> int:
         model = model.replace(structure=Structure(k))
     if not (args.duration > 0 and math.isfinite(args.duration)):
         raise InputError("command line", "--duration", "a positive time in seconds", got=repr(args.duration))
-    from ._cli_basic import parse_float_list
+    from taos.cli.basic import parse_float_list
 
     amps = None if not args.amplitudes_deg else [math.radians(a) for a in
                                                  parse_float_list(args.amplitudes_deg, "--amplitudes-deg")]
@@ -36,7 +36,7 @@ def cmd_lco(args) -> int:
     d = rep.to_dict()
     d["avionics"] = args.avionics
     if args.plot or args.plot_df or args.plot_time:
-        from .plotting import save
+        from taos.plotting import save
         if args.plot:
             save(rep.plot(), args.plot)
         if args.plot_df:

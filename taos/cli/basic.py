@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from .errors import InputError
-from .model import TvcModel, load_model
-from .results import write_json
+from taos.errors import InputError
+from taos.model import TvcModel, load_model
+from taos.results import write_json
 
 AXES = ("pitch", "yaw")
 ENGINES = ("simplex", "taos")
@@ -34,7 +34,7 @@ def info_dict(model: TvcModel) -> dict:
     """Parameters in SI and derived figures (the ``taos info`` JSON)."""
     from dataclasses import asdict
 
-    from .simplex import load_resonance_from_notch, simplex_state_space
+    from taos.simplex import load_resonance_from_notch, simplex_state_space
 
     poles = simplex_state_space(model, "pitch").poles()
     p = poles[poles.imag >= 0]
@@ -83,7 +83,7 @@ def cmd_info(args) -> int:
 
 
 def cmd_freqresp(args) -> int:
-    from .freqresp import linear_freqresp, sine_dwell_freqresp
+    from taos.freqresp import linear_freqresp, sine_dwell_freqresp
 
     freqs = parse_float_list(args.freq_hz, "--freq-hz")
     model = model_from_args(args)
@@ -94,7 +94,7 @@ def cmd_freqresp(args) -> int:
             raise InputError("command line", "--amplitude-deg", "one amplitude in deg", got=args.amplitude_deg)
         amp_rad = math.radians(amp[0])
     if args.engine == "taos":
-        from .taos3d import taos_freqresp, taos_model
+        from taos.taos3d import taos_freqresp, taos_model
         fr = taos_freqresp(taos_model(model), freqs, amp_rad, args.axis, cross=args.cross)
     elif amp_rad is None:
         fr = linear_freqresp(model, freqs, args.axis)
@@ -110,21 +110,21 @@ def cmd_freqresp(args) -> int:
             print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} "
                   f"{d['engine']['gain_db'][i]:10.3f} {d['engine']['phase_deg'][i]:11.2f}")
     if args.plot:
-        from .plotting import save
+        from taos.plotting import save
         save(fr.plot(resonance_hz=model.load_resonance_hz(args.axis)), args.plot)
     return 0
 
 
 def cmd_simulate(args) -> int:
-    from .profiles import load_profile
-    from .simulate import simulate
+    from taos.profiles import load_profile
+    from taos.simulate import simulate
 
     model = model_from_args(args)
     profile = load_profile(args.profile)
     if not (args.dt > 0 and math.isfinite(args.dt)):
         raise InputError("command line", "--dt", "a positive step in seconds", got=repr(args.dt))
     if args.engine == "taos":
-        from .taos3d import simulate_taos, taos_model
+        from taos.taos3d import simulate_taos, taos_model
         th = simulate_taos(taos_model(model), profile, dt_s=args.dt)
     else:
         th = simulate(model, profile, dt_s=args.dt, progress=True)

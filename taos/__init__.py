@@ -1,0 +1,67 @@
+"""taos: thrust-vector-control gimbal and actuator simulation.
+
+The public API, by task (each name is importable from ``taos``)::
+
+    model = taos.load_model("rs25_hotfire")               # a model file, or a shipped name
+    taos.linear_freqresp(model, [0.5, 5.0])                # exact linear response
+    taos.sine_dwell_freqresp(model, [0.5, 5.0], 0.4 * pi / 180)   # with friction and avionics
+    taos.simulate(model, taos.load_profile("greenrun_two_axis"))  # a time history
+    taos.describing_function_map(model, amplitudes_rad, freq_hz)  # N(A, w)
+    taos.analyse_lco(taos.load_flight("core_stage"), model)       # limit-cycle prediction
+    taos.fit_frequency_response(model, responses, ["load_stiffness"])
+    taos.compare_models(model_a, model_b)
+    taos.write_html(run, "run.html")                       # offline 3-D view
+
+Layers, bottom to top (none imports a layer above it):
+
+1. ``units``, ``errors``, ``results``, ``shipped`` - units, one-line input errors, output files;
+2. ``friction``, ``avionics``, ``actuator``, ``linear``, ``model`` - component models;
+3. ``simplex``, ``simulate``, ``freqresp``, ``taos3d``, ``fem`` - the planar and 3-D models;
+4. ``flight``, ``identify`` - analyses built on them;
+5. ``plotting``, ``viewer`` - drawing only;
+6. ``cli`` - the ``taos`` command and the Green Run report.
+
+Names are resolved on first use (PEP 562), so ``import taos`` stays cheap and a command imports
+only what it needs.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__version__ = "0.1.0"
+
+#: public name -> module that defines it
+_API = {
+    "load_model": "taos.model", "TvcModel": "taos.model",
+    "InputError": "taos.errors", "SimulationUnstable": "taos.errors",
+    "linear_freqresp": "taos.freqresp", "sine_dwell_freqresp": "taos.freqresp",
+    "sine_dwell_grid": "taos.freqresp", "FrequencyResponse": "taos.freqresp",
+    "simplex_state_space": "taos.simplex", "load_resonance_from_notch": "taos.simplex",
+    "simulate": "taos.simulate", "TimeHistory": "taos.simulate",
+    "load_profile": "taos.profiles",
+    "FrictionLaw": "taos.friction", "LAWS": "taos.friction",
+    "taos_model": "taos.taos3d", "simulate_taos": "taos.taos3d", "taos_freqresp": "taos.taos3d",
+    "describing_function_map": "taos.flight.describing", "DescribingFunctionMap": "taos.flight.describing",
+    "load_flight": "taos.flight.vehicle", "margins": "taos.flight.vehicle",
+    "analyse_lco": "taos.flight.lco", "predict_lco": "taos.flight.lco",
+    "load_test_data": "taos.identify.data", "estimate": "taos.identify.estimate",
+    "fit_frequency_response": "taos.identify.fit", "compare_models": "taos.identify.compare",
+    "load_run": "taos.viewer", "write_html": "taos.viewer", "serve": "taos.viewer",
+}
+
+__all__ = sorted(_API) + ["__version__"]
+
+
+def __getattr__(name: str):
+    try:
+        module = _API[name]
+    except KeyError:
+        raise AttributeError(f"module 'taos' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return __all__
