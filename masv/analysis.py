@@ -1,5 +1,6 @@
 """MASV analyses: 8x8 frequency responses, notches, coupling, closed-loop eigenvalues, loop
-margins with the other loops closed, and the structural modes near the actuator bandwidth.
+margins with the other loops closed, the TVSE (thrust vector servo elastic) loop break, and the
+structural modes in the band of interest or near the actuator bandwidth.
 
 Conventions: command -> piston is x_p,i / (R_i theta_c,j) and command -> engine is
 theta_i / theta_c,j (dimensionless; element [f, i, j] is output i for command j). Gains are
@@ -223,7 +224,9 @@ def _crossing(x, y0, y1):
 
 def margins_from_loop(name: str, f: np.ndarray, L: np.ndarray) -> LoopMargin:
     """Gain and phase margins of loop transfer L sampled on ascending f (linear interpolation in
-    log f between samples)."""
+    log f between samples). A loop that is zero everywhere (no loop) has infinite margins."""
+    if not np.any(L):
+        return LoopMargin(name, math.inf, None, math.inf, None)
     lf = np.log10(f)
     gm, fgm = math.inf, None
     im, re = L.imag, L.real
@@ -257,6 +260,42 @@ def loop_margins(system: MasvSystem, f_lo_hz: float = 0.01, f_hi_hz: float = 100
     for k, name in enumerate(system.actuator_names):
         T = xp[:, k, k] / system.moment_arms_m[k]
         out.append(margins_from_loop(name, f, T / (1.0 - T)))
+    return tuple(out)
+
+
+# -- TVSE loop break -------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class TvseLoop:
+    """The Thrust Vector Servo Elastic loop of one actuator (paper sec. 3.3; Greensite, *Analysis
+    and Design of Space Vehicle Flight Control Systems*, 1970, on the TWD/DWT coupling): the
+    loop broken between the flexible-body dynamics and the engine's inertial coupling into the
+    structure (:meth:`masv.system.MasvSystem.tvse_loop`), ``loop`` L(j w) (F,) complex on
+    ``freq_hz`` [Hz], its largest gain ``peak_db`` at ``peak_hz``, and its margins
+    (:func:`margins_from_loop`: critical point -1)."""
+
+    actuator: str
+    freq_hz: np.ndarray
+    loop: np.ndarray
+    margin: LoopMargin
+    peak_db: float
+    peak_hz: float
+
+    def to_dict(self) -> dict:
+        return {"actuator": self.actuator, "peak_db": self.peak_db, "peak_hz": self.peak_hz,
+                "margin": self.margin.to_dict()}
+
+
+def tvse_loops(system: MasvSystem, freq_hz=None) -> tuple[TvseLoop, ...]:
+    """TVSE loop of every actuator, each broken alone with everything else closed (:class:`TvseLoop`;
+    default grid 0.1-100 Hz, 3000 points). On a rigid structure there is no loop (L = 0, infinite
+    margins)."""
+    f = np.logspace(-1, 2, 3000) if freq_hz is None else np.atleast_1d(np.asarray(freq_hz, float))
+    out = []
+    loops = system.tvse_loop(f)
+    for k, name in enumerate(system.actuator_names):
+        L = loops[:, k]
+        i = int(np.argmax(np.abs(L)))
+        out.append(TvseLoop(name, f, L, margins_from_loop(name, f, L), float(_db(L[i])), float(f[i])))
     return tuple(out)
 
 

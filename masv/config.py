@@ -7,6 +7,8 @@ Format (every physical value with its unit, parsed by pint; paths relative to th
     modes = "../../fem_data/thrust_structure_modes.npz"   # or "rigid" (no modes)
     damping_ratio = 0.005        # every mode (default, paper sec. 3.3); "file" keeps the file's
     max_frequency = "200 Hz"     # optional: drop modes above this
+    engine_mass_in_modes = false # optional: true when the modes already lump the engines'
+                                 # translational mass at the gimbals (default false: MASV adds it)
     [band]                       # band of interest for notches, coupling and truncation checks
     low = "0.5 Hz"
     high = "20 Hz"
@@ -14,6 +16,8 @@ Format (every physical value with its unit, parsed by pint; paths relative to th
     name = "engine_1"
     model = "../rs25_hotfire.toml"   # taos model file: J_n, K_n, R, K_L, actuator parameters
     gimbal_node = "gimbal_1"         # node of the modal file at the gimbal point
+    cg_offset = ["-1.5 m", "0 m", "0 m"]  # optional: gimbal -> engine c.g. (vehicle frame); default
+                                     # the model's [geometry] engine_cg distance along -x (aft)
     [[actuator]]                 # one per actuator (engine axis)
     name = "actuator_1_pitch"
     engine = "engine_1"
@@ -47,12 +51,36 @@ AXES = ("pitch", "yaw")
 
 @dataclass(frozen=True, eq=False)
 class EngineSpec:
-    """One gimballed engine: its taos model (J_n, K_n and its actuators' parameters) and the
-    modal node at its gimbal."""
+    """One gimballed engine: its taos model (m_e, J_n, K_n and its actuators' parameters), the
+    modal node at its gimbal and ``cg_offset_m``, the vector gimbal -> engine centre of mass in
+    the vehicle frame [m] (None: :func:`engine_cg_offset` derives it from the model)."""
 
     name: str
     model: TvcModel
     gimbal_node: str
+    cg_offset_m: tuple[float, float, float] | None = None
+
+    @property
+    def cg_vector_m(self) -> np.ndarray:
+        """Gimbal -> engine c.g. [m], vehicle frame (:func:`engine_cg_offset` when not given)."""
+        return engine_cg_offset(self.model) if self.cg_offset_m is None else np.asarray(self.cg_offset_m, float)
+
+
+def engine_cg_offset(model: TvcModel) -> np.ndarray:
+    """Gimbal -> engine c.g. in the vehicle frame [m] from the taos model's ``[geometry]
+    engine_cg`` (gimbal frame, z along the engine axis towards the structure): its distance
+    |engine_cg| placed along the engine axis aft, vehicle -x (the engine hangs aft of its
+    gimbal; the shipped files put the c.g. on the engine axis). Zero without ``[geometry]
+    engine_cg``."""
+    geo = model.extra.get("geometry")
+    v = geo.get("engine_cg") if isinstance(geo, Mapping) else None
+    if v is None:
+        return np.zeros(3)
+    if not isinstance(v, list) or len(v) != 3:
+        raise InputError(model.source, "geometry.engine_cg", "a list of three lengths like ['0 m', '0 m', '-1.5 m']",
+                         got=repr(v))
+    c = [to_si(x, "length", source=model.source, field=f"geometry.engine_cg[{i}]") for i, x in enumerate(v)]
+    return np.array([-float(np.linalg.norm(c)), 0.0, 0.0])
 
 
 @dataclass(frozen=True, eq=False)
@@ -168,14 +196,20 @@ def _structure(doc: Mapping, src: str, base: Path) -> ModalStructure:
     st = doc.get("structure")
     if not isinstance(st, Mapping):
         raise InputError(src, "[structure]", "a [structure] table", got="nothing (section missing)")
-    unknown = sorted(set(st) - {"modes", "damping_ratio", "max_frequency"})
+    unknown = sorted(set(st) - {"modes", "damping_ratio", "max_frequency", "engine_mass_in_modes"})
     if unknown:
-        raise InputError(src, f"structure.{unknown[0]}", "one of modes, damping_ratio, max_frequency",
-                         got="an unknown key")
+        raise InputError(src, f"structure.{unknown[0]}", "one of modes, damping_ratio, max_frequency, "
+                         "engine_mass_in_modes", got="an unknown key")
     modes = _str(st, "modes", src, "structure.modes")
     if modes == "rigid":
         return rigid_structure()
     s = load_modes(base / modes)
+    inm = st.get("engine_mass_in_modes", False)
+    if not isinstance(inm, bool):
+        raise InputError(src, "structure.engine_mass_in_modes", "true or false", got=repr(inm))
+    if inm:
+        from dataclasses import replace
+        s = replace(s, engine_mass_in_modes=True)
     z = st.get("damping_ratio", DEFAULT_DAMPING_RATIO)
     if z != "file":
         zeta = to_si(z, "dimensionless", source=src, field="structure.damping_ratio", nonnegative=True)
@@ -214,14 +248,22 @@ def load_config(path) -> MasvConfig:
     cache: dict[Path, TvcModel] = {}
     engines = []
     for i, t in enumerate(etabs):
-        unknown = sorted(set(t) - {"name", "model", "gimbal_node"})
+        unknown = sorted(set(t) - {"name", "model", "gimbal_node", "cg_offset"})
         if unknown:
-            raise InputError(src, f"engine[{i}].{unknown[0]}", "one of name, model, gimbal_node", got="an unknown key")
+            raise InputError(src, f"engine[{i}].{unknown[0]}", "one of name, model, gimbal_node, cg_offset",
+                             got="an unknown key")
         mpath = (base / _str(t, "model", src, f"engine[{i}].model")).resolve()
         if mpath not in cache:
             cache[mpath] = load_model(mpath)
+        cg = None
+        if "cg_offset" in t:
+            v = t["cg_offset"]
+            if not isinstance(v, list) or len(v) != 3:
+                raise InputError(src, f"engine[{i}].cg_offset", "a list of three lengths like ['-1.5 m', '0 m', '0 m']",
+                                 got=repr(v))
+            cg = tuple(to_si(x, "length", source=src, field=f"engine[{i}].cg_offset[{j}]") for j, x in enumerate(v))
         engines.append(EngineSpec(_str(t, "name", src, f"engine[{i}].name"), cache[mpath],
-                                  _str(t, "gimbal_node", src, f"engine[{i}].gimbal_node")))
+                                  _str(t, "gimbal_node", src, f"engine[{i}].gimbal_node"), cg))
     atabs = doc.get("actuator")
     if not isinstance(atabs, list) or not atabs:
         raise InputError(src, "actuator", "one or more [[actuator]] tables", got="none")

@@ -1,8 +1,7 @@
 """Modal model of the core-stage thrust structure seen by the eight TVC actuators.
 
-The elastic structure (core stage thrust structure, gimbal blocks, actuator attach fittings;
-the engines' translational mass lumped at the gimbals, their pitch/yaw rotation left free for
-MASV to add) is represented by its ``n`` normal modes::
+The elastic structure (core stage thrust structure, gimbal blocks, actuator attach fittings)
+is represented by its ``n`` normal modes::
 
     q_i'' + 2 zeta_i w_i q_i' + w_i^2 q_i = phi_i . F          (mass-normalised, M = I)
     u(node, dof) = sum_i phi[i, node, dof] q_i
@@ -12,6 +11,10 @@ the paper's conservative assumption, section 3.3), and ``phi`` the mass-normalis
 at the twelve coupling nodes (four gimbal points, eight actuator attach points): translations
 in m/sqrt(kg), rotations in rad/sqrt(kg), vehicle frame (x along the vehicle axis forward,
 y and z lateral). No modes means a rigid structure.
+
+The engines are MASV's (:mod:`masv.system`): their rotation always, and their translational
+mass m_e at the gimbal unless the modal model already lumps it there
+(``engine_mass_in_modes``; the shipped FEM does not, the synthetic truss does).
 
 File contract (``fem_data/thrust_structure_modes.npz``, with a sidecar ``.toml`` holding its
 provenance): ``freq_hz`` (n,), ``damping_ratio`` (n,), ``node_names`` (12,),
@@ -45,7 +48,10 @@ class ModalStructure:
     ``residual_freq_hz``/``residual_phi``: modes dropped by :meth:`truncated` whose static
     flexibility sum phi phi^T / w^2 [m/N] is kept as a massless compliance (static correction,
     "residual flexibility"; Craig and Kurdila, *Fundamentals of Structural Dynamics*, 2006,
-    sec. 13.3) so that truncation loses only the dropped modes' inertia, not their compliance."""
+    sec. 13.3) so that truncation loses only the dropped modes' inertia, not their compliance.
+
+    ``engine_mass_in_modes``: True when the modes already carry the engines' translational mass
+    lumped at the gimbal nodes (MASV then adds only the engines' rotation and c.g. coupling)."""
 
     freq_hz: np.ndarray
     damping_ratio: np.ndarray
@@ -55,6 +61,7 @@ class ModalStructure:
     source: str = "<code>"
     residual_freq_hz: np.ndarray | None = None
     residual_phi: np.ndarray | None = None
+    engine_mass_in_modes: bool = False
 
     @property
     def n_modes(self) -> int:
@@ -78,7 +85,8 @@ class ModalStructure:
     def with_damping(self, zeta: float) -> "ModalStructure":
         """The same modes with every damping ratio set to ``zeta`` [-]."""
         return ModalStructure(self.freq_hz, np.full_like(self.freq_hz, float(zeta)), self.node_names,
-                              self.node_xyz_m, self.phi, self.source, self.residual_freq_hz, self.residual_phi)
+                              self.node_xyz_m, self.phi, self.source, self.residual_freq_hz, self.residual_phi,
+                              self.engine_mass_in_modes)
 
     def truncated(self, max_freq_hz: float, static_correction: bool = True) -> "ModalStructure":
         """Only the modes at or below ``max_freq_hz`` [Hz]; with ``static_correction`` the
@@ -90,7 +98,7 @@ class ModalStructure:
                                                         else []))
             rp = np.concatenate([self.phi[~keep]] + ([self.residual_phi] if self.residual_phi is not None else []))
         return ModalStructure(self.freq_hz[keep], self.damping_ratio[keep], self.node_names,
-                              self.node_xyz_m, self.phi[keep], self.source, rf, rp)
+                              self.node_xyz_m, self.phi[keep], self.source, rf, rp, self.engine_mass_in_modes)
 
     def translation(self, node: str) -> np.ndarray:
         """(n, 3) translational shapes at ``node`` [m/sqrt(kg)]."""

@@ -40,7 +40,8 @@ def synthetic_structure(n_internal: int = 6, seed: int = 0, *, node_mass_kg: flo
                         rot_stiffness_Nm_per_rad: float = 2.5e9, reach_m: float = 2.2,
                         n_modes: int | None = None, damping_ratio: float = 0.005) -> ModalStructure:
     """Mirror-symmetric lumped truss (module docstring). Gimbal nodes carry the engine's
-    translational mass ``gimbal_mass_kg`` [kg]; spring constants in N/m, N m/rad; ``n_modes``
+    translational mass ``gimbal_mass_kg`` [kg] (``engine_mass_in_modes`` is set: MASV adds only
+    the engines' rotation and c.g. coupling); spring constants in N/m, N m/rad; ``n_modes``
     keeps the lowest modes (all 6 (12 + 4 n_internal) by default)."""
     rng = np.random.default_rng(seed)
     base = layout_xyz()
@@ -75,7 +76,8 @@ def synthetic_structure(n_internal: int = 6, seed: int = 0, *, node_mass_kg: flo
     nk = w2.size if n_modes is None else int(n_modes)
     freq = np.sqrt(np.maximum(w2[:nk], 0.0)) / (2 * np.pi)
     phi = V[:12 * 6, :nk].T.reshape(nk, 12, 6)
-    return ModalStructure(freq, np.full(nk, damping_ratio), NODE_NAMES, base, phi, "<synthetic truss>")
+    return ModalStructure(freq, np.full(nk, damping_ratio), NODE_NAMES, base, phi, "<synthetic truss>",
+                          engine_mass_in_modes=True)
 
 
 def core_stage_specs(models, structure: ModalStructure):

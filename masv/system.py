@@ -1,15 +1,22 @@
-"""The coupled MASV model: four engines, eight actuators, the thrust-structure modes.
+"""The coupled MASV model: four engines, eight actuators, the thrust-structure modes
+(paper sec. 1, "MASV"; the inertial servo-elastic coupling of sec. 3.3).
 
 Pieces (SI)::
 
-    actuator k        taos.actuator.actuator_state_space (inputs x_c, F_L; output x_p)
-    command           x_c,k = R_k theta_c,k                                  [m]
-    load path k       F_L,k = K_L,k (x_p,k - R_k theta_k - e_k)              [N]
-    engine axis k     J_k theta_k'' = R_k F_L,k - K_n,k (theta_k - r_k)      [N m]
-    structure         q'' + 2 Z Om q' + Om^2 q = Phi_c^T f_c                 (modal, M = I)
-    coupling coords   e_k = n_k . (u(gimbal_k) - u(attach_k)) = Phi_e,k q   [m]
-                      r_k = a_k . rot(gimbal_k)               = Phi_r,k q   [rad]
-    coupling forces   f_c = [F_L,k ; K_n,k (theta_k - r_k)]
+    engine axis k     taos.simplex.simplex_state_space(structure_inputs=True): the one simplex
+                      block (actuator, load path, engine axis) with the structure's motion as
+                      inputs and its reactions on the structure as outputs:
+      load path       F_L,k = K_L,k (x_p,k - R_k theta_k - e_k)                          [N]
+      engine axis     J_k theta_k'' = R_k F_L,k - K_n,k (theta_k - r_k) - m_e l_k a_k      [N m]
+      TWD force       f_twd,k = -m_e l_k theta_k''   on the gimbal along d_k               [N]
+    command           x_c,k = R_k theta_c,k                                                [m]
+    structure         q'' + 2 Z Om q' + Om^2 q = Phi_c^T f_c + Phi_G^T f_G     (modal, M = I)
+    coupling coords   e_k = n_k . (u(gimbal_k) - u(attach_k)) = Phi_e,k q                  [m]
+                      r_k = a_k . rot(gimbal_k)               = Phi_r,k q                  [rad]
+                      g_j = u''(gimbal_j)                     = Phi_G,j q''  (3 per engine) [m/s^2]
+                      a_k = d_k . g_j(k)                                                   [m/s^2]
+    coupling forces   f_c = [F_L,k ; K_n,k (theta_k - r_k)],
+                      f_G,j = -m_e,j g_j + sum_{k on j} d_k f_twd,k                        [N]
 
 n_k is the actuator's unit line of action (structure attach -> engine attach) and a_k the engine
 rotation axis of that actuator (rotation about a_k extends it). K_L is the taos model's
@@ -18,24 +25,33 @@ actuator case and attachments), in series with the modal structure. The actuator
 engine (hence, through the gimbal, the gimbal node) along +n_k and the attach node along -n_k;
 the feedline/gravity spring K_n acts between the engine and the structure's gimbal rotation.
 Both follow from the potential 1/2 K_L delta_k^2 + 1/2 K_n (theta_k - r_k)^2, so the
-interconnection is energy-consistent. Each actuator drives one engine axis (pitch and yaw lines
-of action taken orthogonal, as in the simplex model); axis-to-axis and engine-to-engine coupling
-arise only through the structure. Engine translational inertia (tail-wags-dog) is taken to be in
-the modal model (engine mass lumped at the gimbal); the coupling of engine rotation to gimbal
-translation through the engine's centre-of-mass offset is not modelled.
+interconnection is energy-consistent.
+
+Engine inertia (tail wags dog / dog wags tail): engine j, mass m_e, has its centre of mass at
+c_j from the gimbal (:attr:`masv.config.EngineSpec.cg_vector_m`). Turning it by theta_k about
+a_k moves the c.g. by theta_k v_k, v_k = a_k x c_j = l_k d_k (l_k = |v_k| [m], d_k unit). Its
+kinetic energy 1/2 m_e |u_g' + sum_k theta_k' v_k|^2 + 1/2 omega^T I_c omega (axes a_k
+orthogonal to each other and to c_j; J_k = a_k^T (I_c + m_e (|c|^2 - c c^T)) a_k is the model's
+J_n) gives the engine equation above and the force on the gimbal f_G = -m_e (g + sum_k l_k d_k
+theta_k''): the engine is an added mass m_e at the gimbal plus the coupling term. The added mass
+-m_e g is left out when the modal model already lumps the engine's mass at the gimbal
+(``structure.engine_mass_in_modes``, e.g. the synthetic truss). The accelerations g enter
+through the retained modes only (the residual flexibility below is massless).
 
 With no modes the eight engine-axis blocks are independent and each is the planar simplex model
 (taos.simplex), the reduction checked by the tests.
 
 Two views of the one model: :meth:`MasvSystem.state_space` assembles the whole as one
-:class:`taos.linear.StateSpace` (eigenvalues, the naive reference response) and
+:class:`taos.linear.StateSpace` (eigenvalues, the naive reference response; the gimbal
+accelerations make the modal mass I + Phi_G^T M_eff Phi_G, inverted once) and
 :meth:`MasvSystem.frf` computes the same frequency response by block elimination: the
-structure's receptance at the coupling coordinates, R(s) = Phi_c diag(1/(s^2 + 2 zeta w s +
-w^2)) Phi_c^T, costs O(n m^2) per frequency because the modal part is diagonal, and the engine
-blocks are small and independent; closing f_c = G_fu u + G_fc u_c, u_c = R f_c leaves an m x m
-solve per frequency (m = 2 x actuators). Modes dropped by truncation may leave their static
-flexibility g_res (a massless compliance in series, "static correction"): u_c = Phi_c q + g_res f_c,
-i.e. R(s) + g_res in the frequency domain.
+structure's receptance at the coupling coordinates, R(s) = W(s) Phi diag(1/(s^2 + 2 zeta w s +
+w^2)) Phi^T with Phi = [Phi_c; Phi_G] and W = diag(1, .., s^2, ..) (accelerations), costs
+O(n m^2) per frequency because the modal part is diagonal, and the engine blocks are small and
+independent; closing f_c = G_fu u + G_fc u_c, u_c = R f_c leaves an m x m solve per frequency
+(m = 2 x actuators + 3 x engines). Modes dropped by truncation may leave their static
+flexibility g_res (a massless compliance in series, "static correction"): u_c = Phi_c q +
+g_res f_c for e and r, i.e. R(s) + g_res in the frequency domain.
 """
 
 from __future__ import annotations
@@ -45,61 +61,33 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from taos.actuator import actuator_state_space
 from taos.linear import StateSpace
 from taos.model import TvcModel
+from taos.simplex import simplex_state_space
 
 from .config import MasvConfig
 from .structure import ModalStructure
 
-BLOCK_INPUTS = ("command_rad", "elongation_m", "gimbal_rotation_rad")
-BLOCK_OUTPUTS = ("x_p_m", "theta_rad", "f_load_N", "spring_torque_Nm")
+BLOCK_INPUTS = ("command_rad", "elongation_m", "gimbal_rotation_rad", "gimbal_accel_m_s2")
+BLOCK_OUTPUTS = ("x_p_m", "theta_rad", "load_force_N", "spring_torque_Nm", "twd_force_N")
+_IN = {n: i for i, n in enumerate(BLOCK_INPUTS)}
+_OUT = {n: i for i, n in enumerate(BLOCK_OUTPUTS)}
 
 
-def engine_axis_block(model: TvcModel, axis: str) -> StateSpace:
-    """One actuator driving one engine axis, with the structure's motion as inputs.
+def engine_axis_block(model: TvcModel, axis: str, engine_cg_offset_m: float = 0.0) -> StateSpace:
+    """One actuator driving one engine axis, with the structure's motion as inputs: the simplex
+    block :func:`taos.simplex.simplex_state_space` (``structure_inputs=True``), friction input
+    left at zero.
 
     Inputs: ``command_rad`` theta_c [rad] (x_c = R theta_c), ``elongation_m`` e [m] (structure
-    motion along the line of action, gimbal minus attach point), ``gimbal_rotation_rad`` r [rad].
-    Outputs: ``x_p_m``, ``theta_rad``, ``f_load_N`` = K_L (x_p - R theta - e),
-    ``spring_torque_Nm`` = K_n (theta - r). States: the actuator's, ``theta_rad``, ``omega_rad_s``.
-    With e = r = 0 it is taos.simplex.simplex_state_space (the friction input left at zero).
-    """
-    act = actuator_state_space(model.actuator)
-    R = model.actuator.moment_arm_m
-    KL = model.structure.load_stiffness_N_per_m
-    Kn = model.engine.rotational_stiffness_Nm_per_rad
-    J = model.engine.inertia(axis)
-    na = len(act.states)
-    n = na + 2
-    ith, iom = na, na + 1
-    bf = act.B[:, act.input_index("f_load_N")]
-    bx = act.B[:, act.input_index("x_c_m")]
-    cxp = act.C[act.output_index("x_p_m")]
-    fl = np.zeros(n)                     # F_L row over the state (e enters through D)
-    fl[:na] = KL * cxp
-    fl[ith] = -KL * R
-    tq = R * fl                          # torque on the engine about its axis
-    tq[ith] -= Kn
-    A = np.zeros((n, n))
-    A[:na, :na] = act.A
-    A[:na, :] += np.outer(bf, fl)
-    A[ith, iom] = 1.0
-    A[iom, :] = tq / J
-    B = np.zeros((n, 3))
-    B[:na, 0] = bx * R
-    B[:na, 1] = -KL * bf
-    B[iom, 1] = -R * KL / J
-    B[iom, 2] = Kn / J
-    C = np.zeros((4, n))
-    C[0, :na] = cxp
-    C[1, ith] = 1.0
-    C[2] = fl
-    C[3, ith] = Kn
-    D = np.zeros((4, 3))
-    D[2, 1] = -KL
-    D[3, 2] = -Kn
-    return StateSpace(A, B, C, D, tuple(act.states) + ("theta_rad", "omega_rad_s"), BLOCK_INPUTS, BLOCK_OUTPUTS)
+    motion along the line of action, gimbal minus attach point), ``gimbal_rotation_rad`` r [rad],
+    ``gimbal_accel_m_s2`` a [m/s^2] (gimbal acceleration along d). Outputs: ``x_p_m``,
+    ``theta_rad``, ``load_force_N`` = K_L (x_p - R theta - e), ``spring_torque_Nm`` =
+    K_n (theta - r), ``twd_force_N`` = -m_e l_e theta'' [N]. ``engine_cg_offset_m`` l_e [m]."""
+    ss = simplex_state_space(model, axis, structure_inputs=True, engine_cg_offset_m=engine_cg_offset_m)
+    ii = [ss.input_index(n) for n in BLOCK_INPUTS]
+    oo = [ss.output_index(n) for n in BLOCK_OUTPUTS]
+    return StateSpace(ss.A, ss.B[:, ii], ss.C[oo], ss.D[np.ix_(oo, ii)], ss.states, BLOCK_INPUTS, BLOCK_OUTPUTS)
 
 
 def coupling_shapes(cfg: MasvConfig, phi: np.ndarray | None = None) -> np.ndarray:
@@ -119,6 +107,30 @@ def coupling_shapes(cfg: MasvConfig, phi: np.ndarray | None = None) -> np.ndarra
         phi_c[k] = (phi[:, g, 0:3] - phi[:, at, 0:3]) @ np.asarray(a.direction)
         phi_c[na + k] = phi[:, g, 3:6] @ np.asarray(a.rotation_axis)
     return phi_c
+
+
+def gimbal_shapes(cfg: MasvConfig) -> np.ndarray:
+    """Phi_G (3 n_eng, n_modes): translations of each engine's gimbal node [m/sqrt(kg)], engine
+    order, vehicle x, y, z."""
+    st = cfg.structure
+    out = np.zeros((3 * len(cfg.engines), st.n_modes))
+    if st.n_modes:
+        for j, e in enumerate(cfg.engines):
+            out[3 * j:3 * j + 3] = st.phi[:, st.node_index(e.gimbal_node), 0:3].T
+    return out
+
+
+def cg_lever_arms(cfg: MasvConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Per actuator k: l_k = |a_k x c| [m] and the unit direction d_k (n_act, 3) of the engine
+    c.g.'s motion for a positive theta_k (zero where l_k = 0); c the engine's c.g. offset."""
+    na = len(cfg.actuators)
+    arms, dirs = np.zeros(na), np.zeros((na, 3))
+    for k, a in enumerate(cfg.actuators):
+        v = np.cross(np.asarray(a.rotation_axis, float), cfg.engine(a.engine).cg_vector_m)
+        arms[k] = float(np.linalg.norm(v))
+        if arms[k] > 0:
+            dirs[k] = v / arms[k]
+    return arms, dirs
 
 
 def residual_flexibility(cfg: MasvConfig) -> np.ndarray:
@@ -152,10 +164,13 @@ class MasvSystem:
     """The assembled MASV model (see the module docstring for the equations).
 
     ``blocks[k]`` is actuator k's engine-axis block (:func:`engine_axis_block`), ``moment_arms_m``
-    R_k [m], ``phi_c`` the coupling shapes (:func:`coupling_shapes`), ``omega_rad_s`` and
-    ``zeta`` the modal frequencies [rad/s] and damping ratios [-], ``g_res`` the residual
-    flexibility of truncated modes at the coupling coordinates (:func:`residual_flexibility`),
-    a massless compliance in series: u_c = Phi_c q + g_res f_c.
+    R_k [m], ``phi_c`` the coupling shapes (:func:`coupling_shapes`), ``phi_g`` the gimbal
+    translations (:func:`gimbal_shapes`), ``engine_of`` the engine index of each actuator,
+    ``cg_dirs`` the unit directions d_k (n_act, 3), ``added_mass_kg`` the mass each engine adds
+    at its gimbal (m_e, or 0 when the modes already hold it), ``omega_rad_s`` and ``zeta`` the
+    modal frequencies [rad/s] and damping ratios [-], ``g_res`` the residual flexibility of
+    truncated modes at the coupling coordinates (:func:`residual_flexibility`), a massless
+    compliance in series: u_c = Phi_c q + g_res f_c.
     """
 
     config: MasvConfig
@@ -165,6 +180,10 @@ class MasvSystem:
     omega_rad_s: np.ndarray
     zeta: np.ndarray
     g_res: np.ndarray
+    phi_g: np.ndarray
+    engine_of: np.ndarray
+    cg_dirs: np.ndarray
+    added_mass_kg: np.ndarray
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -175,6 +194,16 @@ class MasvSystem:
     def n_actuators(self) -> int:
         return len(self.blocks)
 
+    @property
+    def n_coupling(self) -> int:
+        """m = 2 n_act + 3 n_eng coupling coordinates [e; r; g]."""
+        return 2 * self.n_actuators + self.phi_g.shape[0]
+
+    def _gcols(self, k: int) -> slice:
+        """Columns of actuator k's engine gimbal acceleration in the coupling coordinates."""
+        o = 2 * self.n_actuators + 3 * int(self.engine_of[k])
+        return slice(o, o + 3)
+
     # -- the whole as one state space ---------------------------------------------------------
     def state_space(self) -> StateSpace:
         """One StateSpace of the whole: states [each block's states, q, q'], inputs the eight
@@ -182,8 +211,8 @@ class MasvSystem:
         ``<actuator>.theta_rad`` (all eight position loops closed)."""
         if "ss" in self._cache:
             return self._cache["ss"]
-        na, nm = self.n_actuators, self.omega_rad_s.size
-        m = 2 * na
+        na, nm, ng = self.n_actuators, self.omega_rad_s.size, self.phi_g.shape[0]
+        md = 2 * na
         sizes = [b.A.shape[0] for b in self.blocks]
         off = np.concatenate([[0], np.cumsum(sizes)])
         nb = int(off[-1])
@@ -191,41 +220,65 @@ class MasvSystem:
         A = np.zeros((N, N))
         B = np.zeros((N, na))
         C = np.zeros((2 * na, N))
-        Bc = np.zeros((nb, m))        # block state rates per coupling coordinate
-        Cf = np.zeros((m, nb))        # coupling forces from block states
-        Dfc = np.zeros((m, m))        # coupling forces directly from coupling coordinates
-        ie, ir = BLOCK_INPUTS.index("elongation_m"), BLOCK_INPUTS.index("gimbal_rotation_rad")
-        of, ot = BLOCK_OUTPUTS.index("f_load_N"), BLOCK_OUTPUTS.index("spring_torque_Nm")
+        Bc = np.zeros((nb, md))       # block state rates per coupling coordinate e, r
+        Ba = np.zeros((nb, ng))       # ... per gimbal acceleration
+        Cf = np.zeros((md, nb))       # coupling forces F_L, K_n (theta - r) from block states
+        Dfc = np.zeros((md, md))      # ... directly from e, r
+        Ct = np.zeros((ng, nb))       # gimbal forces f_G from block states
+        Dtu = np.zeros((ng, na))      # ... from the commands
+        Dtc = np.zeros((ng, md))      # ... from e, r
+        Dtg = -np.diag(np.repeat(self.added_mass_kg, 3))   # ... from the gimbal accelerations
+        ic, ie, ir, ia = _IN["command_rad"], _IN["elongation_m"], _IN["gimbal_rotation_rad"], _IN["gimbal_accel_m_s2"]
+        of, ot, otw = _OUT["load_force_N"], _OUT["spring_torque_Nm"], _OUT["twd_force_N"]
         for k, b in enumerate(self.blocks):
             sl = slice(off[k], off[k + 1])
+            gs = slice(3 * int(self.engine_of[k]), 3 * int(self.engine_of[k]) + 3)
+            d = self.cg_dirs[k]
             A[sl, sl] = b.A
-            B[sl, k] = b.B[:, 0]
-            C[k, sl] = b.C[0]
-            C[na + k, sl] = b.C[1]
+            B[sl, k] = b.B[:, ic]
+            C[k, sl] = b.C[_OUT["x_p_m"]]
+            C[na + k, sl] = b.C[_OUT["theta_rad"]]
             Bc[sl, k] = b.B[:, ie]
             Bc[sl, na + k] = b.B[:, ir]
+            Ba[sl, gs] = np.outer(b.B[:, ia], d)
             Cf[k, sl] = b.C[of]
             Cf[na + k, sl] = b.C[ot]
             Dfc[k, k] = b.D[of, ie]
             Dfc[na + k, na + k] = b.D[ot, ir]
+            Ct[gs, sl] += np.outer(d, b.C[otw])
+            Dtu[gs, k] += d * b.D[otw, ic]
+            Dtc[gs, k] += d * b.D[otw, ie]
+            Dtc[gs, na + k] += d * b.D[otw, ir]
+            Dtg[gs, gs] += b.D[otw, ia] * np.outer(d, d)
         # coupling coordinates as a row map over the state: u_c = Phi_c q + g_res f_c with
         # f_c = Cf x_b + Dfc u_c, i.e. u_c = W (Phi_c q + g_res Cf x_b), W = (I - g_res Dfc)^-1
-        U = np.zeros((m, N))
-        W = np.linalg.inv(np.eye(m) - self.g_res @ Dfc)
+        U = np.zeros((md, N))
+        W = np.linalg.inv(np.eye(md) - self.g_res @ Dfc)
         U[:, :nb] = W @ self.g_res @ Cf
         if nm:
             U[:, nb:nb + nm] = W @ self.phi_c
-        Fc = np.zeros((m, N))
+        Fc = np.zeros((md, N))
         Fc[:, :nb] = Cf
         Fc += Dfc @ U
         A[:nb] += Bc @ U
         if nm:
             iq = slice(nb, nb + nm)
             iv = slice(nb + nm, N)
+            # S q'' = Qx X + Qu u with g = Phi_G q'' and f_G = Ct x_b + Dtu u + Dtc u_c + Dtg g
+            Ft = np.zeros((ng, N))
+            Ft[:, :nb] = Ct
+            Ft += Dtc @ U
+            Qx = self.phi_c.T @ Fc + self.phi_g.T @ Ft
+            Qx[:, iq] -= np.diag(self.omega_rad_s ** 2)
+            Qx[:, iv] -= np.diag(2.0 * self.zeta * self.omega_rad_s)
+            Qu = self.phi_g.T @ Dtu
+            S = np.eye(nm) - self.phi_g.T @ Dtg @ self.phi_g
+            Qx, Qu = np.linalg.solve(S, Qx), np.linalg.solve(S, Qu)
             A[iq, iv] = np.eye(nm)
-            A[iv] += self.phi_c.T @ Fc
-            A[iv, iq] -= np.diag(self.omega_rad_s ** 2)
-            A[iv, iv] -= np.diag(2.0 * self.zeta * self.omega_rad_s)
+            A[iv] += Qx
+            B[iv] += Qu
+            A[:nb] += Ba @ self.phi_g @ Qx
+            B[:nb] += Ba @ self.phi_g @ Qu
         names = self.actuator_names
         states = tuple(f"{names[k]}.{s}" for k, b in enumerate(self.blocks) for s in b.states) + tuple(
             f"mode_{i + 1}.q" for i in range(nm)) + tuple(f"mode_{i + 1}.qdot" for i in range(nm))
@@ -236,38 +289,63 @@ class MasvSystem:
 
     # -- fast exact frequency response --------------------------------------------------------
     def receptance(self, freq_hz) -> np.ndarray:
-        """Structure receptance at the coupling coordinates, (F, m, m): u_c = R(j w) f_c."""
+        """Structure receptance at the coupling coordinates, (F, m, m): u_c = R(j w) f_c with
+        u_c = [e; r; g] (g gimbal accelerations, hence the factor s^2 on their rows) and
+        f_c = [F_L; K_n (theta - r); f_G]."""
         f = np.atleast_1d(np.asarray(freq_hz, float))
         w = 2.0 * np.pi * f
         om = self.omega_rad_s
         h = 1.0 / (om[None] ** 2 - w[:, None] ** 2 + 2j * self.zeta[None] * om[None] * w[:, None])
-        P = self.phi_c
-        return (P[None] * h[:, None, :]) @ P.T + self.g_res[None]
+        P = np.vstack([self.phi_c, self.phi_g])
+        md = 2 * self.n_actuators
+        R = (P[None] * h[:, None, :]) @ P.T
+        R[:, md:, :] *= -(w ** 2)[:, None, None]
+        R[:, :md, :md] += self.g_res[None]
+        return R
+
+    def _pieces(self, f: np.ndarray):
+        """Frequency-domain pieces of the block elimination: (Gyu, Gyc, Gfu, Gfc, Gtw) with
+        y = Gyu u + Gyc u_c, f_c = Gfu u + Gfc u_c, and Gtw (F, n_act, m) each block's own
+        TWD-force response to the coupling coordinates (for loop breaks)."""
+        s = 2j * np.pi * f
+        na, m, F = self.n_actuators, self.n_coupling, f.size
+        Gyu = np.zeros((F, 2 * na, na), complex)
+        Gyc = np.zeros((F, 2 * na, m), complex)
+        Gfu = np.zeros((F, m, na), complex)
+        Gfc = np.zeros((F, m, m), complex)
+        Gtw = np.zeros((F, na, m), complex)
+        md = 2 * na
+        for j in range(self.phi_g.shape[0] // 3):
+            Gfc[:, md + 3 * j:md + 3 * j + 3, md + 3 * j:md + 3 * j + 3] -= self.added_mass_kg[j] * np.eye(3)
+        for k, b in enumerate(self.blocks):
+            g = _block_frd(b, s)               # (F, 5 outputs, 4 inputs)
+            gs, d = self._gcols(k), self.cg_dirs[k]
+
+            def row(o, g=g, gs=gs, d=d, k=k):
+                r = np.zeros((F, m), complex)
+                r[:, k] = g[:, o, 1]
+                r[:, na + k] = g[:, o, 2]
+                r[:, gs] = g[:, o, 3][:, None] * d[None]
+                return r
+            for ry, o in ((k, _OUT["x_p_m"]), (na + k, _OUT["theta_rad"])):
+                Gyu[:, ry, k] = g[:, o, 0]
+                Gyc[:, ry] = row(o)
+            for rf, o in ((k, _OUT["load_force_N"]), (na + k, _OUT["spring_torque_Nm"])):
+                Gfu[:, rf, k] = g[:, o, 0]
+                Gfc[:, rf] += row(o)
+            tw = row(_OUT["twd_force_N"])
+            Gtw[:, k] = tw
+            Gfu[:, gs, k] += g[:, _OUT["twd_force_N"], 0][:, None] * d[None]
+            Gfc[:, gs] += d[None, :, None] * tw[:, None, :]
+        return Gyu, Gyc, Gfu, Gfc, Gtw
 
     def frf(self, freq_hz) -> tuple[np.ndarray, np.ndarray]:
         """Exact responses by block elimination (module docstring): returns
         ``x_p`` (F, n_act, n_act) [m/rad] and ``theta`` (F, n_act, n_act) [rad/rad],
         element [f, i, j] from command j to output i."""
         f = np.atleast_1d(np.asarray(freq_hz, float))
-        s = 2j * np.pi * f
-        na = self.n_actuators
-        m = 2 * na
-        F = f.size
-        Gyu = np.zeros((F, 2 * na, na), complex)
-        Gyc = np.zeros((F, 2 * na, m), complex)
-        Gfu = np.zeros((F, m, na), complex)
-        Gfc = np.zeros((F, m, m), complex)
-        for k, b in enumerate(self.blocks):
-            g = _block_frd(b, s)               # (F, 4 outputs, 3 inputs)
-            rows_y, rows_f, cols_c = (k, na + k), (k, na + k), (k, na + k)
-            for a, ry in enumerate(rows_y):
-                Gyu[:, ry, k] = g[:, a, 0]
-                Gyc[:, ry, cols_c[0]] = g[:, a, 1]
-                Gyc[:, ry, cols_c[1]] = g[:, a, 2]
-            for a, rf in enumerate(rows_f):
-                Gfu[:, rf, k] = g[:, 2 + a, 0]
-                Gfc[:, rf, cols_c[0]] = g[:, 2 + a, 1]
-                Gfc[:, rf, cols_c[1]] = g[:, 2 + a, 2]
+        na, m = self.n_actuators, self.n_coupling
+        Gyu, Gyc, Gfu, Gfc, _ = self._pieces(f)
         if self.omega_rad_s.size or np.any(self.g_res):
             R = self.receptance(f)
             fc = np.linalg.solve(np.eye(m)[None] - Gfc @ R, Gfu)
@@ -275,6 +353,32 @@ class MasvSystem:
         else:
             Y = Gyu
         return Y[:, :na, :], Y[:, na:, :]
+
+    def tvse_loop(self, freq_hz, actuator: int | None = None) -> np.ndarray:
+        """Thrust Vector Servo Elastic (TVSE) loop of actuator index ``actuator``, (F,) complex,
+        or of every actuator (F, n_act) when None: the loop broken at that engine axis's
+        inertial coupling into the structure (paper sec. 3.3: "an open loop break between the
+        flexible body dynamics and the nozzle inertial coupling (DWT/TWD interface)"). A force
+        f on the gimbal along d_k drives the structure with everything else closed (all
+        position loops at zero command, the other axes' TWD forces, the load paths, the engines'
+        added mass); the broken block's own response to that motion is its TWD force f_twd,k.
+        L = -f_twd,k / f (the loop closes positively through f = f_twd,k, so 1 + L = 0 is the
+        critical point of :func:`masv.analysis.margins_from_loop`). Zero on a rigid structure
+        or with no c.g. offset."""
+        f = np.atleast_1d(np.asarray(freq_hz, float))
+        m, na = self.n_coupling, self.n_actuators
+        ks = range(na) if actuator is None else [actuator]
+        out = np.zeros((f.size, len(ks)), complex)
+        if self.omega_rad_s.size:
+            _, _, _, Gfc, Gtw = self._pieces(f)
+            R = self.receptance(f)
+            for i, k in enumerate(ks):
+                inj = np.zeros(m)                       # d_k at the broken engine's gimbal force rows
+                inj[self._gcols(k)] = self.cg_dirs[k]
+                Gk = Gfc - inj[None, :, None] * Gtw[:, k][:, None, :]   # cut f_twd,k out of f_G
+                uc = np.linalg.solve(np.eye(m)[None] - R @ Gk, (R @ inj)[..., None])[..., 0]
+                out[:, i] = -np.einsum("fm,fm->f", Gtw[:, k], uc)
+        return out if actuator is None else out[:, 0]
 
     def frf_dense(self, freq_hz) -> tuple[np.ndarray, np.ndarray]:
         """The same responses by a naive dense solve of (j w I - A) per frequency on the whole
@@ -297,12 +401,16 @@ def build_system(cfg: MasvConfig, structure: ModalStructure | None = None) -> Ma
     if structure is not None:
         from dataclasses import replace
         cfg = replace(cfg, structure=structure)
+    arms_cg, dirs = cg_lever_arms(cfg)
+    eidx = {e.name: j for j, e in enumerate(cfg.engines)}
     blocks = []
     arms = []
-    for a in cfg.actuators:
+    for k, a in enumerate(cfg.actuators):
         model = cfg.engine(a.engine).model
-        blocks.append(engine_axis_block(model, a.axis))
+        blocks.append(engine_axis_block(model, a.axis, float(arms_cg[k])))
         arms.append(model.actuator.moment_arm_m)
     st = cfg.structure
+    added = np.array([0.0 if st.engine_mass_in_modes else e.model.engine.mass_kg for e in cfg.engines])
     return MasvSystem(cfg, tuple(blocks), np.asarray(arms), coupling_shapes(cfg), st.omega_rad_s.copy(),
-                      st.damping_ratio.copy(), residual_flexibility(cfg))
+                      st.damping_ratio.copy(), residual_flexibility(cfg), gimbal_shapes(cfg),
+                      np.array([eidx[a.engine] for a in cfg.actuators]), dirs, added)

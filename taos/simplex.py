@@ -9,7 +9,26 @@ Equations (SI), built from the actuator state space of :mod:`taos.actuator`::
     T_f = friction(theta', z, T_app),  T_app = R F_L - K_n theta
 
 The load resonance w_L = sqrt((K_L R^2 + K_n)/J_n) (paper eq. 1) is the notch of the
-command -> piston response. Two views of one model: :func:`simplex_plant` gives the linear
+command -> piston response.
+
+On an elastic structure (MASV, paper sec. 1 and 3.3) the same block takes the structure's
+motion as inputs and returns the reactions on the structure (``structure_inputs=True``)::
+
+    F_L = K_L (x_p - R theta - e)          e  structure elongation along the line of action
+                                              (gimbal point minus actuator attach point) [m]
+    J_n theta'' = R F_L - K_n (theta - r) - T_f - m_e l_e a_g
+                                           r  structure rotation at the gimbal [rad]
+                                           a_g gimbal-point acceleration along d = a x c/|c| [m/s^2]
+    reactions on the structure: F_L (along the line of action), K_n (theta - r) (about the
+    engine axis at the gimbal), f_twd = -m_e l_e theta'' (at the gimbal along d)
+
+theta is the engine's inertial angle, m_e its mass and l_e the distance of its centre of mass
+from the gimbal (perpendicular to the rotation axis a). The engine's kinetic energy
+1/2 m_e (u_d' + l_e theta')^2 + 1/2 I_c theta'^2 (J_n = I_c + m_e l_e^2) gives both inertial
+couplings: "dog wags tail" (the gimbal's acceleration turns the engine, - m_e l_e a_g) and
+"tail wags dog" (the engine's angular acceleration loads the structure, - m_e l_e theta'').
+The rigid-translation part - m_e a_g of the engine's inertia is left to the structure model
+(MASV adds it as a mass at the gimbal). With e = r = a_g = 0 the block is the planar one. Two views of one model: :func:`simplex_plant` gives the linear
 block (exact frequency response, poles), and :mod:`taos.simulate` integrates the same block
 with the friction and avionics nonlinearities closed around it.
 """
@@ -26,6 +45,10 @@ from .model import TvcModel
 
 #: Outputs of the simplex linear block, in order.
 SIMPLEX_OUTPUTS = ("x_p_m", "theta_rad", "omega_rad_s", "applied_torque_Nm", "load_force_N", "p_load_Pa")
+#: Inputs appended with ``structure_inputs=True``: the structure's motion at the engine.
+STRUCTURE_INPUTS = ("elongation_m", "gimbal_rotation_rad", "gimbal_accel_m_s2")
+#: Outputs appended with ``structure_inputs=True``: reactions on the structure.
+STRUCTURE_OUTPUTS = ("spring_torque_Nm", "twd_force_N")
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,12 +75,20 @@ class LurePlant:
         return self.ss.inputs[: self.n_ext]
 
 
-def simplex_state_space(model: TvcModel, axis: str = "pitch") -> StateSpace:
+def simplex_state_space(model: TvcModel, axis: str = "pitch", *, structure_inputs: bool = False,
+                        engine_cg_offset_m: float = 0.0) -> StateSpace:
     """Linear simplex block for one axis.
 
     Inputs: ``command_rad`` (engine-angle command after the avionics), ``friction_torque_Nm``.
     Outputs: :data:`SIMPLEX_OUTPUTS`. States: the actuator states, ``theta_rad``, ``omega_rad_s``.
     Parameters may be CasADi SX expressions (fits); the matrices are then SX.
+
+    ``structure_inputs=True`` (an elastic structure; module docstring) appends the inputs
+    :data:`STRUCTURE_INPUTS` (e [m], r [rad], a_g [m/s^2]) and the outputs
+    :data:`STRUCTURE_OUTPUTS` (K_n (theta - r) [N m], f_twd = -m_e l_e theta'' [N]);
+    ``load_force_N`` and ``applied_torque_Nm`` then include e and r. ``engine_cg_offset_m`` is
+    l_e [m], the engine c.g.'s distance from the gimbal perpendicular to the rotation axis
+    (m_e is ``model.engine.mass_kg``).
     """
     act = actuator_state_space(model.actuator)
     R = model.actuator.moment_arm_m
@@ -99,8 +130,39 @@ def simplex_state_space(model: TvcModel, axis: str = "pitch") -> StateSpace:
     C[4] = fl
     C[5, :na] = actC[act.output_index("p_load_Pa")]
     states = tuple(act.states) + ("theta_rad", "omega_rad_s")
+    if structure_inputs:
+        return _with_structure_inputs(A, B, C, states, bf, R, KL, Kn, J,
+                                      model.engine.mass_kg * engine_cg_offset_m, na, sym)
     return StateSpace(finish(A, sym), finish(B, sym), finish(C, sym), finish(zeros((C.shape[0], 2), sym), sym),
                       states, ("command_rad", "friction_torque_Nm"), SIMPLEX_OUTPUTS)
+
+
+def _with_structure_inputs(A, B, C, states, bf, R, KL, Kn, J, ml, na, sym) -> StateSpace:
+    """Append the structure-motion inputs and the reaction outputs (module docstring) to the
+    planar block (A, B, C; ``bf`` the actuator's load-force input column, ``ml`` = m_e l_e
+    [kg m])."""
+    n = A.shape[0]
+    ith, iom = na, na + 1
+    # dF_L/de = -K_L; d(applied)/de = -R K_L, d(applied)/dr = K_n; the engine also feels -m_e l_e a_g
+    B2 = zeros((n, 5), sym)
+    B2[:, :2] = B
+    B2[:na, 2] = [-KL * b for b in bf]
+    B2[iom, 2] = -R * KL / J
+    B2[iom, 3] = Kn / J
+    B2[iom, 4] = -ml / J
+    C2 = zeros((C.shape[0] + 2, n), sym)
+    C2[:C.shape[0]] = C
+    C2[-2, ith] = Kn
+    C2[-1, :] = [-ml * a for a in A[iom, :]]              # f_twd = -m_e l_e theta''
+    D2 = zeros((C2.shape[0], 5), sym)
+    ia, il = SIMPLEX_OUTPUTS.index("applied_torque_Nm"), SIMPLEX_OUTPUTS.index("load_force_N")
+    D2[ia, 2] = -R * KL
+    D2[ia, 3] = Kn
+    D2[il, 2] = -KL
+    D2[-2, 3] = -Kn
+    D2[-1, :] = [-ml * b for b in B2[iom, :]]
+    return StateSpace(finish(A, sym), finish(B2, sym), finish(C2, sym), finish(D2, sym), states,
+                      ("command_rad", "friction_torque_Nm") + STRUCTURE_INPUTS, SIMPLEX_OUTPUTS + STRUCTURE_OUTPUTS)
 
 
 def simplex_plant(model: TvcModel, axis: str = "pitch") -> LurePlant:

@@ -87,9 +87,12 @@ def test_modal_spring_in_series_with_load_stiffness(hotfire):
     assert notch == pytest.approx(an.notch_frequencies(one_engine(series))["actuator_1_pitch"]["notch_hz"], rel=1e-3)
 
 
-def test_block_elimination_equals_dense_state_space(hotfire, sym_structure):
-    e, a = core_stage_specs(hotfire, sym_structure)
-    s = build_system(make_config(e, a, sym_structure.truncated(40.0)))   # with static correction
+@pytest.mark.parametrize("mass_in_modes", [True, False])
+def test_block_elimination_equals_dense_state_space(hotfire, sym_structure, mass_in_modes):
+    """Also with the engines' mass added at the gimbals (the modal mass matrix is then full)."""
+    st = dataclasses.replace(sym_structure.truncated(40.0), engine_mass_in_modes=mass_in_modes)
+    e, a = core_stage_specs(hotfire, st)
+    s = build_system(make_config(e, a, st))   # with static correction
     f = np.array([0.3, 3.0, 7.0, 8.5, 15.0, 33.0])
     xp, th = s.frf(f)
     xd, td = s.frf_dense(f)
