@@ -314,13 +314,15 @@ def actuator_bandwidth_hz(model, axis: str = "pitch") -> float:
 
 @dataclass(frozen=True, eq=False)
 class ModeParticipation:
-    """Modes within [bandwidth / factor, bandwidth * factor]. For each mode i and actuator k:
-    ``phi_e[i, k]`` the mode's elongation shape along the line of action [m/sqrt(kg)] and
-    ``compliance_ratio[i, k]`` = K_L,k phi_e^2 / w_i^2, the static compliance the mode adds in
-    series with the load path relative to 1/K_L (0.1 = 10 % softer load path)."""
+    """The structure's modes within ``band_hz`` [Hz] (the configuration's band of interest, or
+    [bandwidth / factor, bandwidth * factor] around the actuator bandwidth). For each mode i and
+    actuator k: ``phi_e[i, k]`` the mode's elongation shape along the line of action
+    [m/sqrt(kg)] and ``compliance_ratio[i, k]`` = K_L,k phi_e^2 / w_i^2, the static compliance
+    the mode adds in series with the load path relative to 1/K_L (0.1 = 10 % softer load
+    path). ``factor`` is None for the configuration's band."""
 
     bandwidth_hz: float
-    factor: float
+    factor: float | None
     actuators: tuple[str, ...]
     mode_index: np.ndarray
     freq_hz: np.ndarray
@@ -328,10 +330,14 @@ class ModeParticipation:
     phi_e: np.ndarray
     compliance_ratio: np.ndarray
     n_modes_total: int
+    band_hz: tuple[float, float] = (0.0, math.inf)
+
+    @property
+    def band_source(self) -> str:
+        return "config [band]" if self.factor is None else f"actuator bandwidth x/÷ {self.factor:g}"
 
     def to_dict(self) -> dict:
-        return {"bandwidth_hz": self.bandwidth_hz, "band_hz": [self.bandwidth_hz / self.factor,
-                                                               self.bandwidth_hz * self.factor],
+        return {"bandwidth_hz": self.bandwidth_hz, "band_hz": list(self.band_hz), "band_source": self.band_source,
                 "n_modes_total": self.n_modes_total, "actuators": list(self.actuators),
                 "modes": [{"mode": int(self.mode_index[i]) + 1, "freq_hz": float(self.freq_hz[i]),
                            "damping_ratio": float(self.damping_ratio[i]),
@@ -341,20 +347,43 @@ class ModeParticipation:
                           for i in range(self.freq_hz.size)]}
 
 
-def modes_near_bandwidth(system: MasvSystem, factor: float = 2.0) -> ModeParticipation:
-    """Structural modes near the actuator bandwidth (median of the actuators' simplex -3 dB
-    frequencies) and their participation at the actuator attach points."""
+def median_actuator_bandwidth_hz(system: MasvSystem) -> float:
+    """Median over the actuators of :func:`actuator_bandwidth_hz` [Hz] (each model/axis once)."""
     cfg = system.config
-    bws = [actuator_bandwidth_hz(cfg.engine(a.engine).model, a.axis) for a in cfg.actuators]
-    bw = float(np.median(bws))
+    seen: dict = {}
+    for a in cfg.actuators:
+        m = cfg.engine(a.engine).model
+        key = (id(m), a.axis)
+        if key not in seen:
+            seen[key] = actuator_bandwidth_hz(m, a.axis)
+    return float(np.median([seen[(id(cfg.engine(a.engine).model), a.axis)] for a in cfg.actuators]))
+
+
+def modes_in_band(system: MasvSystem, band_hz: tuple[float, float] | None = None,
+                  factor: float | None = None, bandwidth_hz: float | None = None) -> ModeParticipation:
+    """The structure's modes in ``band_hz`` [Hz] (default: the configuration's ``[band]``) and
+    their participation at the actuator attach points (:class:`ModeParticipation`); ``factor``
+    only labels a band built around the actuator bandwidth (the median of the actuators'
+    simplex -3 dB frequencies, reported in either case; computed unless ``bandwidth_hz`` is
+    given)."""
+    cfg = system.config
+    bw = median_actuator_bandwidth_hz(system) if bandwidth_hz is None else float(bandwidth_hz)
+    lo, hi = (cfg.band_low_hz, cfg.band_high_hz) if band_hz is None else (float(band_hz[0]), float(band_hz[1]))
     fz = system.omega_rad_s / (2 * math.pi)
-    sel = np.nonzero((fz >= bw / factor) & (fz <= bw * factor))[0]
+    sel = np.nonzero((fz >= lo) & (fz <= hi))[0]
     na = system.n_actuators
     KL = np.array([cfg.engine(a.engine).model.structure.load_stiffness_N_per_m for a in cfg.actuators])
     pe = system.phi_c[:na, sel].T
     ratio = KL[None] * pe ** 2 / system.omega_rad_s[sel, None] ** 2
     return ModeParticipation(bw, factor, system.actuator_names, sel, fz[sel], system.zeta[sel], pe, ratio,
-                             int(fz.size))
+                             int(fz.size), (lo, hi))
+
+
+def modes_near_bandwidth(system: MasvSystem, factor: float = 2.0) -> ModeParticipation:
+    """Structural modes within [bandwidth / factor, bandwidth * factor] of the actuator
+    bandwidth (:func:`modes_in_band`)."""
+    bw = median_actuator_bandwidth_hz(system)
+    return modes_in_band(system, (bw / factor, bw * factor), factor, bw)
 
 
 def structure_effect(system: MasvSystem) -> dict:

@@ -1,6 +1,6 @@
 """``masv`` command line: modes, 8x8 frequency responses, coupling and loop margins.
 
-    masv modes CONFIG [--factor 2] [--json PATH]
+    masv modes CONFIG [--factor F] [--json PATH]     (modes in the file's [band], or bandwidth x/÷ F)
     masv freqresp CONFIG --freq-hz 0.5,1,2,5 [--json PATH] [--plot GRID.png]
     masv coupling CONFIG [--json PATH] [--plot MATRIX.png]
 
@@ -31,11 +31,15 @@ def _prov(cfg) -> dict:
             "n_modes": cfg.structure.n_modes, "taos_version": package_version()}
 
 
+#: ``masv modes`` lists every mode up to this many (beyond, only the modes in the band)
+MODES_TABLE_MAX = 60
+
+
 def cmd_modes(args) -> int:
-    if not (args.factor > 1 and math.isfinite(args.factor)):
+    if args.factor is not None and not (args.factor > 1 and math.isfinite(args.factor)):
         raise InputError("command line", "--factor", "a number above 1", got=repr(args.factor))
     s = _system(args)
-    mp = an.modes_near_bandwidth(s, args.factor)
+    mp = an.modes_in_band(s) if args.factor is None else an.modes_near_bandwidth(s, args.factor)
     st = s.config.structure
     d = {"n_modes": st.n_modes, "freq_hz": st.freq_hz.tolist(), "damping_ratio": st.damping_ratio.tolist(),
          "near_bandwidth": mp.to_dict(), "provenance": _prov(s.config)}
@@ -43,12 +47,16 @@ def cmd_modes(args) -> int:
         write_json(args.json, d)
     else:
         print(f"{st.n_modes} modes ({st.source}); actuator bandwidth {mp.bandwidth_hz:.2f} Hz; "
-              f"{mp.freq_hz.size} modes in {mp.bandwidth_hz / args.factor:.2f}-{mp.bandwidth_hz * args.factor:.2f} Hz")
-        print(f"{'mode':>5} {'freq_hz':>9} {'zeta':>7} {'max K_L phi^2/w^2':>18}  strongest actuator")
-        for i in range(mp.freq_hz.size):
-            k = int(mp.compliance_ratio[i].argmax())
-            print(f"{mp.mode_index[i] + 1:5d} {mp.freq_hz[i]:9.3f} {mp.damping_ratio[i]:7.4f} "
-                  f"{mp.compliance_ratio[i, k]:18.4g}  {mp.actuators[k]}")
+              f"{mp.freq_hz.size} modes in {mp.band_hz[0]:.2f}-{mp.band_hz[1]:.2f} Hz ({mp.band_source})")
+        # every mode of the structure (up to MODES_TABLE_MAX; beyond, the in-band ones), in-band marked
+        table = an.modes_in_band(s, (0.0, math.inf), bandwidth_hz=mp.bandwidth_hz) if st.n_modes <= MODES_TABLE_MAX else mp
+        inband = set(int(i) for i in mp.mode_index)
+        print(f"{'mode':>5} {'freq_hz':>9} {'zeta':>7} {'max K_L phi^2/w^2':>18} {'in band':>8}  strongest actuator")
+        for i in range(table.freq_hz.size):
+            k = int(table.compliance_ratio[i].argmax())
+            j = int(table.mode_index[i])
+            print(f"{j + 1:5d} {table.freq_hz[i]:9.3f} {table.damping_ratio[i]:7.4f} "
+                  f"{table.compliance_ratio[i, k]:18.4g} {'yes' if j in inband else 'no':>8}  {table.actuators[k]}")
     return 0
 
 
@@ -106,7 +114,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("modes", help="structural modes near the actuator bandwidth and their participation")
     common(p)
-    p.add_argument("--factor", type=float, default=2.0, help="band: bandwidth / factor .. bandwidth * factor")
+    p.add_argument("--factor", type=float, default=None,
+                   help="band: bandwidth / factor .. bandwidth * factor (default: the file's [band])")
     p.set_defaults(func=cmd_modes)
     p = sub.add_parser("freqresp", help="8x8 command -> piston and command -> engine responses")
     common(p)

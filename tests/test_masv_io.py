@@ -124,3 +124,29 @@ def test_plots_save_png(tmp_path):
     save(plot_actuator_vs_simplex(fr, "actuator_1_pitch", linear_freqresp(model, f, "pitch")), tmp_path / "one.png")
     save(an.coupling(s, n_freq=20).plot(), tmp_path / "c.svg")
     assert all((tmp_path / n).stat().st_size > 1000 for n in ("grid.png", "one.png", "c.svg"))
+
+
+def test_cli_modes_lists_the_shipped_structure_modes_in_the_files_band(tmp_path, capsys):
+    """Issue 17: ``masv modes models/masv/core_stage.toml`` printed an empty table (its 14.548 Hz
+    pair fell outside bandwidth x/÷ 2 and the file's [band] was ignored)."""
+    import tomllib
+
+    shipped = ROOT / "models" / "masv" / "core_stage.toml"
+    meta = tomllib.loads((ROOT / "fem_data" / "thrust_structure_modes.toml").read_text())["modes"]["freq_hz"]
+    assert main(["modes", str(shipped)]) == 0
+    out = capsys.readouterr().out
+    rows = [ln.split() for ln in out.splitlines()[2:]]
+    assert [float(r[1]) for r in rows] == pytest.approx(meta, abs=1e-3)       # every shipped mode listed
+    assert [r[4] for r in rows] == ["yes", "yes", "no", "no", "no"]           # in the file's 0.5-20 Hz band
+    assert main(["modes", str(shipped), "--json", "-"]) == 0
+    d = json.loads(capsys.readouterr().out)["near_bandwidth"]
+    assert d["band_hz"] == [0.5, 20.0] and d["band_source"] == "config [band]"
+    assert [m["freq_hz"] for m in d["modes"]] == pytest.approx(meta[:2], abs=1e-3)
+    # another [band] selects other modes
+    text = shipped.read_text().replace('low = "0.5 Hz"', 'low = "15 Hz"').replace('high = "20 Hz"', 'high = "30 Hz"')
+    text = text.replace('"../../fem_data/', f'"{(ROOT / "fem_data").as_posix()}/').replace(
+        '"../rs25_hotfire.toml"', f'"{(ROOT / "models" / "rs25_hotfire.toml").as_posix()}"')
+    (tmp_path / "c.toml").write_text(text)
+    assert main(["modes", str(tmp_path / "c.toml"), "--json", "-"]) == 0
+    d = json.loads(capsys.readouterr().out)["near_bandwidth"]
+    assert [m["freq_hz"] for m in d["modes"]] == pytest.approx(meta[2:4], abs=1e-3)
