@@ -7,12 +7,12 @@ Modules: :mod:`masv.structure` (modal model, file contract, validation, static c
 :mod:`masv.system` (assembly from taos.actuator.actuator_state_space blocks and the modes; one
 StateSpace of the whole, and a fast block-elimination frequency response),
 :mod:`masv.analysis` (8x8 responses, notches, coupling, closed-loop eigenvalues, loop margins,
-modes near the actuator bandwidth), :mod:`masv.plotting`, :mod:`masv.synthetic` (a
+the TVSE loop break, modes in the band of interest), :mod:`masv.plotting`, :mod:`masv.synthetic` (a
 mirror-symmetric test structure), :mod:`masv.cli` (``masv modes|freqresp|coupling``).
 """
 
-from .analysis import (closed_loop_eigenvalues, coupling, frequency_response, loop_margins,
-                       modes_near_bandwidth, notch_frequencies, structure_effect)
+from .analysis import (TvseLoop, closed_loop_eigenvalues, coupling, frequency_response, loop_margins,
+                       modes_in_band, modes_near_bandwidth, notch_frequencies, structure_effect, tvse_loops)
 from .config import ActuatorSpec, EngineSpec, MasvConfig, load_config, make_config
 from .structure import ModalStructure, load_modes, rigid_structure, validate_modes
 from .system import MasvSystem, build_system, engine_axis_block
@@ -20,4 +20,4 @@ from .system import MasvSystem, build_system, engine_axis_block
 __all__ = ["ActuatorSpec", "EngineSpec", "MasvConfig", "MasvSystem", "ModalStructure", "build_system",
            "closed_loop_eigenvalues", "coupling", "engine_axis_block", "frequency_response", "load_config",
            "load_modes", "loop_margins", "make_config", "modes_near_bandwidth", "notch_frequencies",
-           "rigid_structure", "structure_effect", "validate_modes"]
+           "rigid_structure", "structure_effect", "validate_modes", "TvseLoop", "tvse_loops", "modes_in_band"]

@@ -213,7 +213,8 @@ class LoopMargin:
     def to_dict(self) -> dict:
         return {"actuator": self.actuator,
                 "gain_margin_db": None if math.isinf(self.gain_margin_db) else self.gain_margin_db,
-                "phase_crossover_hz": self.phase_crossover_hz, "phase_margin_deg": self.phase_margin_deg,
+                "phase_crossover_hz": self.phase_crossover_hz,
+                "phase_margin_deg": None if math.isinf(self.phase_margin_deg) else self.phase_margin_deg,
                 "gain_crossover_hz": self.gain_crossover_hz}
 
 
@@ -283,6 +284,12 @@ class TvseLoop:
     def to_dict(self) -> dict:
         return {"actuator": self.actuator, "peak_db": self.peak_db, "peak_hz": self.peak_hz,
                 "margin": self.margin.to_dict()}
+
+    @staticmethod
+    def plot(loops: "tuple[TvseLoop, ...]", **kwargs):
+        """Bode plot of several TVSE loops (thin call into :mod:`masv.plotting`)."""
+        from . import plotting
+        return plotting.plot_tvse_loops(loops, **kwargs)
 
 
 def tvse_loops(system: MasvSystem, freq_hz=None) -> tuple[TvseLoop, ...]:

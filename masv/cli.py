@@ -3,6 +3,7 @@
     masv modes CONFIG [--factor F] [--json PATH]     (modes in the file's [band], or bandwidth x/÷ F)
     masv freqresp CONFIG --freq-hz 0.5,1,2,5 [--json PATH] [--plot GRID.png]
     masv coupling CONFIG [--json PATH] [--plot MATRIX.png]
+    masv tvse CONFIG [--json PATH] [--plot BODE.png]   TVSE loops (paper sec. 3.3) and their margins
 
 Bad input exits with status 2 and one line naming the file, the field and what was expected.
 """
@@ -12,6 +13,8 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+
+import numpy as np
 
 from taos.cli.basic import parse_float_list
 from taos.errors import InputError
@@ -104,6 +107,28 @@ def cmd_coupling(args) -> int:
     return 0
 
 
+def cmd_tvse(args) -> int:
+    s = _system(args)
+    loops = an.tvse_loops(s)
+    d = {"tvse": [lp.to_dict() for lp in loops], "provenance": _prov(s.config)}
+    if args.json:
+        write_json(args.json, d)
+    else:
+        print("TVSE loops, each broken at its engine's inertial coupling into the structure (others closed)")
+        for lp in loops:
+            m = lp.margin
+            if not np.any(lp.loop):
+                print(f"  {lp.actuator:>18}: no loop (rigid structure or no c.g. offset)")
+                continue
+            gm = "inf" if math.isinf(m.gain_margin_db) else f"{m.gain_margin_db:.1f}"
+            pm = "inf" if math.isinf(m.phase_margin_deg) else f"{m.phase_margin_deg:.1f}"
+            print(f"  {lp.actuator:>18}: peak {lp.peak_db:+.1f} dB at {lp.peak_hz:.2f} Hz; GM {gm} dB, PM {pm} deg")
+    if args.plot:
+        from .plotting import save
+        save(an.TvseLoop.plot(loops), args.plot)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="masv", description="MASV: four engines, eight actuators, thrust-structure modes")
     sub = ap.add_subparsers(dest="command", required=True)
@@ -127,6 +152,10 @@ def build_parser() -> argparse.ArgumentParser:
     common(p)
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save the peak-coupling matrix")
     p.set_defaults(func=cmd_coupling)
+    p = sub.add_parser("tvse", help="TVSE loops: engines' inertial coupling with the structure modes, margins")
+    common(p)
+    p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save the Bode plot of the loops")
+    p.set_defaults(func=cmd_tvse)
     return ap
 
 

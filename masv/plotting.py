@@ -9,7 +9,7 @@ import numpy as np
 
 from taos.plotting import save  # noqa: F401  (re-exported: masv.plotting.save(fig, path))
 
-from .analysis import CouplingResult, MasvFrequencyResponse, _db
+from .analysis import CouplingResult, MasvFrequencyResponse, TvseLoop, _db
 
 
 def plot_gain_grid(fr: MasvFrequencyResponse, kind: str = "engine", floor_db: float = -120.0):
@@ -74,5 +74,33 @@ def plot_coupling_matrix(c: CouplingResult, kind: str = "engine"):
     ax.set_xlabel("command")
     ax.set_ylabel("response")
     fig.colorbar(im, label=f"peak {kind} gain [dB], {c.band_hz[0]:g}-{c.band_hz[1]:g} Hz")
+    fig.tight_layout()
+    return fig
+
+
+def plot_tvse_loops(loops: "tuple[TvseLoop, ...]"):
+    """Bode plot of the TVSE loops L(j w) (gain [dB], phase [deg]) of every actuator, with the
+    0 dB line; the critical point of each loop is 1 + L = 0 (0 dB at +-180 deg)."""
+    import matplotlib.pyplot as plt
+
+    from taos.linear import phase_deg
+
+    fig, ax = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
+    for lp in loops:
+        if not np.any(lp.loop):
+            continue
+        ax[0].semilogx(lp.freq_hz, _db(lp.loop), lw=0.9, label=lp.actuator)
+        ax[1].semilogx(lp.freq_hz, phase_deg(lp.loop), lw=0.9)
+    ax[0].axhline(0.0, color="k", lw=0.6)
+    for p in (-180.0, 180.0):
+        ax[1].axhline(p, color="k", lw=0.6, ls="--")
+    ax[0].set_ylabel("TVSE loop gain [dB]")
+    ax[1].set_ylabel("phase [deg]")
+    ax[1].set_xlabel("frequency [Hz]")
+    for a in ax:
+        a.grid(True, which="both", lw=0.3)
+    if ax[0].lines[1:]:
+        ax[0].legend(fontsize=7, ncol=2)
+    fig.suptitle("TVSE loops (broken at the engines' inertial coupling into the structure)")
     fig.tight_layout()
     return fig

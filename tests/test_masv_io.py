@@ -150,3 +150,10 @@ def test_cli_modes_lists_the_shipped_structure_modes_in_the_files_band(tmp_path,
     assert main(["modes", str(tmp_path / "c.toml"), "--json", "-"]) == 0
     d = json.loads(capsys.readouterr().out)["near_bandwidth"]
     assert [m["freq_hz"] for m in d["modes"]] == pytest.approx(meta[2:4], abs=1e-3)
+
+
+def test_cli_tvse_rigid_has_no_loop_and_json(tmp_path, capsys):
+    assert main(["tvse", str(RIGID), "--json", "-"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert len(d["tvse"]) == 8
+    assert all(r["margin"]["gain_margin_db"] is None and r["margin"]["phase_margin_deg"] is None for r in d["tvse"])
