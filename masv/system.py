@@ -298,7 +298,10 @@ class MasvSystem:
         h = 1.0 / (om[None] ** 2 - w[:, None] ** 2 + 2j * self.zeta[None] * om[None] * w[:, None])
         P = np.vstack([self.phi_c, self.phi_g])
         md = 2 * self.n_actuators
-        R = (P[None] * h[:, None, :]) @ P.T
+        m = P.shape[0]
+        # R[f] = P diag(h_f) P^T for all f as two real GEMMs: (m m, n) @ (n, F)
+        Q = (P[:, None, :] * P[None, :, :]).reshape(m * m, -1)
+        R = (Q @ h.real.T + 1j * (Q @ h.imag.T)).T.reshape(f.size, m, m)
         R[:, md:, :] *= -(w ** 2)[:, None, None]
         R[:, :md, :md] += self.g_res[None]
         return R
