@@ -4,8 +4,9 @@ dense solves of the whole state space, 200 modes, 1000 frequencies.
     .venv/bin/python benchmarks/bench_masv.py [--modes 200] [--freqs 1000] [--naive-freqs 100]
 
 Peers, same model, same run:
-  * masv block elimination (MasvSystem.frf): structure receptance Phi_c diag(.) Phi_c^T in
-    O(n m^2), eight small engine blocks, one 16 x 16 solve per frequency (batched numpy);
+  * masv block elimination (MasvSystem.frf): structure receptance Phi diag(.) Phi^T in
+    O(n m^2) (two real GEMMs over all frequencies), eight small engine blocks, one 28 x 28 solve
+    per frequency (8 elongations, 8 gimbal rotations, 4 x 3 gimbal accelerations; batched numpy);
   * naive dense: scipy.linalg.solve(j w I - A, B) on the full balanced state space per frequency
     (MasvSystem.frf_dense);
   * taos.linear.StateSpace.freqresp (Hessenberg reduction once, then a dense solve per frequency).
