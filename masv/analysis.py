@@ -272,7 +272,7 @@ class TvseLoop:
     loop broken between the flexible-body dynamics and the engine's inertial coupling into the
     structure (:meth:`masv.system.MasvSystem.tvse_loop`), ``loop`` L(j w) (F,) complex on
     ``freq_hz`` [Hz], its largest gain ``peak_db`` at ``peak_hz``, and its margins
-    (:func:`margins_from_loop`: critical point -1)."""
+    (:func:`margins_from_loop`: critical point -1). Drawn by :func:`masv.plotting.plot_tvse_loops`."""
 
     actuator: str
     freq_hz: np.ndarray
@@ -284,12 +284,6 @@ class TvseLoop:
     def to_dict(self) -> dict:
         return {"actuator": self.actuator, "peak_db": self.peak_db, "peak_hz": self.peak_hz,
                 "margin": self.margin.to_dict()}
-
-    @staticmethod
-    def plot(loops: "tuple[TvseLoop, ...]", **kwargs):
-        """Bode plot of several TVSE loops (thin call into :mod:`masv.plotting`)."""
-        from . import plotting
-        return plotting.plot_tvse_loops(loops, **kwargs)
 
 
 def tvse_loops(system: MasvSystem, freq_hz=None) -> tuple[TvseLoop, ...]:

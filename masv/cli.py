@@ -124,8 +124,8 @@ def cmd_tvse(args) -> int:
             pm = "inf" if math.isinf(m.phase_margin_deg) else f"{m.phase_margin_deg:.1f}"
             print(f"  {lp.actuator:>18}: peak {lp.peak_db:+.1f} dB at {lp.peak_hz:.2f} Hz; GM {gm} dB, PM {pm} deg")
     if args.plot:
-        from .plotting import save
-        save(an.TvseLoop.plot(loops), args.plot)
+        from .plotting import plot_tvse_loops, save
+        save(plot_tvse_loops(loops), args.plot)
     return 0
 
 

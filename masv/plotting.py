@@ -99,7 +99,7 @@ def plot_tvse_loops(loops: "tuple[TvseLoop, ...]"):
     ax[1].set_xlabel("frequency [Hz]")
     for a in ax:
         a.grid(True, which="both", lw=0.3)
-    if ax[0].lines[1:]:
+    if len(ax[0].lines) > 2:
         ax[0].legend(fontsize=7, ncol=2)
     fig.suptitle("TVSE loops (broken at the engines' inertial coupling into the structure)")
     fig.tight_layout()

@@ -414,6 +414,28 @@ def build_system(cfg: MasvConfig, structure: ModalStructure | None = None) -> Ma
         arms.append(model.actuator.moment_arm_m)
     st = cfg.structure
     added = np.array([0.0 if st.engine_mass_in_modes else e.model.engine.mass_kg for e in cfg.engines])
+    phi_g = gimbal_shapes(cfg)
+    if st.engine_mass_in_modes and st.n_modes:
+        _check_lumped_engine_mass(cfg, phi_g, arms_cg, dirs)
     return MasvSystem(cfg, tuple(blocks), np.asarray(arms), coupling_shapes(cfg), st.omega_rad_s.copy(),
-                      st.damping_ratio.copy(), residual_flexibility(cfg), gimbal_shapes(cfg),
+                      st.damping_ratio.copy(), residual_flexibility(cfg), phi_g,
                       np.array([eidx[a.engine] for a in cfg.actuators]), dirs, added)
+
+
+def _check_lumped_engine_mass(cfg: MasvConfig, phi_g: np.ndarray, arms: np.ndarray, dirs: np.ndarray) -> None:
+    """With the engines' mass lumped in the modes, the engines' free rotation removes
+    m_e^2 l_k^2 / J_k along d_k from it; the modal mass I - Phi_G^T (sum d d^T m^2 l^2/J) Phi_G
+    must stay positive definite (the modes must lump at least that much mass at the gimbal)."""
+    ne = len(cfg.engines)
+    eidx = {e.name: j for j, e in enumerate(cfg.engines)}
+    D = np.zeros((3 * ne, 3 * ne))
+    for k, a in enumerate(cfg.actuators):
+        e = cfg.engine(a.engine)
+        j = 3 * eidx[a.engine]
+        D[j:j + 3, j:j + 3] += (e.model.engine.mass_kg * arms[k]) ** 2 / e.model.engine.inertia(a.axis) \
+            * np.outer(dirs[k], dirs[k])
+    if np.linalg.eigvalsh(np.eye(phi_g.shape[1]) - phi_g.T @ D @ phi_g).min() <= 0:
+        from taos.errors import InputError
+        raise InputError(cfg.source, "structure.engine_mass_in_modes",
+                         "modes that lump at least m_e^2 l_e^2 / J_n of each engine's mass at its gimbal "
+                         "(or false: MASV then adds the engine mass)", got="true")

@@ -199,3 +199,15 @@ def test_tvse_loop_of_one_mode_structure_against_hand(hotfire):
     Ll = m ** 2 * L_E ** 2 * lam ** 2 * Hs * lam ** 2 * phi ** 2 / ((1 + m * phi ** 2) * lam ** 2 + 2 * zeta * w * lam
                                                                    + w ** 2)
     assert abs(1 + Ll) < 1e-6
+
+
+def test_engine_mass_in_modes_needs_the_mass_at_the_gimbal(hotfire):
+    """A mode claiming to hold the engine mass but lumping less than m_e^2 l_e^2 / J_n at the
+    gimbal would give the engine's free rotation a negative mass: one-line InputError."""
+    from taos.errors import InputError
+    m, J = hotfire.engine.mass_kg, hotfire.engine.inertia_pitch_kgm2
+    phi = 1.0 / math.sqrt(0.5 * m ** 2 * L_E ** 2 / J)      # modal mass half the needed amount
+    st = dataclasses.replace(one_mode(10.0, 2, phi), engine_mass_in_modes=True)
+    with pytest.raises(InputError) as e:
+        pitch_engine(hotfire, st)
+    assert e.value.field == "structure.engine_mass_in_modes" and "\n" not in str(e.value)

@@ -62,6 +62,14 @@ def test_config_with_modal_file_round_trip(tmp_path):
     assert np.all(cfg.structure.damping_ratio == 0.01)
     a = cfg.actuators[0]   # rotation axis from the geometry: (attach - gimbal) x direction
     assert np.allclose(a.rotation_axis, [0.0, -1.0, 0.0])
+    # engine c.g.: the model's [geometry] engine_cg (0, 0, -1.5 m) placed 1.5 m aft (-x); the
+    # FEM-style default adds the engine mass at the gimbal
+    assert np.allclose(cfg.engines[0].cg_vector_m, [-1.5, 0.0, 0.0]) and not cfg.structure.engine_mass_in_modes
+    text = config_text(extra="engine_mass_in_modes = true").replace(
+        'gimbal_node = "gimbal_1"', 'gimbal_node = "gimbal_1"\ncg_offset = ["-1.2 m", "0 m", "0.1 m"]')
+    (tmp_path / "c.toml").write_text(text)
+    cfg = load_config(tmp_path / "c.toml")
+    assert np.allclose(cfg.engines[0].cg_vector_m, [-1.2, 0.0, 0.1]) and cfg.structure.engine_mass_in_modes
 
 
 @pytest.mark.parametrize("edit,field", [
@@ -71,6 +79,12 @@ def test_config_with_modal_file_round_trip(tmp_path):
     (lambda t: t.replace("direction = [-1.0, 0.0, 0.0]", "direction = [0.0, 0.0, 0.0]", 1), "actuator[0].direction"),
     (lambda t: t.replace('attach_node = "actuator_1_yaw"', 'attach_node = "nowhere"'), "actuator[1].attach_node"),
     (lambda t: t.replace("damping_ratio = 0.005", "damping_ratio = -1"), "structure.damping_ratio"),
+    (lambda t: t.replace("damping_ratio = 0.005", 'damping_ratio = 0.005\nengine_mass_in_modes = "yes"'),
+     "structure.engine_mass_in_modes"),
+    (lambda t: t.replace('gimbal_node = "gimbal_1"', 'gimbal_node = "gimbal_1"\ncg_offset = ["-1.5 m", "0 m"]'),
+     "engine[0].cg_offset"),
+    (lambda t: t.replace('gimbal_node = "gimbal_2"', 'gimbal_node = "gimbal_2"\ncg_offset = ["-1.5 s", "0 m", "0 m"]'),
+     "engine[1].cg_offset[0]"),
 ])
 def test_bad_config_is_one_line_input_error(tmp_path, edit, field):
     write_modes(tmp_path / "modes.npz")
@@ -157,3 +171,10 @@ def test_cli_tvse_rigid_has_no_loop_and_json(tmp_path, capsys):
     d = json.loads(capsys.readouterr().out)
     assert len(d["tvse"]) == 8
     assert all(r["margin"]["gain_margin_db"] is None and r["margin"]["phase_margin_deg"] is None for r in d["tvse"])
+
+
+def test_cli_tvse_plot_of_the_shipped_core_stage(tmp_path, capsys):
+    shipped = ROOT / "models" / "masv" / "core_stage.toml"
+    assert main(["tvse", str(shipped), "--plot", str(tmp_path / "tvse.png")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("peak +") == 8 and (tmp_path / "tvse.png").stat().st_size > 1000
