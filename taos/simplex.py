@@ -9,7 +9,9 @@ Equations (SI), built from the actuator state space of :mod:`taos.actuator`::
     T_f = friction(theta', z, T_app),  T_app = R F_L - K_n theta
 
 The load resonance w_L = sqrt((K_L R^2 + K_n)/J_n) (paper eq. 1) is the notch of the
-command -> piston response.
+command -> piston response. Two views of one model: :func:`simplex_plant` gives the linear
+block (exact frequency response, poles), and :mod:`taos.simulate` integrates the same block
+with the friction and avionics nonlinearities closed around it.
 
 On an elastic structure (MASV, paper sec. 1 and 3.3) the same block takes the structure's
 motion as inputs and returns the reactions on the structure (``structure_inputs=True``)::
@@ -18,9 +20,10 @@ motion as inputs and returns the reactions on the structure (``structure_inputs=
                                               (gimbal point minus actuator attach point) [m]
     J_n theta'' = R F_L - K_n (theta - r) - T_f - m_e l_e a_g
                                            r  structure rotation at the gimbal [rad]
-                                           a_g gimbal-point acceleration along d = a x c/|c| [m/s^2]
-    reactions on the structure: F_L (along the line of action), K_n (theta - r) (about the
-    engine axis at the gimbal), f_twd = -m_e l_e theta'' (at the gimbal along d)
+                                           a_g gimbal-point acceleration along d = unit(a x c) [m/s^2]
+    reactions on the structure: F_L (pushing the gimbal along the line of action and the
+    attach point against it), K_n (theta - r) (a torque about a at the gimbal),
+    f_twd = -m_e l_e theta'' (a force at the gimbal along d)
 
 theta is the engine's inertial angle, m_e its mass and l_e the distance of its centre of mass
 from the gimbal (perpendicular to the rotation axis a). The engine's kinetic energy
@@ -28,9 +31,7 @@ from the gimbal (perpendicular to the rotation axis a). The engine's kinetic ene
 couplings: "dog wags tail" (the gimbal's acceleration turns the engine, - m_e l_e a_g) and
 "tail wags dog" (the engine's angular acceleration loads the structure, - m_e l_e theta'').
 The rigid-translation part - m_e a_g of the engine's inertia is left to the structure model
-(MASV adds it as a mass at the gimbal). With e = r = a_g = 0 the block is the planar one. Two views of one model: :func:`simplex_plant` gives the linear
-block (exact frequency response, poles), and :mod:`taos.simulate` integrates the same block
-with the friction and avionics nonlinearities closed around it.
+(MASV adds it as a mass at the gimbal). With e = r = a_g = 0 the block is the planar one.
 """
 
 from __future__ import annotations
