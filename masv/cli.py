@@ -52,7 +52,8 @@ def cmd_modes(args) -> int:
         print(f"{st.n_modes} modes ({st.source}); actuator bandwidth {mp.bandwidth_hz:.2f} Hz; "
               f"{mp.freq_hz.size} modes in {mp.band_hz[0]:.2f}-{mp.band_hz[1]:.2f} Hz ({mp.band_source})")
         # every mode of the structure (up to MODES_TABLE_MAX; beyond, the in-band ones), in-band marked
-        table = an.modes_in_band(s, (0.0, math.inf), bandwidth_hz=mp.bandwidth_hz) if st.n_modes <= MODES_TABLE_MAX else mp
+        table = (an.modes_in_band(s, (0.0, math.inf), bandwidth_hz=mp.bandwidth_hz)
+                 if st.n_modes <= MODES_TABLE_MAX else mp)
         inband = set(int(i) for i in mp.mode_index)
         print(f"{'mode':>5} {'freq_hz':>9} {'zeta':>7} {'max K_L phi^2/w^2':>18} {'in band':>8}  strongest actuator")
         for i in range(table.freq_hz.size):

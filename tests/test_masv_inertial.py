@@ -102,7 +102,8 @@ def test_quasi_static_rotational_mode_is_a_spring_in_series_with_kn(hotfire):
     kr = 1.5 * Kn
     f_m = 50.0
     st = one_mode(f_m, 4, 2 * math.pi * f_m / math.sqrt(kr), zeta=0.005)
-    series = model.replace(engine=dataclasses.replace(model.engine, rotational_stiffness_Nm_per_rad=Kn * kr / (Kn + kr)))
+    series = model.replace(engine=dataclasses.replace(model.engine,
+                                                      rotational_stiffness_Nm_per_rad=Kn * kr / (Kn + kr)))
     f = np.logspace(-1, 1.5, 100)
     ref = simplex_state_space(series, "pitch").freqresp(f, "command_rad", ["x_p_m", "theta_rad"])
     xp, th = pitch_engine(model, st.truncated(0.0), cg=(0.0, 0.0, 0.0)).frf(f)
