@@ -4,11 +4,12 @@ masv imports taos; taos never imports masv.
 
 Modules: :mod:`masv.structure` (modal model, file contract, validation, static correction),
 :mod:`masv.config` (TOML configuration: engines, actuators, structure, band of interest),
-:mod:`masv.system` (assembly from taos.actuator.actuator_state_space blocks and the modes; one
-StateSpace of the whole, and a fast block-elimination frequency response),
+:mod:`masv.system` (assembly of taos.simplex.simplex_state_space engine-axis blocks, the engines'
+mass and c.g. offset, and the modes; one StateSpace of the whole, and a fast block-elimination
+frequency response),
 :mod:`masv.analysis` (8x8 responses, notches, coupling, closed-loop eigenvalues, loop margins,
 the TVSE loop break, modes in the band of interest), :mod:`masv.plotting`, :mod:`masv.synthetic` (a
-mirror-symmetric test structure), :mod:`masv.cli` (``masv modes|freqresp|coupling``).
+mirror-symmetric test structure), :mod:`masv.cli` (``masv modes|freqresp|coupling|tvse``).
 """
 
 from .analysis import (TvseLoop, closed_loop_eigenvalues, coupling, frequency_response, loop_margins,
