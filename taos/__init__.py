@@ -47,6 +47,8 @@ _API = {
     "analyse_lco": "taos.flight.lco", "predict_lco": "taos.flight.lco",
     "load_test_data": "taos.identify.data", "estimate": "taos.identify.estimate",
     "fit_frequency_response": "taos.identify.fit", "compare_models": "taos.identify.compare",
+    "load_ascent": "taos.flight.ascent", "simulate_ascent": "taos.flight.ascent_sim",
+    "load_campaign": "taos.montecarlo", "run_campaign": "taos.montecarlo",
     "load_run": "taos.viewer", "write_html": "taos.viewer", "serve": "taos.viewer",
 }
 

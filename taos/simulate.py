@@ -62,8 +62,9 @@ def kernel_args(plant: LurePlant, model: TvcModel):
 
 
 def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: float, record_every: int = 1,
-                    x0: np.ndarray | None = None):
-    """Integrate ``plant`` over input samples ``r`` (n_steps + 1, n_ext) every ``dt_s``.
+                    x0: np.ndarray | None = None, z0: float = 0.0):
+    """Integrate ``plant`` over input samples ``r`` (n_steps + 1, n_ext) every ``dt_s``, from the
+    linear state ``x0`` and the friction state ``z0`` (default rest).
 
     Returns (y (n_rec, n_out), aux (n_rec, 3) = friction torque, friction state, avionics
     output). Raises :class:`SimulationUnstable` on a non-finite state."""
@@ -75,7 +76,7 @@ def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: floa
     x0 = np.zeros(n) if x0 is None else np.asarray(x0, float)
     status = _ig.integrate_samples(*kernel_args(plant, model), np.ascontiguousarray(plant.ss.C),
                                    model.friction.fid, model.friction.pack(), model.avionics.pack(),
-                                   x0, 0.0, np.ascontiguousarray(r, dtype=np.float64), dt_s,
+                                   x0, float(z0), np.ascontiguousarray(r, dtype=np.float64), dt_s,
                                    record_every, y, aux)
     if status >= 0:
         raise SimulationUnstable(status * dt_s, f"{model.friction.name} friction, dt = {dt_s} s")

@@ -1,0 +1,159 @@
+"""``taos ascent`` (fly an ascent with the nonlinear TVC, friction laws overlaid) and
+``taos montecarlo`` (dispersed campaigns of the flight LCO on Dask)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+from taos.errors import InputError
+from taos.results import atomic_write, write_json
+
+
+def _out_folder(path: str, names: list[str]) -> Path:
+    """An output folder receiving ``names``: refused if it is a file or if one of the names
+    exists already (taos replaces no file it did not write in this run)."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise InputError("command line", "--out", "a folder (or a new path)", got=f"{out} (a file)")
+    clash = [n for n in names if (out / n).exists()]
+    if clash:
+        raise InputError("command line", "--out", "a folder where the run's file names are free", got=f"{out / clash[0]} exists")
+    return out
+
+
+def cmd_ascent(args) -> int:
+    from taos.flight.ascent import load_ascent
+    from taos.flight.ascent_sim import analyse_ascent, simulate_ascent
+    from taos.flight.lco import with_bounding_avionics
+    from taos.model import Structure, load_model
+    from taos.units import to_si
+
+    ascent = load_ascent(args.ascent)
+    laws = [s.strip() for s in args.friction.split(",") if s.strip()] if args.friction else [None]
+    if len(laws) > 6:
+        raise InputError("command line", "--friction", "at most six friction laws", got=args.friction)
+    tvc = args.model or ascent.tvc_model
+    if not tvc:
+        raise InputError(ascent.source, "tvc_model", "a TVC model (here or --model)", got="none")
+    start, end = args.start, ascent.end_time_s if args.end is None else args.end
+    if not (0.0 <= start < end <= ascent.end_time_s):
+        raise InputError("command line", "--end", f"0 <= start < end <= {ascent.end_time_s:g} s",
+                         got=f"start {start:g}, end {end:g}")
+    if not 1e-5 <= args.dt <= 2e-3:
+        raise InputError("command line", "--dt", "an RK4 step from 1e-5 to 2e-3 s", got=repr(args.dt))
+    axes = ("pitch", "yaw") if args.axis == "both" else (args.axis,)
+    models = []
+    for law in laws + ["none"]:
+        m = load_model(tvc, friction=law)
+        if args.load_stiffness:
+            m = m.replace(structure=Structure(to_si(args.load_stiffness, "stiffness", source="command line",
+                                                    field="--load-stiffness", positive=True)))
+        models.append(with_bounding_avionics(m) if args.avionics == "bounding" else m)
+    names = [f"ascent_{m.friction.name}.h5" for m in models[:-1]] + ["summary.json", "ascent.png"]
+    out = _out_folder(args.out, names)
+    reference = simulate_ascent(ascent, models[-1], axes=axes, start_s=start, end_s=end, dt_s=args.dt, seed=args.seed)
+    runs, summary = [], {"ascent_file": ascent.source, "ascent_sha256": ascent.sha256, "avionics": args.avionics,
+                         "axes": list(axes), "runs": []}
+    from tqdm import tqdm
+    for m in tqdm(models[:-1], desc="ascent", unit="law", disable=not args.progress):
+        h = reference if m.friction.name == "none" else simulate_ascent(
+            ascent, m, axes=axes, start_s=start, end_s=end, dt_s=args.dt, seed=args.seed)
+        runs.append(h)
+        wins = analyse_ascent(h, reference)
+        summary["runs"].append({"friction_model": m.friction.name, "file": f"ascent_{m.friction.name}.h5",
+                                "windows": [w.to_dict() for w in wins], "provenance": h.provenance})
+    text = json.dumps(summary, indent=1, allow_nan=False) + "\n"  # checked before anything is written
+    out.mkdir(parents=True, exist_ok=True)
+    for h in runs:
+        h.to_hdf5(out / f"ascent_{h.friction_model}.h5")
+    from taos.plotting import save
+    from taos.plotting.ascent import plot_ascent
+    save(plot_ascent(runs, axis=axes[-1], zoom_s=min(60.0, 0.25 * (end - start))), out / "ascent.png")
+    atomic_write(out / "summary.json", lambda p: p.write_text(text))
+    if args.json:
+        write_json(args.json, summary)
+    else:
+        for r in summary["runs"]:
+            for w in r["windows"]:
+                if w["kind"] == "quiescent":
+                    verdict = (f"limit cycle {w['amplitude_deg']:.3f} deg command at {w['frequency_hz']:.3f} Hz"
+                               if w["lco"] else "no sustained oscillation")
+                    print(f"{r['friction_model']:>17s} {w['axis']:>5s} {w['start_s']:6.0f}-{w['end_s']:4.0f} s: {verdict}")
+        print(f"ascent runs written to {out}")
+    return 0
+
+
+_SCHEDULER = re.compile(r"^(tcp|tls|inproc)://[^\s:/]+(:\d{1,5})?$")
+
+
+def cmd_montecarlo(args) -> int:
+    from taos.montecarlo import load_campaign, run_campaign
+
+    if args.scheduler and args.workers is not None:
+        raise InputError("command line", "--scheduler", "either --workers or --scheduler, not both")
+    if args.scheduler and not _SCHEDULER.match(args.scheduler):
+        raise InputError("command line", "--scheduler", "an address like tcp://127.0.0.1:8786", got=repr(args.scheduler))
+    c = load_campaign(args.campaign)
+    res = run_campaign(c, args.out, runs=args.runs, case=args.case, friction=args.friction, workers=args.workers,
+                       scheduler=args.scheduler, resume=args.resume, progress=not args.no_progress)
+    s = res.summary
+    if args.json:
+        summary = json.loads((Path(args.out) / "summary.json").read_text())
+        write_json(args.json, summary)
+    else:
+        f = s["lco_fraction"]
+        amp = s["amplitude_deg_lco_runs"]
+        print(f"{c.name}, case {s['case']}: limit cycle in {f['lco_runs']} of {s['runs_ok']} runs "
+              f"({100 * f['value']:.1f} %, 95 % CI {100 * f['ci_low']:.1f}-{100 * f['ci_high']:.1f} %)"
+              + (f"; command amplitude median {amp['p50']:.3f} deg (5-95 %: {amp['p5']:.3f}-{amp['p95']:.3f})"
+                 if amp else ""))
+        if s["runs_failed"]:
+            print(f"{s['runs_failed']} runs failed (seeds and reasons in summary.json)")
+        if s["sensitivity_of_amplitude"]:
+            top = s["sensitivity_of_amplitude"][0]
+            print(f"strongest driver of the amplitude: {top['parameter']} (Spearman {top['spearman_rho']:+.2f})")
+        print(f"campaign written to {args.out}")
+    return 0
+
+
+def _positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise InputError("command line", "--runs/--workers", "a whole number", got=repr(text)) from None
+    return v
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser("ascent", help="fly an ascent (boosters, PTIs, winds) with the nonlinear TVC")
+    p.add_argument("ascent", help="ascent file or shipped name, e.g. ascent (models/flight/ascent.toml)")
+    p.add_argument("--model", help="TVC model (default: the ascent file's tvc_model)")
+    p.add_argument("--friction", help="friction law(s), comma-separated, overlaid (e.g. coulomb-switching,dahl,lugre)")
+    p.add_argument("--load-stiffness", help="override the load stiffness, e.g. '205000 lbf/in' (stiff structure)")
+    p.add_argument("--axis", choices=("pitch", "yaw", "both"), default="yaw", help="axes flown (default yaw)")
+    p.add_argument("--avionics", choices=("bounding", "model"), default="bounding",
+                   help="bounding: the paper's -1 dB gain (default); model: the file's quantisation")
+    p.add_argument("--start", type=float, default=0.0, help="start of the flown segment [s] (default 0)")
+    p.add_argument("--end", type=float, help="end of the flown segment [s] (default the trajectory's end)")
+    p.add_argument("--dt", type=float, default=2e-4, help="RK4 step [s] (default 2e-4: the switching Coulomb stick band needs it)")
+    p.add_argument("--seed", type=int, default=0, help="turbulence seed (default 0)")
+    p.add_argument("--out", required=True, help="output folder: ascent_<law>.h5, ascent.png, summary.json")
+    p.add_argument("--json", metavar="PATH", help="write the window analysis here ('-' for standard output)")
+    p.add_argument("--progress", action="store_true", help="show a progress bar")
+    p.set_defaults(func=cmd_ascent)
+
+    p = sub.add_parser("montecarlo", help="dispersed campaign of the flight LCO on Dask (resumable)")
+    p.add_argument("campaign", help="campaign file or shipped name, e.g. post_separation (models/montecarlo/)")
+    p.add_argument("--runs", type=_positive_int, required=True, help="number of dispersed runs")
+    p.add_argument("--case", help="named case of the campaign (default: its default_case)")
+    p.add_argument("--friction", help="swap the friction law, keeping the torque levels")
+    p.add_argument("--workers", type=_positive_int, help="local Dask workers (default 2)")
+    p.add_argument("--scheduler", help="an existing Dask scheduler, e.g. tcp://127.0.0.1:8786")
+    p.add_argument("--out", required=True, help="campaign folder (runs are stored as they arrive)")
+    p.add_argument("--resume", action="store_true", help="continue the campaign stored in --out")
+    p.add_argument("--json", metavar="PATH", help="write the summary here ('-' for standard output)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_montecarlo)
+
