@@ -32,10 +32,11 @@ from ._laws import (
     friction_keys,
     param,
 )
+from ._vector import coeff_bearing_step
 from .registry import LAWS, FrictionLawEntry, get, ids, register, unregister
 
 __all__ = [
-    "LAWS", "CoulombSmooth", "CoulombSwitching", "Dahl", "FrictionLaw", "FrictionLawEntry", "LuGre",
+    "LAWS", "CoulombSmooth", "CoulombSwitching", "Dahl", "FrictionLaw", "FrictionLawEntry", "LuGre", "coeff_bearing_step",
     "ModifiedLuGre", "NoFriction", "coulomb_describing_function", "dahl_angle_df", "friction_from_table",
     "friction_keys", "get", "ids", "param", "register", "unregister",
 ]
