@@ -47,7 +47,7 @@ def scipy_baseline(model, t_eval, rtol):
     plant = simplex_plant(model)
     A, Br, bc, bf, cc, dc, cw, ca = kernel_args(plant, model)
     fp, avp = model.friction.pack(), model.avionics.pack()
-    (zdot, torque), apply = model.friction.entry.kernels, av.apply.py_func
+    rates, apply = model.friction.entry.rates, av.apply.py_func
     prof = profile()
     ith = plant.ss.output_index("theta_rad")
     Cth = plant.ss.C[ith]
@@ -57,8 +57,7 @@ def scipy_baseline(model, t_eval, rtol):
         r = float(prof(t))
         u = apply(r, avp)
         w = cw @ x
-        dz = zdot(w, z, fp)
-        tf = torque(w, z, dz, ca @ x, fp)
+        dz, tf = rates(w, z, ca @ x, fp)
         return np.append(A @ x + bc * u + bf * tf, dz)
 
     t0 = time.perf_counter()

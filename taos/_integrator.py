@@ -5,14 +5,15 @@ State equations (see :class:`taos.simplex.LurePlant`)::
     c   = cc . x + dc . r(t)                 pre-avionics command [rad]
     u   = avionics(c)                        post-avionics command [rad]
     w   = cw . x,  T_a = ca . x              friction relative rate [rad/s], applied torque [N m]
-    T_f = friction.torque(w, z, T_a)         z' = friction.zdot(w, z)
+    (z', T_f) = friction.rates(w, z, T_a)    the law's kernel (registry entry)
     x'  = A x + Br r(t) + bc u + bf T_f
 
 Classical fourth-order Runge-Kutta with a fixed step; the external input is evaluated at the
 stage times (linear interpolation of samples, or exactly for sines). The friction kernels
-come from the law's registry entry (:mod:`taos.friction.registry`): ``fid`` is the pair
-``entry.kernels`` = (zdot, torque) of compiled C callbacks, passed as first-class functions,
-so one compiled integrator serves every law, including laws registered at run time. The
+come from the law's registry entry (:mod:`taos.friction.registry`): ``fid`` is its
+``rates(w, z, T_a, p) -> (z', T_f)``, a compiled C callback passed as a first-class
+function, so one compiled integrator serves every law, including laws registered at run
+time. The
 avionics kernel is the single definition in :mod:`taos.avionics`. A non-finite state stops
 the run and reports the step.
 """
@@ -44,8 +45,7 @@ def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, dx):
     for j in range(nr):
         c += dc[j] * r[j]
     u = _av.apply(c, avp)
-    dz = fid[0](w, z, fp)
-    tf = fid[1](w, z, dz, ta, fp)
+    dz, tf = fid(w, z, ta, fp)
     for i in range(n):
         s = bc[i] * u + bf[i] * tf
         for j in range(n):

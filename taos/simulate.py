@@ -63,7 +63,7 @@ def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: floa
     aux = np.empty((nrec, 3))
     x0 = np.zeros(n) if x0 is None else np.asarray(x0, float)
     status = _ig.integrate_samples(*kernel_args(plant, model), np.ascontiguousarray(plant.ss.C),
-                                   model.friction.entry.kernels, model.friction.pack(), model.avionics.pack(),
+                                   model.friction.entry.rates, model.friction.pack(), model.avionics.pack(),
                                    x0, 0.0, np.ascontiguousarray(r, dtype=np.float64), dt_s,
                                    record_every, y, aux)
     if status >= 0:

@@ -66,13 +66,9 @@ class ViscousCoulomb(friction.FrictionLaw):
             raise InputError(source, f"{section}.viscous_damping", "dt (c + T_c / v_eps) / J below 2")
 
 
-def toy_zdot(v, z, p):
-    return 0.0
-
-
-def toy_torque(v, z, dz, t_app, p):
+def toy_rates(v, z, t_app, p):
     e = p[K.SLOT_VEPS]
-    return p[K.SLOT_SIGMA2] * v + p[K.SLOT_TC] * v / math.sqrt(v * v + e * e)
+    return 0.0, p[K.SLOT_SIGMA2] * v + p[K.SLOT_TC] * v / math.sqrt(v * v + e * e)
 
 
 def toy_zdot3(w0, w1, z0, z1, p):
@@ -103,7 +99,7 @@ def toy_fit_df(law, X, w):
 @pytest.fixture(scope="module")
 def toy():
     entry = friction.register(friction.FrictionLawEntry(
-        TOY, ViscousCoulomb, toy_zdot, toy_torque, toy_zdot3, toy_torque3, toy_bearing,
+        TOY, ViscousCoulomb, toy_rates, toy_zdot3, toy_torque3, toy_bearing,
         fit_describing_function=toy_fit_df, fit_parameters=("coulomb_torque", "viscous_damping")))
     yield entry
     friction.unregister(TOY)
@@ -268,7 +264,7 @@ def test_unregister_removes_a_run_time_law_and_keeps_builtins(flight):
     class Temp(ViscousCoulomb):
         name: ClassVar[str] = "temp-law"
 
-    friction.register(friction.FrictionLawEntry("temp-law", Temp, toy_zdot, toy_torque, toy_zdot3, toy_torque3,
+    friction.register(friction.FrictionLawEntry("temp-law", Temp, toy_rates, toy_zdot3, toy_torque3,
                                                 toy_bearing))
     m = flight.with_friction("temp-law")
     friction.unregister("temp-law")

@@ -11,7 +11,7 @@ tools, the fit surrogate and the step check all ask the entry; an unknown id sto
 To add a law (everything in this folder, or in your own code): write a frozen parameter
 class deriving :class:`FrictionLaw` with fields made by :func:`param`, its ``steady_state``
 (and ``describing_function``, ``check_step`` where they apply); write its kernels with the
-registry's signatures (``zdot``, ``torque``, ``zdot3``, ``torque3``, ``bearing_step``; numba
+registry's signatures (``rates``, ``zdot3``, ``torque3``, ``bearing_step``; numba
 functions, see :mod:`._builtin` for the built-in ones and the helpers in :mod:`._vector`);
 and call :func:`register` with a :class:`FrictionLawEntry`. The tests parametrised over the
 registry then cover it.

@@ -25,10 +25,9 @@ from ._laws import (
 )
 from .registry import (
     BEARING_SIG,
+    RATES_SIG,
     TORQUE3_SIG,
-    TORQUE_SIG,
     ZDOT3_SIG,
-    ZDOT_SIG,
     FrictionLawEntry,
     register,
 )
@@ -39,20 +38,15 @@ def _kernel(sig):
 
 
 # -- memoryless laws: no state ------------------------------------------------------------------
-@_kernel(ZDOT_SIG)
-def zero_zdot(v, z, p):
-    return 0.0
-
-
 @_kernel(ZDOT3_SIG)
 def zero_zdot3(w0, w1, z0, z1, p):
     return 0.0, 0.0
 
 
 # -- none ------------------------------------------------------------------------------------------
-@_kernel(TORQUE_SIG)
-def none_torque(v, z, dz, t_app, p):
-    return 0.0
+@_kernel(RATES_SIG)
+def none_rates(v, z, t_app, p):
+    return 0.0, 0.0
 
 
 @_kernel(TORQUE3_SIG)
@@ -66,9 +60,9 @@ def none_bearing(p, Kc, d0, d1, z0, z1, dt):
 
 
 # -- Coulomb, stick-slip switching -----------------------------------------------------------------
-@_kernel(TORQUE_SIG)
-def switching_torque(v, z, dz, t_app, p):
-    return K.coulomb_switching_torque(v, t_app, p)
+@_kernel(RATES_SIG)
+def switching_rates(v, z, t_app, p):
+    return 0.0, K.coulomb_switching_torque(v, t_app, p)
 
 
 @_kernel(TORQUE3_SIG)
@@ -82,9 +76,9 @@ def switching_bearing(p, Kc, d0, d1, z0, z1, dt):
 
 
 # -- Coulomb, smooth ---------------------------------------------------------------------------------
-@_kernel(TORQUE_SIG)
-def smooth_torque(v, z, dz, t_app, p):
-    return K.coulomb_smooth_torque(v, p)
+@_kernel(RATES_SIG)
+def smooth_rates(v, z, t_app, p):
+    return 0.0, K.coulomb_smooth_torque(v, p)
 
 
 @_kernel(TORQUE3_SIG)
@@ -98,14 +92,9 @@ def smooth_bearing(p, Kc, d0, d1, z0, z1, dt):
 
 
 # -- Dahl -------------------------------------------------------------------------------------------
-@_kernel(ZDOT_SIG)
-def dahl_zdot(v, z, p):
-    return K.dahl_zdot(v, z, p)
-
-
-@_kernel(TORQUE_SIG)
-def dahl_torque(v, z, dz, t_app, p):
-    return K.dahl_torque(z, p)
+@_kernel(RATES_SIG)
+def dahl_rates(v, z, t_app, p):
+    return K.dahl_zdot(v, z, p), K.dahl_torque(z, p)
 
 
 @_kernel(ZDOT3_SIG)
@@ -126,14 +115,10 @@ def dahl_bearing(p, Kc, d0, d1, z0, z1, dt):
 
 
 # -- LuGre and modified LuGre (one kernel set: the vibration factor is 1 at V_d = 0) --------------
-@_kernel(ZDOT_SIG)
-def lugre_zdot(v, z, p):
-    return K.lugre_zdot(v, z, p)
-
-
-@_kernel(TORQUE_SIG)
-def lugre_torque(v, z, dz, t_app, p):
-    return K.lugre_torque(v, z, dz, p)
+@_kernel(RATES_SIG)
+def lugre_rates(v, z, t_app, p):
+    dz = K.lugre_zdot(v, z, p)
+    return dz, K.lugre_torque(v, z, dz, p)
 
 
 @_kernel(ZDOT3_SIG)
@@ -181,18 +166,18 @@ _LUGRE_FIT = dict(fit_describing_function=_dahl_fit_df,
                   fit_parameters=("coulomb_torque", "bristle_stiffness", "viscous_damping"))
 
 for _e in (
-    FrictionLawEntry("none", NoFriction, zero_zdot, none_torque, zero_zdot3, none_torque3, none_bearing,
+    FrictionLawEntry("none", NoFriction, none_rates, zero_zdot3, none_torque3, none_bearing,
                      fit_describing_function=lambda law, X, w: (0.0, 0.0)),
-    FrictionLawEntry("coulomb-switching", CoulombSwitching, zero_zdot, switching_torque, zero_zdot3,
+    FrictionLawEntry("coulomb-switching", CoulombSwitching, switching_rates, zero_zdot3,
                      switching_torque3, switching_bearing, **_COULOMB_FIT),
-    FrictionLawEntry("coulomb-smooth", CoulombSmooth, zero_zdot, smooth_torque, zero_zdot3, smooth_torque3,
+    FrictionLawEntry("coulomb-smooth", CoulombSmooth, smooth_rates, zero_zdot3, smooth_torque3,
                      smooth_bearing, **_COULOMB_FIT),
-    FrictionLawEntry("dahl", Dahl, dahl_zdot, dahl_torque, dahl_zdot3, dahl_torque3, dahl_bearing,
+    FrictionLawEntry("dahl", Dahl, dahl_rates, dahl_zdot3, dahl_torque3, dahl_bearing,
                      fit_describing_function=_dahl_fit_df, fit_check=_dahl_fit_check,
                      fit_parameters=("coulomb_torque", "bristle_stiffness")),
-    FrictionLawEntry("lugre", LuGre, lugre_zdot, lugre_torque, lugre_zdot3, lugre_torque3, lugre_bearing,
+    FrictionLawEntry("lugre", LuGre, lugre_rates, lugre_zdot3, lugre_torque3, lugre_bearing,
                      **_LUGRE_FIT),
-    FrictionLawEntry("modified-lugre", ModifiedLuGre, lugre_zdot, lugre_torque, lugre_zdot3, lugre_torque3,
+    FrictionLawEntry("modified-lugre", ModifiedLuGre, lugre_rates, lugre_zdot3, lugre_torque3,
                      lugre_bearing, **_LUGRE_FIT),
 ):
     register(_e, builtin=True)

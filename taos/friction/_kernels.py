@@ -10,8 +10,9 @@ calls make them numeric only; fits use describing functions of these laws instea
   stick-slip law).
 
 ``p`` is the packed parameter vector (float64, :data:`NPARAM` slots, see ``SLOT_*``).
-Each law's entry in :mod:`taos.friction.registry` wraps these as C callbacks with uniform
-signatures (:mod:`taos.friction._builtin`), which the integrators take as arguments.
+Each law's entry in :mod:`taos.friction.registry` wraps these as one C callback
+``rates(v, z, t_app, p) -> (dz/dt, T_f)`` (:mod:`taos.friction._builtin`), which the
+integrators take as an argument.
 """
 
 from __future__ import annotations
@@ -135,26 +136,23 @@ def lugre_torque(v, z, dz, p):
 
 # --- prescribed rate ---------------------------------------------------------------------
 @njit(cache=True)
-def prescribed_rate_response(kern, p, v, dt, z0):
+def prescribed_rate_response(rates, p, v, dt, z0):
     """Torque history for a prescribed relative-rate history ``v`` sampled every ``dt``, for
-    the law whose scalar kernels are ``kern`` = (zdot, torque) (its registry entry's
-    ``kernels``).
+    the law whose scalar kernel is ``rates`` (its registry entry's).
 
     The state is advanced by classical RK4 with ``v`` linearly interpolated at the
     half-step. Returns (torque[n], z[n])."""
-    zdot, torque = kern
     n = v.shape[0]
     tq = np.empty(n)
     zs = np.empty(n)
     z = z0
     for k in range(n):
         zs[k] = z
-        tq[k] = torque(v[k], z, zdot(v[k], z, p), 0.0, p)
+        k1, tq[k] = rates(v[k], z, 0.0, p)
         if k + 1 < n:
             vm = 0.5 * (v[k] + v[k + 1])
-            k1 = zdot(v[k], z, p)
-            k2 = zdot(vm, z + 0.5 * dt * k1, p)
-            k3 = zdot(vm, z + 0.5 * dt * k2, p)
-            k4 = zdot(v[k + 1], z + dt * k3, p)
+            k2 = rates(vm, z + 0.5 * dt * k1, 0.0, p)[0]
+            k3 = rates(vm, z + 0.5 * dt * k2, 0.0, p)[0]
+            k4 = rates(v[k + 1], z + dt * k3, 0.0, p)[0]
             z = z + dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
     return tq, zs

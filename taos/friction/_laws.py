@@ -99,14 +99,11 @@ class FrictionLaw(abc.ABC):
     def __call__(self, v: float, z: float = 0.0, t_app: float = 0.0) -> float:
         """Friction torque [N m] at relative rate ``v`` [rad/s], state ``z`` [rad] and applied
         torque ``t_app`` [N m]."""
-        p = self.pack()
-        e = self.entry
-        dz = e.zdot(float(v), float(z), p)
-        return float(e.torque(float(v), float(z), dz, float(t_app), p))
+        return float(self.entry.rates(float(v), float(z), float(t_app), self.pack())[1])
 
     def derivative(self, v: float, z: float) -> float:
         """dz/dt [rad/s] (0 for memoryless laws)."""
-        return float(self.entry.zdot(float(v), float(z), self.pack()))
+        return float(self.entry.rates(float(v), float(z), 0.0, self.pack())[0])
 
     @abc.abstractmethod
     def steady_state(self, v: np.ndarray) -> np.ndarray:
@@ -124,7 +121,7 @@ class FrictionLaw(abc.ABC):
 
     def response(self, v: np.ndarray, dt: float, z0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Torque [N m] and state [rad] for a prescribed rate history ``v`` [rad/s] every ``dt`` [s]."""
-        return K.prescribed_rate_response(self.entry.kernels, self.pack(), np.ascontiguousarray(v, float),
+        return K.prescribed_rate_response(self.entry.rates, self.pack(), np.ascontiguousarray(v, float),
                                           float(dt), float(z0))
 
     def numeric_describing_function(self, rate_amplitude: float, freq_hz: float,

@@ -6,8 +6,9 @@ An entry (:class:`FrictionLawEntry`) holds everything about a law:
   subclass; the fields carry their model-file key and unit kind, see
   :func:`~taos.friction._laws.param`), which also holds the law's analytic steady-state
   curve, its analytic describing function (if one exists) and its stable-step rule;
-* ``zdot``, ``torque``: the scalar kernels (planar model), compiled C callbacks with the
-  signatures :data:`ZDOT_SIG` and :data:`TORQUE_SIG`;
+* ``rates``: the scalar kernel (planar model), a compiled C callback with the signature
+  :data:`RATES_SIG` giving the bristle-state rate and the torque together (the torque of the
+  bristle laws needs the rate; one call per integrator stage);
 * ``zdot3``, ``torque3``, ``bearing_step``: the vector spherical-bearing form (3-D model),
   signatures :data:`ZDOT3_SIG`, :data:`TORQUE3_SIG`, :data:`BEARING_SIG`;
 * ``fit_describing_function`` (and ``fit_relay_level``, ``fit_check``): the describing
@@ -18,7 +19,7 @@ The compiled integrators (:mod:`taos._integrator`, :mod:`taos.taos3d.dynamics`) 
 kernels as first-class function arguments (numba ``FunctionType``): one compiled (and
 cached) integrator serves every law, including a law registered at run time. Kernel
 arguments (SI): relative rate ``v``/``w`` [rad/s], bristle state ``z`` [rad], its
-derivative ``dz`` [rad/s], applied (non-friction) torque ``t_app`` [N m], packed parameter
+derivative ``dz`` [rad/s] (vector form: from ``zdot3``), applied (non-friction) torque ``t_app`` [N m], packed parameter
 vector ``p`` (float64, C-contiguous, the law's :meth:`pack`), chain compliance ``Kc`` (2, 2)
 [rad/(N m)], trial bearing increment ``d`` [rad], step ``dt`` [s].
 
@@ -47,10 +48,8 @@ warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
 
 _f8 = nt.float64
 _p = nt.float64[::1]
-#: dz/dt [rad/s] = zdot(v, z, p)
-ZDOT_SIG = _f8(_f8, _f8, _p)
-#: T_f [N m] = torque(v, z, dz, t_app, p)
-TORQUE_SIG = _f8(_f8, _f8, _f8, _f8, _p)
+#: (dz/dt [rad/s], T_f [N m]) = rates(v, z, t_app, p)
+RATES_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _p)
 #: (dz0, dz1) [rad/s] = zdot3(w0, w1, z0, z1, p)
 ZDOT3_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _f8, _p)
 #: (T0, T1) [N m] = torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p)
@@ -58,7 +57,7 @@ TORQUE3_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _f8, _f8, _f8, _f8, _f8, _p)
 #: (w0, w1, z0, z1, T0, T1) = bearing_step(p, Kc, d0, d1, z0, z1, dt)
 BEARING_SIG = nt.UniTuple(_f8, 6)(_p, nt.float64[:, ::1], _f8, _f8, _f8, _f8, _f8)
 
-_SIGS = {"zdot": ZDOT_SIG, "torque": TORQUE_SIG, "zdot3": ZDOT3_SIG, "torque3": TORQUE3_SIG,
+_SIGS = {"rates": RATES_SIG, "zdot3": ZDOT3_SIG, "torque3": TORQUE3_SIG,
          "bearing_step": BEARING_SIG}
 
 
@@ -78,8 +77,7 @@ class FrictionLawEntry:
 
     id: str
     params: type
-    zdot: object
-    torque: object
+    rates: object
     zdot3: object
     torque3: object
     bearing_step: object
@@ -88,11 +86,6 @@ class FrictionLawEntry:
     fit_check: Callable | None = None
     fit_parameters: tuple[str, ...] = ()
     builtin: bool = False
-
-    @property
-    def kernels(self) -> tuple:
-        """(zdot, torque): the scalar kernels as the planar integrator takes them."""
-        return (self.zdot, self.torque)
 
 
 _REGISTRY: dict[str, FrictionLawEntry] = {}
