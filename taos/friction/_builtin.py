@@ -33,8 +33,14 @@ from .registry import (
 )
 
 
+#: the planar integrator's floating-point flags (reassociation and FMA contraction only;
+#: no-NaN/no-Inf flags would remove its stability checks), which the scalar kernels were
+#: compiled with when inlined there; the vector kernels keep strict IEEE arithmetic
+_FM = {"reassoc", "contract", "arcp", "nsz"}
+
+
 def _kernel(sig):
-    return cfunc(sig, cache=True)
+    return cfunc(sig, cache=True, fastmath=_FM if sig is RATES_SIG else False)
 
 
 # -- memoryless laws: no state ------------------------------------------------------------------
