@@ -1,15 +1,18 @@
-"""Friction laws as small frozen classes over the scalar kernels in :mod:`._kernels`.
+"""Friction-law parameter classes: fields, model-file keys, analytic properties.
 
 Every law acts at the gimbal bearing between the two gimbal halves (planar: between the
 engine and the thrust structure) and returns a torque opposing the relative rotation rate.
-All fields are SI; the TOML keys (``[friction]`` table) are the field names without the
-unit suffix and carry their unit in the value, e.g. ``coulomb_torque = "144000 in*lbf"``.
+All fields are SI and made by :func:`param`, which records the ``[friction]`` model-file key
+(the field name without the unit suffix; the value carries its unit, e.g.
+``coulomb_torque = "144000 in*lbf"``), the unit kind, the packed kernel slot and whether the
+parameter scales with the bearing normal load. A class is one part of its law's registry
+entry (:mod:`.registry`), which also holds the compiled kernels.
 
 Interface (python-control ``descfcn`` style): ``law(v, z, t_app)`` gives the torque,
 ``law.derivative(v, z)`` the state derivative, ``law.steady_state(v)`` the analytic
-steady-sliding curve, ``law.describing_function(V)`` the analytic describing function
-where one exists (else ``None``) and ``law.numeric_describing_function(V, f)`` the
-numeric one by simulation.
+steady-sliding curve, ``law.describing_function(V, w)`` the analytic describing function
+where one exists (else ``None``), ``law.numeric_describing_function(V, f)`` the numeric one
+by simulation, and ``law.check_step(J, dt, source)`` the explicit-step limit.
 
 References
 ----------

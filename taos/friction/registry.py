@@ -72,7 +72,8 @@ class FrictionLawEntry:
     ``fit_relay_level(law) -> a`` [N m] marks a pure relay N = a / (w X): the fit then solves
     the loop in closed form, including the held engine. ``fit_check(law, source)`` raises
     :class:`InputError` for parameter values the fit's describing function does not cover.
-    ``fit_parameters``: the ``[friction]`` keys a fit may free.
+    ``fit_parameters``: the ``[friction]`` keys a fit may free (names of
+    :data:`taos.identify.surrogate.PARAMETERS`).
     """
 
     id: str
