@@ -13,9 +13,8 @@ stage times (linear interpolation of samples, or exactly for sines). The frictio
 come from the law's registry entry (:mod:`taos.friction.registry`): ``fid`` is its
 ``rates(w, z, T_a, p) -> (z', T_f)``, a compiled C callback passed as a first-class
 function, so one compiled integrator serves every law, including laws registered at run
-time. The
-avionics kernel is the single definition in :mod:`taos.avionics`. A non-finite state stops
-the run and reports the step.
+time. The avionics kernel is the single definition in :mod:`taos.avionics`. A non-finite
+state stops the run and reports the step.
 """
 
 from __future__ import annotations
