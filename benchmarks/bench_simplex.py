@@ -1,8 +1,8 @@
 """Benchmark: simplex model with LuGre friction, simulated seconds per wall second.
 
 Our compiled fixed-step RK4 kernel against a plain scipy.integrate.solve_ivp (LSODA) on the
-same equations (the same plant matrices; the friction and avionics kernels' pure-Python
-originals, ``.py_func``), run in the same script. Both are checked against a reference run
+same equations (the same plant matrices; the friction law's registry kernels called from
+Python and the avionics kernel's pure-Python original, ``.py_func``), run in the same script. Both are checked against a reference run
 (our kernel at dt = 2.5e-5 s) so each figure is quoted at its accuracy.
 
     .venv/bin/python benchmarks/bench_simplex.py
@@ -19,7 +19,6 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from taos import avionics as av
-from taos.friction import _kernels as fk
 from taos.model import load_model
 from taos.profiles import MultiRamp, Sequence, SineDwell
 from taos.simplex import simplex_plant
@@ -47,8 +46,8 @@ def ours(model, dt):
 def scipy_baseline(model, t_eval, rtol):
     plant = simplex_plant(model)
     A, Br, bc, bf, cc, dc, cw, ca = kernel_args(plant, model)
-    fid, fp, avp = model.friction.fid, model.friction.pack(), model.avionics.pack()
-    zdot, torque, apply = fk.zdot.py_func, fk.torque.py_func, av.apply.py_func
+    fp, avp = model.friction.pack(), model.avionics.pack()
+    rates, apply = model.friction.entry.rates, av.apply.py_func
     prof = profile()
     ith = plant.ss.output_index("theta_rad")
     Cth = plant.ss.C[ith]
@@ -58,8 +57,7 @@ def scipy_baseline(model, t_eval, rtol):
         r = float(prof(t))
         u = apply(r, avp)
         w = cw @ x
-        dz = zdot(fid, w, z, fp)
-        tf = torque(fid, w, z, dz, ca @ x, fp)
+        dz, tf = rates(w, z, ca @ x, fp)
         return np.append(A @ x + bc * u + bf * tf, dz)
 
     t0 = time.perf_counter()

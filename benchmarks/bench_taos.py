@@ -28,7 +28,6 @@ from taos.linear import gain_db
 from taos.profiles import Sequence, TwoAxis, load_profile
 from taos.taos3d import load_taos_model, two_axis_dwell
 from taos.taos3d import dynamics as dy
-from taos.taos3d import friction3d as f3
 from taos.taos3d.simulate import pack, rest_state, run_samples
 
 DT = 2e-4
@@ -49,7 +48,8 @@ def commands(profile, T, dt):
 def naive_rhs_factory(tm, cmd_fun):
     """Uncondensed ODE: y = (x, phi (2), phi_dot (2), z (2))."""
     pk = pack(tm)
-    P, fid, fp, avp = pk.P, pk.fid, pk.fp, pk.avp
+    P, fp, avp = pk.P, pk.fp, pk.avp
+    law = tm.base.friction.entry  # the vector kernels (Python-callable C callbacks)
     n = pk.n_state
     Kphi = np.linalg.inv(P[4])
     aux = np.empty(12)
@@ -63,8 +63,8 @@ def naive_rhs_factory(tm, cmd_fun):
         c = cmd_fun(t)
         dx = np.empty(n)
         dy.rhs(x, T[0], T[1], av.apply(c[0], avp), av.apply(c[1], avp), P, dx, aux)
-        dz = f3.zdot3(fid, w[0], w[1], z[0], z[1], fp)
-        tf = f3.torque3(fid, w[0], w[1], z[0], z[1], dz[0], dz[1], 0.0, 0.0, fp)
+        dz = law.zdot3(w[0], w[1], z[0], z[1], fp)
+        tf = law.torque3(w[0], w[1], z[0], z[1], dz[0], dz[1], 0.0, 0.0, fp)
         out = np.empty_like(y)
         out[:n] = dx
         out[n:n + 2] = w

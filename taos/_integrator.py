@@ -5,13 +5,16 @@ State equations (see :class:`taos.simplex.LurePlant`)::
     c   = cc . x + dc . r(t)                 pre-avionics command [rad]
     u   = avionics(c)                        post-avionics command [rad]
     w   = cw . x,  T_a = ca . x              friction relative rate [rad/s], applied torque [N m]
-    T_f = friction.torque(w, z, T_a)         z' = friction.zdot(w, z)
+    (z', T_f) = friction.rates(w, z, T_a)    the law's kernel (registry entry)
     x'  = A x + Br r(t) + bc u + bf T_f
 
 Classical fourth-order Runge-Kutta with a fixed step; the external input is evaluated at the
-stage times (linear interpolation of samples, or exactly for sines). The friction and
-avionics kernels are the single definitions in :mod:`taos.friction._kernels` and
-:mod:`taos.avionics`. A non-finite state stops the run and reports the step.
+stage times (linear interpolation of samples, or exactly for sines). The friction kernels
+come from the law's registry entry (:mod:`taos.friction.registry`): ``fid`` is its
+``rates(w, z, T_a, p) -> (z', T_f)``, a compiled C callback passed as a first-class
+function, so one compiled integrator serves every law, including laws registered at run
+time. The avionics kernel is the single definition in :mod:`taos.avionics`. A non-finite
+state stops the run and reports the step.
 """
 
 from __future__ import annotations
@@ -22,7 +25,6 @@ import numpy as np
 from numba import njit, prange
 
 from . import avionics as _av
-from .friction import _kernels as _fk
 
 # reassociation and FMA contraction only: no-NaN/no-Inf flags would remove the stability checks
 _FM = {"reassoc", "contract", "arcp", "nsz"}
@@ -42,8 +44,7 @@ def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, dx):
     for j in range(nr):
         c += dc[j] * r[j]
     u = _av.apply(c, avp)
-    dz = _fk.zdot(fid, w, z, fp)
-    tf = _fk.torque(fid, w, z, dz, ta, fp)
+    dz, tf = fid(w, z, ta, fp)
     for i in range(n):
         s = bc[i] * u + bf[i] * tf
         for j in range(n):

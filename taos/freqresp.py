@@ -95,7 +95,7 @@ def sine_dwell_grid(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch
     Cy = np.ascontiguousarray(plant.ss.C[[o("x_p_m"), o("theta_rad")]])
     out = np.zeros((A.size, 2, 3))
     status = np.full(A.size, -1, np.int64)
-    _ig.sine_dwell_batch(*kernel_args(plant, model), Cy, model.friction.fid, model.friction.pack(),
+    _ig.sine_dwell_batch(*kernel_args(plant, model), Cy, model.friction.entry.rates, model.friction.pack(),
                          model.avionics.pack(), A, F, npc, nset, nmeas, out, status)
     bad = np.flatnonzero(status >= 0)
     if bad.size:

@@ -146,7 +146,7 @@ def freqresp_symbolic(ss: StateSpace, w_rad_s: float, inputs, outputs, scale: np
     oo = [ss.output_index(outputs)] if isinstance(outputs, str) else [ss.output_index(n) for n in outputs]
     A = ca.SX(ss.A) if not isinstance(ss.A, (ca.SX, ca.MX)) else ss.A
     B = ca.horzcat(*[ss.B[:, i] for i in ii])
-    C = ca.vertcat(*[ss.C[o, :] for o in oo])
+    C = ca.vertcat(*[ss.C[o:o + 1, :] for o in oo])  # rows stay rows (numeric C: a free set of friction only)
     D = ca.SX(len(oo), len(ii))
     for a, o in enumerate(oo):
         for b, i in enumerate(ii):

@@ -15,8 +15,7 @@ import h5py
 import numpy as np
 
 from . import _integrator as _ig
-from .errors import InputError, SimulationUnstable
-from .friction import CoulombSmooth, CoulombSwitching
+from .errors import SimulationUnstable
 from .model import TvcModel
 from .profiles import is_two_axis
 from .results import atomic_write, package_version, write_provenance
@@ -35,19 +34,9 @@ class SolverSettings:
 
 
 def check_step(model: TvcModel, inertia_kgm2: float, dt_s: float) -> None:
-    """Refuse steps that the friction law cannot be integrated with (explicit-step limits)."""
-    law = model.friction
-    if isinstance(law, CoulombSwitching):
-        dv = dt_s * (max(law.static_torque_Nm, law.coulomb_torque_Nm) + law.coulomb_torque_Nm) / inertia_kgm2
-        if dv >= law.stick_velocity_rad_s:
-            raise InputError(model.source, "friction.stick_velocity",
-                             f"a stick band above one step's rate change {dv:.3g} rad/s (or a smaller step)")
-        if law.stick_damping_Nms_per_rad * dt_s / inertia_kgm2 > 1.0:
-            raise InputError(model.source, "friction.stick_damping", "c_stick dt / J below 1 (or a smaller step)")
-    if isinstance(law, CoulombSmooth):
-        if dt_s * law.coulomb_torque_Nm / (law.regularization_velocity_rad_s * inertia_kgm2) > 2.0:
-            raise InputError(model.source, "friction.regularization_velocity",
-                             "dt T_c / (v_eps J) below 2 (or a smaller step)")
+    """Refuse steps that the friction law cannot be integrated with (the law's own explicit-step
+    rule, :meth:`taos.friction.FrictionLaw.check_step`)."""
+    model.friction.check_step(inertia_kgm2, dt_s, model.source)
 
 
 def kernel_args(plant: LurePlant, model: TvcModel):
@@ -75,7 +64,7 @@ def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: floa
     aux = np.empty((nrec, 3))
     x0 = np.zeros(n) if x0 is None else np.asarray(x0, float)
     status = _ig.integrate_samples(*kernel_args(plant, model), np.ascontiguousarray(plant.ss.C),
-                                   model.friction.fid, model.friction.pack(), model.avionics.pack(),
+                                   model.friction.entry.rates, model.friction.pack(), model.avionics.pack(),
                                    x0, float(z0), np.ascontiguousarray(r, dtype=np.float64), dt_s,
                                    record_every, y, aux)
     if status >= 0:

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from taos.flight.describing import (DescribingFunctionMap, describing_function_map, rigid_coulomb_engine_response,
+from taos.flight.describing import (DescribingFunctionMap, describing_function_map, rigid_engine_response,
                              rigid_limit_model)
 from taos.freqresp import linear_freqresp
 from taos.model import load_model
@@ -42,7 +42,7 @@ def test_rigid_limit_engine_response_matches_relay_in_loop_describing_function()
     dfm = describing_function_map(m, [0.4 * DEG], f)
     lin = linear_freqresp(m, f).engine
     for j, fj in enumerate(f):
-        ana = rigid_coulomb_engine_response(m, 0.4 * DEG, fj)
+        ana = rigid_engine_response(m, 0.4 * DEG, fj)
         num = dfm.engine[0, j]
         assert abs(num / ana - 1) < 0.02, (fj, num, ana)
         assert abs(num / lin[j] - 1) > 0.10

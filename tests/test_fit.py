@@ -98,13 +98,13 @@ def test_standard_errors_cover_the_truth_at_the_stated_confidence():
 
 def test_surrogate_describing_functions_equal_the_friction_kernels(hotfire):
     """Closed-form Dahl loop (quadrature) and Coulomb DF vs the numba friction kernels."""
-    from taos.identify.surrogate import dahl_df_x
+    from taos.friction import dahl_angle_df
 
     dahl = hotfire.with_friction("dahl").friction
     for V, f in ((0.01, 1.0), (0.05, 2.0), (0.3, 5.0)):
         w = 2 * math.pi * f
         n_rate = dahl.numeric_describing_function(V, f, cycles=12, steps_per_cycle=4000)
-        nr, ni = dahl_df_x(dahl.coulomb_torque_Nm, dahl.bristle_stiffness_Nm_per_rad, V / w)
+        nr, ni = dahl_angle_df(dahl.coulomb_torque_Nm, dahl.bristle_stiffness_Nm_per_rad, V / w)
         n_sur = complex(float(nr), float(ni)) / (1j * w)
         assert abs(n_sur / n_rate - 1) < 2e-3, (V, f, n_sur, n_rate)
     coul = hotfire.with_friction("coulomb-switching").friction

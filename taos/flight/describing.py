@@ -9,10 +9,11 @@ the compiled integrator) over a grid of amplitudes x frequencies and interpolate
 (log A, log f) bilinearly in gain [dB] and unwrapped phase [deg]; outside the grid the
 nearest edge value is held.
 
-:func:`rigid_coulomb_engine_response` is the analytic check: with a rigid load path the
-engine angle is the piston angle and Coulomb friction is a relay on the engine rate in a
-linear loop; replacing it by its describing function 4 T_c / (pi V) (V the rate amplitude)
-gives theta / theta_c = G_c / (1 + j w G_f N_c(w |theta|)), solved for |theta| by fixed point.
+:func:`rigid_engine_response` is the analytic check: with a rigid load path the engine
+angle is the piston angle and friction acts on the engine rate in a linear loop; replacing it
+by the law's analytic describing function N(V, w) (V the rate amplitude; Coulomb:
+4 T_c / (pi V)) gives theta / theta_c = G_c / (1 + j w G_f N(w |theta|, w)), solved for
+|theta| by a bracketed root search.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from dataclasses import dataclass, field
 import h5py
 import numpy as np
 
+from taos.errors import InputError
 from taos.freqresp import sine_dwell_grid
 from taos.linear import StateSpace
 from taos.model import Structure, TvcModel
@@ -169,32 +171,37 @@ def describing_function_map(model: TvcModel, amplitudes_rad, freq_hz, axis: str 
                                  model.structure.load_stiffness_N_per_m, prov)
 
 
-# -- analytic check: Coulomb relay in the rigid-load loop --------------------------------------
+# -- analytic check: the friction describing function in the rigid-load loop ----------------------
 def rigid_limit_model(model: TvcModel, stiffness_factor: float = 1000.0) -> TvcModel:
     """The model with its load path ``stiffness_factor`` times stiffer and ideal avionics."""
     return model.replace(structure=Structure(model.structure.load_stiffness_N_per_m * stiffness_factor),
                          avionics=model.avionics.ideal())
 
 
-def rigid_coulomb_engine_response(model: TvcModel, amplitude_rad: float, freq_hz: float,
-                                  axis: str = "pitch") -> complex:
-    """Analytic relay-in-loop engine response theta/theta_c [-] for Coulomb friction.
+def rigid_engine_response(model: TvcModel, amplitude_rad: float, freq_hz: float,
+                          axis: str = "pitch") -> complex:
+    """Analytic friction-in-loop engine response theta/theta_c [-] from the friction law's
+    analytic describing function (:meth:`taos.friction.FrictionLaw.describing_function`).
 
     The linear simplex block gives theta = G_c theta_c - G_f T_f (G_c, G_f exact at j w).
-    Replacing T_f by its describing function on the engine rate, T_f = N_c (j w theta) with
-    N_c(V) = 4 T_c / (pi V), V = w |theta|, gives theta/theta_c = G_c / (1 + j w G_f N_c),
-    solved for |theta| by a bracketed root search (largest root). (Valid while the engine slides through
-    most of the cycle; with a rigid load path the piston and engine coincide.)"""
+    Replacing T_f by its describing function on the engine rate, T_f = N(V, w) (j w theta),
+    V = w |theta| (Coulomb: N = 4 T_c / (pi V)), gives theta/theta_c = G_c / (1 + j w G_f N),
+    solved for |theta| by a bracketed root search (largest root). (Valid while the engine
+    slides through most of the cycle; with a rigid load path the piston and engine
+    coincide.) ``amplitude_rad`` command amplitude [rad], ``freq_hz`` [Hz]."""
     import scipy.optimize
 
+    law = model.friction
+    w = 2 * math.pi * freq_hz
+    if law.describing_function(1.0, w) is None:
+        raise InputError(model.source, "friction.model", "a law with an analytic describing function",
+                         got=law.name)
     ss: StateSpace = simplex_state_space(model, axis)
     h = ss.freqresp([freq_hz], ["command_rad", "friction_torque_Nm"], "theta_rad")[0]
     gc, gf = complex(h[0]), -complex(h[1])
-    w = 2 * math.pi * freq_hz
-    tc = model.friction.coulomb_torque_Nm
 
     def resp(mag):
-        return gc / (1 + 1j * w * gf * 4 * tc / (math.pi * w * mag))
+        return gc / (1 + 1j * w * gf * law.describing_function(w * mag, w))
 
     # |theta| = A |resp(|theta|)|: bracket from the linear amplitude downwards, take the largest root
     hi = 2 * abs(gc) * amplitude_rad

@@ -1,14 +1,24 @@
 """Gimbal friction laws: Coulomb (switching and smooth), Dahl, LuGre, modified LuGre.
 
-To add a law: write its scalar ``torque``/``zdot`` kernels in :mod:`._kernels` (give it an
-id and dispatch it there), write a small frozen class in :mod:`._laws` with its
-``steady_state`` (and ``describing_function`` if analytic), register it in ``LAWS``, and add
-its steady-state and passivity tests in ``tests/test_friction.py``.
+Every law has one entry in :mod:`taos.friction.registry`, reachable by its id
+(``taos.friction.get("lugre")``, ``taos.friction.LAWS``): its parameter class (fields with
+model-file keys and units, steady-state curve, analytic describing function, stable-step
+rule), its scalar kernels (planar model), its vector spherical-bearing kernels (3-D model)
+and its fit describing function. The planar and 3-D integrators, the describing-function
+tools, the fit surrogate and the step check all ask the entry; an unknown id stops with
+:class:`~taos.errors.InputError`.
+
+To add a law (everything in this folder, or in your own code): write a frozen parameter
+class deriving :class:`FrictionLaw` with fields made by :func:`param`, its ``steady_state``
+(and ``describing_function``, ``check_step`` where they apply); write its kernels with the
+registry's signatures (``rates``, ``zdot3``, ``torque3``, ``bearing_step``; numba
+functions, see :mod:`._builtin` for the built-in ones and the helpers in :mod:`._vector`);
+and call :func:`register` with a :class:`FrictionLawEntry`. The tests parametrised over the
+registry then cover it.
 """
 
+from . import _builtin  # noqa: F401  (registers the built-in laws)
 from ._laws import (
-    FRICTION_KEYS,
-    LAWS,
     CoulombSmooth,
     CoulombSwitching,
     Dahl,
@@ -16,10 +26,17 @@ from ._laws import (
     LuGre,
     ModifiedLuGre,
     NoFriction,
+    coulomb_describing_function,
+    dahl_angle_df,
     friction_from_table,
+    friction_keys,
+    param,
 )
+from ._vector import coeff_bearing_step
+from .registry import LAWS, FrictionLawEntry, get, ids, register, unregister
 
 __all__ = [
-    "FRICTION_KEYS", "LAWS", "CoulombSmooth", "CoulombSwitching", "Dahl", "FrictionLaw", "LuGre",
-    "ModifiedLuGre", "NoFriction", "friction_from_table",
+    "LAWS", "CoulombSmooth", "CoulombSwitching", "Dahl", "FrictionLaw", "FrictionLawEntry", "LuGre", "coeff_bearing_step",
+    "ModifiedLuGre", "NoFriction", "coulomb_describing_function", "dahl_angle_df", "friction_from_table",
+    "friction_keys", "get", "ids", "param", "register", "unregister",
 ]

@@ -10,8 +10,9 @@ calls make them numeric only; fits use describing functions of these laws instea
   stick-slip law).
 
 ``p`` is the packed parameter vector (float64, :data:`NPARAM` slots, see ``SLOT_*``).
-The kernels are dispatched by integer id (:data:`IDS`) inside the time-domain integrator so
-that one compiled integrator serves every law.
+Each law's entry in :mod:`taos.friction.registry` wraps these as one C callback
+``rates(v, z, t_app, p) -> (dz/dt, T_f)`` (:mod:`taos.friction._builtin`), which the
+integrators take as an argument.
 """
 
 from __future__ import annotations
@@ -36,15 +37,6 @@ SLOT_V1 = 10       # bristle-damping decay velocity v_1 [rad/s] (0: constant sig
 SLOT_CSTICK = 11   # stick damping c_stick [N m s/rad] (switching law)
 NPARAM = 12
 
-ID_NONE, ID_COULOMB_SWITCHING, ID_COULOMB_SMOOTH, ID_DAHL, ID_LUGRE, ID_MODIFIED_LUGRE = range(6)
-IDS = {
-    "none": ID_NONE,
-    "coulomb-switching": ID_COULOMB_SWITCHING,
-    "coulomb-smooth": ID_COULOMB_SMOOTH,
-    "dahl": ID_DAHL,
-    "lugre": ID_LUGRE,
-    "modified-lugre": ID_MODIFIED_LUGRE,
-}
 
 
 @njit(cache=True, inline="always")
@@ -142,34 +134,11 @@ def lugre_torque(v, z, dz, p):
     return p[SLOT_SIGMA0] * z + _sigma1(v, p) * dz + p[SLOT_SIGMA2] * v
 
 
-# --- dispatch -------------------------------------------------------------------------
-@njit(cache=True, inline="always")
-def torque(fid, v, z, dz, t_app, p):
-    """Friction torque [N m] of law ``fid``; ``dz`` is ``zdot(fid, v, z, p)``."""
-    if fid == ID_NONE:
-        return 0.0
-    if fid == ID_COULOMB_SWITCHING:
-        return coulomb_switching_torque(v, t_app, p)
-    if fid == ID_COULOMB_SMOOTH:
-        return coulomb_smooth_torque(v, p)
-    if fid == ID_DAHL:
-        return dahl_torque(z, p)
-    return lugre_torque(v, z, dz, p)  # LuGre and modified LuGre share the kernel
-
-
-@njit(cache=True, inline="always")
-def zdot(fid, v, z, p):
-    """Internal-state derivative [rad/s] of law ``fid`` (0 for memoryless laws)."""
-    if fid == ID_DAHL:
-        return dahl_zdot(v, z, p)
-    if fid == ID_LUGRE or fid == ID_MODIFIED_LUGRE:
-        return lugre_zdot(v, z, p)
-    return 0.0
-
-
+# --- prescribed rate ---------------------------------------------------------------------
 @njit(cache=True)
-def prescribed_rate_response(fid, p, v, dt, z0):
-    """Torque history for a prescribed relative-rate history ``v`` sampled every ``dt``.
+def prescribed_rate_response(rates, p, v, dt, z0):
+    """Torque history for a prescribed relative-rate history ``v`` sampled every ``dt``, for
+    the law whose scalar kernel is ``rates`` (its registry entry's).
 
     The state is advanced by classical RK4 with ``v`` linearly interpolated at the
     half-step. Returns (torque[n], z[n])."""
@@ -179,12 +148,11 @@ def prescribed_rate_response(fid, p, v, dt, z0):
     z = z0
     for k in range(n):
         zs[k] = z
-        tq[k] = torque(fid, v[k], z, zdot(fid, v[k], z, p), 0.0, p)
+        k1, tq[k] = rates(v[k], z, 0.0, p)
         if k + 1 < n:
             vm = 0.5 * (v[k] + v[k + 1])
-            k1 = zdot(fid, v[k], z, p)
-            k2 = zdot(fid, vm, z + 0.5 * dt * k1, p)
-            k3 = zdot(fid, vm, z + 0.5 * dt * k2, p)
-            k4 = zdot(fid, v[k + 1], z + dt * k3, p)
+            k2 = rates(vm, z + 0.5 * dt * k1, 0.0, p)[0]
+            k3 = rates(vm, z + 0.5 * dt * k2, 0.0, p)[0]
+            k4 = rates(v[k + 1], z + dt * k3, 0.0, p)[0]
             z = z + dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
     return tq, zs

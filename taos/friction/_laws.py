@@ -1,15 +1,18 @@
-"""Friction laws as small frozen classes over the scalar kernels in :mod:`._kernels`.
+"""Friction-law parameter classes: fields, model-file keys, analytic properties.
 
 Every law acts at the gimbal bearing between the two gimbal halves (planar: between the
 engine and the thrust structure) and returns a torque opposing the relative rotation rate.
-All fields are SI; the TOML keys (``[friction]`` table) are the field names without the
-unit suffix and carry their unit in the value, e.g. ``coulomb_torque = "144000 in*lbf"``.
+All fields are SI and made by :func:`param`, which records the ``[friction]`` model-file key
+(the field name without the unit suffix; the value carries its unit, e.g.
+``coulomb_torque = "144000 in*lbf"``), the unit kind, the packed kernel slot and whether the
+parameter scales with the bearing normal load. A class is one part of its law's registry
+entry (:mod:`.registry`), which also holds the compiled kernels.
 
 Interface (python-control ``descfcn`` style): ``law(v, z, t_app)`` gives the torque,
 ``law.derivative(v, z)`` the state derivative, ``law.steady_state(v)`` the analytic
-steady-sliding curve, ``law.describing_function(V)`` the analytic describing function
-where one exists (else ``None``) and ``law.numeric_describing_function(V, f)`` the
-numeric one by simulation.
+steady-sliding curve, ``law.describing_function(V, w)`` the analytic describing function
+where one exists (else ``None``), ``law.numeric_describing_function(V, f)`` the numeric one
+by simulation, and ``law.check_step(J, dt, source)`` the explicit-step limit.
 
 References
 ----------
@@ -27,7 +30,7 @@ from __future__ import annotations
 import abc
 import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
@@ -35,74 +38,93 @@ import numpy as np
 from ..errors import InputError
 from ..units import to_si
 from . import _kernels as K
+from . import registry
 
-# field name -> (TOML key, unit kind, packed slot)
-_FIELD_INFO: dict[str, tuple[str, str, int]] = {
-    "coulomb_torque_Nm": ("coulomb_torque", "torque", K.SLOT_TC),
-    "static_torque_Nm": ("static_torque", "torque", K.SLOT_TS),
-    "stribeck_velocity_rad_s": ("stribeck_velocity", "angular_velocity", K.SLOT_VS),
-    "stribeck_exponent": ("stribeck_exponent", "dimensionless", K.SLOT_DELTA),
-    "bristle_stiffness_Nm_per_rad": ("bristle_stiffness", "rotational_stiffness", K.SLOT_SIGMA0),
-    "bristle_damping_Nms_per_rad": ("bristle_damping", "rotational_damping", K.SLOT_SIGMA1),
-    "viscous_damping_Nms_per_rad": ("viscous_damping", "rotational_damping", K.SLOT_SIGMA2),
-    "vibration_velocity_rad_s": ("vibration_velocity", "angular_velocity", K.SLOT_VD),
-    "damping_decay_velocity_rad_s": ("damping_decay_velocity", "angular_velocity", K.SLOT_V1),
-    "stick_velocity_rad_s": ("stick_velocity", "angular_velocity", K.SLOT_VEPS),
-    "stick_damping_Nms_per_rad": ("stick_damping", "rotational_damping", K.SLOT_CSTICK),
-    "regularization_velocity_rad_s": ("regularization_velocity", "angular_velocity", K.SLOT_VEPS),
-    "dahl_exponent": ("dahl_exponent", "dimensionless", K.SLOT_ALPHA),
-}
-#: Every key a ``[friction]`` table may hold (besides ``model``).
-FRICTION_KEYS = frozenset(info[0] for info in _FIELD_INFO.values())
+
+def param(default: float, key: str, kind: str, slot: int | None, *, torque_like: bool = False):
+    """A law parameter field: its model-file ``key`` (in the ``[friction]`` table), pint unit
+    ``kind`` (:func:`taos.units.to_si`), ``slot`` in the packed kernel vector (``None``: not
+    packed) and ``torque_like`` (a torque or torque per angle/rate: scaled with the bearing
+    normal load by :meth:`FrictionLaw.scaled`)."""
+    return field(default=default, metadata={"key": key, "kind": kind, "slot": slot, "torque_like": torque_like})
+
+
+def _info(f: dataclasses.Field) -> dict:
+    return f.metadata
+
+
+def friction_keys() -> frozenset[str]:
+    """Every key a ``[friction]`` table may hold (besides ``model``): the keys of every
+    registered law."""
+    return frozenset(_info(f)["key"] for e in registry.LAWS.values() for f in dataclasses.fields(e.params))
 
 
 @dataclass(frozen=True)
 class FrictionLaw(abc.ABC):
-    """Base class: a gimbal friction law. Subclasses set ``name`` and ``fid``."""
+    """Base class: a gimbal friction law's parameters (fields made with :func:`param`, SI)
+    and its analytic properties. Subclasses set ``name`` (the registry id) and
+    ``has_state``; the compiled kernels live in the law's registry entry (:attr:`entry`)."""
 
     name: ClassVar[str] = ""
-    fid: ClassVar[int] = -1
     has_state: ClassVar[bool] = False
+    has_friction: ClassVar[bool] = True
 
-    coulomb_torque_Nm: float = 0.0
+    coulomb_torque_Nm: float = param(0.0, "coulomb_torque", "torque", K.SLOT_TC, torque_like=True)
+
+    @property
+    def entry(self) -> registry.FrictionLawEntry:
+        """This law's registry entry (kernels, vector form, fit describing function)."""
+        return registry.entry_of(self)
 
     # -- packing for the compiled kernels -------------------------------------------------
     def pack(self) -> np.ndarray:
-        """Packed float64 parameter vector for :mod:`taos.friction._kernels` (the switching
-        law's breakaway slot holds max(T_s, T_c))."""
+        """Packed float64 parameter vector for the kernels (:mod:`taos.friction._kernels`
+        slots; the switching law's breakaway slot holds max(T_s, T_c))."""
         p = np.zeros(K.NPARAM)
         p[K.SLOT_TS] = self.coulomb_torque_Nm
         p[K.SLOT_VS] = 1.0
         p[K.SLOT_DELTA] = 2.0
         p[K.SLOT_ALPHA] = 1.0
         for f in dataclasses.fields(self):
-            p[_FIELD_INFO[f.name][2]] = getattr(self, f.name)
+            if _info(f)["slot"] is not None:
+                p[_info(f)["slot"]] = getattr(self, f.name)
         return p
+
+    def scaled(self, factor: float) -> "FrictionLaw":
+        """The law with every torque-like parameter (torque levels, bristle stiffness and
+        damping, viscous and stick damping) times ``factor``: friction proportional to a
+        normal load, pre-sliding angle T_c / sigma_0 unchanged (every law is homogeneous of
+        degree one in these, so the torque scales and nothing else)."""
+        return dataclasses.replace(self, **{f.name: getattr(self, f.name) * factor
+                                            for f in dataclasses.fields(self) if _info(f)["torque_like"]})
 
     # -- the interface ----------------------------------------------------------------------
     def __call__(self, v: float, z: float = 0.0, t_app: float = 0.0) -> float:
         """Friction torque [N m] at relative rate ``v`` [rad/s], state ``z`` [rad] and applied
         torque ``t_app`` [N m]."""
-        p = self.pack()
-        dz = K.zdot(self.fid, float(v), float(z), p)
-        return float(K.torque(self.fid, float(v), float(z), dz, float(t_app), p))
+        return float(self.entry.rates(float(v), float(z), float(t_app), self.pack())[1])
 
     def derivative(self, v: float, z: float) -> float:
         """dz/dt [rad/s] (0 for memoryless laws)."""
-        return float(K.zdot(self.fid, float(v), float(z), self.pack()))
+        return float(self.entry.rates(float(v), float(z), 0.0, self.pack())[0])
 
     @abc.abstractmethod
     def steady_state(self, v: np.ndarray) -> np.ndarray:
         """Torque [N m] under steady sliding at constant rate ``v`` [rad/s] (analytic)."""
 
-    def describing_function(self, rate_amplitude: float) -> complex | None:
-        """Analytic describing function from a rate sinusoid of amplitude ``rate_amplitude``
-        [rad/s] to the torque fundamental [N m s/rad], or ``None`` if there is none."""
+    def describing_function(self, rate_amplitude: float, omega_rad_s: float | None = None) -> complex | None:
+        """Analytic describing function from a rate sinusoid V sin(w t) of amplitude
+        ``rate_amplitude`` V [rad/s] and frequency ``omega_rad_s`` w [rad/s] (needed only by
+        laws with memory) to the torque fundamental [N m s/rad], or ``None`` if there is none."""
         return None
+
+    def check_step(self, inertia_kgm2: float, dt_s: float, source: str, section: str = "friction") -> None:
+        """Refuse an explicit integration step ``dt_s`` [s] this law cannot be integrated with
+        on a joint of inertia ``inertia_kgm2`` [kg m^2] (raise :class:`InputError`)."""
 
     def response(self, v: np.ndarray, dt: float, z0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Torque [N m] and state [rad] for a prescribed rate history ``v`` [rad/s] every ``dt`` [s]."""
-        return K.prescribed_rate_response(self.fid, self.pack(), np.ascontiguousarray(v, float),
+        return K.prescribed_rate_response(self.entry.rates, self.pack(), np.ascontiguousarray(v, float),
                                           float(dt), float(z0))
 
     def numeric_describing_function(self, rate_amplitude: float, freq_hz: float,
@@ -127,7 +149,7 @@ class FrictionLaw(abc.ABC):
         """Build from a ``[friction]`` table; keys this law does not use are ignored."""
         kwargs = {}
         for f in dataclasses.fields(cls):
-            key, kind, _ = _FIELD_INFO[f.name]
+            key, kind = _info(f)["key"], _info(f)["kind"]
             if key in table:
                 nonneg = kind != "dimensionless"
                 kwargs[f.name] = to_si(table[key], kind, source=source, field=f"{section}.{key}",
@@ -148,7 +170,43 @@ class FrictionLaw(abc.ABC):
 def coulomb_describing_function(coulomb_torque_Nm: float, rate_amplitude: float) -> complex:
     """4 T_c / (pi V): fundamental of T_c sign(V sin wt) over V [N m s/rad] (relay describing
     function, Gelb & Vander Velde, Multiple-Input Describing Functions, 1968)."""
-    return complex(4.0 * coulomb_torque_Nm / (math.pi * rate_amplitude), 0.0)
+    return complex(coulomb_relay_level(coulomb_torque_Nm) / rate_amplitude, 0.0)
+
+
+def coulomb_relay_level(coulomb_torque_Nm):
+    """4 T_c / pi [N m]: the relay describing function times the rate amplitude (float or SX)."""
+    return 4.0 * coulomb_torque_Nm / math.pi
+
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(64)
+
+
+def dahl_angle_df(tc, sigma0, X):
+    """Dahl (exponent 1) describing function from relative angle to torque [N m/rad] at angle
+    amplitude ``X`` [rad], as (re, im); float or CasADi SX arguments.
+
+    The periodic hysteresis loop under theta = X sin(psi) is exact: on the upward branch
+    T_up = T_c - (T_c + T_top) exp(-beta (1 + sin psi)), beta = sigma_0 X / T_c,
+    T_top = T_c tanh(beta) (the downward branch is its odd mirror), so the fundamental is
+    N_x = (2/pi) int_{-pi/2}^{pi/2} T_up (sin psi + j cos psi) dpsi / X, integrated by
+    64-point Gauss-Legendre quadrature (Dahl 1968; rate form N = N_x / (j w))."""
+    if isinstance(tc, (int, float, np.floating)) and isinstance(sigma0, (int, float, np.floating)) \
+            and isinstance(X, (int, float, np.floating)):
+        exp, tanh = math.exp, math.tanh
+    else:
+        import casadi as ca
+        exp, tanh = ca.exp, ca.tanh
+    psi = 0.5 * math.pi * _GL_X
+    w = 0.5 * math.pi * _GL_W
+    beta = sigma0 * X / tc
+    ttop = tc * tanh(beta)
+    a = 0
+    b = 0
+    for p, wi in zip(psi, w):
+        tu = tc - (tc + ttop) * exp(-beta * (1 + math.sin(p)))
+        a = a + wi * tu * math.sin(p)
+        b = b + wi * tu * math.cos(p)
+    return (2 / math.pi) * a / X, (2 / math.pi) * b / X
 
 
 @dataclass(frozen=True)
@@ -156,7 +214,7 @@ class NoFriction(FrictionLaw):
     """No gimbal friction: T_f = 0."""
 
     name: ClassVar[str] = "none"
-    fid: ClassVar[int] = K.ID_NONE
+    has_friction: ClassVar[bool] = False
 
     def steady_state(self, v):
         return np.zeros_like(np.asarray(v, float))
@@ -179,17 +237,27 @@ class CoulombSwitching(FrictionLaw):
     """
 
     name: ClassVar[str] = "coulomb-switching"
-    fid: ClassVar[int] = K.ID_COULOMB_SWITCHING
 
-    static_torque_Nm: float = 0.0
-    stick_velocity_rad_s: float = 1e-3
-    stick_damping_Nms_per_rad: float = 0.0
+    static_torque_Nm: float = param(0.0, "static_torque", "torque", K.SLOT_TS, torque_like=True)
+    stick_velocity_rad_s: float = param(1e-3, "stick_velocity", "angular_velocity", K.SLOT_VEPS)
+    stick_damping_Nms_per_rad: float = param(0.0, "stick_damping", "rotational_damping", K.SLOT_CSTICK,
+                                             torque_like=True)
 
     def steady_state(self, v):
         return self.coulomb_torque_Nm * np.sign(np.asarray(v, float))
 
-    def describing_function(self, rate_amplitude):
+    def describing_function(self, rate_amplitude, omega_rad_s=None):
         return coulomb_describing_function(self.coulomb_torque_Nm, rate_amplitude)
+
+    def check_step(self, inertia_kgm2, dt_s, source, section="friction"):
+        """The stick band must exceed one step's rate change dt (max(T_s, T_c) + T_c) / J, and
+        the stick damping must not overshoot: c_stick dt / J <= 1."""
+        dv = dt_s * (max(self.static_torque_Nm, self.coulomb_torque_Nm) + self.coulomb_torque_Nm) / inertia_kgm2
+        if dv >= self.stick_velocity_rad_s:
+            raise InputError(source, f"{section}.stick_velocity",
+                             f"a stick band above one step's rate change {dv:.3g} rad/s (or a smaller step)")
+        if self.stick_damping_Nms_per_rad * dt_s / inertia_kgm2 > 1.0:
+            raise InputError(source, f"{section}.stick_damping", "c_stick dt / J below 1 (or a smaller step)")
 
     def validate(self, source, section="friction"):
         if not self.stick_velocity_rad_s > 0:
@@ -206,18 +274,24 @@ class CoulombSmooth(FrictionLaw):
     """
 
     name: ClassVar[str] = "coulomb-smooth"
-    fid: ClassVar[int] = K.ID_COULOMB_SMOOTH
 
-    regularization_velocity_rad_s: float = 1e-3
+    regularization_velocity_rad_s: float = param(1e-3, "regularization_velocity", "angular_velocity", K.SLOT_VEPS)
 
     def steady_state(self, v):
         v = np.asarray(v, float)
         e = self.regularization_velocity_rad_s
         return self.coulomb_torque_Nm * v / np.sqrt(v * v + e * e)
 
-    def describing_function(self, rate_amplitude):
+    def describing_function(self, rate_amplitude, omega_rad_s=None):
         # exact for v_eps -> 0; the regularisation changes it by O((v_eps/V)^2)
         return coulomb_describing_function(self.coulomb_torque_Nm, rate_amplitude)
+
+    def check_step(self, inertia_kgm2, dt_s, source, section="friction"):
+        """Explicit steps on the regularised slope T_c / v_eps are stable while
+        dt T_c / (v_eps J) <= 2."""
+        if dt_s * self.coulomb_torque_Nm / (self.regularization_velocity_rad_s * inertia_kgm2) > 2.0:
+            raise InputError(source, f"{section}.regularization_velocity",
+                             "dt T_c / (v_eps J) below 2 (or a smaller step)")
 
     def validate(self, source, section="friction"):
         if not self.regularization_velocity_rad_s > 0:
@@ -236,14 +310,23 @@ class Dahl(FrictionLaw):
     """
 
     name: ClassVar[str] = "dahl"
-    fid: ClassVar[int] = K.ID_DAHL
     has_state: ClassVar[bool] = True
 
-    bristle_stiffness_Nm_per_rad: float = 0.0
-    dahl_exponent: float = 1.0
+    bristle_stiffness_Nm_per_rad: float = param(0.0, "bristle_stiffness", "rotational_stiffness", K.SLOT_SIGMA0,
+                                                torque_like=True)
+    dahl_exponent: float = param(1.0, "dahl_exponent", "dimensionless", K.SLOT_ALPHA)
 
     def steady_state(self, v):
         return self.coulomb_torque_Nm * np.sign(np.asarray(v, float))
+
+    def describing_function(self, rate_amplitude, omega_rad_s=None):
+        """Exact for exponent 1 (the closed-form hysteresis loop, :func:`dahl_angle_df`):
+        N = N_x(V / w) / (j w); ``None`` for other exponents or without ``omega_rad_s``."""
+        if self.dahl_exponent != 1.0 or omega_rad_s is None:
+            return None
+        nr, ni = dahl_angle_df(self.coulomb_torque_Nm, self.bristle_stiffness_Nm_per_rad,
+                               rate_amplitude / omega_rad_s)
+        return complex(float(nr), float(ni)) / (1j * omega_rad_s)
 
     def validate(self, source, section="friction"):
         if not self.bristle_stiffness_Nm_per_rad > 0:
@@ -268,16 +351,18 @@ class LuGre(FrictionLaw):
     """
 
     name: ClassVar[str] = "lugre"
-    fid: ClassVar[int] = K.ID_LUGRE
     has_state: ClassVar[bool] = True
 
-    static_torque_Nm: float = 0.0
-    stribeck_velocity_rad_s: float = 1e-3
-    stribeck_exponent: float = 2.0
-    bristle_stiffness_Nm_per_rad: float = 0.0
-    bristle_damping_Nms_per_rad: float = 0.0
-    viscous_damping_Nms_per_rad: float = 0.0
-    damping_decay_velocity_rad_s: float = 0.0
+    static_torque_Nm: float = param(0.0, "static_torque", "torque", K.SLOT_TS, torque_like=True)
+    stribeck_velocity_rad_s: float = param(1e-3, "stribeck_velocity", "angular_velocity", K.SLOT_VS)
+    stribeck_exponent: float = param(2.0, "stribeck_exponent", "dimensionless", K.SLOT_DELTA)
+    bristle_stiffness_Nm_per_rad: float = param(0.0, "bristle_stiffness", "rotational_stiffness", K.SLOT_SIGMA0,
+                                                torque_like=True)
+    bristle_damping_Nms_per_rad: float = param(0.0, "bristle_damping", "rotational_damping", K.SLOT_SIGMA1,
+                                               torque_like=True)
+    viscous_damping_Nms_per_rad: float = param(0.0, "viscous_damping", "rotational_damping", K.SLOT_SIGMA2,
+                                               torque_like=True)
+    damping_decay_velocity_rad_s: float = param(0.0, "damping_decay_velocity", "angular_velocity", K.SLOT_V1)
 
     def _g(self, v):
         v = np.abs(np.asarray(v, float))
@@ -331,9 +416,8 @@ class ModifiedLuGre(LuGre):
     """
 
     name: ClassVar[str] = "modified-lugre"
-    fid: ClassVar[int] = K.ID_MODIFIED_LUGRE
 
-    vibration_velocity_rad_s: float = 0.0
+    vibration_velocity_rad_s: float = param(0.0, "vibration_velocity", "angular_velocity", K.SLOT_VD)
 
     def _h(self, v):
         v = np.abs(np.asarray(v, float))
@@ -343,25 +427,17 @@ class ModifiedLuGre(LuGre):
         return (2.0 / math.pi) * np.arcsin(np.minimum(1.0, v / vd))
 
 
-
-#: Registry: model name -> class (the names are a contract, DESIGN.md).
-LAWS: dict[str, type[FrictionLaw]] = {
-    cls.name: cls for cls in (NoFriction, CoulombSwitching, CoulombSmooth, Dahl, LuGre, ModifiedLuGre)
-}
-
-
 def friction_from_table(table: dict, source: str, model: str | None = None,
                         section: str = "friction") -> FrictionLaw:
     """Build the law named by ``table['model']`` (or ``model``, the ``--friction`` override,
-    which keeps the table's torque levels and parameters)."""
+    which keeps the table's torque levels and parameters) from its registry entry."""
     name = model if model is not None else table.get("model")
-    if name not in LAWS:
-        raise InputError(source if model is None else "command line",
-                         f"{section}.model" if model is None else "--friction",
-                         "one of " + ", ".join(LAWS), got=repr(name))
-    unknown = sorted(set(table) - FRICTION_KEYS - {"model"})
+    entry = registry.get(name, source if model is None else "command line",
+                         f"{section}.model" if model is None else "--friction")
+    keys = friction_keys()
+    unknown = sorted(set(table) - keys - {"model"})
     if unknown:
         raise InputError(source, f"{section}.{unknown[0]}",
-                         "a known friction parameter (" + ", ".join(sorted(FRICTION_KEYS)) + ")",
+                         "a known friction parameter (" + ", ".join(sorted(keys)) + ")",
                          got="an unknown key")
-    return LAWS[name].from_table(table, source, section)
+    return entry.params.from_table(table, source, section)

@@ -11,19 +11,18 @@ differentiably (:func:`taos.linear.freqresp_symbolic`), the four responses from 
 friction torque T to piston x_p and engine rate omega: G_xc, G_xT, G_wc, G_wT. The command
 path is the describing function of the avionics (quantiser and crossover gain, a static map:
 its fundamental computed numerically from :class:`taos.avionics.Avionics` itself), times the
-free ``avionics_gain`` k: C = k N_av(A) A. The friction element is replaced by its describing
-function from engine rate to torque, T = N(V) Omega at rate amplitude V:
+free ``avionics_gain`` k: C = k N_av(A) A. The friction element is replaced by the describing
+function its registry entry gives the fit (``fit_describing_function``, from engine rate to
+torque, T = N Omega; :mod:`taos.friction.registry`). Two loop solutions:
 
-* Coulomb (both forms): N = 4 T_c / (pi V). The loop Omega = G_wc C + G_wT N Omega gives
+* a relay (the entry gives ``fit_relay_level`` a; Coulomb, both forms: N = a / V,
+  a = 4 T_c / pi). The loop Omega = G_wc C + G_wT N Omega gives
   |V - a G_wT| = |G_wc C| with a = 4 T_c / pi, solved in closed form:
   V = a Re G_wT + sqrt(|G_wc C|^2 - a^2 (Im G_wT)^2), and V = 0 (engine held, the load path
   takes the whole piston motion) when that is not positive: smoothed for the NLP.
-* Dahl with exponent 1, and LuGre/modified LuGre through their Dahl core (T_s = T_c,
-  sigma_1 = 0, h = 1: then LuGre *is* Dahl, plus sigma_2 v): the periodic hysteresis loop
-  under theta = X sin(psi) is exact, T_up = T_c - (T_c + T_top) exp(-beta (1 + sin psi)) with
-  beta = sigma_0 X / T_c, T_top = T_c tanh(beta), and its fundamental is integrated by
-  64-point Gauss-Legendre quadrature: N_x = (2/pi) int T_up (sin psi + j cos psi) dpsi / X,
-  N = N_x / (j w) + sigma_2. The amplitude X solves the implicit loop equation
+* any other describing function N(X, w) of the engine angle amplitude X (Dahl with exponent
+  1: the exact hysteresis loop, :func:`taos.friction.dahl_angle_df`; LuGre/modified LuGre
+  through their Dahl core plus sigma_2): the amplitude X solves the implicit loop equation
   ln(w X) + ln|1 - G_wT N| - ln|G_wc C| = 0, which the NLP carries as constraints with
   u = ln(X / X_lin) as variables.
 
@@ -43,7 +42,6 @@ from typing import Callable
 import numpy as np
 
 from taos.errors import InputError
-from taos.friction import CoulombSmooth, CoulombSwitching, Dahl, LuGre, NoFriction
 from taos.model import TvcModel
 from taos.linear import freqresp_symbolic
 
@@ -112,20 +110,18 @@ PARAMETERS: dict[str, FitParam] = {p.name: p for p in (
 
 
 def friction_family(model: TvcModel) -> str:
-    """'none', 'coulomb' or 'dahl' (the surrogate used for the model's friction law)."""
+    """How the surrogate treats the model's friction law, asked of its registry entry: 'none'
+    (no friction), 'relay' (closed-form loop) or 'implicit' (amplitude unknowns)."""
     law = model.friction
-    if isinstance(law, NoFriction):
+    if not law.has_friction:
         return "none"
-    if isinstance(law, (CoulombSwitching, CoulombSmooth)):
-        return "coulomb"
-    if isinstance(law, Dahl):
-        if law.dahl_exponent != 1.0:
-            raise InputError(model.source, "friction.dahl_exponent", "1 for fits (closed-form Dahl loop)",
-                             got=repr(law.dahl_exponent))
-        return "dahl"
-    if isinstance(law, LuGre):
-        return "dahl"
-    raise InputError(model.source, "friction.model", "a law the fit supports", got=law.name)
+    e = law.entry
+    if e.fit_describing_function is None and e.fit_relay_level is None:
+        raise InputError(model.source, "friction.model", "a law the fit supports (one whose registry entry "
+                         "gives a fit describing function)", got=law.name)
+    if e.fit_check is not None:
+        e.fit_check(law, model.source)
+    return "relay" if e.fit_relay_level is not None else "implicit"
 
 
 def check_free(model: TvcModel, names) -> list[FitParam]:
@@ -137,9 +133,7 @@ def check_free(model: TvcModel, names) -> list[FitParam]:
             raise InputError("command line", "--free", "names from " + ", ".join(PARAMETERS), got=repr(n))
         p = PARAMETERS[n]
         if p.section == "friction":
-            ok = {"none": (), "coulomb": ("coulomb_torque",),
-                  "dahl": ("coulomb_torque", "bristle_stiffness") + (("viscous_damping",)
-                                                                     if isinstance(model.friction, LuGre) else ())}[fam]
+            ok = () if fam == "none" else model.friction.entry.fit_parameters
             if n not in ok:
                 raise InputError("command line", "--free", f"friction parameters of the {model.friction.name} law "
                                  f"({', '.join(ok) or 'none: choose --friction'})", got=repr(n))
@@ -180,32 +174,12 @@ def _ca(a, b):
     return (a[0] + b[0], a[1] + b[1])
 
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(64)
-
-
-def dahl_df_x(tc, sigma0, X):
-    """Dahl (exponent 1) describing function from engine angle to torque [N m/rad] at angle
-    amplitude X [rad], as (re, im); SX or float arguments (module docstring)."""
-    import casadi as ca
-    psi = 0.5 * math.pi * _GL_X
-    w = 0.5 * math.pi * _GL_W
-    beta = sigma0 * X / tc
-    ttop = tc * ca.tanh(beta)
-    a = 0
-    b = 0
-    for p, wi in zip(psi, w):
-        tu = tc - (tc + ttop) * ca.exp(-beta * (1 + math.sin(p)))
-        a = a + wi * tu * math.sin(p)
-        b = b + wi * tu * math.cos(p)
-    return (2 / math.pi) * a / X, (2 / math.pi) * b / X
-
-
 @dataclass(frozen=True, eq=False)
 class Surrogate:
     """CasADi function ``fn(s, u) -> (hx_re, hx_im, he_re, he_im, g)`` over the points.
 
     ``s`` are the free parameters over their reference values (p = p_ref s); ``u`` the
-    implicit amplitude variables (ln(X / X_lin), Dahl family only; empty otherwise); ``g`` the
+    implicit amplitude variables (ln(X / X_lin), 'implicit' family only; empty otherwise); ``g`` the
     implicit loop residuals. hx is x_p / theta_c [m/rad], he theta / theta_c."""
 
     fn: object
@@ -239,16 +213,17 @@ def build_surrogate(model: TvcModel, params, axes, freq_hz, amp_rad) -> Surrogat
         else:
             msym = p.set(msym, v)
     law = msym.friction
+    entry = model.friction.entry
     axes = np.asarray(axes)
     f = np.asarray(freq_hz, float)
     A = np.asarray(amp_rad, float)
     m = f.size
-    n_u = m if fam == "dahl" else 0
+    n_u = m if fam == "implicit" else 0
     u = ca.SX.sym("u", n_u)
     out = {k: [] for k in ("xr", "xi", "er", "ei", "g")}
     cache = {}
     lin = {}
-    if fam == "dahl":  # numeric linear command -> rate at the start values (amplitude scale)
+    if fam == "implicit":  # numeric linear command -> rate at the start values (amplitude scale)
         for ax in set(map(str, axes)):
             lin[ax] = simplex_state_space(model, ax).freqresp(f, "command_rad", "omega_rad_s")
     for k in range(m):
@@ -266,8 +241,8 @@ def build_surrogate(model: TvcModel, params, axes, freq_hz, amp_rad) -> Surrogat
         if fam == "none":
             N = (0.0, 0.0)
             Om = _cm(Gwc, C)
-        elif fam == "coulomb":
-            a = 4 * law.coulomb_torque_Nm / math.pi / Aeff   # per unit A (phasors per unit command)
+        elif fam == "relay":
+            a = entry.fit_relay_level(law) / Aeff   # per unit A (phasors per unit command)
             gc2 = (Gwc[0] ** 2 + Gwc[1] ** 2) * (C[0] ** 2 + C[1] ** 2)
             disc = gc2 - a * a * Gwt[1] ** 2
             dsm = 1e-8 * gc2
@@ -278,13 +253,10 @@ def build_surrogate(model: TvcModel, params, axes, freq_hz, amp_rad) -> Surrogat
             den = (V - a * Gwt[0], -a * Gwt[1])
             Om = _cd(_cm((V, 0.0), _cm(Gwc, C)), den)
             N = (a / V, 0.0)
-        else:  # dahl family
+        else:  # implicit: the law's describing function at engine angle amplitude X
             Xlin = Aeff * abs(lin[ax][k] * nav) / w
             X = Xlin * ca.exp(u[k])
-            nx = dahl_df_x(law.coulomb_torque_Nm, law.bristle_stiffness_Nm_per_rad, X)
-            # T = N Omega per unit... N in rate form: N_x / (j w) + sigma_2
-            s2 = law.viscous_damping_Nms_per_rad if isinstance(law, LuGre) else 0.0
-            N = (nx[1] / w + s2, -nx[0] / w)
+            N = tuple(entry.fit_describing_function(law, X, w))   # rate form [N m s/rad]
             one_m = (1 - (Gwt[0] * N[0] - Gwt[1] * N[1]), -(Gwt[0] * N[1] + Gwt[1] * N[0]))
             Om = _cd(_cm(Gwc, C), one_m)
             # per unit A: Omega amplitude w X / Aeff

@@ -17,8 +17,10 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
                  = (E_i - S_i)/L_i with F_L,i = K_L (x_p,i - (L_i - L0_i)) at E_i
     actuators    the one linear actuator model (taos.actuator), x_c,i = R avionics(theta_c,i),
                  load input F_L,i
-    bearing      (phi, z, T) advanced once per step by the backward-Euler bearing solve of
-                 :func:`taos.taos3d.friction3d.bearing_step`, given the pose at the step end
+    bearing      (phi, z, T) advanced once per step by the friction law's backward-Euler
+                 bearing solve (its registry entry's ``bearing_step``, passed to the kernels
+                 as the first-class function ``fid``; :mod:`taos.friction._vector`), given
+                 the pose at the step end
 
 Time stepping: classical RK4 for (q, v, actuators) with T held over the step, then the
 implicit bearing update (a first-order split in T only; T is bounded by the friction level,
@@ -37,7 +39,6 @@ import numpy as np
 from numba import njit, prange
 
 from .. import avionics as _av
-from . import friction3d as _f3
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 N_BODY = 13  # p (3), quaternion (4), v (6)
@@ -241,7 +242,7 @@ def step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
     for i in range(3, 7):
         x[i] /= qn
     ps0, ps1 = pose_psi(x, P)
-    w0, w1, z0, z1, t0, t1 = _f3.bearing_step(fid, fp, P[4], ps0 - bs[0], ps1 - bs[1], bs[2], bs[3], dt)
+    w0, w1, z0, z1, t0, t1 = fid(fp, P[4], ps0 - bs[0], ps1 - bs[1], bs[2], bs[3], dt)
     bs[0] += w0 * dt
     bs[1] += w1 * dt
     bs[2] = z0

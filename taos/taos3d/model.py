@@ -25,7 +25,7 @@ axis)^2; the roll inertia comes from ``engine_roll_inertia``.
 
 Bearing normal load N: the thrust when firing, the engine weight m g0 when hanging. The
 friction torque level is T_c = mu N r_b; the planar law's torque-like parameters are scaled by
-lambda = T_c / T_c,file (:mod:`taos.taos3d.friction3d`).
+lambda = T_c / T_c,file (:meth:`taos.friction.FrictionLaw.scaled`).
 """
 
 from __future__ import annotations

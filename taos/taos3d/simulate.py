@@ -25,7 +25,6 @@ from ..linear import StateSpace
 from ..profiles import is_two_axis
 from ..simulate import SolverSettings, TimeHistory, provenance
 from . import dynamics as _dy
-from . import friction3d as _f3
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
 
 DEFAULT_DT_S = 2e-4
@@ -36,7 +35,7 @@ class Packed:
     """Arrays the compiled kernels take (see :func:`pack`)."""
 
     P: tuple
-    fid: int
+    fid: object  # the friction law's bearing_step kernel (its registry entry)
     fp: np.ndarray
     avp: np.ndarray
     n_state: int
@@ -62,10 +61,10 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
          f64(act.B[:, act.input_index("f_load_N")]), f64(act.C[act.output_index("x_p_m")]),
          f64(np.vstack([PITCH_AXIS, YAW_AXIS])), f64(sc))
     law = tm.base.friction
-    fp = _f3.scale_params(law.pack(), tm.friction_scale)
+    fp = law.scaled(tm.friction_scale).pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
     na = act.A.shape[0]
-    return Packed(P, law.fid, fp, av.pack(), _dy.N_BODY + 2 * na, na)
+    return Packed(P, law.entry.bearing_step, fp, av.pack(), _dy.N_BODY + 2 * na, na)
 
 
 def rest_state(pk: Packed) -> np.ndarray:

@@ -1,0 +1,151 @@
+"""The friction-law registry: one entry per law, reachable by its id.
+
+An entry (:class:`FrictionLawEntry`) holds everything about a law:
+
+* ``params``: its parameter class (a frozen :class:`~taos.friction._laws.FrictionLaw`
+  subclass; the fields carry their model-file key and unit kind, see
+  :func:`~taos.friction._laws.param`), which also holds the law's analytic steady-state
+  curve, its analytic describing function (if one exists) and its stable-step rule;
+* ``rates``: the scalar kernel (planar model), a compiled C callback with the signature
+  :data:`RATES_SIG` giving the bristle-state rate and the torque together (the torque of the
+  bristle laws needs the rate; one call per integrator stage);
+* ``zdot3``, ``torque3``, ``bearing_step``: the vector spherical-bearing form (3-D model),
+  signatures :data:`ZDOT3_SIG`, :data:`TORQUE3_SIG`, :data:`BEARING_SIG`;
+* ``fit_describing_function`` (and ``fit_relay_level``, ``fit_check``): the describing
+  function the fit surrogate uses (CasADi or float arithmetic), and ``fit_parameters``, the
+  friction parameters a fit may free.
+
+The compiled integrators (:mod:`taos._integrator`, :mod:`taos.taos3d.dynamics`) take the
+kernels as first-class function arguments (numba ``FunctionType``): one compiled (and
+cached) integrator serves every law, including a law registered at run time. Kernel
+arguments (SI): relative rate ``v``/``w`` [rad/s], bristle state ``z`` [rad], its
+derivative ``dz`` [rad/s] (vector form: from ``zdot3``), applied (non-friction) torque ``t_app`` [N m], packed parameter
+vector ``p`` (float64, C-contiguous, the law's :meth:`pack`), chain compliance ``Kc`` (2, 2)
+[rad/(N m)], trial bearing increment ``d`` [rad], step ``dt`` [s].
+
+An unknown id stops with :class:`~taos.errors.InputError` naming it and the known ids.
+"""
+
+from __future__ import annotations
+
+import types as _pytypes
+import warnings
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Callable
+
+from numba import cfunc
+from numba import types as nt
+from numba.core.ccallback import CFunc
+from numba.core.errors import NumbaExperimentalFeatureWarning
+
+from ..errors import InputError
+
+if TYPE_CHECKING:
+    from ._laws import FrictionLaw
+
+# first-class function arguments are marked experimental in numba; they are this design
+warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+
+_f8 = nt.float64
+_p = nt.float64[::1]
+#: (dz/dt [rad/s], T_f [N m]) = rates(v, z, t_app, p)
+RATES_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _p)
+#: (dz0, dz1) [rad/s] = zdot3(w0, w1, z0, z1, p)
+ZDOT3_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _f8, _p)
+#: (T0, T1) [N m] = torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p)
+TORQUE3_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _f8, _f8, _f8, _f8, _f8, _p)
+#: (w0, w1, z0, z1, T0, T1) = bearing_step(p, Kc, d0, d1, z0, z1, dt)
+BEARING_SIG = nt.UniTuple(_f8, 6)(_p, nt.float64[:, ::1], _f8, _f8, _f8, _f8, _f8)
+
+_SIGS = {"rates": RATES_SIG, "zdot3": ZDOT3_SIG, "torque3": TORQUE3_SIG,
+         "bearing_step": BEARING_SIG}
+
+
+@dataclass(frozen=True, eq=False)
+class FrictionLawEntry:
+    """Everything about one friction law (see the module docstring).
+
+    ``fit_describing_function(law, X, w) -> (re, im)``: torque fundamental over relative-rate
+    fundamental [N m s/rad] at relative-angle amplitude ``X`` [rad] and frequency ``w``
+    [rad/s] (rate amplitude w X), in arithmetic that also takes CasADi SX (``law``'s fields
+    may be symbolic in a fit); ``None`` when the fit does not support the law.
+    ``fit_relay_level(law) -> a`` [N m] marks a pure relay N = a / (w X): the fit then solves
+    the loop in closed form, including the held engine. ``fit_check(law, source)`` raises
+    :class:`InputError` for parameter values the fit's describing function does not cover.
+    ``fit_parameters``: the ``[friction]`` keys a fit may free (names of
+    :data:`taos.identify.surrogate.PARAMETERS`).
+    """
+
+    id: str
+    params: type
+    rates: object
+    zdot3: object
+    torque3: object
+    bearing_step: object
+    fit_describing_function: Callable | None = None
+    fit_relay_level: Callable | None = None
+    fit_check: Callable | None = None
+    fit_parameters: tuple[str, ...] = ()
+    builtin: bool = False
+
+
+_REGISTRY: dict[str, FrictionLawEntry] = {}
+#: id -> entry (read-only view of the registry)
+LAWS = _pytypes.MappingProxyType(_REGISTRY)
+
+
+def _compiled(fn, sig, law_id: str, name: str):
+    """A numba C callback with signature ``sig`` for ``fn`` (a CFunc, a numba dispatcher or a
+    plain function that numba can compile)."""
+    if isinstance(fn, CFunc):
+        if fn._sig != sig:
+            raise InputError("friction registry", f"{law_id}.{name}", f"a kernel with signature {sig}",
+                             got=str(fn._sig))
+        return fn
+    py = getattr(fn, "py_func", fn)
+    if not callable(py):
+        raise InputError("friction registry", f"{law_id}.{name}", "a numba-compilable function", got=repr(fn))
+    return cfunc(sig)(py)
+
+
+def register(entry: FrictionLawEntry, *, replace_existing: bool = False, builtin: bool = False) -> FrictionLawEntry:
+    """Add ``entry`` under ``entry.id`` (kernels compiled to C callbacks here); returns the
+    stored entry. Its parameter class must name the same id (``params.name``)."""
+    if not entry.id or not isinstance(entry.id, str):
+        raise InputError("friction registry", "id", "a non-empty law id", got=repr(entry.id))
+    if entry.id in _REGISTRY and (not replace_existing or _REGISTRY[entry.id].builtin):
+        raise InputError("friction registry", entry.id, "an id not yet registered", got="a duplicate")
+    if getattr(entry.params, "name", None) != entry.id:
+        raise InputError("friction registry", f"{entry.id}.params", f"a parameter class with name = {entry.id!r}",
+                         got=repr(getattr(entry.params, "name", None)))
+    compiled = {k: _compiled(getattr(entry, k), sig, entry.id, k) for k, sig in _SIGS.items()}
+    stored = replace(entry, builtin=builtin, **compiled)
+    _REGISTRY[entry.id] = stored
+    return stored
+
+
+def unregister(law_id: str) -> None:
+    """Remove a law registered at run time (built-in laws stay)."""
+    e = get(law_id)
+    if e.builtin:
+        raise InputError("friction registry", law_id, "a law registered at run time", got="a built-in law")
+    del _REGISTRY[law_id]
+
+
+def get(law_id: str, source: str = "friction registry", field: str = "friction.model") -> FrictionLawEntry:
+    """The entry of ``law_id``; an unknown id raises :class:`InputError` naming the known ids."""
+    try:
+        return _REGISTRY[law_id]
+    except (KeyError, TypeError):
+        raise InputError(source, field, "a friction law id, one of " + ", ".join(_REGISTRY),
+                         got=repr(law_id)) from None
+
+
+def ids() -> tuple[str, ...]:
+    """The registered law ids, in registration order."""
+    return tuple(_REGISTRY)
+
+
+def entry_of(law: "FrictionLaw") -> FrictionLawEntry:
+    """The entry of a law instance (by its class's ``name``)."""
+    return get(type(law).name)
