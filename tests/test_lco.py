@@ -43,6 +43,9 @@ def test_soft_structure_lco_about_0p1_deg_at_0p1_to_0p2_hz_in_prediction_and_tim
     amplitude and 15 % in frequency, and the predicted cycle is stable (Loeb)."""
     d = reports["ambient", law].to_dict()
     td = d["time_domain"]
+    print(f"{law}: DF {d['amplitude_deg']:.4f} deg {d['frequency_hz']:.4f} Hz, time domain "
+          f"{td['amplitude_deg']:.4f} deg {td['frequency_hz']:.4f} Hz: ratios "
+          f"{td['amplitude_deg'] / d['amplitude_deg'] - 1:+.4f}, {td['frequency_hz'] / d['frequency_hz'] - 1:+.4f}")
     assert d["lco"] and d["stable"] and td["lco"]
     assert 0.1 <= d["frequency_hz"] <= 0.2 and 0.1 <= td["frequency_hz"] <= 0.2
     assert 0.03 <= d["engine_amplitude_deg"] <= 0.3 and 0.03 <= td["engine_amplitude_deg"] <= 0.3
@@ -72,6 +75,8 @@ def test_stiff_structure_no_lco_for_dahl_lugre_and_coulomb_about_halved(reports)
     hard = reports["hot", "coulomb-switching"].to_dict()
     assert hard["lco"] and hard["time_domain"]["lco"]
     for key in ("amplitude_deg", "engine_amplitude_deg"):
+        print(f"hot / ambient {key}: DF {hard[key] / soft[key]:.4f}, "
+              f"time domain {hard['time_domain'][key] / soft['time_domain'][key]:.4f}")
         assert hard[key] / soft[key] <= 0.6
         assert hard["time_domain"][key] / soft["time_domain"][key] <= 0.6
 

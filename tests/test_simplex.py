@@ -35,13 +35,15 @@ def test_load_resonance_equation_1_and_piston_notch(name):
     J = p["engine"]["inertia_pitch_kgm2"]
     wl = math.sqrt((KL * R * R + Kn) / J) / (2 * math.pi)
     assert d["load_resonance_hz"] == pytest.approx(wl, rel=1e-12)
-    # independent notch search on a dense grid of the exact response
+    # independent reference: the notch of the exact response of the whole actuator state space on
+    # a dense grid (spacing 3.8e-4 w_L); with the piston still the engine is the undamped
+    # oscillator J, K_L R^2 + K_n, so the notch is w_L itself (the search reaches ~1e-9)
     from taos.model import load_model
     m = load_model(MODELS / f"{name}.toml")
     f = np.linspace(0.5 * wl, 2 * wl, 4001)
     g = np.abs(linear_freqresp(m, f).piston)
-    assert f[np.argmin(g)] == pytest.approx(wl, rel=0.01)
-    assert d["notch_frequency_hz"] == pytest.approx(wl, rel=0.01)
+    assert f[np.argmin(g)] == pytest.approx(wl, rel=4e-4)
+    assert d["notch_frequency_hz"] == pytest.approx(wl, rel=1e-7)
 
 
 def test_hot_fire_notch_above_ambient(ambient, hotfire):
