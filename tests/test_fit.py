@@ -126,6 +126,19 @@ def test_surrogate_describing_functions_equal_the_friction_kernels(hotfire):
     assert coul.describing_function(0.1) == pytest.approx(4 * coul.coulomb_torque_Nm / (math.pi * 0.1))
 
 
+def test_fit_with_no_corrections_allowed_is_the_surrogate_fit():
+    """``max_corrections=0`` with the correction asked for: no correction, the surrogate's own
+    fitted responses (once a NameError)."""
+    truth = load_model(MODELS / "rs25_hotfire.toml", friction="coulomb-smooth")
+    lin = linear_freqresp(truth, F)
+    one = np.ones(F.size)
+    d = MeasuredResponse("pitch", F, np.full(F.size, 0.8 * DEG), lin.piston * truth.actuator.moment_arm_m,
+                         lin.engine, one, one, 0.01 * one, 0.01 * one)
+    r = fit_frequency_response(truth, [d], ["load_stiffness"], starts=1, correct=True, max_corrections=0)
+    assert r.corrections == 0 and len(r.history) == 1
+    assert r.fitted_piston[0].shape == (F.size,) and np.all(np.isfinite(r.fitted_piston[0]))
+
+
 def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
     truth = load_model(MODELS / "rs25_hotfire.toml", friction="none")
     data = synthetic(truth, 0.01, seed=3)
@@ -136,6 +149,11 @@ def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
     line = next(x for x in text.splitlines() if x.startswith("load_stiffness"))
     assert "lbf/in" in line and "# fitted" in line
     assert 'model = "none"' in text  # the law the fit used
+    # only the fitted lines change: every other line of the source, comments included, is kept
+    source = (MODELS / "rs25_hotfire.toml").read_text().splitlines()
+    kept = set(text.splitlines())
+    changed = [x for x in source if x not in kept]
+    assert [x.split("=")[0].strip() for x in changed] == ["name", "load_stiffness", "model"], changed
     back = load_model(out)
     assert back.structure.load_stiffness_N_per_m == pytest.approx(r.values[0], rel=1e-5)
     assert back.actuator == truth.actuator and back.engine == truth.engine

@@ -5,6 +5,10 @@ The wheel is built from the source tree (``pip wheel --no-deps``), installed wit
 running interpreter's environment), and the shipped commands are run from another working
 directory with only that folder on ``PYTHONPATH``: ``taos info rs25_hotfire`` (a shipped model
 named without a path) and ``python -m taos greenrun rs25_hotfire --out DIR`` (the report).
+
+Building the wheel fetches setuptools and wheel into pip's isolated build environment (network);
+the fresh install compiles its numba kernels on first use (about a minute of CPU), so the
+greenrun test is marked slow.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _run(args, cwd, env=None, timeout=900):
+def _run(args, cwd, env=None, timeout=1800):
     return subprocess.run([str(a) for a in args], cwd=cwd, env=env, capture_output=True, text=True,
                           timeout=timeout)
 

@@ -65,19 +65,19 @@ def test_pressure_feedback_keeps_static_stiffness(ambient):
     off = ambient.replace(actuator=dataclasses.replace(ambient.actuator, pressure_feedback_gain_m_per_s_Pa=0.0))
     h_on = linear_freqresp(ambient, [1e-4]).piston[0]
     h_off = linear_freqresp(off, [1e-4]).piston[0]
-    assert abs(h_on - h_off) < 1e-4
+    assert abs(h_on - h_off) < 1e-5  # achieved 2.9e-6 at 1e-4 Hz (the high-pass's leak)
 
 
 def test_sine_dwell_equals_linear_without_friction(ambient):
     """Friction off, small avionics effects off: time-domain sine dwell = exact linear response
-    within 0.1 dB and 1 deg from 0.1 to 20 Hz."""
+    within 0.003 dB and 0.15 deg from 0.1 to 20 Hz (achieved 1.0e-3 dB, 0.047 deg)."""
     m = ambient.with_friction("none").replace(avionics=ambient.avionics.ideal())
     f = np.array([0.1, 0.3, 1.0, 2.0, 4.0, 5.3, 7.0, 10.0, 14.0, 20.0])
     piston, engine = sine_dwell_grid(m, [0.4 * DEG], f)
     lin = linear_freqresp(m, f)
     for sim, ref in ((piston[0], lin.piston), (engine[0], lin.engine)):
-        assert np.max(np.abs(gain_db(sim) - gain_db(ref))) < 0.1
-        assert np.max(np.abs(np.degrees(np.angle(sim / ref)))) < 1.0
+        assert np.max(np.abs(gain_db(sim) - gain_db(ref))) < 0.003
+        assert np.max(np.abs(np.degrees(np.angle(sim / ref)))) < 0.15
 
 
 def test_coulomb_friction_amplitude_dependence_section_3_1(ambient):
