@@ -137,6 +137,13 @@ def test_fit_with_no_corrections_allowed_is_the_surrogate_fit():
     r = fit_frequency_response(truth, [d], ["load_stiffness"], starts=1, correct=True, max_corrections=0)
     assert r.corrections == 0 and len(r.history) == 1
     assert r.fitted_piston[0].shape == (F.size,) and np.all(np.isfinite(r.fitted_piston[0]))
+    # the plot draws what the analysis computed (fitted_linear_curves), data and residuals
+    from taos.identify.fit import fitted_linear_curves
+    from taos.plotting.fit import plot_fit
+    curves = fitted_linear_curves(r)
+    assert list(curves) == ["pitch"] and curves["pitch"].freq_hz[0] < F[0] < F[-1] < curves["pitch"].freq_hz[-1]
+    fig = plot_fit(r, curves)
+    assert {"data", "model", "linear", "residual", "notch"} <= {ln.get_gid() for a in fig.axes for ln in a.lines}
 
 
 def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
