@@ -72,8 +72,9 @@ class GimbalGeometry:
 
 def _nozzle(g: GimbalGeometry) -> trimesh.Trimesh:
     """Bell nozzle and combustion chamber, revolved about z (open surface, drawn two-sided)."""
-    z_throat = -g.powerhead_length_m
-    z_exit = -g.engine_length_m
+    top = g.gimbal_height_m / 2  # the engine length runs from the bearing top, as in models/meshes
+    z_throat = top - g.powerhead_length_m
+    z_exit = top - g.engine_length_m
     rt, re = g.throat_diameter_m / 2, g.nozzle_exit_diameter_m / 2
     s = np.linspace(0.0, 1.0, 24)
     # bell: radius rises fast past the throat then flattens (parabolic in the axial coordinate)
