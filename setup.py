@@ -6,7 +6,15 @@ pyproject.toml [tool.setuptools.package-dir]); find_packages cannot see mapped f
 this file.
 """
 
+from pathlib import Path
+
 from setuptools import find_packages, setup
 
+#: the data sub-folders of models/ (data, flight, masv, meshes, profiles, ...), declared so that
+#: setuptools does not warn about them; their files come from the package-data patterns
+MODEL_FOLDERS = sorted(p.name for p in (Path(__file__).parent / "models").iterdir()
+                       if p.is_dir() and not p.name.startswith((".", "_")))
+
 setup(packages=find_packages(include=["taos", "taos.*", "masv", "masv.*"])
-      + ["taos.shipped.models", "taos.shipped.fem_data"])
+      + ["taos.shipped.models", "taos.shipped.fem_data"]
+      + [f"taos.shipped.models.{d}" for d in MODEL_FOLDERS])

@@ -13,10 +13,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.optimize
 
 from taos.freqresp import FrequencyResponse
-from taos.linear import phase_deg
+from taos.linear import gain_db, notch_hz, phase_deg
 from taos.simplex import simplex_state_space
 
 from .system import MasvSystem, build_system
@@ -25,7 +24,7 @@ GAIN_FLOOR = 1e-20   # |h| floor for dB (-400 dB)
 
 
 def _db(h) -> np.ndarray:
-    return 20.0 * np.log10(np.maximum(np.abs(h), GAIN_FLOOR))
+    return gain_db(h, GAIN_FLOOR)
 
 
 def band_grid(system: MasvSystem, n: int = 400) -> np.ndarray:
@@ -61,11 +60,6 @@ class MasvFrequencyResponse:
         return FrequencyResponse(self.freq_hz, self.piston[:, k, k], self.engine[:, k, k], None,
                                  engine_model="masv", provenance=dict(self.provenance))
 
-    def plot(self, kind: str = "engine", **kwargs):
-        """8x8 gain grid (thin call into :mod:`masv.plotting`)."""
-        from . import plotting
-        return plotting.plot_gain_grid(self, kind=kind, **kwargs)
-
 
 def frequency_response(system: MasvSystem, freq_hz) -> MasvFrequencyResponse:
     """Exact linear 8x8 responses by block elimination (:meth:`MasvSystem.frf`)."""
@@ -82,21 +76,17 @@ def frequency_response(system: MasvSystem, freq_hz) -> MasvFrequencyResponse:
 def notch_frequencies(system: MasvSystem, n_grid: int = 400) -> dict[str, dict]:
     """Each actuator's notch (minimum of its own |x_p / (R theta_c)| in the band), refined with a
     bounded scalar search, beside the rigid-structure simplex notch sqrt((K_L R^2+K_n)/J)/2pi."""
-    f = band_grid(system, n_grid)
-    xp, _ = system.frf(f)
+    c = system.config
+    n = len(system.actuator_names)
+    notches = notch_hz(lambda f: np.abs(system.frf(f)[0][:, range(n), range(n)]), c.band_low_hz, c.band_high_hz,
+                       n_grid, xatol=1e-7)
     out = {}
     for k, name in enumerate(system.actuator_names):
-        g = np.abs(xp[:, k, k])
-        i = int(np.argmin(g))
-        lo, hi = np.log10(f[max(i - 1, 0)]), np.log10(f[min(i + 1, f.size - 1)])
-
-        def gk(lf, k=k):
-            return abs(system.frf([10 ** lf])[0][0, k, k])
-        r = scipy.optimize.minimize_scalar(gk, bounds=(lo, hi), method="bounded", options={"xatol": 1e-7})
+        f_notch = float(notches[k])
         a = system.config.actuators[k]
         model = system.config.engine(a.engine).model
-        out[name] = {"notch_hz": float(10 ** r.x),
-                     "depth_db": float(_db(r.fun / system.moment_arms_m[k])),
+        out[name] = {"notch_hz": f_notch,
+                     "depth_db": float(_db(abs(system.frf([f_notch])[0][0, k, k]) / system.moment_arms_m[k])),
                      "simplex_load_resonance_hz": model.load_resonance_hz(a.axis)}
     return out
 
@@ -150,10 +140,6 @@ class CouplingResult:
                 "strongest_axis_to_axis": self.strongest_axis_to_axis,
                 "strongest_engine_to_engine_piston": self._strongest(False, "piston"),
                 "strongest_axis_to_axis_piston": self._strongest(True, "piston")}
-
-    def plot(self, **kwargs):
-        from . import plotting
-        return plotting.plot_coupling_matrix(self, **kwargs)
 
 
 def coupling(system: MasvSystem, n_freq: int = 400) -> CouplingResult:

@@ -77,8 +77,8 @@ def cmd_freqresp(args) -> int:
         for i, f in enumerate(fr.freq_hz):
             print(f"{f:9.4g} " + " ".join(f"{d['piston']['gain_db'][k][k][i]:13.3f}" for k in range(len(fr.actuators))))
     if args.plot:
-        from .plotting import save
-        save(fr.plot(kind=args.kind), args.plot)
+        from .plotting import plot_gain_grid, save
+        save(plot_gain_grid(fr, kind=args.kind), args.plot)
     return 0
 
 
@@ -103,8 +103,8 @@ def cmd_coupling(args) -> int:
             if v:
                 print(f"  {k}: {v['command']} -> {v['response']} {v['gain_db']:.1f} dB at {v['freq_hz']:.2f} Hz")
     if args.plot:
-        from .plotting import save
-        save(c.plot(), args.plot)
+        from .plotting import plot_coupling_matrix, save
+        save(plot_coupling_matrix(c), args.plot)
     return 0
 
 

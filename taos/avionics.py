@@ -1,6 +1,6 @@
 """TVC command avionics: flight-software quantisation and servo-amplifier crossover gain.
 
-Command path (seed paper section 2.3, DESIGN.md)::
+Command path (seed paper section 2.3)::
 
     FCS command theta_c [rad] -> quantise (N bits over the full command range, truncation
     toward zero or rounding to nearest) -> crossover-distortion gain g(|c|) -> c_out

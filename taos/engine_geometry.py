@@ -13,7 +13,9 @@ exit plane, z = -4.155 m), nozzle exit diameter 2.4 m. Notional (documented here
 * nozzle: a bell-shaped shell r(s) = r_j + (r_e - r_j) sqrt(s), s in [0, 1] from the joint
   (r_j = 0.33 m) to the exit (r_e = 1.20 m), 20 mm thick (coolant tubes and jackets
   smeared), 785 kg;
-* the masses are shared so that the centre of mass lies 1.50 m below the gimbal (DESIGN.md).
+* the masses are shared so that the centre of mass lies 1.50 m below the gimbal (notional: the
+  inertia about the gimbal is not public; 1.5 m makes a 3,500 kg engine's inertia near the
+  12,000 kg m^2 of the model files).
 
 Each part's density is its mass over its mesh volume; inertia comes from the meshes
 (trimesh's exact polyhedral integrals), moved to O by the parallel-axis theorem::
@@ -23,7 +25,6 @@ Each part's density is its mass over its mesh volume; inertia comes from the mes
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -217,28 +218,30 @@ def urdf_text(props: MassProperties) -> str:
 """
 
 
-_INERTIA_LINE = re.compile(r'^(inertia_(pitch|yaw))\s*=.*$', re.M)
-
-
-def model_file_inertia_lines(props: MassProperties) -> dict[str, str]:
-    """The two rewritten TOML lines {'inertia_pitch': ..., 'inertia_yaw': ...}."""
+def model_file_inertia_values(props: MassProperties) -> dict[str, tuple[str, str]]:
+    """The two model-file entries of [engine]: {'inertia_pitch': (value, comment), ...}."""
     d = abs(float(props.com_m[2]))
     note = (f"# [derived] scripts/build_engine_geometry.py from models/meshes "
             f"({props.mass_kg:.0f} kg, centre of mass {d:.2f} m below the gimbal)")
-    out = {}
-    for key, val in (("inertia_pitch", props.inertia_pitch_kgm2), ("inertia_yaw", props.inertia_yaw_kgm2)):
-        lhs = f'{key} = "{val:.0f} kg*m**2"'
-        out[key] = f"{lhs:<38}{note}"
-    return out
+    return {key: (f"{val:.0f} kg*m**2", note)
+            for key, val in (("inertia_pitch", props.inertia_pitch_kgm2), ("inertia_yaw", props.inertia_yaw_kgm2))}
 
 
 def rewrite_model_inertia(path: Path, props: MassProperties) -> bool:
-    """Rewrite just the inertia_pitch / inertia_yaw lines of a model file; True if changed."""
+    """Rewrite just the [engine] inertia_pitch / inertia_yaw entries of a model file (tomlkit:
+    every other line and comment stays as it was); True if the file changed."""
+    import tomlkit
+
+    from .results import toml_set
+
     text = Path(path).read_text()
-    lines = model_file_inertia_lines(props)
-    new, n = _INERTIA_LINE.subn(lambda m: lines[m.group(1)], text)
-    if n != 2:
-        raise ValueError(f"{path}: expected one inertia_pitch and one inertia_yaw line, found {n}")
+    doc = tomlkit.parse(text)
+    engine = doc.get("engine", {})
+    if not all(key in engine for key in ("inertia_pitch", "inertia_yaw")):
+        raise ValueError(f"{path}: expected inertia_pitch and inertia_yaw in [engine]")
+    for key, (value, note) in model_file_inertia_values(props).items():
+        toml_set(doc, "engine", key, value, note)
+    new = tomlkit.dumps(doc)
     if new != text:
         Path(path).write_text(new)
         return True

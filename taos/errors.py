@@ -1,7 +1,7 @@
 """Errors raised for bad user input.
 
 Every input problem is reported as one line naming the file, the field and what was
-expected (DESIGN.md, "Bad input"). The CLI prints ``str(err)`` and exits with status 2.
+expected. The CLI prints ``str(err)`` and exits with status 2.
 """
 
 from __future__ import annotations

@@ -41,7 +41,7 @@ class FrequencyResponse:
     provenance: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        """The JSON contract of ``taos freqresp`` (DESIGN.md)."""
+        """The JSON contract of ``taos freqresp`` (these keys are kept from release to release)."""
         return {
             "freq_hz": [float(f) for f in self.freq_hz],
             "amplitude_deg": None if self.amplitude_rad is None else math.degrees(self.amplitude_rad),
@@ -52,11 +52,6 @@ class FrequencyResponse:
             "engine": {"gain_db": gain_db(self.engine).tolist(), "phase_deg": phase_deg(self.engine).tolist()},
             "provenance": self.provenance,
         }
-
-    def plot(self, **kwargs):
-        """Bode plot (thin call into :mod:`taos.plotting.bode`)."""
-        from .plotting import bode
-        return bode.plot_freqresp([self], **kwargs)
 
 
 def linear_freqresp(model: TvcModel, freq_hz, axis: str = "pitch") -> FrequencyResponse:

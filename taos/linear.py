@@ -112,9 +112,10 @@ def finish(M: np.ndarray, symbolic: bool):
     return ca.blockcat([[ca.SX(v) if not isinstance(v, (ca.SX, ca.MX)) else v for v in row] for row in M2.tolist()])
 
 
-def gain_db(h) -> np.ndarray:
-    """20 log10 |h| [dB]."""
-    return 20.0 * np.log10(np.abs(h))
+def gain_db(h, floor: float = 1e-300) -> np.ndarray:
+    """20 log10 |h| [dB], with |h| floored at ``floor`` (same unit as h) so that an exact zero
+    gives a finite level (-6000 dB by default) instead of -inf. The one gain-in-dB helper."""
+    return 20.0 * np.log10(np.maximum(np.abs(h), floor))
 
 
 def phase_deg(h, unwrap: bool = True) -> np.ndarray:
@@ -123,6 +124,49 @@ def phase_deg(h, unwrap: bool = True) -> np.ndarray:
     if unwrap:
         ph = np.unwrap(ph, axis=0)
     return np.degrees(ph)
+
+
+def notch_hz(abs_gain, f_lo_hz: float, f_hi_hz: float, n_grid: int = 400, xatol: float = 1e-9):
+    """Frequency [Hz] of the minimum of a gain |H(f)| over [f_lo_hz, f_hi_hz] (the notch).
+
+    ``abs_gain`` maps an array of F frequencies [Hz] to |H| (any unit), shape (F,) for one
+    response (the result is then a float) or (F, m) for m responses evaluated together (an (m,)
+    array). The minimum of a log grid of ``n_grid`` points is refined by a bounded scalar search
+    in log10 f between the grid's neighbours (tolerance ``xatol`` in log10 f). The one notch
+    finder for responses that can be evaluated at any frequency; :func:`sampled_notch_hz` is the
+    one for sampled responses."""
+    import scipy.optimize
+
+    grid = np.linspace(np.log10(f_lo_hz), np.log10(f_hi_hz), n_grid)
+    g = np.asarray(abs_gain(10 ** grid), float)
+    cols = g.reshape(grid.size, -1)
+    out = np.empty(cols.shape[1])
+    for j in range(cols.shape[1]):
+        k = int(np.argmin(cols[:, j]))
+        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+
+        def at(lf, j=j):
+            return float(np.asarray(abs_gain(np.array([10 ** lf])), float).reshape(-1)[j])
+        res = scipy.optimize.minimize_scalar(at, bounds=(lo, hi), method="bounded", options={"xatol": xatol})
+        out[j] = 10 ** res.x
+    return float(out[0]) if g.ndim == 1 else out
+
+
+def sampled_notch_hz(freq_hz, h) -> float:
+    """Frequency [Hz] of the deepest interior local minimum of |h| on its own frequency grid
+    (a measured or sine-dwell response), refined by a parabola in log10 f through the three
+    points around it; NaN when |h| has no interior minimum (no notch in the band)."""
+    f = np.asarray(freq_hz, float)
+    g = gain_db(h)
+    if f.size < 3:
+        return float("nan")
+    inner = np.flatnonzero((g[1:-1] < g[:-2]) & (g[1:-1] < g[2:])) + 1
+    if inner.size == 0:
+        return float("nan")
+    k = int(inner[np.argmin(g[inner])])
+    x = np.log10(f[k - 1:k + 2])
+    a, b, _ = np.polyfit(x, g[k - 1:k + 2], 2)
+    return float(10 ** np.clip(-b / (2 * a), x[0], x[2])) if a > 0 else float(f[k])
 
 
 def balancing_scale(ss: StateSpace) -> np.ndarray:

@@ -1,8 +1,8 @@
 """Model files: TOML parameter sets with units, loaded into frozen SI dataclasses.
 
 A model file (``models/rs25_ambient.toml`` and friends) holds the sections below; every
-physical value is a string with its unit, parsed by pint (:mod:`taos.units`). The keys of
-DESIGN.md are a contract::
+physical value is a string with its unit, parsed by pint (:mod:`taos.units`). These keys are
+a contract (model files written for one release load in the next)::
 
     [engine]    mass, inertia_pitch, inertia_yaw, rotational_stiffness, (thrust)
     [actuator]  moment_arm, piston_area, supply_pressure, oil_bulk_modulus, trapped_volume,

@@ -51,3 +51,27 @@ def write_provenance(h5: h5py.File, provenance: dict) -> None:
     """Store provenance as attributes of the root group (JSON for nested values)."""
     for k, v in provenance.items():
         h5.attrs[k] = v if isinstance(v, (str, int, float)) else json.dumps(v)
+
+
+def toml_set(doc, section: str, key: str, value, comment: str | None = None) -> None:
+    """Set ``key`` of ``[section]`` ('' for the top level, dots for sub-tables) in a tomlkit
+    document to ``value`` with a trailing ``comment`` (None: no comment), keeping the line's
+    indentation and its comment column (a new key goes at the end of its section). Every other
+    line, comments included, is left as it was. KeyError when the section does not exist."""
+    import tomlkit
+
+    table = doc
+    for part in filter(None, section.split(".")):
+        table = table[part]
+    item = tomlkit.item(value)
+    old = table.item(key) if key in table else None
+    if old is not None:
+        item.trivia.indent, item.trivia.trail = old.trivia.indent, old.trivia.trail
+    if comment:
+        item.comment(comment)
+        ws = 2
+        if old is not None and old.trivia.comment:
+            column = len(old.as_string()) + len(old.trivia.comment_ws)
+            ws = max(2, column - len(item.as_string()))
+        item.trivia.comment_ws = " " * ws
+    table[key] = item

@@ -1,5 +1,5 @@
 """Planar "simplex" TVC model: one actuator, one engine axis, compliant load path, gimbal
-friction and command avionics (seed paper sections 2 and 3; DESIGN.md "Physics").
+friction and command avionics (seed paper sections 2 and 3).
 
 Equations (SI), built from the actuator state space of :mod:`taos.actuator`::
 
@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .actuator import actuator_state_space
-from .linear import StateSpace, finish, is_symbolic, zeros
+from .linear import StateSpace, finish, is_symbolic, notch_hz, zeros
 from .model import TvcModel
 
 #: Outputs of the simplex linear block, in order.
@@ -183,21 +183,7 @@ def simplex_plant(model: TvcModel, axis: str = "pitch") -> LurePlant:
 
 def load_resonance_from_notch(model: TvcModel, axis: str = "pitch",
                               f_lo: float = 0.5, f_hi: float = 30.0) -> float:
-    """Frequency [Hz] of the minimum of the linear command -> piston gain (the notch),
-    located by a dense log grid and refined with a bounded scalar search."""
-    import scipy.optimize
-
+    """Frequency [Hz] of the minimum of the linear command -> piston gain (the notch) between
+    ``f_lo`` and ``f_hi`` [Hz] (:func:`taos.linear.notch_hz`: dense log grid, bounded search)."""
     ss = simplex_state_space(model, axis)
-    R = model.actuator.moment_arm_m
-
-    def g(logf):
-        h = ss.freqresp(10 ** logf, "command_rad", "x_p_m")[0] / R
-        return abs(h)
-
-    grid = np.linspace(np.log10(f_lo), np.log10(f_hi), 400)
-    vals = np.abs(ss.freqresp(10 ** grid, "command_rad", "x_p_m")) / R
-    k = int(np.argmin(vals))
-    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-    res = scipy.optimize.minimize_scalar(g, bounds=(lo, hi), method="bounded",
-                                         options={"xatol": 1e-9})
-    return float(10 ** res.x)
+    return notch_hz(lambda f: np.abs(ss.freqresp(f, "command_rad", "x_p_m")), f_lo, f_hi)

@@ -2,8 +2,8 @@
 
 Fixed-step classical RK4 in the compiled kernel of :mod:`taos._integrator`. The default step
 (2e-4 s) resolves the fastest dynamics of the shipped models (oil column ~ 250 Hz,
-servovalve 100 Hz) with a wide RK4 stability margin; ``tests/test_simplex_convergence.py``
-shows that halving it changes a 20 s LuGre run by far less than 1e-4 deg.
+servovalve 100 Hz) with a wide RK4 stability margin; halving it changes a 20 s LuGre run by
+less than 1e-4 deg (``tests/test_simplex.py::test_step_refinement_lugre_20s``).
 """
 
 from __future__ import annotations

@@ -15,7 +15,6 @@ import pint
 from .errors import InputError
 
 ureg = pint.UnitRegistry()
-ureg.define("lbf_in = lbf * inch")  # convenience alias used in some reports
 Q_ = ureg.Quantity
 
 #: Named physical dimensions used by model-file fields: name -> (pint dimensionality
@@ -102,10 +101,3 @@ def from_si(value: float, si_unit: str, unit: str) -> float:
     """Convert an SI float to ``unit`` (e.g. ``from_si(k, 'N/m', 'lbf/in')``)."""
     return float(Q_(value, si_unit).to(unit).magnitude)
 
-
-def fmt(value: float, si_unit: str, unit: str, digits: int = 4) -> str:
-    """Format an SI float in an engineering unit, e.g. ``'115000 lbf/in'``."""
-    return f"{from_si(value, si_unit, unit):.{digits}g} {unit}"
-
-
-DEG = math.pi / 180.0

@@ -82,5 +82,6 @@ def test_df_map_interpolates_nodes_and_round_trips(tmp_path):
     j = json.loads((tmp_path / "df.json").read_text())
     assert j["amplitude_deg"][0] == pytest.approx(0.05) and len(j["engine"]["gain_db"]) == 3
     from taos.plotting import save
-    save(d.plot(), tmp_path / "df.png")
+    from taos.plotting.describing import plot_df_map
+    save(plot_df_map(d), tmp_path / "df.png")
     assert (tmp_path / "df.png").stat().st_size > 1000

@@ -41,7 +41,9 @@ def synthetic(model, noise, seed, axis="pitch"):
 
 
 @pytest.mark.parametrize("name", ["rs25_ambient", "rs25_hotfire"])
-def test_fit_recovers_load_stiffness_within_2pct_and_notch_within_1pct(name):
+def test_fit_recovers_load_stiffness_within_0p3pct_and_notch_within_0p1pct(name):
+    """1 % noise on 12 points: K_L within 0.3 % and 4 standard errors (achieved 2e-4 with a
+    standard error of 4e-4 to 7e-4), the notch within 0.1 % (achieved 1e-4)."""
     truth = load_model(MODELS / f"{name}.toml", friction="none")
     data = synthetic(truth, 0.01, seed=1)
     k_true = truth.structure.load_stiffness_N_per_m
@@ -49,12 +51,14 @@ def test_fit_recovers_load_stiffness_within_2pct_and_notch_within_1pct(name):
     k = r.values[0]
     print(f"{name}: K_L fitted {k / LBF_IN:.0f} +- {r.std_errors[0] / LBF_IN:.0f} lbf/in, true {k_true / LBF_IN:.0f}; "
           f"notch {r.notch_hz['pitch']:.4f} Hz vs {load_resonance_from_notch(truth):.4f} Hz")
-    assert abs(k / k_true - 1) < 0.02
-    assert abs(r.notch_hz["pitch"] / load_resonance_from_notch(truth) - 1) < 0.01
+    assert abs(k / k_true - 1) < 3e-3
+    assert abs(r.notch_hz["pitch"] / load_resonance_from_notch(truth) - 1) < 1e-3
     assert 0 < r.std_errors[0] and abs(k - k_true) < 4 * r.std_errors[0]
 
 
-def test_fit_recovers_coulomb_torque_within_10pct_with_friction():
+def test_fit_recovers_coulomb_torque_within_2pct_with_friction():
+    """Full nonlinear data (smooth Coulomb), K_L and T_c free: K_L within 0.5 % and T_c within
+    2 % (achieved 1.5e-3 and 1.6e-3, standard error of T_c 5.5e-3)."""
     truth = load_model(MODELS / "rs25_hotfire.toml", friction="coulomb-smooth")
     data = synthetic(truth, 0.01, seed=2)
     start = {"load_stiffness": 150000 * LBF_IN, "coulomb_torque": 100000 * INLBF}
@@ -62,15 +66,21 @@ def test_fit_recovers_coulomb_torque_within_10pct_with_friction():
     k, tc = r.values
     print(f"K_L {k / LBF_IN:.0f} lbf/in, T_c {tc / INLBF:.0f} +- {r.std_errors[1] / INLBF:.0f} in*lbf, "
           f"{r.corrections} corrections, corr {r.correlation[0, 1]:.3f}")
-    assert abs(k / truth.structure.load_stiffness_N_per_m - 1) < 0.02
-    assert abs(tc / truth.friction.coulomb_torque_Nm - 1) < 0.10
+    assert abs(k / truth.structure.load_stiffness_N_per_m - 1) < 5e-3
+    assert abs(tc / truth.friction.coulomb_torque_Nm - 1) < 0.02
     assert r.corrections >= 1 and np.all(r.std_errors > 0)
     assert r.correlation.shape == (2, 2) and r.correlation[0, 0] == pytest.approx(1.0)
 
 
-def test_standard_errors_cover_the_truth_at_the_stated_confidence():
-    """Repeated noise on exact linear responses: the 95 % intervals hold the true K_L and
-    loop gain in close to 95 % of the trials (binomial spread for 40 trials)."""
+def test_standard_errors_are_neither_too_small_nor_too_large():
+    """Repeated noise on exact linear responses (40 trials, K_L and loop gain free), checked
+    from both sides against the statistics of an unbiased Gaussian estimate:
+
+    * the 95 % intervals hold the truth in 70 to 79 of the 80 cases (binomial: mean 76,
+      sd 1.9; all 80 would mean intervals too wide);
+    * the mean normalised squared error ((value - truth) / std_error)^2 is near 1 (a chi^2_1
+      mean; over 80 cases its sd is about 0.16): 0.55 to 1.6. Standard errors twice too large
+      give about 0.25, twice too small about 4."""
     truth = load_model(MODELS / "rs25_ambient.toml", friction="none")
     truth = truth.replace(avionics=truth.avionics.ideal())
     lin = linear_freqresp(truth, F)
@@ -81,6 +91,7 @@ def test_standard_errors_cover_the_truth_at_the_stated_confidence():
     prob = FitProblem(start, free, np.array(["pitch"] * F.size), F, np.full(F.size, 0.4 * DEG))
     rng = np.random.default_rng(7)
     hits = np.zeros(2)
+    z2 = []
     n = 40
     noise = 0.02
     for _ in range(n):
@@ -91,9 +102,13 @@ def test_standard_errors_cover_the_truth_at_the_stated_confidence():
         ci = r.confidence_interval(0.95)
         true = np.array([truth.structure.load_stiffness_N_per_m, truth.actuator.loop_gain_per_s])
         hits += (ci[:, 0] <= true) & (true <= ci[:, 1])
-    cover = hits / n
-    print(f"coverage of 95 % intervals over {n} trials: {cover}")
-    assert np.all(cover >= 0.85) and np.all(cover <= 1.0)
+        z2.append(((r.values - true) / r.std_errors) ** 2)
+    cover = hits.sum() / (2 * n)
+    nees = float(np.mean(z2))
+    print(f"coverage of 95 % intervals over {n} trials: {hits / n}; mean normalised squared error "
+          f"{np.mean(z2, axis=0)}")
+    assert 70 / 80 <= cover <= 79 / 80
+    assert 0.55 <= nees <= 1.6
 
 
 def test_surrogate_describing_functions_equal_the_friction_kernels(hotfire):
@@ -111,6 +126,26 @@ def test_surrogate_describing_functions_equal_the_friction_kernels(hotfire):
     assert coul.describing_function(0.1) == pytest.approx(4 * coul.coulomb_torque_Nm / (math.pi * 0.1))
 
 
+def test_fit_with_no_corrections_allowed_is_the_surrogate_fit():
+    """``max_corrections=0`` with the correction asked for: no correction, the surrogate's own
+    fitted responses (once a NameError)."""
+    truth = load_model(MODELS / "rs25_hotfire.toml", friction="coulomb-smooth")
+    lin = linear_freqresp(truth, F)
+    one = np.ones(F.size)
+    d = MeasuredResponse("pitch", F, np.full(F.size, 0.8 * DEG), lin.piston * truth.actuator.moment_arm_m,
+                         lin.engine, one, one, 0.01 * one, 0.01 * one)
+    r = fit_frequency_response(truth, [d], ["load_stiffness"], starts=1, correct=True, max_corrections=0)
+    assert r.corrections == 0 and len(r.history) == 1
+    assert r.fitted_piston[0].shape == (F.size,) and np.all(np.isfinite(r.fitted_piston[0]))
+    # the plot draws what the analysis computed (fitted_linear_curves), data and residuals
+    from taos.identify.fit import fitted_linear_curves
+    from taos.plotting.fit import plot_fit
+    curves = fitted_linear_curves(r)
+    assert list(curves) == ["pitch"] and curves["pitch"].freq_hz[0] < F[0] < F[-1] < curves["pitch"].freq_hz[-1]
+    fig = plot_fit(r, curves)
+    assert {"data", "model", "linear", "residual", "notch"} <= {ln.get_gid() for a in fig.axes for ln in a.lines}
+
+
 def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
     truth = load_model(MODELS / "rs25_hotfire.toml", friction="none")
     data = synthetic(truth, 0.01, seed=3)
@@ -121,6 +156,11 @@ def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
     line = next(x for x in text.splitlines() if x.startswith("load_stiffness"))
     assert "lbf/in" in line and "# fitted" in line
     assert 'model = "none"' in text  # the law the fit used
+    # only the fitted lines change: every other line of the source, comments included, is kept
+    source = (MODELS / "rs25_hotfire.toml").read_text().splitlines()
+    kept = set(text.splitlines())
+    changed = [x for x in source if x not in kept]
+    assert [x.split("=")[0].strip() for x in changed] == ["name", "load_stiffness", "model"], changed
     back = load_model(out)
     assert back.structure.load_stiffness_N_per_m == pytest.approx(r.values[0], rel=1e-5)
     assert back.actuator == truth.actuator and back.engine == truth.engine
@@ -147,6 +187,7 @@ def test_demo_datasets_reproduce_the_paper_direction_hot_fire_stiffer(tmp_path):
     print(f"demo: ambient K_L {k_amb:.0f} lbf/in notch {n_amb:.3f} Hz; hot fire K_L {k_hot:.0f} lbf/in "
           f"notch {n_hot:.3f} Hz, T_c {res_hot.eng(1):.0f} in*lbf")
     assert k_hot > 1.5 * k_amb and n_hot > 1.2 * n_amb
-    assert abs(k_amb / 115000 - 1) < 0.02 and abs(k_hot / 205000 - 1) < 0.02
-    assert abs(res_hot.eng(1) / 144000 - 1) < 0.10
+    # achieved: K_L -1.3e-3 (ambient), 5e-6 (hot fire); T_c 2.6e-3
+    assert abs(k_amb / 115000 - 1) < 5e-3 and abs(k_hot / 205000 - 1) < 5e-3
+    assert abs(res_hot.eng(1) / 144000 - 1) < 0.02
     assert load_model(tmp_path / "amb.toml").structure.load_stiffness_N_per_m == pytest.approx(k_amb * LBF_IN, rel=1e-5)

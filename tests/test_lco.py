@@ -39,15 +39,19 @@ def reports():
 @pytest.mark.parametrize("law", ["coulomb-switching", "dahl", "lugre"])
 def test_soft_structure_lco_about_0p1_deg_at_0p1_to_0p2_hz_in_prediction_and_time_domain(reports, law):
     """Paper fig. 7: with the ambient stiffness every bounding law limit-cycles, about 0.1 deg
-    at 0.1-0.2 Hz; the describing function and the time-domain run agree within 30 % in
-    amplitude and 15 % in frequency, and the predicted cycle is stable (Loeb)."""
+    at 0.1-0.2 Hz; the describing function and the time-domain run agree within 12 % in
+    amplitude and 10 % in frequency (achieved: Dahl and LuGre +3 % and +0.1 %, Coulomb, the
+    least sinusoidal, -5.7 % and -5.1 %), and the predicted cycle is stable (Loeb)."""
     d = reports["ambient", law].to_dict()
     td = d["time_domain"]
+    print(f"{law}: DF {d['amplitude_deg']:.4f} deg {d['frequency_hz']:.4f} Hz, time domain "
+          f"{td['amplitude_deg']:.4f} deg {td['frequency_hz']:.4f} Hz: ratios "
+          f"{td['amplitude_deg'] / d['amplitude_deg'] - 1:+.4f}, {td['frequency_hz'] / d['frequency_hz'] - 1:+.4f}")
     assert d["lco"] and d["stable"] and td["lco"]
     assert 0.1 <= d["frequency_hz"] <= 0.2 and 0.1 <= td["frequency_hz"] <= 0.2
     assert 0.03 <= d["engine_amplitude_deg"] <= 0.3 and 0.03 <= td["engine_amplitude_deg"] <= 0.3
-    assert abs(td["amplitude_deg"] / d["amplitude_deg"] - 1) < 0.30
-    assert abs(td["frequency_hz"] / d["frequency_hz"] - 1) < 0.15
+    assert abs(td["amplitude_deg"] / d["amplitude_deg"] - 1) < 0.12
+    assert abs(td["frequency_hz"] / d["frequency_hz"] - 1) < 0.10
 
 
 def test_coulomb_cycle_is_largest_and_most_square(reports):
@@ -62,8 +66,8 @@ def test_coulomb_cycle_is_largest_and_most_square(reports):
 
 def test_stiff_structure_no_lco_for_dahl_lugre_and_coulomb_about_halved(reports):
     """Paper fig. 8: at 205,000 lbf/in Dahl and LuGre do not limit-cycle (prediction and time
-    domain), and the Coulomb amplitude is at most about half the ambient one (it scales with
-    the breakaway deflection T_c/(K_L R^2): 115/205 = 0.56)."""
+    domain), and the Coulomb amplitude is about half the ambient one: it scales with the
+    breakaway deflection T_c/(K_L R^2), 115/205 = 0.561, within 8 % (achieved 0.571 to 0.581)."""
     for law in ("dahl", "lugre"):
         d = reports["hot", law].to_dict()
         assert not d["lco"] and d["margin_db"] > 0.3
@@ -72,8 +76,10 @@ def test_stiff_structure_no_lco_for_dahl_lugre_and_coulomb_about_halved(reports)
     hard = reports["hot", "coulomb-switching"].to_dict()
     assert hard["lco"] and hard["time_domain"]["lco"]
     for key in ("amplitude_deg", "engine_amplitude_deg"):
-        assert hard[key] / soft[key] <= 0.6
-        assert hard["time_domain"][key] / soft["time_domain"][key] <= 0.6
+        print(f"hot / ambient {key}: DF {hard[key] / soft[key]:.4f}, "
+              f"time domain {hard['time_domain'][key] / soft['time_domain'][key]:.4f}")
+        assert hard[key] / soft[key] == pytest.approx(115 / 205, rel=0.08)
+        assert hard["time_domain"][key] / soft["time_domain"][key] == pytest.approx(115 / 205, rel=0.08)
 
 
 @pytest.mark.parametrize("law", ["coulomb-switching", "dahl", "lugre"])

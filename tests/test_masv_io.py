@@ -126,17 +126,17 @@ def test_cli_modes_and_coupling_with_modal_file(tmp_path, capsys):
 def test_plots_save_png(tmp_path):
     from masv import analysis as an
     from masv.config import load_config
-    from masv.plotting import plot_actuator_vs_simplex, save
+    from masv.plotting import plot_actuator_vs_simplex, plot_coupling_matrix, plot_gain_grid, save
     from masv.system import build_system
     from taos.freqresp import linear_freqresp
 
     s = build_system(load_config(RIGID))
     f = np.logspace(-1, 1.5, 30)
     fr = an.frequency_response(s, f)
-    save(fr.plot(kind="piston"), tmp_path / "grid.png")
+    save(plot_gain_grid(fr, kind="piston"), tmp_path / "grid.png")
     model = s.config.engines[0].model
     save(plot_actuator_vs_simplex(fr, "actuator_1_pitch", linear_freqresp(model, f, "pitch")), tmp_path / "one.png")
-    save(an.coupling(s, n_freq=20).plot(), tmp_path / "c.svg")
+    save(plot_coupling_matrix(an.coupling(s, n_freq=20)), tmp_path / "c.svg")
     assert all((tmp_path / n).stat().st_size > 1000 for n in ("grid.png", "one.png", "c.svg"))
 
 

@@ -1,4 +1,4 @@
-"""Model files: the DESIGN.md key contract, units through pint, and bad input."""
+"""Model files: the model-file key contract, units through pint, and bad input."""
 
 from __future__ import annotations
 

@@ -55,10 +55,11 @@ def test_two_axis_run_dwells_agree_with_the_sine_dwell_kernel(report):
         dw = {(round(x["amplitude_deg"], 6), x["freq_hz"]): x for x in s["sine_dwell"][ax]}
         for r in s["run_dwell"][ax]:
             d = dw[(round(r["amplitude_deg"], 6), r["freq_hz"])]
-            assert r["engine_gain_db"] == pytest.approx(d["engine_gain_db"], abs=0.05)
-            assert r["piston_gain_db"] == pytest.approx(d["piston_gain_db"], abs=0.05)
+            # achieved: 0.006 dB (engine), 0.0013 dB (piston), 0.03 deg
+            assert r["engine_gain_db"] == pytest.approx(d["engine_gain_db"], abs=0.02)
+            assert r["piston_gain_db"] == pytest.approx(d["piston_gain_db"], abs=0.005)
             dp = (r["engine_phase_deg"] - d["engine_phase_deg"] + 180) % 360 - 180
-            assert abs(dp) < 0.5
+            assert abs(dp) < 0.1
 
 
 def test_greenrun_h5_holds_the_run_and_the_responses(report):

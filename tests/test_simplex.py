@@ -35,13 +35,15 @@ def test_load_resonance_equation_1_and_piston_notch(name):
     J = p["engine"]["inertia_pitch_kgm2"]
     wl = math.sqrt((KL * R * R + Kn) / J) / (2 * math.pi)
     assert d["load_resonance_hz"] == pytest.approx(wl, rel=1e-12)
-    # independent notch search on a dense grid of the exact response
+    # independent reference: the notch of the exact response of the whole actuator state space on
+    # a dense grid (spacing 3.8e-4 w_L); with the piston still the engine is the undamped
+    # oscillator J, K_L R^2 + K_n, so the notch is w_L itself (the search reaches ~1e-9)
     from taos.model import load_model
     m = load_model(MODELS / f"{name}.toml")
     f = np.linspace(0.5 * wl, 2 * wl, 4001)
     g = np.abs(linear_freqresp(m, f).piston)
-    assert f[np.argmin(g)] == pytest.approx(wl, rel=0.01)
-    assert d["notch_frequency_hz"] == pytest.approx(wl, rel=0.01)
+    assert f[np.argmin(g)] == pytest.approx(wl, rel=4e-4)
+    assert d["notch_frequency_hz"] == pytest.approx(wl, rel=1e-7)
 
 
 def test_hot_fire_notch_above_ambient(ambient, hotfire):
@@ -63,19 +65,19 @@ def test_pressure_feedback_keeps_static_stiffness(ambient):
     off = ambient.replace(actuator=dataclasses.replace(ambient.actuator, pressure_feedback_gain_m_per_s_Pa=0.0))
     h_on = linear_freqresp(ambient, [1e-4]).piston[0]
     h_off = linear_freqresp(off, [1e-4]).piston[0]
-    assert abs(h_on - h_off) < 1e-4
+    assert abs(h_on - h_off) < 1e-5  # achieved 2.9e-6 at 1e-4 Hz (the high-pass's leak)
 
 
 def test_sine_dwell_equals_linear_without_friction(ambient):
     """Friction off, small avionics effects off: time-domain sine dwell = exact linear response
-    within 0.1 dB and 1 deg from 0.1 to 20 Hz."""
+    within 0.003 dB and 0.15 deg from 0.1 to 20 Hz (achieved 1.0e-3 dB, 0.047 deg)."""
     m = ambient.with_friction("none").replace(avionics=ambient.avionics.ideal())
     f = np.array([0.1, 0.3, 1.0, 2.0, 4.0, 5.3, 7.0, 10.0, 14.0, 20.0])
     piston, engine = sine_dwell_grid(m, [0.4 * DEG], f)
     lin = linear_freqresp(m, f)
     for sim, ref in ((piston[0], lin.piston), (engine[0], lin.engine)):
-        assert np.max(np.abs(gain_db(sim) - gain_db(ref))) < 0.1
-        assert np.max(np.abs(np.degrees(np.angle(sim / ref)))) < 1.0
+        assert np.max(np.abs(gain_db(sim) - gain_db(ref))) < 0.003
+        assert np.max(np.abs(np.degrees(np.angle(sim / ref)))) < 0.15
 
 
 def test_coulomb_friction_amplitude_dependence_section_3_1(ambient):

@@ -125,7 +125,7 @@ def test_engine_meshes_have_the_rs25_public_dimensions():
         m = engine_meshes(g, use_files)
         lo, hi = m["nozzle"].bounds
         assert hi[0] - lo[0] == pytest.approx(2.4, abs=0.05)
-        assert -lo[2] + g.gimbal_height_m / 2 == pytest.approx(4.3, abs=0.16)
+        assert -lo[2] + g.gimbal_height_m / 2 == pytest.approx(4.3, abs=1e-5)
         assert m["powerhead"].bounds[1][2] <= 1e-9  # below the gimbal pivot
 
 

@@ -1,4 +1,4 @@
-"""``taos`` command line (DESIGN.md "CLI").
+"""``taos`` command line (its commands, options and exit codes are a contract).
 
 Each subcommand lives in a small module with ``add_parser(subparsers)`` and ``run(args)``;
 register new ones in :data:`COMMANDS`. Bad input exits with status 2 and one line naming

@@ -110,8 +110,8 @@ def cmd_freqresp(args) -> int:
             print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} "
                   f"{d['engine']['gain_db'][i]:10.3f} {d['engine']['phase_deg'][i]:11.2f}")
     if args.plot:
-        from taos.plotting import save
-        save(fr.plot(resonance_hz=model.load_resonance_hz(args.axis)), args.plot)
+        from taos.plotting import bode, save
+        save(bode.plot_freqresp([fr], resonance_hz=model.load_resonance_hz(args.axis)), args.plot)
     return 0
 
 

@@ -8,7 +8,9 @@ import math
 import sys
 
 from taos.errors import InputError
+from taos.linear import gain_db
 from taos.results import write_json
+from taos.units import from_si
 
 AXES = ("pitch", "yaw")
 
@@ -56,9 +58,10 @@ def cmd_estimate(args) -> int:
         for r in responses:
             print(f"{r.axis} ({r.method}), {len(r)} points")
             print(f"{'freq_hz':>9} {'amp_deg':>8} {'piston dB':>10} {'deg':>8} {'coh':>6}")
+            in_per_deg = from_si(1.0, "m/rad", "in/deg")
             for k in range(len(r)):
-                h = r.piston_m_per_rad[k] / 0.0254 * math.pi / 180
-                print(f"{r.freq_hz[k]:9.4g} {math.degrees(r.amplitude_rad[k]):8.3g} {20 * math.log10(abs(h)):10.3f} "
+                h = r.piston_m_per_rad[k] * in_per_deg
+                print(f"{r.freq_hz[k]:9.4g} {math.degrees(r.amplitude_rad[k]):8.3g} {float(gain_db(h)):10.3f} "
                       f"{math.degrees(math.atan2(h.imag, h.real)):8.2f} {r.coherence_piston[k]:6.3f}")
     return 0
 
@@ -84,8 +87,10 @@ def cmd_fit(args) -> int:
         res.write_model(args.out_model, data_label=", ".join(labels))
         d["fitted_model_file"] = str(args.out_model)
     if args.plot:
+        from taos.identify.fit import fitted_linear_curves
+        from taos.plotting import fit as pf
         from taos.plotting import save
-        save(res.plot(), args.plot)
+        save(pf.plot_fit(res, fitted_linear_curves(res)), args.plot)
     if args.json:
         write_json(args.json, d)
     out = sys.stderr if args.json == "-" else sys.stdout
@@ -95,8 +100,52 @@ def cmd_fit(args) -> int:
     return 0
 
 
+def write_comparison(cmp, out_dir, json_path: str | None = None):
+    """Write ``table.txt``, ``comparison.json``, ``piston_side_by_side.png`` (paper fig. 2) and
+    ``bode_overlay.png`` (fig. 11 style) of a :class:`taos.identify.compare.Comparison` into
+    ``out_dir``: built in a temporary folder beside it and renamed into place, so a failure
+    leaves nothing half-written. Returns the folder's Path."""
+    import os
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    import matplotlib.pyplot as plt
+
+    from taos.identify.compare import comparison_curves
+    from taos.plotting import fit as pf
+    from taos.plotting import save
+
+    out = Path(out_dir)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        (tmp / "table.txt").write_text(cmp.table() + "\n")
+        write_json(str(tmp / "comparison.json"), cmp.to_dict())
+        curves = comparison_curves(cmp)
+        for name, fig in (("piston_side_by_side.png", pf.plot_compare_side_by_side(curves)),
+                          ("bode_overlay.png", pf.plot_compare_overlay(curves))):
+            save(fig, tmp / name)
+            plt.close(fig)
+        if out.exists():
+            old = out.with_name(f".{out.name}.old")
+            if old.exists():
+                shutil.rmtree(old)
+            os.replace(out, old)
+            os.replace(tmp, out)
+            shutil.rmtree(old)
+        else:
+            os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    if json_path:
+        write_json(json_path, cmp.to_dict())
+    return out
+
+
 def cmd_compare(args) -> int:
-    from taos.identify.compare import compare_models, write_comparison
+    from taos.identify.compare import compare_models
     from taos.model import load_model
 
     ma = load_model(args.model_a)

@@ -1,5 +1,5 @@
 """``taos lco``: describing-function limit-cycle prediction of the flight-control loop and its
-time-domain confirmation (DESIGN.md "CLI"; seed paper sections 3.1-3.2)."""
+time-domain confirmation (seed paper sections 3.1-3.2)."""
 
 from __future__ import annotations
 
@@ -36,13 +36,13 @@ def cmd_lco(args) -> int:
     d = rep.to_dict()
     d["avionics"] = args.avionics
     if args.plot or args.plot_df or args.plot_time:
-        from taos.plotting import save
+        from taos.plotting import describing, nichols, save
         if args.plot:
-            save(rep.plot(), args.plot)
+            save(nichols.plot_lco_nichols(rep.prediction), args.plot)
         if args.plot_df:
-            save(rep.prediction.df.plot(), args.plot_df)
+            save(describing.plot_df_map(rep.prediction.df), args.plot_df)
         if args.plot_time and rep.history is not None:
-            save(rep.history.plot(), args.plot_time)
+            save(nichols.plot_flight_histories([rep.history]), args.plot_time)
     if args.df_out:
         rep.prediction.df.to_hdf5(args.df_out)
     if args.json:

@@ -38,6 +38,7 @@ import h5py
 import numpy as np
 
 from taos.errors import InputError
+from taos.linear import gain_db, notch_hz
 from taos.profiles import Sequence, SineDwell, TwoAxis, load_profile
 from taos.shipped import models_dir
 
@@ -109,7 +110,7 @@ def _h(x) -> str:
 
 
 def _db(h) -> float:
-    return 20 * math.log10(max(abs(h), 1e-300))
+    return float(gain_db(h))
 
 
 def _deg(h) -> float:
@@ -218,12 +219,12 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
         step("linear response")
         f_lin = np.logspace(-1, math.log10(30.0), 240)
         linear = {ax: lin_fr(f_lin, ax) for ax in AXES}
-        if engine == "taos":  # the notch of the 3-D response, refined on a fine grid around the coarse one
+        if engine == "taos":  # the notch of the 3-D response, refined between the coarse grid's neighbours
             notch = {}
             for ax in AXES:
                 k = int(np.argmin(np.abs(linear[ax].piston)))
-                ff = np.linspace(f_lin[max(k - 1, 0)], f_lin[min(k + 1, f_lin.size - 1)], 201)
-                notch[ax] = float(ff[np.argmin(np.abs(lin_fr(ff, ax).piston))])
+                notch[ax] = notch_hz(lambda f, ax=ax: np.abs(lin_fr(f, ax).piston), f_lin[max(k - 1, 0)],
+                                     f_lin[min(k + 1, f_lin.size - 1)], n_grid=21, xatol=1e-6)
         else:
             notch = {ax: load_resonance_from_notch(model, ax) for ax in AXES}
         wl = {ax: model.load_resonance_hz(ax) for ax in AXES}
@@ -322,7 +323,7 @@ def _summary(model, info, th, notch, wl, dwell, run, ppath) -> dict:
         "avionics_lsb_deg": info["avionics_lsb_deg"],
         "run": {"duration_s": float(th.t_s[-1]), "samples": int(th.t_s.size),
                 "peak_engine_deg": {ax: float(np.degrees(np.max(np.abs(th.engine_rad[k])))) for k, ax in enumerate(th.axes)},
-                "peak_piston_in": {ax: float(np.max(np.abs(th.piston_m[k])) / 0.0254) for k, ax in enumerate(th.axes)},
+                "peak_piston_in": {ax: from_si(float(np.max(np.abs(th.piston_m[k]))), "m", "in") for k, ax in enumerate(th.axes)},
                 "peak_friction_torque_Nm": {ax: float(np.max(np.abs(th.friction_torque_Nm[k]))) for k, ax in enumerate(th.axes)},
                 "peak_load_force_N": {ax: float(np.max(np.abs(th.load_force_N[k]))) for k, ax in enumerate(th.axes)}},
         "sine_dwell": dw, "run_dwell": rn,

@@ -1,6 +1,6 @@
 """Parametric ball-and-socket gimbal bearing, its two halves, two load conditions.
 
-Public facts (DESIGN.md; NASA SSME reference data): the RS-25 gimbal bearing is a
+Public facts (NASA SSME reference data): the RS-25 gimbal bearing is a
 ball-and-socket universal joint about 0.29 m high and 0.36 m in diameter (11.4 in x 14 in),
 titanium, 48 kg (105 lb), bolted above to the core-stage thrust structure and below to the
 engine's main injector/dome. Everything else here is notional and listed in

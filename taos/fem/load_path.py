@@ -31,9 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solve
 
+from ..units import to_si
 from .elasticity import rigid_transform
 
-LBF_PER_IN = 175.126835  # N/m per lbf/in (4.4482216152605 N / 0.0254 m)
+LBF_PER_IN = to_si("1 lbf/in", "stiffness", source="taos.fem", field="LBF_PER_IN")  # N/m per lbf/in
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.freqresp import sine_dwell_grid
-from taos.linear import StateSpace
+from taos.linear import StateSpace, gain_db
 from taos.model import Structure, TvcModel
 from taos.results import atomic_write, package_version, write_json, write_provenance
 from taos.simplex import simplex_state_space
@@ -42,7 +42,7 @@ def _unwrap_map(h: np.ndarray) -> np.ndarray:
     """Phase [deg] of a (n_amp, n_freq) map, unwrapped along frequency from the lowest, and
     each amplitude row shifted by whole turns to lie within 180 deg of its neighbour at the
     lowest frequency (stuck rows borrow the nearest moving row's phase)."""
-    g = 20 * np.log10(np.maximum(np.abs(h), 1e-300))
+    g = gain_db(h)
     ph = np.degrees(np.unwrap(np.angle(h), axis=1))
     moving = (g > STUCK_DB).all(axis=1)
     if moving.any():
@@ -75,7 +75,7 @@ class DescribingFunctionMap:
     # -- views ------------------------------------------------------------------------------
     def gain_db(self, which: str = "engine") -> np.ndarray:
         """20 log10 |N| [dB], floored at :data:`STUCK_DB`."""
-        return np.maximum(20 * np.log10(np.maximum(np.abs(getattr(self, which)), 1e-300)), STUCK_DB)
+        return np.maximum(gain_db(getattr(self, which)), STUCK_DB)
 
     def phase_deg(self, which: str = "engine") -> np.ndarray:
         """Unwrapped phase [deg] (see :func:`_unwrap_map`)."""
@@ -139,11 +139,6 @@ class DescribingFunctionMap:
                        piston=h5["piston"][()], friction_model=str(h5.attrs["friction_model"]),
                        axis=str(h5.attrs["axis"]), load_stiffness_N_per_m=float(h5.attrs["load_stiffness_N_per_m"]),
                        provenance=json.loads(h5.attrs["provenance"]))
-
-    def plot(self, **kwargs):
-        """Gain and phase families, one curve per amplitude (:mod:`taos.plotting.describing`)."""
-        from taos.plotting import describing
-        return describing.plot_df_map(self, **kwargs)
 
 
 def describing_function_map(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,

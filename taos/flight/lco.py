@@ -32,6 +32,7 @@ import scipy.optimize
 from taos.avionics import Avionics
 from taos.flight.describing import DescribingFunctionMap, describing_function_map
 from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
+from taos.linear import gain_db
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
 from taos.simulate import DEFAULT_DT_S, integrate_plant
@@ -116,12 +117,6 @@ class LcoPrediction:
                 "margin_db": self.margin_db if math.isfinite(self.margin_db) else None,
                 "cycles": [x.to_dict() for x in self.cycles]}
 
-    def plot(self, **kwargs):
-        """Nichols chart of L0 N at several amplitudes with the critical point and the predicted
-        cycle (:mod:`taos.plotting.nichols`, the paper's figure 6)."""
-        from taos.plotting import nichols
-        return nichols.plot_lco_nichols(self, **kwargs)
-
 
 def _wrap180(x):
     return (np.asarray(x) + 180.0) % 360.0 - 180.0
@@ -135,7 +130,7 @@ def predict_lco(flight: FlightModel, df: DescribingFunctionMap, axis: str | None
     lf = np.linspace(np.log(df.freq_hz[0]), np.log(df.freq_hz[-1]), n_grid)
     f = np.exp(lf)
     L0 = loop_freqresp(flight, f, axis)
-    l0db = 20 * np.log10(np.abs(L0))
+    l0db = gain_db(L0)
     l0ph = np.degrees(np.unwrap(np.angle(L0)))
 
     def nichols(lA, lF):
@@ -143,11 +138,11 @@ def predict_lco(flight: FlightModel, df: DescribingFunctionMap, axis: str | None
         ff = math.exp(lF)
         L = complex(loop_freqresp(flight, [ff], axis)[0])
         h = L * df(math.exp(lA), ff)
-        return np.array([20 * math.log10(max(abs(h), 1e-300)), float(_wrap180(math.degrees(math.atan2(h.imag, h.real)) + 180.0))])
+        return np.array([float(gain_db(h)), float(_wrap180(math.degrees(math.atan2(h.imag, h.real)) + 180.0))])
 
     A, F = np.meshgrid(la, lf, indexing="ij")
     N = df(np.exp(A), np.exp(F))
-    G = l0db[None, :] + 20 * np.log10(np.maximum(np.abs(N), 1e-300))
+    G = l0db[None, :] + gain_db(N)
     E = _wrap180(l0ph[None, :] + np.degrees(np.angle(N)) + 180.0)
     found: list[tuple[float, float]] = []
     for i in range(n_grid - 1):
@@ -226,11 +221,6 @@ class FlightHistory:
                 h5.attrs["load_stiffness_N_per_m"] = self.load_stiffness_N_per_m
                 write_provenance(h5, {"provenance": self.provenance})
         atomic_write(path, write)
-
-    def plot(self, **kwargs):
-        """Time histories (:mod:`taos.plotting.nichols`)."""
-        from taos.plotting import nichols
-        return nichols.plot_flight_histories([self], **kwargs)
 
 
 def simulate_flight(flight: FlightModel, model: TvcModel, duration_s: float = 300.0, *,
@@ -359,9 +349,6 @@ class LcoReport:
                            "package_version": package_version()},
         })
         return d
-
-    def plot(self, **kwargs):
-        return self.prediction.plot(**kwargs)
 
 
 def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None,

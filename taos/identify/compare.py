@@ -16,11 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import os
-import shutil
-import tempfile
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -78,17 +74,6 @@ class Comparison:
             if r.name == name:
                 return r.value_a, r.value_b
         raise KeyError(name)
-
-    def plot_side_by_side(self, **kw):
-        """Figure 2 of the paper: command -> piston gain and phase, A left, B right."""
-        from taos.plotting import fit as pf
-        return pf.plot_compare_side_by_side(self, **kw)
-
-    def plot_overlay(self, **kw):
-        """Figure 11 style: both conditions' piston and engine Bode curves overlaid, with data."""
-        from taos.plotting import fit as pf
-        return pf.plot_compare_overlay(self, **kw)
-
 
 def _num(v: float):
     return float(v) if math.isfinite(v) else None
@@ -152,41 +137,6 @@ def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
     return Comparison(tuple(labels), (model_a, model_b), tuple(rows), (tuple(data_a), tuple(data_b)))
 
 
-def write_comparison(cmp: Comparison, out_dir, json_path: str | None = None) -> Path:
-    """Write ``table.txt``, ``comparison.json``, ``piston_side_by_side.png`` (paper fig. 2) and
-    ``bode_overlay.png`` (fig. 11 style) into ``out_dir``: built in a temporary folder beside
-    it and renamed into place, so a failure leaves nothing half-written."""
-    from taos.plotting import save
-    from taos.results import write_json
-
-    out = Path(out_dir)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
-        (tmp / "table.txt").write_text(cmp.table() + "\n")
-        write_json(str(tmp / "comparison.json"), cmp.to_dict())
-        import matplotlib.pyplot as plt
-        for name, fig in (("piston_side_by_side.png", cmp.plot_side_by_side()),
-                          ("bode_overlay.png", cmp.plot_overlay())):
-            save(fig, tmp / name)
-            plt.close(fig)
-        if out.exists():
-            old = out.with_name(f".{out.name}.old")
-            if old.exists():
-                shutil.rmtree(old)
-            os.replace(out, old)
-            os.replace(tmp, out)
-            shutil.rmtree(old)
-        else:
-            os.replace(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if json_path:
-        write_json(json_path, cmp.to_dict())
-    return out
-
-
 def model_curves(model: TvcModel, axis: str, amplitudes_rad, f_lo: float = 0.3, f_hi: float = 20.0, n: int = 24):
     """(dense linear FrequencyResponse, [sine-dwell FrequencyResponse per amplitude]) for plots."""
     from taos.freqresp import linear_freqresp, sine_dwell_freqresp
@@ -197,3 +147,33 @@ def model_curves(model: TvcModel, axis: str, amplitudes_rad, f_lo: float = 0.3, 
     amps = sorted({float(a) for a in np.round(np.asarray(amplitudes_rad, float), 7) if math.isfinite(a) and a > 0})
     dwell = [sine_dwell_freqresp(model, fd, a, axis) for a in amps]
     return lin, dwell
+
+
+@dataclass(frozen=True, eq=False)
+class ConditionCurves:
+    """What the comparison plots draw for one condition and axis: the model's exact linear
+    response and its sine dwells at the data's command amplitudes (FrequencyResponse objects),
+    the piston notch [Hz] (:func:`taos.simplex.load_resonance_from_notch`), the measured
+    responses on this axis, and the moment arm R [m] and load stiffness K_L [N/m]."""
+
+    label: str
+    axis: str
+    linear: object
+    dwell: tuple
+    notch_hz: float
+    data: tuple
+    moment_arm_m: float
+    load_stiffness_N_per_m: float
+
+
+def comparison_curves(cmp: Comparison, axis: str = "pitch") -> tuple[ConditionCurves, ConditionCurves]:
+    """The model curves of both conditions of ``cmp`` on ``axis`` (computed here, drawn by
+    :mod:`taos.plotting.fit`)."""
+    out = []
+    notches = cmp.value(f"notch_frequency_{axis}_hz")
+    for label, model, data, notch in zip(cmp.labels, cmp.models, cmp.data, notches):
+        on_axis = tuple(d for d in data if d.axis == axis)
+        lin, dwell = model_curves(model, axis, [a for d in on_axis for a in d.amplitude_rad])
+        out.append(ConditionCurves(label, axis, lin, tuple(dwell), notch, on_axis,
+                                   model.actuator.moment_arm_m, model.structure.load_stiffness_N_per_m))
+    return out[0], out[1]

@@ -36,6 +36,8 @@ import numpy as np
 
 from taos.identify.data import TestData
 from taos.errors import InputError
+from taos.linear import gain_db
+from taos.units import from_si
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,11 +88,11 @@ class MeasuredResponse:
 
     def to_dict(self) -> dict:
         def gp(h):
-            return None if h is None else {"gain_db": (20 * np.log10(np.abs(h))).tolist(),
+            return None if h is None else {"gain_db": gain_db(h).tolist(),
                                            "phase_deg": np.degrees(np.angle(h)).tolist()}
         return {"axis": self.axis, "method": self.method, "source": self.source, "condition": self.condition,
                 "freq_hz": self.freq_hz.tolist(), "amplitude_deg": np.degrees(self.amplitude_rad).tolist(),
-                "piston_in_per_deg": gp(self.piston_m_per_rad / 0.0254 * math.pi / 180),
+                "piston_in_per_deg": gp(self.piston_m_per_rad * from_si(1.0, "m/rad", "in/deg")),
                 "engine": gp(self.engine), "coherence_piston": self.coherence_piston.tolist(),
                 "coherence_engine": None if self.coherence_engine is None else self.coherence_engine.tolist(),
                 "engine_dc_observable": self.engine_dc_observable}

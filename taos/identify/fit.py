@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -128,13 +127,20 @@ class FitResult:
                      f"{self.n_residuals} residuals, {self.corrections} defect corrections, {self.wall_s:.2f} s")
         return "\n".join(lines)
 
-    def plot(self, **kwargs):
-        """Data vs fitted model and normalised residuals (:mod:`taos.plotting.fit`)."""
-        from taos.plotting import fit as pf
-        return pf.plot_fit(self, **kwargs)
-
     def write_model(self, path, data_label: str = "") -> None:
         write_fitted_model(self, path, data_label)
+
+
+def fitted_linear_curves(result: FitResult, n: int = 300) -> dict:
+    """axis -> exact linear FrequencyResponse of the fitted model on a log grid of ``n``
+    points spanning the data's frequencies (x 1/1.5 .. x 1.5) [Hz]: the grey lines that
+    :func:`taos.plotting.fit.plot_fit` draws behind the data."""
+    from taos.freqresp import linear_freqresp
+
+    fmin = min(float(np.min(d.freq_hz)) for d in result.data)
+    fmax = max(float(np.max(d.freq_hz)) for d in result.data)
+    f = np.geomspace(fmin / 1.5, fmax * 1.5, n)
+    return {ax: linear_freqresp(result.model, f, ax) for ax in sorted({d.axis for d in result.data})}
 
 
 def _si_unit(kind: str) -> str:
@@ -331,7 +337,7 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
     values = s * prob.p_ref
     mfit = _apply(m0, free, values)
     gx, ge = prob.surrogate(s, u)
-    if correct:
+    if ncorr:  # (max_corrections=0: no correction factors, the surrogate's own response)
         gx, ge = gx * cx, ge * ce
     fitted_p, fitted_e, pos = [], [], 0
     for dset in data:
@@ -353,68 +359,54 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
 
 
 # -- writing the fitted model ------------------------------------------------------------------
-def _fmt_value(p, v_si: float) -> str:
+def _toml_value(p, v_si: float):
+    """A fitted value as written to the model file: a string with the parameter's unit, or a
+    plain number for a dimensionless parameter (6 significant digits)."""
     if not p.unit:
-        return f"{v_si:.6g}"
-    return f'"{from_si(v_si, _si_unit(p.kind), p.unit):.6g} {p.unit}"'
+        return float(f"{v_si:.6g}")
+    return f"{from_si(v_si, _si_unit(p.kind), p.unit):.6g} {p.unit}"
 
 
 def fitted_model_text(result: FitResult, data_label: str = "") -> str:
-    """The model file of ``result.initial`` with the fitted values replaced and commented."""
+    """The model file of ``result.initial`` with the fitted values replaced and commented
+    (edited with tomlkit: every other line and comment stays as it was)."""
+    import tomlkit
+
+    from taos.results import toml_set
+
     src = result.initial.source
     try:
-        lines = Path(src).read_text().splitlines()
+        doc = tomlkit.parse(Path(src).read_text())
     except OSError as e:
         raise InputError(src, "(file)", "the model file the fit started from", got=e.strerror) from None
     stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     label = data_label or ", ".join(sorted({d.source for d in result.data}))
-    todo = {}
+    todo = {}   # (section, key) -> (value, comment)
     for i, n in enumerate(result.names):
         p = PARAMETERS[n]
         se = abs(result.eng(i, result.values[i] + result.std_errors[i]) - result.eng(i))
         note = f"# fitted by taos fit ({label}, {stamp}): {result.eng(i):.6g} +- {se:.3g} {p.unit or ''} (1-sigma)"
         if n == "avionics_gain":
             g = result.model.avionics.gain_table
-            todo[(p.section, p.toml_key)] = (f"crossover_gain = [{', '.join(f'{x:.6g}' for x in g)}]  "
-                                             + note.replace("fitted by", "scaled by the gain fitted by"))
+            todo[(p.section, p.toml_key)] = ([float(f"{x:.6g}") for x in g],
+                                             note.replace("fitted by", "scaled by the gain fitted by"))
             if len(result.initial.avionics.gain_table) == 0:
-                todo[(p.section, "crossover_command")] = 'crossover_command = ["0 deg"]  # added by taos fit'
+                todo[(p.section, "crossover_command")] = (["0 deg"], "# added by taos fit")
         else:
-            todo[(p.section, p.toml_key)] = f"{p.toml_key} = {_fmt_value(p, result.values[i])}  {note}"
+            todo[(p.section, p.toml_key)] = (_toml_value(p, result.values[i]), note)
     file_law = str(result.initial.friction_table.get("model", result.initial.friction.name))
     if result.initial.friction.name != file_law:
-        todo[("friction", "model")] = (f'model = "{result.initial.friction.name}"  # law used by the fit '
-                                       f'(--friction; the file had "{file_law}")')
-    out, section, done = [], "", set()
-    header = re.compile(r"^\s*\[([A-Za-z0-9_.]+)\]\s*(#.*)?$")
-
-    def flush(sec):
-        for (s, key), line in todo.items():
-            if s == sec and (s, key) not in done:
-                out.append(line)
-                done.add((s, key))
-
-    for line in lines:
-        mh = header.match(line)
-        if mh:
-            flush(section)
-            section = mh.group(1)
-        else:
-            mk = re.match(r"^\s*([A-Za-z0-9_]+)\s*=", line)
-            if mk and (section, mk.group(1)) in todo:
-                out.append(todo[(section, mk.group(1))])
-                done.add((section, mk.group(1)))
-                continue
-            if mk and section == "" and mk.group(1) == "name":
-                out.append(f'name = "{result.initial.name} (fitted)"')
-                continue
-        out.append(line)
-    flush(section)
-    missing = [k for k in todo if k not in done]
-    if missing:
-        raise InputError(src, f"[{missing[0][0]}]", "the section of a fitted value", got="no such section")
-    head = [f"# Model fitted by taos fit on {stamp} to {label}; values marked '# fitted' were estimated."]
-    return "\n".join(head + out) + "\n"
+        todo[("friction", "model")] = (result.initial.friction.name,
+                                       f'# law used by the fit (--friction; the file had "{file_law}")')
+    if "name" in doc:
+        toml_set(doc, "", "name", f"{result.initial.name} (fitted)")
+    for (section, key), (value, comment) in todo.items():
+        try:
+            toml_set(doc, section, key, value, comment)
+        except KeyError:
+            raise InputError(src, f"[{section}]", "the section of a fitted value", got="no such section") from None
+    head = f"# Model fitted by taos fit on {stamp} to {label}; values marked '# fitted' were estimated.\n"
+    return head + tomlkit.dumps(doc)
 
 
 def write_fitted_model(result: FitResult, path, data_label: str = "") -> None:

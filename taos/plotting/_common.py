@@ -9,9 +9,10 @@ import matplotlib
 matplotlib.use("Agg")
 
 from ..results import atomic_write  # noqa: E402
+from ..units import to_si  # noqa: E402
 
 #: selectable length units for piston positions: name -> metres per unit
-LENGTH_UNITS = {"in": 0.0254, "mm": 1e-3, "m": 1.0}
+LENGTH_UNITS = {u: to_si(f"1 {u}", "length", source="taos.plotting", field="LENGTH_UNITS") for u in ("in", "mm", "m")}
 
 
 def save(fig, path, dpi: int = 120) -> None:

@@ -22,6 +22,7 @@ import numpy as np
 
 from ._common import LENGTH_UNITS, finish_bode_axes  # (importing _common also sets the Agg backend)
 from ..errors import InputError
+from ..linear import gain_db, sampled_notch_hz
 
 import matplotlib.pyplot as plt  # noqa: E402
 
@@ -40,10 +41,6 @@ def piston_scale(length_unit: str, moment_arm_m: float | None) -> tuple[float, s
     return moment_arm_m * math.pi / 180.0 / unit_m, f"x_p / θ_c [{length_unit}/deg]"
 
 
-def gain_db(h) -> np.ndarray:
-    return 20.0 * np.log10(np.maximum(np.abs(h), 1e-300))
-
-
 def phase_deg(h, freq_hz=None, ref=None) -> np.ndarray:
     """Unwrapped phase [deg]; with ``ref`` = (freq_hz, phase_deg) of a dense reference curve,
     each point is shifted by the multiple of 360 deg that brings it nearest the reference
@@ -59,23 +56,6 @@ def response_label(fr) -> str:
     if fr.amplitude_rad is None:
         return "linear"
     return f"{math.degrees(fr.amplitude_rad):.3g} deg ({fr.friction_model})"
-
-
-def notch_frequency_hz(fr) -> float:
-    """Frequency of the deepest interior local minimum of |piston| on the response's grid,
-    refined by a parabola in log f through the three points around it [Hz]; NaN if the gain
-    has no interior minimum (no notch in the band)."""
-    f = np.asarray(fr.freq_hz, float)
-    g = gain_db(fr.piston)
-    if f.size < 3:
-        return float("nan")
-    inner = np.flatnonzero((g[1:-1] < g[:-2]) & (g[1:-1] < g[2:])) + 1
-    if inner.size == 0:
-        return float("nan")
-    k = int(inner[np.argmin(g[inner])])
-    x = np.log10(f[k - 1:k + 2])
-    a, b, _ = np.polyfit(x, g[k - 1:k + 2], 2)
-    return float(10 ** np.clip(-b / (2 * a), x[0], x[2])) if a > 0 else float(f[k])
 
 
 def reference_response(responses):
@@ -147,7 +127,7 @@ def plot_freqresp(responses, resonance_hz: float | None = None, length_unit: str
         Moment arm R [m]; turns the piston gain into length_unit/deg.
     notch_hz : float, optional
         Notch frequency [Hz] to mark on the piston gain. None: located on the densest
-        response's grid (:func:`notch_frequency_hz`); False: no marker.
+        response's grid (:func:`taos.linear.sampled_notch_hz`); False: no marker.
     title : str, optional
     data : list of FrequencyResponse, optional
         Measured points drawn as open circles (gid "data"), labelled ``data_label``.
@@ -178,7 +158,7 @@ def plot_freqresp(responses, resonance_hz: float | None = None, length_unit: str
     if resonance_hz is not None:
         mark_resonance(ax, resonance_hz)
     if notch_hz is not False:
-        nf = notch_frequency_hz(ref) if notch_hz is None else float(notch_hz)
+        nf = sampled_notch_hz(ref.freq_hz, ref.piston) if notch_hz is None else float(notch_hz)
         if math.isfinite(nf):
             mark_notch(ax, ref, nf, scale)
     ax[0, 0].legend(fontsize=8, loc="best")

@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from . import bode
+from ..linear import sampled_notch_hz
 from .timehist import units
 
 import matplotlib.pyplot as plt  # noqa: E402
@@ -57,7 +58,7 @@ def plot_compare_freqresp(sets, *, resonance_hz=None, notch_hz=None, data=None, 
         if resonance_hz and label in resonance_hz:
             bode.mark_resonance(ax, resonance_hz[label], color=c, label_prefix=f"{label}: ")
         if rs:
-            nf = notch_hz[label] if notch_hz and label in notch_hz else bode.notch_frequency_hz(ref)
+            nf = notch_hz[label] if notch_hz and label in notch_hz else sampled_notch_hz(ref.freq_hz, ref.piston)
             if math.isfinite(nf):
                 bode.mark_notch(ax, ref, nf, scale, color=c, label_prefix=f"{label}: ")
         if data and label in data:

@@ -7,6 +7,8 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..units import from_si
+
 
 def plot_df_map(df, which: str = "engine", title: str | None = None, ax=None):
     """Gain [dB] and phase [deg] of ``df`` (a :class:`taos.flight.describing.DescribingFunctionMap`)
@@ -33,23 +35,7 @@ def plot_df_map(df, which: str = "engine", title: str | None = None, ax=None):
         a.grid(True, which="both", alpha=0.3)
     ag.legend(fontsize=7, ncol=2, title="command amplitude", title_fontsize=7)
     ag.set_title(title or f"TVC describing function N(A, w): {df.friction_model}, "
-                 f"K_L = {df.load_stiffness_N_per_m / 175.1268:.0f} lbf/in")
+                 f"K_L = {from_si(df.load_stiffness_N_per_m, 'N/m', 'lbf/in'):.0f} lbf/in")
     fig.tight_layout()
     return fig
 
-
-def plot_df_low_frequency(maps, freq_hz: float, ax=None):
-    """Amplitude dependence at one frequency for several maps (friction laws): gain [dB]
-    against command amplitude [deg]."""
-    fig, ax = (plt.subplots(figsize=(6, 4)) if ax is None else (ax.figure, ax))
-    for m in maps:
-        h = m(m.amplitude_rad, np.full(m.amplitude_rad.shape, freq_hz))
-        ax.semilogx(np.degrees(m.amplitude_rad), 20 * np.log10(np.maximum(np.abs(h), 1e-6)), "o-", ms=3,
-                    label=m.friction_model)
-    ax.set_xlabel("command amplitude [deg]")
-    ax.set_ylabel(f"engine gain at {freq_hz:g} Hz [dB]")
-    ax.set_ylim(max(ax.get_ylim()[0], -30), 1)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    return fig

@@ -18,38 +18,32 @@ import math
 import numpy as np
 
 from ._common import finish_bode_axes  # (importing _common also sets the Agg backend)
+from .bode import phase_deg
+from ..linear import gain_db as _db
+from ..units import from_si
 
 import matplotlib.pyplot as plt  # noqa: E402
 
 COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:purple")
-IN_PER_DEG = math.pi / 180 / 0.0254   # (m/rad) -> (in/deg)
+IN_PER_DEG = from_si(1.0, "m/rad", "in/deg")   # (m/rad) -> (in/deg)
 
 
-def _db(h):
-    return 20 * np.log10(np.maximum(np.abs(h), 1e-300))
+def _ph(h, ref_f, ref_ph, f):
+    """Phase [deg] of sparse points, each on the 360-deg branch nearest the dense reference."""
+    return phase_deg(h, f, (ref_f, ref_ph))
 
 
-def _ph(h, ref_f=None, ref_ph=None, f=None):
-    ph = np.degrees(np.angle(h))
-    if ref_f is not None and f is not None and np.size(f):
-        r = np.interp(np.log10(f), np.log10(ref_f), ref_ph)
-        ph = ph - 360 * np.round((ph - r) / 360)
-    return ph
-
-
-def plot_fit(result, title: str | None = None):
-    """Data vs fitted model and residuals of a :class:`taos.identify.fit.FitResult`."""
-    from ..freqresp import linear_freqresp
-
+def plot_fit(result, linear: dict, title: str | None = None):
+    """Data vs fitted model and residuals of a :class:`taos.identify.fit.FitResult`;
+    ``linear`` maps axis -> the fitted model's linear FrequencyResponse
+    (:func:`taos.identify.fit.fitted_linear_curves`)."""
     has_e = any(e is not None for e in result.fitted_engine)
     ncol = 2 if has_e else 1
     fig, ax = plt.subplots(3, ncol, figsize=(6 * ncol + 1, 9), sharex=True, squeeze=False, constrained_layout=True)
     R = result.model.actuator.moment_arm_m
-    fmin = min(float(np.min(d.freq_hz)) for d in result.data)
-    fmax = max(float(np.max(d.freq_hz)) for d in result.data)
-    fl = np.geomspace(fmin / 1.5, fmax * 1.5, 300)
-    for k, ax_name in enumerate(sorted({d.axis for d in result.data})):
-        lin = linear_freqresp(result.model, fl, ax_name)
+    for k, ax_name in enumerate(sorted(linear)):
+        lin = linear[ax_name]
+        fl = lin.freq_hz
         lp = np.degrees(np.unwrap(np.angle(lin.piston)))
         le = np.degrees(np.unwrap(np.angle(lin.engine)))
         ls = "-" if k == 0 else "--"
@@ -99,32 +93,19 @@ def plot_fit(result, title: str | None = None):
         a.set_xlabel("frequency [Hz]")
     ax[0, 0].legend(fontsize=7)
     txt = "  ".join(f"{n} = {result.eng(i):.5g} ± {abs(result.eng(i, result.values[i] + result.std_errors[i]) - result.eng(i)):.2g}"
-                    f" {PARAM_UNIT(n)}" for i, n in enumerate(result.names))
+                    f" {unit}" for i, (n, unit) in enumerate(zip(result.names, result.units())))
     fig.suptitle(title or f"fit: {txt}", fontsize=10)
     return fig
 
 
-def PARAM_UNIT(name: str) -> str:  # noqa: N802
-    from taos.identify.surrogate import PARAMETERS
-    return PARAMETERS[name].unit
-
-
-def _curves(cmp, k, axis):
-    from taos.identify.compare import model_curves
-    amps = [a for d in cmp.data[k] if d.axis == axis for a in d.amplitude_rad]
-    return model_curves(cmp.models[k], axis, amps)
-
-
-def plot_compare_side_by_side(cmp, axis: str = "pitch"):
-    """Command -> piston gain and phase (in/deg), condition A left, B right (paper fig. 2)."""
-    from ..simplex import load_resonance_from_notch
-    from ..units import from_si
-
+def plot_compare_side_by_side(curves):
+    """Command -> piston gain and phase (in/deg), condition A left, B right (paper fig. 2);
+    ``curves`` from :func:`taos.identify.compare.comparison_curves`."""
     fig, ax = plt.subplots(2, 2, figsize=(12, 7), sharex=True, constrained_layout=True)
-    for k in range(2):
-        m = cmp.models[k]
-        R = m.actuator.moment_arm_m
-        lin, dwell = _curves(cmp, k, axis)
+    for k, cc in enumerate(curves):
+        axis = cc.axis
+        R = cc.moment_arm_m
+        lin, dwell = cc.linear, cc.dwell
         lp = np.degrees(np.unwrap(np.angle(lin.piston)))
         ax[0, k].plot(lin.freq_hz, _db(lin.piston * R * IN_PER_DEG), "k-", gid="linear", label="model, linear")
         ax[1, k].plot(lin.freq_hz, lp, "k-", gid="linear")
@@ -133,18 +114,16 @@ def plot_compare_side_by_side(cmp, axis: str = "pitch"):
             lab = f"model, {math.degrees(fr.amplitude_rad):.2g} deg sine dwell"
             ax[0, k].plot(fr.freq_hz, _db(fr.piston * R * IN_PER_DEG), "-", color=c, gid="model", label=lab)
             ax[1, k].plot(fr.freq_hz, _ph(fr.piston, lin.freq_hz, lp, fr.freq_hz), "-", color=c, gid="model")
-        for d in cmp.data[k]:
-            if d.axis != axis:
-                continue
+        for d in cc.data:
             ax[0, k].plot(d.freq_hz, _db(d.piston_m_per_rad * IN_PER_DEG), "o", mfc="none", color="tab:red",
                           gid="data", label=f"test data ({d.method})")
             ax[1, k].plot(d.freq_hz, _ph(d.piston_m_per_rad, lin.freq_hz, lp, d.freq_hz), "o", mfc="none",
                           color="tab:red", gid="data")
-        nf = load_resonance_from_notch(m, axis)
+        nf = cc.notch_hz
         y = float(np.interp(np.log10(nf), np.log10(lin.freq_hz), _db(lin.piston * R * IN_PER_DEG)))
         ax[0, k].plot([nf], [y], "v", color="k", ms=9, gid="notch", label=f"notch {nf:.2f} Hz")
-        ax[0, k].set_title(f"{cmp.labels[k]}: command → piston ({axis})\nK_L = "
-                           f"{from_si(m.structure.load_stiffness_N_per_m, 'N/m', 'lbf/in'):.4g} lbf/in", fontsize=10)
+        ax[0, k].set_title(f"{cc.label}: command → piston ({axis})\nK_L = "
+                           f"{from_si(cc.load_stiffness_N_per_m, 'N/m', 'lbf/in'):.4g} lbf/in", fontsize=10)
         ax[0, k].legend(fontsize=7)
     ax[0, 0].set_ylabel("gain [dB re 1 in/deg]")
     ax[1, 0].set_ylabel("phase [deg]")
@@ -152,19 +131,18 @@ def plot_compare_side_by_side(cmp, axis: str = "pitch"):
     return fig
 
 
-def plot_compare_overlay(cmp, axis: str = "pitch"):
-    """Both conditions on one Bode layout: piston (in/deg) and engine, gain and phase."""
-    from ..simplex import load_resonance_from_notch
-
+def plot_compare_overlay(curves):
+    """Both conditions on one Bode layout: piston (in/deg) and engine, gain and phase;
+    ``curves`` from :func:`taos.identify.compare.comparison_curves`."""
     fig, ax = plt.subplots(2, 2, figsize=(12, 7), sharex=True, constrained_layout=True)
-    for k in range(2):
+    for k, cc in enumerate(curves):
         c = COLOURS[k]
-        m = cmp.models[k]
-        R = m.actuator.moment_arm_m
-        lin, dwell = _curves(cmp, k, axis)
+        axis = cc.axis
+        R = cc.moment_arm_m
+        lin, dwell = cc.linear, cc.dwell
         lp = np.degrees(np.unwrap(np.angle(lin.piston)))
         le = np.degrees(np.unwrap(np.angle(lin.engine)))
-        lab = cmp.labels[k]
+        lab = cc.label
         ax[0, 0].plot(lin.freq_hz, _db(lin.piston * R * IN_PER_DEG), "-", color=c, gid="linear", label=f"{lab}: linear")
         ax[1, 0].plot(lin.freq_hz, lp, "-", color=c, gid="linear")
         ax[0, 1].plot(lin.freq_hz, _db(lin.engine), "-", color=c, gid="linear", label=f"{lab}: linear")
@@ -175,9 +153,7 @@ def plot_compare_overlay(cmp, axis: str = "pitch"):
             ax[1, 0].plot(fr.freq_hz, _ph(fr.piston, lin.freq_hz, lp, fr.freq_hz), "--", color=c, gid="model")
             ax[0, 1].plot(fr.freq_hz, _db(fr.engine), "--", color=c, gid="model")
             ax[1, 1].plot(fr.freq_hz, _ph(fr.engine, lin.freq_hz, le, fr.freq_hz), "--", color=c, gid="model")
-        for d in cmp.data[k]:
-            if d.axis != axis:
-                continue
+        for d in cc.data:
             ax[0, 0].plot(d.freq_hz, _db(d.piston_m_per_rad * IN_PER_DEG), "o", mfc="none", color=c, gid="data",
                           label=f"{lab}: data")
             ax[1, 0].plot(d.freq_hz, _ph(d.piston_m_per_rad, lin.freq_hz, lp, d.freq_hz), "o", mfc="none", color=c,
@@ -186,7 +162,7 @@ def plot_compare_overlay(cmp, axis: str = "pitch"):
                 ax[0, 1].plot(d.freq_hz, _db(d.engine), "o", mfc="none", color=c, gid="data")
                 ax[1, 1].plot(d.freq_hz, _ph(d.engine, lin.freq_hz, le, d.freq_hz), "o", mfc="none", color=c,
                               gid="data")
-        nf = load_resonance_from_notch(m, axis)
+        nf = cc.notch_hz
         ax[0, 0].axvline(nf, color=c, ls=":", lw=1, gid="notch", label=f"{lab}: notch {nf:.2f} Hz")
     ax[0, 0].set_title(f"command → piston ({axis})")
     ax[0, 1].set_title(f"command → engine angle ({axis})")
@@ -199,5 +175,5 @@ def plot_compare_overlay(cmp, axis: str = "pitch"):
         a.set_xscale("log")
         a.grid(True, which="both", alpha=0.3)
     ax[0, 0].legend(fontsize=7)
-    fig.suptitle(f"{cmp.labels[0]} vs {cmp.labels[1]}")
+    fig.suptitle(f"{curves[0].label} vs {curves[1].label}")
     return fig

@@ -8,6 +8,9 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..linear import gain_db
+from ..units import from_si
+
 
 def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
     """Nichols chart (phase [deg] vs gain [dB]) of L0 N(A, .) at several command amplitudes of
@@ -21,7 +24,7 @@ def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
     def draw(h, **kw):
         ph = np.degrees(np.unwrap(np.angle(h)))
         ph -= 360.0 * np.round((ph[len(ph) // 2] + 180.0) / 360.0)  # the branch around -180
-        ax.plot(ph, 20 * np.log10(np.maximum(np.abs(h), 1e-6)), **kw)
+        ax.plot(ph, gain_db(h, 1e-6), **kw)
 
     draw(pred.loop(f), color="k", lw=2, label="L0 (TVC = 1)")
     cmap = plt.get_cmap("plasma")
@@ -50,7 +53,7 @@ def plot_flight_histories(histories, labels=None, ax=None):
     """Engine angle [deg] against time [s] for one or more :class:`taos.flight.lco.FlightHistory`."""
     fig, ax = (plt.subplots(figsize=(8, 4)) if ax is None else (ax.figure, ax))
     for i, h in enumerate(histories):
-        lab = labels[i] if labels else f"{h.friction_model}, K_L = {h.load_stiffness_N_per_m / 175.1268:.0f} lbf/in"
+        lab = labels[i] if labels else f"{h.friction_model}, K_L = {from_si(h.load_stiffness_N_per_m, 'N/m', 'lbf/in'):.0f} lbf/in"
         ax.plot(h.t_s, np.degrees(h.engine_rad), lw=0.8, label=lab)
     ax.set_xlabel("time [s]")
     ax.set_ylabel("engine angle [deg]")

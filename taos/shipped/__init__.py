@@ -21,11 +21,12 @@ KIND_FOLDERS = {"model": "", "profile": "profiles", "flight": "flight", "masv": 
 
 
 def _package_dir(name: str) -> Path | None:
-    try:
-        root = resources.files(f"taos.shipped.{name}")
-    except ModuleNotFoundError:
-        return None
-    p = Path(str(root))
+    """The package-data folder ``taos/shipped/<name>`` of an installed wheel, or None.
+
+    Resolved from this regular package: ``taos.shipped.<name>`` has no ``__init__.py`` (a
+    namespace package), and ``importlib.resources.files`` of a namespace package is a
+    MultiplexedPath, whose str() is not a folder path."""
+    p = Path(str(resources.files(__name__) / name))
     return p if p.is_dir() else None
 
 

@@ -280,22 +280,15 @@ def check_stiffness(K, src: str, field: str) -> np.ndarray:
 
 
 def load_stiffness_file(path: str) -> tuple[np.ndarray, np.ndarray]:
-    """(K_upper, K_lower) from a fem_data .npz (through ``taos.fem.load_gimbal_stiffness`` when
-    that loader exists, else the npz keys directly), validated."""
+    """(K_upper, K_lower) from a fem_data .npz or .csv (:func:`taos.fem.load_gimbal_stiffness`),
+    validated."""
+    from ..fem import load_gimbal_stiffness
+
     if not Path(path).is_file():
         raise InputError(path, "(file)", "a gimbal stiffness file (.npz with K_upper, K_lower)",
                          got="no such file")
-    try:
-        from ..fem import load_gimbal_stiffness  # type: ignore[attr-defined]
-        data = load_gimbal_stiffness(path)
-        get = (lambda k: getattr(data, k)) if not isinstance(data, dict) else data.__getitem__
-        Ku, Kl = get("K_upper"), get("K_lower")
-    except ImportError:
-        with np.load(path) as z:
-            if "K_upper" not in z or "K_lower" not in z:
-                raise InputError(path, "K_upper", "arrays K_upper and K_lower", got=", ".join(z.files)) from None
-            Ku, Kl = z["K_upper"], z["K_lower"]
-    return check_stiffness(Ku, path, "K_upper"), check_stiffness(Kl, path, "K_lower")
+    data = load_gimbal_stiffness(path)
+    return check_stiffness(data.K_upper, path, "K_upper"), check_stiffness(data.K_lower, path, "K_lower")
 
 
 def taos_model(model: TvcModel, K_upper=None, K_lower=None) -> TaosModel:

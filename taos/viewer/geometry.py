@@ -5,7 +5,7 @@ works in the x-z plane (engine rotation about +y), the yaw actuator in the y-z p
 (rotation about -x), each vertical at a perpendicular distance ``moment_arm_m`` (R) from the
 pivot, so a small engine rotation theta moves its clevis by R theta along the actuator line.
 
-Public dimensions (DESIGN.md table): engine length 4.3 m, nozzle exit diameter 2.4 m, gimbal
+Public dimensions (RS-25 public figures): engine length 4.3 m, nozzle exit diameter 2.4 m, gimbal
 bearing about 0.29 m x 0.36 m. RS-25 throat diameter 0.262 m and nozzle length about 3.07 m
 are public figures too. Powerhead envelope, actuator lengths and attach heights are notional
 (display only, they change no result).
@@ -72,8 +72,9 @@ class GimbalGeometry:
 
 def _nozzle(g: GimbalGeometry) -> trimesh.Trimesh:
     """Bell nozzle and combustion chamber, revolved about z (open surface, drawn two-sided)."""
-    z_throat = -g.powerhead_length_m
-    z_exit = -g.engine_length_m
+    top = g.gimbal_height_m / 2  # the engine length runs from the bearing top, as in models/meshes
+    z_throat = top - g.powerhead_length_m
+    z_exit = top - g.engine_length_m
     rt, re = g.throat_diameter_m / 2, g.nozzle_exit_diameter_m / 2
     s = np.linspace(0.0, 1.0, 24)
     # bell: radius rises fast past the throat then flattens (parabolic in the axial coordinate)
