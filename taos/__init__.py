@@ -17,7 +17,7 @@ Layers, bottom to top (none imports a layer above it):
 1. ``units``, ``errors``, ``results``, ``shipped`` - units, one-line input errors, output files;
 2. ``friction``, ``avionics``, ``actuator``, ``linear``, ``model`` - component models;
 3. ``simplex``, ``simulate``, ``freqresp``, ``taos3d``, ``fem`` - the planar and 3-D models;
-4. ``flight``, ``identify`` - analyses built on them;
+4. ``flight``, ``identify``, ``montecarlo`` - analyses built on them;
 5. ``plotting``, ``viewer`` - drawing only;
 6. ``cli`` - the ``taos`` command and the Green Run report.
 

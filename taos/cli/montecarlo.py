@@ -98,6 +98,9 @@ def cmd_montecarlo(args) -> int:
     c = load_campaign(args.campaign)
     res = run_campaign(c, args.out, runs=args.runs, case=args.case, friction=args.friction, workers=args.workers,
                        scheduler=args.scheduler, resume=args.resume, progress=not args.no_progress)
+    from taos.plotting import save
+    from taos.plotting.ascent import plot_campaign
+    save(plot_campaign(res), Path(args.out) / "montecarlo.png")
     s = res.summary
     if args.json:
         summary = json.loads((Path(args.out) / "summary.json").read_text())

@@ -138,11 +138,6 @@ class AscentHistory:
                         g.create_dataset(k, data=self.signals[k][i], compression="gzip")
         atomic_write(path, write)
 
-    def plot(self, **kwargs):
-        """Figure-7-style engine-angle plot (:mod:`taos.plotting.ascent`)."""
-        from taos.plotting import ascent as pa
-        return pa.plot_ascent([self], **kwargs)
-
 
 def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes=AXES, start_s: float = 0.0,
                     end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,

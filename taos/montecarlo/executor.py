@@ -14,7 +14,7 @@ Output folder (only these names are written; anything else in it is left alone):
     runs/             one JSON per run (and nominal.json)
     summary.json      statistics (:mod:`taos.montecarlo.stats`) + provenance + timing
     campaign.h5       every run: scalars, factors, traces, envelopes, provenance
-    montecarlo.png    figure-9-style plot
+    montecarlo.png    figure-9-style plot (drawn by the ``taos montecarlo`` command)
 """
 
 from __future__ import annotations
@@ -195,5 +195,3 @@ def _write_outputs(res: CampaignResult, out: Path, prov: dict, timing: dict) -> 
             f.create_dataset("nominal_trace_rad", data=res.nominal_trace_rad)
             f.attrs["statistics"] = json.dumps(res.summary)
     atomic_write(out / "campaign.h5", h5)
-    from taos.plotting import save
-    save(res.plot(), out / "montecarlo.png")

@@ -59,11 +59,6 @@ class CampaignResult:
     def n_runs(self) -> int:
         return len(self.runs)
 
-    def plot(self, **kwargs):
-        """Figure-9-style plot (:func:`taos.plotting.ascent.plot_campaign`)."""
-        from taos.plotting import ascent as pa
-        return pa.plot_campaign(self, **kwargs)
-
 
 def summarise(campaign_name: str, case: str, runs, nominal: RunResult, start_s: float, trace_interval_s: float,
               confidence: float = 0.95) -> CampaignResult:
