@@ -181,6 +181,27 @@ def _read_mark(folder: Path) -> set[str]:
         return set()
 
 
+def check_output_folder(out: str | Path, names, field: str = "--out") -> Path:
+    """Refuse, before any work, an output folder that is a regular file, sits under one, or
+    holds a file of one of ``names`` that this program did not write."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputError(str(out), field, "an output folder (or a new name)", got="an existing regular file")
+    check_output_file(out / "x", field)
+    if out.is_dir():
+        owned = _read_mark(out)
+        for name in names:
+            p = out / name
+            if os.path.lexists(p) and name not in owned:
+                raise InputError(str(p), field, "a folder whose files of that name this program wrote "
+                                 "(it never replaces a file it did not write)", got="a file it did not write")
+            if p.is_dir():
+                raise InputError(str(p), field, "a file place", got="an existing folder")
+        if not os.access(out, os.W_OK | os.X_OK):
+            raise InputError(str(out), field, "a folder this program can write", got="no permission")
+    return out
+
+
 def write_output_folder(out: str | Path, files: Mapping[str, Callable[[Path], None]],
                         field: str = "--out") -> Path:
     """Write ``files`` (name -> ``write(tmp_path)``) into folder ``out``.
@@ -189,22 +210,12 @@ def write_output_folder(out: str | Path, files: Mapping[str, Callable[[Path], No
     file of the same name as an output that this program did not write. Every output is first
     written to a temporary file in ``out``; only when all are complete are they renamed into
     place (the previous result stays whole until then). Foreign files are never touched."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise InputError(str(out), field, "an output folder (or a new name)", got="an existing regular file")
-    check_output_file(out / "x", field)
+    out = check_output_folder(out, list(files), field)
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise _output_error(out, e, field) from None
     owned = _read_mark(out)
-    for name in files:
-        p = out / name
-        if os.path.lexists(p) and name not in owned:
-            raise InputError(str(p), field, "a folder whose files of that name this program wrote "
-                             "(it never replaces a file it did not write)", got="a file it did not write")
-        if p.is_dir():
-            raise InputError(str(p), field, "a file place", got="an existing folder")
     clean_stale_temps(out)
     tmps: dict[str, Path] = {}
     mode = _mode()

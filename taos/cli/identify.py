@@ -22,7 +22,11 @@ def _estimate(path, args):
     if axes and axes[0] not in data.axes:
         raise InputError(str(path), f"{axes[0]}_command", f"a {axes[0]} axis in the data", got=", ".join(data.axes))
     kw = {"axes": axes}
-    if getattr(args, "nperseg", None):
+    if getattr(args, "nperseg", None) is not None:
+        from taos.limits import NPERSEG_MIN
+        if not NPERSEG_MIN <= args.nperseg <= data.t_s.size:
+            raise InputError("command line", "--nperseg", f"a segment length from {NPERSEG_MIN} to the "
+                             f"{data.t_s.size} samples of {path}", got=str(args.nperseg))
         kw["nperseg"] = args.nperseg
     return data, estimate(data, method=args.method, **kw)
 
@@ -45,7 +49,18 @@ def _parse_start(items, model) -> dict:
     return out
 
 
+def _outputs(args, *names) -> None:
+    """Refuse output places that cannot be written before any work."""
+    from taos.results import check_output_file
+
+    for n in names:
+        v = getattr(args, n, None)
+        if v not in (None, "-"):
+            check_output_file(v, "--" + n.replace("_", "-"))
+
+
 def cmd_estimate(args) -> int:
+    _outputs(args, "json")
     data, responses = _estimate(args.data, args)
     d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
          "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
@@ -67,6 +82,13 @@ def cmd_fit(args) -> int:
     from taos.identify.fit import fit_frequency_response
     from taos.model import load_model
 
+    from taos.limits import MAX_STARTS
+
+    _outputs(args, "json", "plot", "out_model")
+    if not 1 <= args.starts <= MAX_STARTS:
+        raise InputError("command line", "--starts", f"a number of starts from 1 to {MAX_STARTS}", got=str(args.starts))
+    if not 0.0 <= args.min_coherence <= 1.0:
+        raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
     model = load_model(args.model, friction=args.friction)
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     start = _parse_start(args.start, model)
@@ -99,6 +121,10 @@ def cmd_compare(args) -> int:
     from taos.identify.compare import compare_models, write_comparison
     from taos.model import load_model
 
+    from taos.results import check_output_folder
+
+    check_output_folder(args.out, ("table.txt", "comparison.json", "piston_side_by_side.png", "bode_overlay.png"))
+    _outputs(args, "json")
     ma = load_model(args.model_a)
     mb = load_model(args.model_b)
     da, db = (), ()

@@ -15,10 +15,8 @@ command amplitudes.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
-import os
-import shutil
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -154,34 +152,29 @@ def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
 
 def write_comparison(cmp: Comparison, out_dir, json_path: str | None = None) -> Path:
     """Write ``table.txt``, ``comparison.json``, ``piston_side_by_side.png`` (paper fig. 2) and
-    ``bode_overlay.png`` (fig. 11 style) into ``out_dir``: built in a temporary folder beside
-    it and renamed into place, so a failure leaves nothing half-written."""
-    from taos.plotting import save
-    from taos.results import write_json
+    ``bode_overlay.png`` (fig. 11 style) into ``out_dir``: written through
+    :func:`taos.results.write_output_folder` (only its own files, each complete or not at all;
+    foreign files in ``out_dir`` are left alone)."""
+    import matplotlib.pyplot as plt
 
-    out = Path(out_dir)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
-        (tmp / "table.txt").write_text(cmp.table() + "\n")
-        write_json(str(tmp / "comparison.json"), cmp.to_dict())
-        import matplotlib.pyplot as plt
-        for name, fig in (("piston_side_by_side.png", cmp.plot_side_by_side()),
-                          ("bode_overlay.png", cmp.plot_overlay())):
-            save(fig, tmp / name)
-            plt.close(fig)
-        if out.exists():
-            old = out.with_name(f".{out.name}.old")
-            if old.exists():
-                shutil.rmtree(old)
-            os.replace(out, old)
-            os.replace(tmp, out)
-            shutil.rmtree(old)
-        else:
-            os.replace(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+    from taos.results import write_json, write_output_folder
+
+    def fig_writer(make):
+        def write(p):
+            fig = make()
+            try:
+                fig.savefig(p, dpi=120, format="png")
+            finally:
+                plt.close(fig)
+        return write
+
+    text = json.dumps(cmp.to_dict(), indent=2, allow_nan=False) + "\n"
+    out = write_output_folder(out_dir, {
+        "table.txt": lambda p: p.write_text(cmp.table() + "\n"),
+        "comparison.json": lambda p: p.write_text(text),
+        "piston_side_by_side.png": fig_writer(cmp.plot_side_by_side),
+        "bode_overlay.png": fig_writer(cmp.plot_overlay),
+    })
     if json_path:
         write_json(json_path, cmp.to_dict())
     return out
