@@ -331,6 +331,8 @@ def load_profile(path: str | Path):
         yaw = profile_from_table(doc["yaw"], src, "yaw") if "yaw" in doc else zero
         prof = TwoAxis(pitch, yaw, name)
     else:
+        if "type" not in doc:
+            check_keys(doc, {"pitch", "yaw", "type"} | _TOP, src)
         prof = profile_from_table(doc, src, "profile")
     check_duration(prof.duration_s, src, "(total duration)")
     return prof

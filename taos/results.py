@@ -127,9 +127,12 @@ def _output_error(path, e: OSError, field: str = "(output)"):
     return InputError(str(path), field, "a place this program can write", got=e.strerror or str(e))
 
 
-def check_output_file(path: str | Path, field: str = "(output)") -> Path:
-    """Refuse an output file place that is an existing folder or whose parent is not a folder."""
+def check_output_file(path: str | Path, field: str = "(output)", suffixes: tuple[str, ...] = ()) -> Path:
+    """Refuse an output file place that is an existing folder or whose parent is not a folder
+    (and, with ``suffixes``, a name not ending in one of them)."""
     p = Path(path)
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise InputError(str(path), field, "a file name ending in " + " or ".join(suffixes), got=repr(p.suffix))
     if p.is_dir():
         raise InputError(str(path), field, "a file name (not a folder)", got="an existing folder")
     parent = p.parent

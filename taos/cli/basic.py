@@ -90,9 +90,9 @@ def cmd_freqresp(args) -> int:
 
     freqs = parse_float_list(args.freq_hz, "--freq-hz")
     limits.check_response_frequencies(freqs)
-    for opt in ("json", "plot"):
+    for opt, suf in (("json", ()), ("plot", (".png", ".svg"))):
         if getattr(args, opt) not in (None, "-"):
-            check_output_file(getattr(args, opt), f"--{opt}")
+            check_output_file(getattr(args, opt), f"--{opt}", suf)
     model = model_from_args(args)
     amp_rad = None
     if args.amplitude_deg is not None and not args.linear:

@@ -56,7 +56,7 @@ def _outputs(args, *names) -> None:
     for n in names:
         v = getattr(args, n, None)
         if v not in (None, "-"):
-            check_output_file(v, "--" + n.replace("_", "-"))
+            check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
 
 
 def cmd_estimate(args) -> int:
