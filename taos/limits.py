@@ -259,6 +259,9 @@ def check_envelope(th, model) -> None:
                  + _unstable_hint(model).removeprefix("likely cause: "))
     elif np.max(np.abs(th.command_rad)) > GIMBAL_RANGE_RAD:
         cause = "a command beyond the gimbal range"
+    elif what == "load":
+        cause = ("a stall force A P_s too small for the load (actuator.supply_pressure, piston_area), "
+                 "or a command too fast or too large for the actuator")
     else:
         cause = "a command too fast or too large for the actuator's flow and force (check the profile)"
     raise EnvelopeExceeded(t, state, cause)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
@@ -139,7 +140,7 @@ def cmd_simulate(args) -> int:
         from taos.taos3d import simulate_taos, taos_model
         th = simulate_taos(taos_model(model), profile, dt_s=args.dt)
     else:
-        th = simulate(model, profile, dt_s=args.dt, progress=True)
+        th = simulate(model, profile, dt_s=args.dt, progress=sys.stderr.isatty())
     if not args.allow_unstable:
         limits.check_envelope(th, model)
     th.provenance.update(input_provenance(args.profile, "profile", th.provenance))
