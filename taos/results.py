@@ -71,6 +71,21 @@ def file_sha256(path: str | Path) -> str:
     return h.hexdigest()
 
 
+def output_provenance(models=(), inputs=()) -> dict:
+    """Provenance block of a JSON output: package version, git revision, and the path and
+    SHA-256 of each model (``TvcModel``) and input file (``(kind, path)``)."""
+    out = base_provenance()
+    for i, m in enumerate(models):
+        sfx = "" if len(models) == 1 else f"_{i + 1}"
+        out[f"model_file{sfx}"] = str(m.source)
+        out[f"model_sha256{sfx}"] = m.sha256
+    for i, (kind, path) in enumerate(inputs):
+        sfx = "" if sum(k == kind for k, _ in inputs) == 1 else f"_{i + 1}"
+        out[f"{kind}_file{sfx}"] = str(path)
+        out[f"{kind}_sha256{sfx}"] = file_sha256(path)
+    return out
+
+
 def input_provenance(path, kind: str, prov: dict | None = None) -> dict:
     """``{kind}_file`` (resolved path) and ``{kind}_sha256`` of an input file, plus the SHA-256
     of the stiffness file named in ``prov['stiffness_source']`` (3-D runs) when it is a file."""

@@ -72,6 +72,8 @@ def cmd_info(args) -> int:
     model = model_from_args(args)
     d = info_dict(model)
     if args.json:
+        from taos.results import output_provenance
+        d["provenance"] = output_provenance([model])
         write_json(args.json, d)
     else:
         print(f"{d['name']}  ({d['model_file']})")
@@ -111,7 +113,11 @@ def cmd_freqresp(args) -> int:
     else:
         fr = sine_dwell_freqresp(model, freqs, amp_rad, args.axis)
     d = fr.to_dict()
-    d["provenance"].update({"model_file": model.source})
+    from taos.results import output_provenance
+    d["provenance"].update(output_provenance([model]))
+    d["provenance"]["solver"] = {"method": "linear (exact)" if amp_rad is None else "rk4 sine dwell",
+                                 "engine": args.engine}
+    d["provenance"]["seeds"] = "none (deterministic)"
     if args.json:
         write_json(args.json, d)
     else:

@@ -65,6 +65,9 @@ def cmd_estimate(args) -> int:
     d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
          "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
          "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict() for r in responses]}
+    from taos.results import output_provenance
+    d["provenance"] = {**output_provenance(inputs=[("data", args.data)]), "method": args.method,
+                       "nperseg": args.nperseg, "seeds": "none (deterministic)"}
     if args.json:
         write_json(args.json, d)
     else:
@@ -102,6 +105,9 @@ def cmd_fit(args) -> int:
                                  correct=None if not args.no_correction else False)
     d = res.to_dict()
     d["model_file"] = model.source
+    from taos.results import output_provenance
+    d["provenance"] = {**output_provenance([model], [("data", p) for p in args.data]), "starts": args.starts,
+                       "seeds": "none (deterministic starts)"}
     if args.out_model:
         res.write_model(args.out_model, data_label=", ".join(labels))
         d["fitted_model_file"] = str(args.out_model)

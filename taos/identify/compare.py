@@ -168,7 +168,10 @@ def write_comparison(cmp: Comparison, out_dir, json_path: str | None = None) -> 
                 plt.close(fig)
         return write
 
-    text = json.dumps(cmp.to_dict(), indent=2, allow_nan=False) + "\n"
+    from taos.results import output_provenance
+
+    payload = {**cmp.to_dict(), "provenance": output_provenance(list(cmp.models))}
+    text = json.dumps(payload, indent=2, allow_nan=False) + "\n"
     out = write_output_folder(out_dir, {
         "table.txt": lambda p: p.write_text(cmp.table() + "\n"),
         "comparison.json": lambda p: p.write_text(text),
@@ -176,7 +179,7 @@ def write_comparison(cmp: Comparison, out_dir, json_path: str | None = None) -> 
         "bode_overlay.png": fig_writer(cmp.plot_overlay),
     })
     if json_path:
-        write_json(json_path, cmp.to_dict())
+        write_json(json_path, payload)
     return out
 
 
