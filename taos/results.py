@@ -32,7 +32,7 @@ import h5py
 from .errors import InputError
 
 MARK = ".taos-output.json"
-_TMP_RE = re.compile(r"^\..+\.(\d+)\.taos\.tmp$|^\..+\.(\d+)\.tmp$")
+_TMP_RE = re.compile(r"^\..+\.(\d+)\.taos\.tmp$")  # only this program's own temporaries
 
 
 def package_version() -> str:
@@ -125,7 +125,7 @@ def clean_stale_temps(folder: str | Path) -> list[Path]:
         m = _TMP_RE.match(p.name)
         if not m:
             continue
-        pid = int(m.group(1) or m.group(2))
+        pid = int(m.group(1))
         if _pid_alive(pid) and pid != os.getpid():
             continue
         if pid == os.getpid():

@@ -223,6 +223,8 @@ CASES = [
     C("--dt text", lambda t: sim(AMBIENT, PROFILE, "--dt", "abc")),
     C("--freq-hz 1e9", lambda t: fr("--freq-hz", "1e9", "--amplitude-deg", "0.4")),
     C("--freq-hz 1e-9", lambda t: fr("--freq-hz", "1e-9", "--amplitude-deg", "0.4")),
+    C("--freq-hz 1e-4 sine dwell (job too long)", lambda t: fr("--freq-hz", "1e-4", "--amplitude-deg", "0.4"),
+      expect_in_line=("steps",)),
     C("--freq-hz text", lambda t: fr("--freq-hz", "abc")),
     C("--freq-hz negative", lambda t: fr("--freq-hz", "-1")),
     C("--amplitude-deg 20", lambda t: fr("--freq-hz", "1", "--amplitude-deg", "20"), expect_in_line=("10.5",)),

@@ -297,3 +297,30 @@ def test_viewer_server_ends_when_its_parent_is_killed(tmp_path):
     while time.time() < t_end and any(alive(c) for c in children):
         time.sleep(0.2)
     assert not any(alive(c) for c in children), "the meshcat server outlived its parent"
+
+
+def test_stale_temporaries_of_dead_runs_are_removed_and_nothing_else(tmp_path):
+    from taos.results import atomic_write
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    stale = tmp_path / f".run.h5.{dead.pid}.taos.tmp"
+    stale.write_text("half")
+    mine = tmp_path / ".notes.123.tmp"      # looks temporary, but not this program's
+    mine.write_text("keep")
+    atomic_write(tmp_path / "run.json", lambda p: p.write_text("{}"))
+    assert not stale.exists() and mine.read_text() == "keep"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".notes.123.tmp", "run.json"]
+
+
+def test_debug_shows_the_traceback_and_an_internal_error_is_still_one_line(tmp_path, capsys, monkeypatch):
+    assert main(["info", str(tmp_path / "none.toml"), "--debug"]) == 2
+    assert "Traceback" in capsys.readouterr().err
+    import taos.cli.basic as basic
+
+    def boom(args):
+        raise RuntimeError("bug\nwith two lines")
+    monkeypatch.setattr(basic, "info_dict", lambda m: boom(None))
+    assert main(["info", str(AMBIENT)]) == 1
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "internal error" in err and "Traceback" not in err

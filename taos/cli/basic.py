@@ -105,6 +105,7 @@ def cmd_freqresp(args) -> int:
         amp_rad = math.radians(amp[0])
         limits.check_amplitude(amp_rad, model, "--amplitude-deg")
         limits.check_linear_stability(model, (args.axis,), allow=args.allow_unstable)
+        limits.check_dwell(model, freqs, axis=args.axis)
     if args.engine == "taos":
         from taos.taos3d import taos_freqresp, taos_model
         fr = taos_freqresp(taos_model(model), freqs, amp_rad, args.axis, cross=args.cross)

@@ -359,9 +359,7 @@ def friction_from_table(table: dict, source: str, model: str | None = None,
         raise InputError(source if model is None else "command line",
                          f"{section}.model" if model is None else "--friction",
                          "one of " + ", ".join(LAWS), got=repr(name))
-    unknown = sorted(set(table) - FRICTION_KEYS - {"model"})
-    if unknown:
-        raise InputError(source, f"{section}.{unknown[0]}",
-                         "a known friction parameter (" + ", ".join(sorted(FRICTION_KEYS)) + ")",
-                         got="an unknown key")
+    from ..errors import check_keys
+
+    check_keys(table, set(FRICTION_KEYS) | {"model"}, source, section)
     return LAWS[name].from_table(table, source, section)
