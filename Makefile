@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEMO_MODEL ?= models/rs25_hotfire.toml
 DEMO_OUT   ?= out/greenrun
 
-.PHONY: demo test browser bench clean
+.PHONY: demo test browser bench clean verification
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "Python 3.11+ needed"'
@@ -31,6 +31,10 @@ browser:
 test: $(STAMP) browser
 	@$(BIN)/python -m pytest -q -p no:cacheprovider tests; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
+
+# the verification suite (tests/verification) and its table docs/verification.md
+verification: $(STAMP)
+	$(BIN)/python scripts/verification_report.py
 
 bench: $(STAMP)
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done

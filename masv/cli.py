@@ -30,8 +30,10 @@ def _system(args):
 
 
 def _prov(cfg) -> dict:
+    from taos.results import base_provenance
+
     return {"config_file": cfg.source, "config_sha256": cfg.sha256, "modes_file": cfg.structure.source,
-            "n_modes": cfg.structure.n_modes, "taos_version": package_version()}
+            "n_modes": cfg.structure.n_modes, "taos_version": package_version(), **base_provenance()}
 
 
 #: ``masv modes`` lists every mode up to this many (beyond, only the modes in the band)

@@ -39,7 +39,7 @@ from typing import Mapping
 
 import numpy as np
 
-from taos.errors import InputError
+from taos.errors import InputError, check_keys
 from taos.model import TvcModel, load_model, read_toml
 from taos.shipped import resolve
 from taos.units import to_si
@@ -196,10 +196,7 @@ def _structure(doc: Mapping, src: str, base: Path) -> ModalStructure:
     st = doc.get("structure")
     if not isinstance(st, Mapping):
         raise InputError(src, "[structure]", "a [structure] table", got="nothing (section missing)")
-    unknown = sorted(set(st) - {"modes", "damping_ratio", "max_frequency", "engine_mass_in_modes"})
-    if unknown:
-        raise InputError(src, f"structure.{unknown[0]}", "one of modes, damping_ratio, max_frequency, "
-                         "engine_mass_in_modes", got="an unknown key")
+    check_keys(st, {"modes", "damping_ratio", "max_frequency", "engine_mass_in_modes"}, src, "structure")
     modes = _str(st, "modes", src, "structure.modes")
     if modes == "rigid":
         return rigid_structure()
@@ -231,15 +228,13 @@ def load_config(path) -> MasvConfig:
     p = resolve(path, "masv")
     src = str(p)
     raw, doc = read_toml(p, "a readable MASV configuration file")
-    unknown = sorted(set(doc) - {"name", "description", "structure", "band", "engine", "actuator"})
-    if unknown:
-        raise InputError(src, unknown[0], "one of name, description, structure, band, engine, actuator",
-                         got="an unknown section")
+    check_keys(doc, {"name", "description", "structure", "band", "engine", "actuator"}, src)
     base = p.parent
     structure = _structure(doc, src, base)
     band = doc.get("band", {})
     if not isinstance(band, Mapping):
-        raise InputError(src, "[band]", "a [band] table with low and high")
+        raise InputError(src, "[band]", "a [band] table with low and high", got=repr(band)[:60])
+    check_keys(band, {"low", "high"}, src, "band")
     lo = to_si(band.get("low", "0.5 Hz"), "frequency", source=src, field="band.low", positive=True)
     hi = to_si(band.get("high", "20 Hz"), "frequency", source=src, field="band.high", positive=True)
     etabs = doc.get("engine")
@@ -248,10 +243,7 @@ def load_config(path) -> MasvConfig:
     cache: dict[Path, TvcModel] = {}
     engines = []
     for i, t in enumerate(etabs):
-        unknown = sorted(set(t) - {"name", "model", "gimbal_node", "cg_offset"})
-        if unknown:
-            raise InputError(src, f"engine[{i}].{unknown[0]}", "one of name, model, gimbal_node, cg_offset",
-                             got="an unknown key")
+        check_keys(t, {"name", "model", "gimbal_node", "cg_offset"}, src, f"engine[{i}]")
         mpath = (base / _str(t, "model", src, f"engine[{i}].model")).resolve()
         if mpath not in cache:
             cache[mpath] = load_model(mpath)
@@ -271,10 +263,7 @@ def load_config(path) -> MasvConfig:
     actuators = []
     for i, t in enumerate(atabs):
         f = f"actuator[{i}]"
-        unknown = sorted(set(t) - {"name", "engine", "axis", "attach_node", "direction", "rotation_axis"})
-        if unknown:
-            raise InputError(src, f"{f}.{unknown[0]}", "one of name, engine, axis, attach_node, direction, "
-                             "rotation_axis", got="an unknown key")
+        check_keys(t, {"name", "engine", "axis", "attach_node", "direction", "rotation_axis"}, src, f)
         eng = _str(t, "engine", src, f"{f}.engine")
         if eng not in gimbal_of:
             raise InputError(src, f"{f}.engine", "the name of an [[engine]]", got=repr(eng))

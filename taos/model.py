@@ -164,15 +164,15 @@ def _need(table: Mapping, key: str, kind: str, src: str, section: str, **checks)
 def _section(doc: Mapping, name: str, src: str) -> Mapping:
     sec = doc.get(name)
     if not isinstance(sec, Mapping):
-        raise InputError(src, f"[{name}]", f"a [{name}] table", got="nothing (section missing)")
+        raise InputError(src, f"[{name}]", f"a [{name}] table",
+                         got="nothing (section missing)" if sec is None else repr(sec)[:60])
     return sec
 
 
 def _check_keys(sec: Mapping, allowed: set[str], src: str, section: str) -> None:
-    unknown = sorted(set(sec) - allowed)
-    if unknown:
-        raise InputError(src, f"{section}.{unknown[0]}", "one of " + ", ".join(sorted(allowed)),
-                         got="an unknown key")
+    from .errors import check_keys
+
+    check_keys(sec, allowed, src, section)
 
 
 def parse_engine(doc: Mapping, src: str) -> Engine:
@@ -282,10 +282,9 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     p = resolve(path, "model")
     src = str(p)
     raw, doc = read_toml(p, "a readable model file")
-    unknown = sorted(set(doc) - KNOWN_SECTIONS)
-    if unknown:
-        raise InputError(src, unknown[0], "a known section (" + ", ".join(sorted(KNOWN_SECTIONS)) + ")",
-                         got="an unknown section")
+    _check_keys(doc, KNOWN_SECTIONS, src, "")
+    if "name" in doc and not isinstance(doc["name"], str):
+        raise InputError(src, "name", "a text name", got=repr(doc["name"])[:60])
     engine = parse_engine(doc, src)
     actuator = parse_actuator(doc, src)
     st = _section(doc, "structure", src)
@@ -295,6 +294,9 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     law = friction_from_table(ftab, src, model=friction)
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}
+    from .limits import check_model_plausible
+
+    check_model_plausible(src, engine, actuator, structure)
     return TvcModel(name=str(doc.get("name", p.stem)), engine=engine, actuator=actuator,
                     structure=structure, friction=law, avionics=avionics, source=src,
                     sha256=hashlib.sha256(raw).hexdigest(),

@@ -197,58 +197,108 @@ def is_two_axis(profile) -> bool:
 
 
 # -- TOML loading -----------------------------------------------------------------------
+#: keys of each profile type (unknown keys are refused with the nearest one suggested)
+TYPE_KEYS = {
+    "step": {"amplitude", "start", "hold"},
+    "multi_ramp": {"levels", "rate", "hold"},
+    "sine_dwell": {"amplitude", "frequency", "cycles"},
+    "sine_sweep": {"amplitude", "start_frequency", "end_frequency", "duration", "logarithmic"},
+    "multisine": {"amplitude", "frequencies", "duration"},
+    "sequence": {"segments"},
+    "circular": {"amplitude", "frequency", "cycles"},
+}
+_TOP = {"name", "description"}
+
+
 def _angle(tab, key, src, sec):
+    from .limits import check_command_angle
+
     if key not in tab:
         raise InputError(src, f"{sec}.{key}", "an angle with its unit, like '0.4 deg'", got="nothing (key missing)")
-    return to_si(tab[key], "angle", source=src, field=f"{sec}.{key}")
+    return check_command_angle(to_si(tab[key], "angle", source=src, field=f"{sec}.{key}"), src, f"{sec}.{key}")
 
 
 def _pos(tab, key, kind, src, sec, example):
+    from .limits import check_command_frequency, check_duration
+
     if key not in tab:
         raise InputError(src, f"{sec}.{key}", f"a {kind} with its unit, like {example}", got="nothing (key missing)")
-    return to_si(tab[key], kind, source=src, field=f"{sec}.{key}", positive=True)
+    v = to_si(tab[key], kind, source=src, field=f"{sec}.{key}", positive=True)
+    if kind == "frequency":
+        check_command_frequency(v, src, f"{sec}.{key}")
+    elif kind == "time":
+        check_duration(v, src, f"{sec}.{key}")
+    return v
+
+
+def _time(tab, key, default, src, sec, **chk):
+    from .limits import check_duration
+
+    return check_duration(to_si(tab.get(key, default), "time", source=src, field=f"{sec}.{key}", **chk),
+                          src, f"{sec}.{key}")
 
 
 def _int(tab, key, src, sec, default):
+    from .limits import check_cycles
+
     v = tab.get(key, default)
     if not isinstance(v, int) or isinstance(v, bool) or v < 1:
         raise InputError(src, f"{sec}.{key}", "a positive whole number", got=repr(v))
-    return v
+    return check_cycles(v, src, f"{sec}.{key}")
+
+
+def _table(tab, src, sec, kind=None):
+    from .errors import check_keys
+
+    if not isinstance(tab, dict):
+        raise InputError(src, sec, "a profile table with a type, like {type = 'sine_dwell', ...}", got=repr(tab)[:60])
+    kind = tab.get("type") if kind is None else kind
+    if isinstance(kind, str) and kind in TYPE_KEYS:
+        check_keys(tab, TYPE_KEYS[kind] | {"type"} | (_TOP if sec in ("profile",) else set()), src, sec)
+    return kind
 
 
 def profile_from_table(tab: dict, src: str, sec: str):
     """One single-axis profile from a TOML table."""
-    kind = tab.get("type")
+    kind = _table(tab, src, sec)
     if kind == "step":
-        return Step(_angle(tab, "amplitude", src, sec),
-                    to_si(tab.get("start", "0.5 s"), "time", source=src, field=f"{sec}.start", nonnegative=True),
-                    to_si(tab.get("hold", "2 s"), "time", source=src, field=f"{sec}.hold", positive=True))
+        return Step(_angle(tab, "amplitude", src, sec), _time(tab, "start", "0.5 s", src, sec, nonnegative=True),
+                    _time(tab, "hold", "2 s", src, sec, positive=True))
     if kind == "multi_ramp":
+        from .limits import check_command_angle
+
         levels = tab.get("levels")
         if not isinstance(levels, list) or not levels:
-            raise InputError(src, f"{sec}.levels", "a list of angles like ['0.2 deg', '-0.2 deg']")
-        return MultiRamp(tuple(to_si(v, "angle", source=src, field=f"{sec}.levels[{i}]") for i, v in enumerate(levels)),
+            raise InputError(src, f"{sec}.levels", "a list of angles like ['0.2 deg', '-0.2 deg']", got=repr(levels))
+        return MultiRamp(tuple(check_command_angle(to_si(v, "angle", source=src, field=f"{sec}.levels[{i}]"), src,
+                                                   f"{sec}.levels[{i}]") for i, v in enumerate(levels)),
                          _pos(tab, "rate", "angular_velocity", src, sec, "'0.5 deg/s'"),
-                         to_si(tab.get("hold", "1 s"), "time", source=src, field=f"{sec}.hold", nonnegative=True))
+                         _time(tab, "hold", "1 s", src, sec, nonnegative=True))
     if kind == "sine_dwell":
         return SineDwell(_angle(tab, "amplitude", src, sec), _pos(tab, "frequency", "frequency", src, sec, "'1 Hz'"),
                          _int(tab, "cycles", src, sec, 10))
     if kind == "sine_sweep":
+        log = tab.get("logarithmic", True)
+        if not isinstance(log, bool):
+            raise InputError(src, f"{sec}.logarithmic", "true or false", got=repr(log))
         return SineSweep(_angle(tab, "amplitude", src, sec), _pos(tab, "start_frequency", "frequency", src, sec, "'0.1 Hz'"),
                          _pos(tab, "end_frequency", "frequency", src, sec, "'10 Hz'"),
-                         _pos(tab, "duration", "time", src, sec, "'60 s'"), bool(tab.get("logarithmic", True)))
+                         _pos(tab, "duration", "time", src, sec, "'60 s'"), log)
     if kind == "multisine":
+        from .limits import check_command_frequency
+
         fr = tab.get("frequencies")
         if not isinstance(fr, list) or not fr:
-            raise InputError(src, f"{sec}.frequencies", "a list of frequencies like ['0.5 Hz', '1 Hz']")
+            raise InputError(src, f"{sec}.frequencies", "a list of frequencies like ['0.5 Hz', '1 Hz']", got=repr(fr))
         return Multisine(_angle(tab, "amplitude", src, sec),
-                         tuple(to_si(v, "frequency", source=src, field=f"{sec}.frequencies[{i}]", positive=True)
+                         tuple(check_command_frequency(to_si(v, "frequency", source=src, field=f"{sec}.frequencies[{i}]",
+                                                             positive=True), src, f"{sec}.frequencies[{i}]")
                                for i, v in enumerate(fr)),
                          _pos(tab, "duration", "time", src, sec, "'20 s'"))
     if kind == "sequence":
         segs = tab.get("segments")
         if not isinstance(segs, list) or not segs:
-            raise InputError(src, f"{sec}.segments", "a list of profile tables ([[...segments]])")
+            raise InputError(src, f"{sec}.segments", "a list of profile tables ([[...segments]])", got=repr(segs)[:60])
         return Sequence(tuple(profile_from_table(s, src, f"{sec}.segments[{i}]") for i, s in enumerate(segs)))
     raise InputError(src, f"{sec}.type", "one of step, multi_ramp, sine_dwell, sine_sweep, multisine, sequence",
                      got=repr(kind))
@@ -256,20 +306,33 @@ def profile_from_table(tab: dict, src: str, sec: str):
 
 def load_profile(path: str | Path):
     """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
-    ``[pitch]`` and/or ``[yaw]`` tables (two-axis)."""
+    ``[pitch]`` and/or ``[yaw]`` tables (two-axis). Every value is checked against the
+    documented limits of :mod:`taos.limits` (gimbal range, frequencies, durations, cycles)."""
+    from .errors import check_keys
+    from .limits import check_duration
     from .model import read_toml
     from .shipped import resolve
 
     path = resolve(path, "profile")
     src = str(path)
     _, doc = read_toml(path, "a readable profile file")
-    name = str(doc.get("name", Path(path).stem))
+    name = doc.get("name", Path(path).stem)
+    if not isinstance(name, str):
+        raise InputError(src, "name", "a text name", got=repr(name)[:60])
     if doc.get("type") == "circular":
-        return Circular(_angle(doc, "amplitude", src, "profile"), _pos(doc, "frequency", "frequency", src, "profile", "'1 Hz'"),
+        check_keys(doc, TYPE_KEYS["circular"] | {"type"} | _TOP, src)
+        prof = Circular(_angle(doc, "amplitude", src, "profile"),
+                        _pos(doc, "frequency", "frequency", src, "profile", "'1 Hz'"),
                         _int(doc, "cycles", src, "profile", 10), name)
-    if "pitch" in doc or "yaw" in doc:
+    elif "pitch" in doc or "yaw" in doc:
+        check_keys(doc, {"pitch", "yaw"} | _TOP, src)
         zero = Step(0.0, 0.0, 1e-9)
         pitch = profile_from_table(doc["pitch"], src, "pitch") if "pitch" in doc else zero
         yaw = profile_from_table(doc["yaw"], src, "yaw") if "yaw" in doc else zero
-        return TwoAxis(pitch, yaw, name)
-    return profile_from_table(doc, src, "profile")
+        prof = TwoAxis(pitch, yaw, name)
+    else:
+        if "type" not in doc:
+            check_keys(doc, {"pitch", "yaw", "type"} | _TOP, src)
+        prof = profile_from_table(doc, src, "profile")
+    check_duration(prof.duration_s, src, "(total duration)")
+    return prof

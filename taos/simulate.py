@@ -18,7 +18,7 @@ from . import _integrator as _ig
 from .errors import SimulationUnstable
 from .model import TvcModel
 from .profiles import is_two_axis
-from .results import atomic_write, package_version, write_provenance
+from .results import atomic_write, base_provenance, write_provenance
 from .simplex import LurePlant, simplex_plant
 
 DEFAULT_DT_S = 2e-4
@@ -101,14 +101,14 @@ class TimeHistory:
         """Write atomically: /t_s, /<axis>/<array>, provenance as root attributes."""
         def write(tmp):
             with h5py.File(tmp, "w") as h5:
-                h5.create_dataset("t_s", data=self.t_s)
+                h5.create_dataset("t_s", data=self.t_s, track_times=False)
                 h5.attrs["axes"] = ",".join(self.axes)
                 h5.attrs["moment_arm_m"] = self.moment_arm_m
                 write_provenance(h5, self.provenance)
                 for i, ax in enumerate(self.axes):
                     g = h5.create_group(ax)
                     for name in self.ARRAYS:
-                        g.create_dataset(name, data=getattr(self, name)[i], compression="gzip")
+                        g.create_dataset(name, data=getattr(self, name)[i], compression="gzip", track_times=False)
                 self._write_extra(h5)
         atomic_write(path, write)
 
@@ -132,7 +132,7 @@ class TimeHistory:
 
 def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
     return {"model_file": model.source, "model_sha256": model.sha256, "model_name": model.name,
-            "package_version": package_version(), "friction_model": model.friction.name,
+            **base_provenance(), "seeds": "none (deterministic)", "friction_model": model.friction.name,
             "solver": {"method": solver.method, "dt_s": solver.dt_s, "record_every": solver.record_every},
             **more}
 

@@ -45,7 +45,7 @@ def test_compare_cli_writes_table_json_and_both_figures(tmp_path):
     assert r.returncode == 0, r.stderr
     d = json.loads(r.stdout)
     assert d["labels"] == ["ambient", "hot fire"]
-    assert sorted(p.name for p in out.iterdir()) == ["bode_overlay.png", "comparison.json",
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["bode_overlay.png", "comparison.json",
                                                      "piston_side_by_side.png", "table.txt"]
     assert json.loads((out / "comparison.json").read_text())["rows"]
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
@@ -71,6 +72,8 @@ def cmd_info(args) -> int:
     model = model_from_args(args)
     d = info_dict(model)
     if args.json:
+        from taos.results import output_provenance
+        d["provenance"] = output_provenance([model])
         write_json(args.json, d)
     else:
         print(f"{d['name']}  ({d['model_file']})")
@@ -85,7 +88,14 @@ def cmd_info(args) -> int:
 def cmd_freqresp(args) -> int:
     from taos.freqresp import linear_freqresp, sine_dwell_freqresp
 
+    from taos import limits
+    from taos.results import check_output_file
+
     freqs = parse_float_list(args.freq_hz, "--freq-hz")
+    limits.check_response_frequencies(freqs)
+    for opt, suf in (("json", ()), ("plot", (".png", ".svg"))):
+        if getattr(args, opt) not in (None, "-"):
+            check_output_file(getattr(args, opt), f"--{opt}", suf)
     model = model_from_args(args)
     amp_rad = None
     if args.amplitude_deg is not None and not args.linear:
@@ -93,6 +103,9 @@ def cmd_freqresp(args) -> int:
         if len(amp) != 1:
             raise InputError("command line", "--amplitude-deg", "one amplitude in deg", got=args.amplitude_deg)
         amp_rad = math.radians(amp[0])
+        limits.check_amplitude(amp_rad, model, "--amplitude-deg")
+        limits.check_linear_stability(model, (args.axis,), allow=args.allow_unstable)
+        limits.check_dwell(model, freqs, axis=args.axis)
     if args.engine == "taos":
         from taos.taos3d import taos_freqresp, taos_model
         fr = taos_freqresp(taos_model(model), freqs, amp_rad, args.axis, cross=args.cross)
@@ -101,7 +114,11 @@ def cmd_freqresp(args) -> int:
     else:
         fr = sine_dwell_freqresp(model, freqs, amp_rad, args.axis)
     d = fr.to_dict()
-    d["provenance"].update({"model_file": model.source})
+    from taos.results import output_provenance
+    d["provenance"].update(output_provenance([model]))
+    d["provenance"]["solver"] = {"method": "linear (exact)" if amp_rad is None else "rk4 sine dwell",
+                                 "engine": args.engine}
+    d["provenance"]["seeds"] = "none (deterministic)"
     if args.json:
         write_json(args.json, d)
     else:
@@ -116,18 +133,24 @@ def cmd_freqresp(args) -> int:
 
 
 def cmd_simulate(args) -> int:
+    from taos import limits
     from taos.profiles import load_profile
+    from taos.results import check_output_file, input_provenance
     from taos.simulate import simulate
 
+    check_output_file(args.out, "--out")
     model = model_from_args(args)
     profile = load_profile(args.profile)
-    if not (args.dt > 0 and math.isfinite(args.dt)):
-        raise InputError("command line", "--dt", "a positive step in seconds", got=repr(args.dt))
+    limits.check_run(model, profile, args.dt)
+    limits.check_linear_stability(model, allow=args.allow_unstable)
     if args.engine == "taos":
         from taos.taos3d import simulate_taos, taos_model
         th = simulate_taos(taos_model(model), profile, dt_s=args.dt)
     else:
-        th = simulate(model, profile, dt_s=args.dt, progress=True)
+        th = simulate(model, profile, dt_s=args.dt, progress=sys.stderr.isatty())
+    if not args.allow_unstable:
+        limits.check_envelope(th, model)
+    th.provenance.update(input_provenance(args.profile, "profile", th.provenance))
     th.to_hdf5(args.out)
     print(f"wrote {args.out} ({th.t_s.size} samples, {', '.join(th.axes)})")
     return 0
@@ -155,6 +178,7 @@ def add_parsers(sub) -> None:
                    help="simplex (planar) or taos (3-D, two actuators, compliant two-half gimbal)")
     p.add_argument("--cross", action="store_true", help="with --engine taos: the other axis' response")
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save a Bode plot")
+    p.add_argument("--allow-unstable", action="store_true", help="run the sine dwell even if the linear model is unstable")
     p.set_defaults(func=cmd_freqresp)
 
     p = sub.add_parser("simulate", help="time history of a command profile, to HDF5")
@@ -164,4 +188,6 @@ def add_parsers(sub) -> None:
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
     p.add_argument("--friction", help="swap the friction law")
     p.add_argument("--dt", type=float, default=2e-4, help="integration step [s] (default 2e-4)")
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="run a model whose linear block is unstable, and do not stop at the envelope")
     p.set_defaults(func=cmd_simulate)

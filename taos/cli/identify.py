@@ -24,7 +24,11 @@ def _estimate(path, args):
     if axes and axes[0] not in data.axes:
         raise InputError(str(path), f"{axes[0]}_command", f"a {axes[0]} axis in the data", got=", ".join(data.axes))
     kw = {"axes": axes}
-    if getattr(args, "nperseg", None):
+    if getattr(args, "nperseg", None) is not None:
+        from taos.limits import NPERSEG_MIN
+        if not NPERSEG_MIN <= args.nperseg <= data.t_s.size:
+            raise InputError("command line", "--nperseg", f"a segment length from {NPERSEG_MIN} to the "
+                             f"{data.t_s.size} samples of {path}", got=str(args.nperseg))
         kw["nperseg"] = args.nperseg
     return data, estimate(data, method=args.method, **kw)
 
@@ -47,11 +51,25 @@ def _parse_start(items, model) -> dict:
     return out
 
 
+def _outputs(args, *names) -> None:
+    """Refuse output places that cannot be written before any work."""
+    from taos.results import check_output_file
+
+    for n in names:
+        v = getattr(args, n, None)
+        if v not in (None, "-"):
+            check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
+
+
 def cmd_estimate(args) -> int:
+    _outputs(args, "json")
     data, responses = _estimate(args.data, args)
     d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
          "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
          "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict() for r in responses]}
+    from taos.results import output_provenance
+    d["provenance"] = {**output_provenance(inputs=[("data", args.data)]), "method": args.method,
+                       "nperseg": args.nperseg, "seeds": "none (deterministic)"}
     if args.json:
         write_json(args.json, d)
     else:
@@ -70,6 +88,13 @@ def cmd_fit(args) -> int:
     from taos.identify.fit import fit_frequency_response
     from taos.model import load_model
 
+    from taos.limits import MAX_STARTS
+
+    _outputs(args, "json", "plot", "out_model")
+    if not 1 <= args.starts <= MAX_STARTS:
+        raise InputError("command line", "--starts", f"a number of starts from 1 to {MAX_STARTS}", got=str(args.starts))
+    if not 0.0 <= args.min_coherence <= 1.0:
+        raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
     model = load_model(args.model, friction=args.friction)
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     start = _parse_start(args.start, model)
@@ -83,6 +108,9 @@ def cmd_fit(args) -> int:
                                  correct=None if not args.no_correction else False)
     d = res.to_dict()
     d["model_file"] = model.source
+    from taos.results import output_provenance
+    d["provenance"] = {**output_provenance([model], [("data", p) for p in args.data]), "starts": args.starts,
+                       "seeds": "none (deterministic starts)"}
     if args.out_model:
         res.write_model(args.out_model, data_label=", ".join(labels))
         d["fitted_model_file"] = str(args.out_model)
@@ -103,44 +131,37 @@ def cmd_fit(args) -> int:
 def write_comparison(cmp, out_dir, json_path: str | None = None):
     """Write ``table.txt``, ``comparison.json``, ``piston_side_by_side.png`` (paper fig. 2) and
     ``bode_overlay.png`` (fig. 11 style) of a :class:`taos.identify.compare.Comparison` into
-    ``out_dir``: built in a temporary folder beside it and renamed into place, so a failure
-    leaves nothing half-written. Returns the folder's Path."""
-    import os
-    import shutil
-    import tempfile
-    from pathlib import Path
+    ``out_dir`` through :func:`taos.results.write_output_folder` (only its own files, each
+    complete or not at all; foreign files in ``out_dir`` are left alone). Returns the folder."""
+    import json
 
     import matplotlib.pyplot as plt
 
     from taos.identify.compare import comparison_curves
     from taos.plotting import fit as pf
-    from taos.plotting import save
+    from taos.results import output_provenance, write_output_folder
 
-    out = Path(out_dir)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
-        (tmp / "table.txt").write_text(cmp.table() + "\n")
-        write_json(str(tmp / "comparison.json"), cmp.to_dict())
-        curves = comparison_curves(cmp)
-        for name, fig in (("piston_side_by_side.png", pf.plot_compare_side_by_side(curves)),
-                          ("bode_overlay.png", pf.plot_compare_overlay(curves))):
-            save(fig, tmp / name)
-            plt.close(fig)
-        if out.exists():
-            old = out.with_name(f".{out.name}.old")
-            if old.exists():
-                shutil.rmtree(old)
-            os.replace(out, old)
-            os.replace(tmp, out)
-            shutil.rmtree(old)
-        else:
-            os.replace(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+    curves = comparison_curves(cmp)
+
+    def fig_writer(make):
+        def write(p):
+            fig = make(curves)
+            try:
+                fig.savefig(p, dpi=120, format="png")
+            finally:
+                plt.close(fig)
+        return write
+
+    payload = {**cmp.to_dict(), "provenance": output_provenance(list(cmp.models))}
+    text = json.dumps(payload, indent=2, allow_nan=False) + "\n"
+    out = write_output_folder(out_dir, {
+        "table.txt": lambda p: p.write_text(cmp.table() + "\n"),
+        "comparison.json": lambda p: p.write_text(text),
+        "piston_side_by_side.png": fig_writer(pf.plot_compare_side_by_side),
+        "bode_overlay.png": fig_writer(pf.plot_compare_overlay),
+    })
     if json_path:
-        write_json(json_path, cmp.to_dict())
+        write_json(json_path, payload)
     return out
 
 
@@ -148,6 +169,10 @@ def cmd_compare(args) -> int:
     from taos.identify.compare import compare_models
     from taos.model import load_model
 
+    from taos.results import check_output_folder
+
+    check_output_folder(args.out, ("table.txt", "comparison.json", "piston_side_by_side.png", "bode_overlay.png"))
+    _outputs(args, "json")
     ma = load_model(args.model_a)
     mb = load_model(args.model_b)
     da, db = (), ()

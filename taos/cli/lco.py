@@ -46,6 +46,8 @@ def cmd_lco(args) -> int:
     if args.df_out:
         rep.prediction.df.to_hdf5(args.df_out)
     if args.json:
+        from taos.results import output_provenance
+        d.setdefault("provenance", {}).update(output_provenance([model], [("flight", flight.source)]))
         write_json(args.json, d)
     else:
         td = d["time_domain"] or {}

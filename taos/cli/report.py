@@ -28,10 +28,7 @@ import html
 import io
 import json
 import math
-import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import h5py
@@ -43,6 +40,11 @@ from taos.profiles import Sequence, SineDwell, TwoAxis, load_profile
 from taos.shipped import models_dir
 
 DEFAULT_PROFILE = models_dir() / "profiles" / "greenrun_two_axis.toml"
+#: the report's own files (``--out`` receives only these, plus its mark ``.taos-output.json``)
+OUTPUTS = ("index.html", "summary.json", "greenrun.h5")
+#: keyframes of the embedded 3-D view (fps lowered for long runs) and samples per plotted trace
+MAX_VIEW_FRAMES = 4000
+MAX_PLOT_POINTS = 20000
 AXES = ("pitch", "yaw")
 
 
@@ -97,6 +99,25 @@ def run_responses(th, profile, moment_arm_m: float) -> dict:
 
 # -- helpers ---------------------------------------------------------------------------------
 
+def decimated(th, max_points: int, t_range_s: tuple[float, float] | None = None):
+    """A copy of run ``th`` (optionally cut to ``t_range_s``) keeping every k-th sample so that
+    at most about ``max_points`` remain: for plots only (the HDF5 keeps every sample)."""
+    import dataclasses
+
+    sel = slice(None)
+    if t_range_s is not None:
+        lo, hi = np.searchsorted(th.t_s, t_range_s)
+        sel = slice(int(lo), int(hi) + 1)
+    n = th.t_s[sel].size
+    k = max(1, int(math.ceil(n / max_points)))
+    if k == 1 and t_range_s is None:
+        return th
+    idx = np.arange(n)[::k]
+    base = sel.start or 0
+    ch = {name: np.asarray(getattr(th, name))[:, base:base + n][:, idx] for name in th.ARRAYS}
+    return dataclasses.replace(th, t_s=th.t_s[sel][idx], **ch)
+
+
 def _png(fig) -> str:
     import matplotlib.pyplot as plt
     buf = io.BytesIO()
@@ -145,7 +166,7 @@ def _write_h5(path: Path, th, linear: dict, dwell: dict, run: dict) -> None:
 
 def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, friction: str | None = None,
                     engine: str = "simplex", progress: bool = True, dt_s: float = 2e-4,
-                    view_angle_scale: float = 5.0, view_fps: float = 100.0) -> Path:
+                    view_angle_scale: float = 5.0, view_fps: float = 100.0, allow_unstable: bool = False) -> Path:
     """Build the Green Run report folder ``out_dir`` (see the module docstring); returns its path.
 
     Parameters
@@ -168,7 +189,13 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     view_angle_scale : float
         Engine-angle exaggeration of the embedded 3-D view [-].
     view_fps : float
-        Keyframe rate of the embedded 3-D view [1/s].
+        Keyframe rate of the embedded 3-D view [1/s]; lowered so that the view holds at most
+        :data:`MAX_VIEW_FRAMES` keyframes (the page stays under 15 MB for any run length).
+    allow_unstable : bool
+        Run a model whose linear block is unstable (else refused, exit 3) and skip the envelope check.
+
+    The plotted traces are decimated to at most :data:`MAX_PLOT_POINTS` samples per line; the
+    HDF5 keeps every recorded sample.
     """
     from tqdm import tqdm
 
@@ -180,14 +207,20 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     from taos.simulate import simulate
     from taos.viewer import offline_html
 
+    from taos import limits
+    from taos.results import check_output_folder, input_provenance, write_output_folder
+
     out = Path(out_dir)
     # bad input fails here, before any progress output: one line, nothing written
+    check_output_folder(out, OUTPUTS)
     model = load_model(model_path, friction=friction)
     ppath = DEFAULT_PROFILE if profile_path is None else Path(profile_path)
     profile = load_profile(ppath)
     if not isinstance(profile, TwoAxis):
         raise InputError(str(ppath), "(profile)", "a two-axis profile with [pitch] and [yaw] tables",
                          got=type(profile).__name__)
+    limits.check_run(model, profile, dt_s)
+    limits.check_linear_stability(model, allow=allow_unstable)
     info = info_dict(model)
     R = model.actuator.moment_arm_m
     if engine == "taos":
@@ -214,6 +247,9 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     try:
         step("simulate")
         th = run_sim()
+        if not allow_unstable:
+            limits.check_envelope(th, model)
+        th.provenance.update(input_provenance(ppath, "profile", th.provenance))
         bar.update()
 
         step("linear response")
@@ -254,37 +290,26 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
             figs[f"bode_{ax}"] = _png(bode.plot_freqresp(
                 [linear[ax]] + dwell_fr[ax], resonance_hz=wl[ax], notch_hz=notch[ax], length_unit="in",
                 moment_arm_m=R, data=run.get(ax), data_label="two-axis run", title=f"{ax}: command → piston and engine ({model.name})"))
-        figs["timehist"] = _png(timehist.plot_timehistory(th, "in", "deg"))
+        figs["timehist"] = _png(timehist.plot_timehistory(decimated(th, MAX_PLOT_POINTS), "in", "deg"))
+        zoom = decimated(th, MAX_PLOT_POINTS, t_range_s=(0.0, 4.0))
         figs["timehist_zoom"] = _png(timehist.plot_timehistory(
-            th, "in", "deg", t_range_s=(0.0, 4.0), title="first 4 s (0.4 deg dwell, stick-slip onset)"))
+            zoom, "in", "deg", t_range_s=(0.0, 4.0), title="first 4 s (0.4 deg dwell, stick-slip onset)"))
         bar.update()
 
         step("3-D view")
-        view = offline_html(th, angle_scale=view_angle_scale, fps=view_fps)
+        fps = min(view_fps, MAX_VIEW_FRAMES / max(float(th.t_s[-1] - th.t_s[0]), 1e-9))
+        view = offline_html(th, angle_scale=view_angle_scale, fps=fps)
         bar.update()
 
         step("write")
         summary = _summary(model, info, th, notch, wl, dwell, run, ppath)
         page = _page(model, summary, figs, view, view_angle_scale, dwell, run)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
-        try:
-            (tmp / "index.html").write_text(page, encoding="utf-8")
-            (tmp / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
-            _write_h5(tmp / "greenrun.h5", th, linear, dwell, run)
-            os.chmod(tmp, 0o755)
-            for f in tmp.iterdir():
-                os.chmod(f, 0o644)
-            old = None
-            if out.exists():
-                old = out.parent / f".{out.name}.old.{os.getpid()}"
-                os.replace(out, old)
-            os.replace(tmp, out)
-            if old is not None:
-                shutil.rmtree(old, ignore_errors=True)
-        except BaseException:
-            shutil.rmtree(tmp, ignore_errors=True)
-            raise
+        text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
+        write_output_folder(out, {
+            "index.html": lambda p: p.write_text(page, encoding="utf-8"),
+            "summary.json": lambda p: p.write_text(text),
+            "greenrun.h5": lambda p: _write_h5(p, th, linear, dwell, run),
+        })
         bar.update()
     finally:
         bar.close()
@@ -310,6 +335,9 @@ def _summary(model, info, th, notch, wl, dwell, run, ppath) -> dict:
         "profile_file": str(ppath), "profile": th.provenance.get("profile", ""),
         "friction_model": fr.name, "engine_model": th.provenance.get("engine", "simplex"),
         "package_version": th.provenance.get("package_version", ""),
+        "provenance": {k: th.provenance.get(k, "") for k in (
+            "package_version", "git_revision", "model_file", "model_sha256", "profile_file", "profile_sha256",
+            "stiffness_source", "stiffness_sha256", "solver", "seeds", "engine", "friction_model")},
         "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "load_resonance_hz": {ax: wl[ax] for ax in wl}, "notch_frequency_hz": notch,
         "breakaway_deflection_deg": info["breakaway_deflection_deg"],

@@ -17,6 +17,9 @@ def _positive(value: float, option: str) -> float:
 def cmd_view(args) -> int:
     from taos.viewer import load_run, serve, write_html
 
+    if args.html:
+        from taos.results import check_output_file
+        check_output_file(args.html, "--html")
     th = load_run(args.run)
     kw = dict(angle_scale=_positive(args.angle_scale, "--angle-scale"),
               deflection_scale=(None if args.deflection_scale is None
@@ -42,7 +45,7 @@ def cmd_greenrun(args) -> int:
     from taos.cli.report import greenrun_report
 
     out = greenrun_report(args.model, args.out, profile_path=args.profile, friction=args.friction,
-                          engine=args.engine, progress=not args.quiet)
+                          engine=args.engine, progress=not args.quiet, allow_unstable=args.allow_unstable)
     print(f"wrote {out / 'index.html'} and {out / 'greenrun.h5'}")
     return 0
 
@@ -71,6 +74,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--engine", choices=("simplex", "taos"), default="simplex",
                    help="simplex (planar) or taos (3-D engine, FEM gimbal halves)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="run a model whose linear block is unstable, and do not stop at the envelope")
     p.set_defaults(func=cmd_greenrun)
 
 

@@ -92,6 +92,27 @@ def _read_csv(path: Path) -> np.ndarray:
         raise InputError(str(path), "matrix", "comma-separated numbers", got=str(exc).splitlines()[0]) from None
 
 
+def read_npz(path: str | Path, field: str = "(file)") -> dict[str, np.ndarray]:
+    """Every array of an ``.npz`` file (no pickled objects); :class:`InputError` (one line) when
+    it is not a readable NumPy archive, holds pickled/object data, or is empty."""
+    import zipfile
+
+    src = str(path)
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            if not hasattr(z, "files"):
+                raise InputError(src, field, "a NumPy .npz archive of matrices", got="a single .npy array")
+            data = {k: z[k] for k in z.files}
+    except InputError:
+        raise
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError) as e:
+        raise InputError(src, field, "a NumPy .npz archive of numeric matrices (no pickled objects)",
+                         got=" ".join(str(e).split())[:100]) from None
+    if not data:
+        raise InputError(src, field, "a NumPy .npz archive of matrices", got="an empty archive")
+    return data
+
+
 def load_stiffness_matrix(path: str | Path, *, kind: str = "held", field: str = "K") -> np.ndarray:
     """Load one stiffness matrix from CSV (rows of comma-separated numbers, '#' comments)
     or NPZ (key ``field``) and validate it (see :func:`validate_stiffness_matrix`)."""
@@ -99,10 +120,10 @@ def load_stiffness_matrix(path: str | Path, *, kind: str = "held", field: str = 
     if not path.exists():
         raise InputError(str(path), field, "an existing .csv or .npz file", got="no such file")
     if path.suffix.lower() == ".npz":
-        with np.load(path, allow_pickle=False) as z:
-            if field not in z:
-                raise InputError(str(path), field, "the key present", got=f"keys {sorted(z.files)}")
-            A = z[field]
+        z = read_npz(path, field)
+        if field not in z:
+            raise InputError(str(path), field, "the key present", got=f"keys {sorted(z)}")
+        A = z[field]
     else:
         A = _read_csv(path)
     return validate_stiffness_matrix(A, source=str(path), field=field, kind=kind)
@@ -120,8 +141,7 @@ def load_gimbal_stiffness(path: str | Path) -> GimbalStiffness:
     if not path.exists():
         raise InputError(src, "K_upper", "an existing .npz or .csv file", got="no such file")
     if path.suffix.lower() == ".npz":
-        with np.load(path, allow_pickle=False) as z:
-            data = {k: z[k] for k in z.files}
+        data = read_npz(path, "K_upper")
         for key in ("K_upper", "K_lower"):
             if key not in data:
                 raise InputError(src, key, "a 6x6 stiffness matrix", got="missing key")
@@ -181,8 +201,9 @@ MODE_KEYS = ("freq_hz", "damping_ratio", "node_names", "node_xyz_m", "phi")
 def load_thrust_structure_modes(path: str | Path) -> dict[str, np.ndarray]:
     """Load fem_data/thrust_structure_modes.npz and check its contract (shapes, finiteness)."""
     src = str(path)
-    with np.load(path, allow_pickle=False) as z:
-        data = {k: z[k] for k in z.files}
+    if not Path(path).is_file():
+        raise InputError(src, "(file)", "an existing .npz mode file", got="no such file")
+    data = read_npz(path)
     for k in MODE_KEYS:
         if k not in data:
             raise InputError(src, k, "present (thrust-structure mode file contract)", got="missing key")

@@ -182,10 +182,9 @@ def _value(table: Mapping, key: str, unit: str, check: str, src: str, section: s
 def _parse(table: Mapping, keys: dict, src: str, section: str) -> dict:
     if not isinstance(table, Mapping):
         raise InputError(src, f"[{section}]", f"a [{section}] table", got="nothing (section missing)")
-    extra = set(table) - set(keys) - ({"engine_count"} if section == "vehicle" else {"pade_order"})
-    if extra:
-        raise InputError(src, f"{section}.{sorted(extra)[0]}", "one of " + ", ".join(sorted(keys)),
-                         got="an unknown key")
+    from taos.errors import check_keys
+
+    check_keys(table, set(keys) | ({"engine_count"} if section == "vehicle" else {"pade_order"}), src, section)
     out = {}
     for k, (fld, unit, check) in keys.items():
         if k not in table:
@@ -201,10 +200,9 @@ def load_flight(path: str | Path) -> FlightModel:
     p = resolve(path, "flight")
     src = str(p)
     raw, doc = read_toml(p, "a readable flight file")
-    unknown = set(doc) - {"name", "description", "axis", "tvc_model", "vehicle", "fcs"}
-    if unknown:
-        raise InputError(src, sorted(unknown)[0], "a known section (name, description, axis, tvc_model, "
-                         "vehicle, fcs)", got="an unknown section")
+    from taos.errors import check_keys
+
+    check_keys(doc, {"name", "description", "axis", "tvc_model", "vehicle", "fcs"}, src)
     vt = doc.get("vehicle")
     vkw = _parse(vt, _VEHICLE_KEYS, src, "vehicle")
     n = vt.get("engine_count")

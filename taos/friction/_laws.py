@@ -434,10 +434,7 @@ def friction_from_table(table: dict, source: str, model: str | None = None,
     name = model if model is not None else table.get("model")
     entry = registry.get(name, source if model is None else "command line",
                          f"{section}.model" if model is None else "--friction")
-    keys = friction_keys()
-    unknown = sorted(set(table) - keys - {"model"})
-    if unknown:
-        raise InputError(source, f"{section}.{unknown[0]}",
-                         "a known friction parameter (" + ", ".join(sorted(keys)) + ")",
-                         got="an unknown key")
+    from ..errors import check_keys
+
+    check_keys(table, set(friction_keys()) | {"model"}, source, section)
     return entry.params.from_table(table, source, section)

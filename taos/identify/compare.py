@@ -15,6 +15,7 @@ command amplitudes.
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from dataclasses import dataclass, field
 

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from taos.errors import InputError
+from taos.limits import MAX_DATA_SAMPLES, MAX_RESAMPLE_FACTOR
 from taos.results import atomic_write
 from taos.units import Q_
 
@@ -150,73 +151,112 @@ def _split_header(name: str) -> tuple[str, str | None]:
     return name, None
 
 
+#: metadata keys the loader reads; other metadata is kept as free-form provenance, but a key
+#: close to one of these (a typo such as ``conditon``) is refused with the nearest suggested
+META_KEYS = {"condition", "synthetic", "engine_angle_reference", "description"}
+
+
+def _check_meta(meta: dict, src: str, sidecar: bool) -> None:
+    from taos.errors import nearest
+
+    known = META_KEYS | ({"columns"} if sidecar else set())
+    for k in meta:
+        if k not in known:
+            guess = nearest(k, known)
+            if guess is not None:
+                raise InputError(src, k, f"a known key (did you mean {guess!r}?)", got="an unknown key")
+    if "synthetic" in meta and not isinstance(meta["synthetic"], bool):
+        raise InputError(src, "synthetic", "true or false", got=repr(meta["synthetic"])[:60])
+    for k in ("condition", "engine_angle_reference", "description"):
+        if k in meta and not isinstance(meta[k], str):
+            raise InputError(src, k, "a text value", got=repr(meta[k])[:60])
+
+
 def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
-    """Returns (metadata, {signal: array SI}, {signal: column label})."""
+    """Returns (metadata, {signal: array SI}, {signal: column label}). Streams the numbers
+    (``numpy.loadtxt`` on the open file), so memory stays near the size of the array itself."""
     try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(src, "(file)", "a readable CSV text file", got=getattr(e, "strerror", None) or str(e)) from None
-    lines = text.splitlines()
-    meta_lines, k = [], 0
-    while k < len(lines) and (lines[k].startswith("#") or not lines[k].strip()):
-        meta_lines.append(lines[k].lstrip("#").strip())
-        k += 1
-    if k >= len(lines):
-        raise InputError(src, "(header)", "a header row of column names like 'time [s],pitch_command [deg],...'",
-                         got="no rows")
-    try:
-        meta = tomllib.loads("\n".join(meta_lines))
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(src, "(# metadata)", "TOML 'key = value' comment lines", got=str(e).splitlines()[0]) from None
-    header = [h.strip() for h in lines[k].split(",")]
-    sidecar = path.with_suffix(".toml")
-    mapping: dict[str, tuple[str, str]] = {}
-    if sidecar.exists():
+        f = open(path, encoding="utf-8")
+    except OSError as e:
+        raise InputError(src, "(file)", "a readable CSV text file", got=e.strerror) from None
+    with f:
+        meta_lines, k, header_line = [], 0, None
         try:
-            side = tomllib.loads(sidecar.read_text())
-        except (OSError, tomllib.TOMLDecodeError) as e:
-            raise InputError(str(sidecar), "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
-        cols = side.pop("columns", {})
-        meta.update(side)
-        for col, spec in cols.items():
-            if not isinstance(spec, dict) or "signal" not in spec or "unit" not in spec:
-                raise InputError(str(sidecar), f"columns.{col}", "a table {signal = '...', unit = '...'}", got=repr(spec))
-            if spec["signal"] not in SIGNALS:
-                raise InputError(str(sidecar), f"columns.{col}.signal", "one of " + ", ".join(SIGNALS),
-                                 got=repr(spec["signal"]))
-            if col not in header:
-                raise InputError(src, col, f"a column named {col!r} (from {sidecar.name})", got="no such column")
-            mapping[col] = (spec["signal"], str(spec["unit"]))
-    else:
-        for h in header:
-            base, unit = _split_header(h)
-            if base in SIGNALS:
-                if unit is None:
-                    raise InputError(src, h, f"a unit in brackets like '{base} [{SIGNALS[base][2][1:-1]}]'",
-                                     got="no unit")
-                mapping[h] = (base, unit)
-    body = "\n".join(lines[k + 1:])
-    try:
-        arr = np.genfromtxt(io.StringIO(body), delimiter=",", dtype=float, ndmin=2, invalid_raise=True)
-    except ValueError as e:
-        raise InputError(src, "(rows)", f"{len(header)} comma-separated numbers per row", got=str(e).splitlines()[0]) from None
+            for line in f:
+                if line.startswith("#") or not line.strip():
+                    meta_lines.append(line.lstrip("#").strip())
+                    k += 1
+                    continue
+                header_line = line
+                break
+        except UnicodeDecodeError as e:
+            raise InputError(src, "(file)", "a readable CSV text file", got=str(e)[:80]) from None
+        if header_line is None:
+            raise InputError(src, "(header)", "a header row of column names like 'time [s],pitch_command [deg],...'",
+                             got="no rows")
+        try:
+            meta = tomllib.loads("\n".join(meta_lines))
+        except tomllib.TOMLDecodeError as e:
+            raise InputError(src, "(# metadata)", "TOML 'key = value' comment lines", got=str(e).splitlines()[0]) from None
+        _check_meta(meta, src, sidecar=False)
+        header = [h.strip() for h in header_line.split(",")]
+        sidecar = path.with_suffix(".toml")
+        mapping: dict[str, tuple[str, str]] = {}
+        if sidecar.exists():
+            try:
+                side = tomllib.loads(sidecar.read_text())
+            except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+                raise InputError(str(sidecar), "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+            _check_meta(side, str(sidecar), sidecar=True)
+            cols = side.pop("columns", {})
+            if not isinstance(cols, dict):
+                raise InputError(str(sidecar), "columns", "a [columns] table of {signal = '...', unit = '...'}",
+                                 got=repr(cols)[:60])
+            meta.update(side)
+            for col, spec in cols.items():
+                if not isinstance(spec, dict) or "signal" not in spec or "unit" not in spec:
+                    raise InputError(str(sidecar), f"columns.{col}", "a table {signal = '...', unit = '...'}",
+                                     got=repr(spec)[:60])
+                from taos.errors import check_keys
+                check_keys(spec, {"signal", "unit"}, str(sidecar), f"columns.{col}")
+                if spec["signal"] not in SIGNALS:
+                    raise InputError(str(sidecar), f"columns.{col}.signal", "one of " + ", ".join(SIGNALS),
+                                     got=repr(spec["signal"]))
+                if not isinstance(spec["unit"], str):
+                    raise InputError(str(sidecar), f"columns.{col}.unit", "a unit name like 'deg'", got=repr(spec["unit"]))
+                if col not in header:
+                    raise InputError(src, col, f"a column named {col!r} (from {sidecar.name})", got="no such column")
+                mapping[col] = (spec["signal"], str(spec["unit"]))
+        else:
+            for h in header:
+                base, unit = _split_header(h)
+                if base in SIGNALS:
+                    if unit is None:
+                        raise InputError(src, h, f"a unit in brackets like '{base} [{SIGNALS[base][2][1:-1]}]'",
+                                         got="no unit")
+                    mapping[h] = (base, unit)
+        try:
+            arr = np.loadtxt(f, delimiter=",", dtype=float, ndmin=2, comments=None)
+        except (ValueError, UnicodeDecodeError) as e:
+            raise InputError(src, "(rows)", f"{len(header)} comma-separated numbers per row",
+                             got=" ".join(str(e).split())[:120]) from None
     if arr.size == 0:
         arr = np.zeros((0, len(header)))
     if arr.shape[1] != len(header):
         raise InputError(src, "(rows)", f"{len(header)} columns as in the header", got=f"{arr.shape[1]}")
+    if arr.shape[0] > MAX_DATA_SAMPLES:
+        raise InputError(src, "(rows)", f"at most {MAX_DATA_SAMPLES} samples", got=str(arr.shape[0]))
     out, labels = {}, {}
     for col, (sig, unit) in mapping.items():
         j = header.index(col)
-        f = unit_factor(unit, sig, src, col)
+        fct = unit_factor(unit, sig, src, col)
         x = arr[:, j]
         bad = np.flatnonzero(~np.isfinite(x))
         if bad.size:
-            raise InputError(src, col, "finite numbers in every row",
-                             got=f"{lines[k + 1 + bad[0]].split(',')[j].strip() or 'an empty cell'!s} "
-                                 f"at data row {bad[0] + 1}")
+            raise InputError(src, col, "finite numbers in every row", got=f"{x[bad[0]]} at data row {bad[0] + 1}")
         if sig in out:
             raise InputError(src, col, f"one column for {sig}", got="a second one")
-        out[sig] = x * f
+        out[sig] = x * fct
         labels[sig] = col
     return meta, out, labels
 
@@ -317,6 +357,12 @@ def load_test_data(path, *, resample: bool = True) -> TestData:
         if not resample:
             raise InputError(src, labels["time"], f"a regular sample interval (spread below {IRREGULAR_TOL:.0e})",
                              got=f"intervals from {dt.min():.6g} s to {dt.max():.6g} s")
+        n_new = (t[-1] - t[0]) / med + 1
+        if not n_new <= MAX_RESAMPLE_FACTOR * n:
+            j = int(np.argmax(dt))
+            raise InputError(src, labels["time"], f"time stamps spanning at most {MAX_RESAMPLE_FACTOR:g} x the "
+                             f"samples at the median interval {med:.6g} s (resampling would need {n_new:.3g} samples)",
+                             got=f"{t[j + 1]:.9g} s after {t[j]:.9g} s at sample {j + 1}")
         tn = t[0] + med * np.arange(int(math.floor((t[-1] - t[0]) / med)) + 1)
         sig = {s: (tn if s == "time" else np.interp(tn, t, x)) for s, x in sig.items()}
         t = tn

@@ -196,10 +196,9 @@ def _table(model: TvcModel, name: str, keys: set[str]) -> dict:
     if not isinstance(tab, dict):
         raise InputError(model.source, f"[{name}]", f"a [{name}] table for the TAOS engine model",
                          got="nothing (section missing)")
-    unknown = sorted(set(tab) - keys)
-    if unknown:
-        raise InputError(model.source, f"{name}.{unknown[0]}", "one of " + ", ".join(sorted(keys)),
-                         got="an unknown key")
+    from ..errors import check_keys
+
+    check_keys(tab, keys, model.source, name)
     return tab
 
 

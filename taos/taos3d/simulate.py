@@ -85,7 +85,7 @@ class TaosTimeHistory(TimeHistory):
         """The ``/taos`` group with ``extra`` (the rest as the planar history)."""
         g = h5.create_group("taos")
         for k, v in self.extra.items():
-            g.create_dataset(k, data=v, compression="gzip")
+            g.create_dataset(k, data=v, compression="gzip", track_times=False)
 
     @classmethod
     def _read_extra(cls, h5) -> dict:

@@ -290,6 +290,7 @@ def start_loopback_server(timeout_s: float = 20.0):
     env = dict(os.environ)
     root = str(Path(__file__).resolve().parents[2])
     env["PYTHONPATH"] = root + os.pathsep + env.get("PYTHONPATH", "")
+    env["TAOS_VIEWER_PARENT"] = str(os.getpid())  # the server ends when this process ends
     proc = subprocess.Popen([sys.executable, "-u", "-m", "taos.viewer._server"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, env=env, start_new_session=True)
     zmq_url = web_url = None
