@@ -88,7 +88,7 @@ def cmd_info(args) -> int:
 def cmd_freqresp(args) -> int:
     from taos.freqresp import linear_freqresp, sine_dwell_freqresp
 
-    from taos import limits
+    from taos import limits, run_checks
     from taos.results import check_output_file
 
     freqs = parse_float_list(args.freq_hz, "--freq-hz")
@@ -104,8 +104,8 @@ def cmd_freqresp(args) -> int:
             raise InputError("command line", "--amplitude-deg", "one amplitude in deg", got=args.amplitude_deg)
         amp_rad = math.radians(amp[0])
         limits.check_amplitude(amp_rad, model, "--amplitude-deg")
-        limits.check_linear_stability(model, (args.axis,), allow=args.allow_unstable)
-        limits.check_dwell(model, freqs, axis=args.axis)
+        run_checks.check_linear_stability(model, (args.axis,), allow=args.allow_unstable)
+        run_checks.check_dwell(model, freqs, axis=args.axis)
     if args.engine == "taos":
         from taos.taos3d import taos_freqresp, taos_model
         fr = taos_freqresp(taos_model(model), freqs, amp_rad, args.axis, cross=args.cross)
@@ -133,7 +133,7 @@ def cmd_freqresp(args) -> int:
 
 
 def cmd_simulate(args) -> int:
-    from taos import limits
+    from taos import run_checks
     from taos.profiles import load_profile
     from taos.results import check_output_file, input_provenance
     from taos.simulate import simulate
@@ -141,15 +141,15 @@ def cmd_simulate(args) -> int:
     check_output_file(args.out, "--out")
     model = model_from_args(args)
     profile = load_profile(args.profile)
-    limits.check_run(model, profile, args.dt)
-    limits.check_linear_stability(model, allow=args.allow_unstable)
+    run_checks.check_run(model, profile, args.dt)
+    run_checks.check_linear_stability(model, allow=args.allow_unstable)
     if args.engine == "taos":
         from taos.taos3d import simulate_taos, taos_model
         th = simulate_taos(taos_model(model), profile, dt_s=args.dt)
     else:
         th = simulate(model, profile, dt_s=args.dt, progress=sys.stderr.isatty())
     if not args.allow_unstable:
-        limits.check_envelope(th, model)
+        run_checks.check_envelope(th, model)
     th.provenance.update(input_provenance(args.profile, "profile", th.provenance))
     th.to_hdf5(args.out)
     print(f"wrote {args.out} ({th.t_s.size} samples, {', '.join(th.axes)})")

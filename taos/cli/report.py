@@ -207,7 +207,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     from taos.simulate import simulate
     from taos.viewer import offline_html
 
-    from taos import limits
+    from taos import run_checks
     from taos.results import check_output_folder, input_provenance, write_output_folder
 
     out = Path(out_dir)
@@ -219,8 +219,8 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     if not isinstance(profile, TwoAxis):
         raise InputError(str(ppath), "(profile)", "a two-axis profile with [pitch] and [yaw] tables",
                          got=type(profile).__name__)
-    limits.check_run(model, profile, dt_s)
-    limits.check_linear_stability(model, allow=allow_unstable)
+    run_checks.check_run(model, profile, dt_s)
+    run_checks.check_linear_stability(model, allow=allow_unstable)
     info = info_dict(model)
     R = model.actuator.moment_arm_m
     if engine == "taos":
@@ -248,7 +248,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
         step("simulate")
         th = run_sim()
         if not allow_unstable:
-            limits.check_envelope(th, model)
+            run_checks.check_envelope(th, model)
         th.provenance.update(input_provenance(ppath, "profile", th.provenance))
         bar.update()
 
