@@ -48,6 +48,8 @@ _API = {
     "load_test_data": "taos.identify.data", "estimate": "taos.identify.estimate",
     "fit_frequency_response": "taos.identify.fit", "compare_models": "taos.identify.compare",
     "load_run": "taos.viewer", "write_html": "taos.viewer", "serve": "taos.viewer",
+    "loop_margins": "taos.margins", "LoopMargins": "taos.margins",
+    "to_control": "taos.interop", "from_control_ss": "taos.interop",
 }
 
 __all__ = sorted(_API) + ["__version__"]
