@@ -14,10 +14,10 @@ from __future__ import annotations
 import base64
 import contextlib
 import io
-import os
 import re
 import shlex
 import shutil
+import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -127,12 +127,17 @@ def _main(prog: str):
 _PNG = re.compile(r'data:image/png;base64,([A-Za-z0-9+/=]+)')
 
 
-def extract_report_pictures(html_file: Path, dest: Path, prefix: str) -> list[Path]:
-    """The inline base64 PNG pictures of an HTML report, saved as ``prefix_N.png`` in ``dest``."""
+def extract_report_pictures(html_file: Path, dest: Path, prefix: str, min_px: int = 100) -> list[Path]:
+    """The inline base64 PNG pictures of an HTML report (plots, not icons: both sides at least
+    ``min_px`` pixels), saved as ``prefix_N.png`` in ``dest``."""
     out = []
-    for k, m in enumerate(_PNG.finditer(Path(html_file).read_text(encoding="utf-8"))):
-        p = dest / f"{prefix}_{k + 1}.png"
-        p.write_bytes(base64.b64decode(m.group(1)))
+    for m in _PNG.finditer(Path(html_file).read_text(encoding="utf-8")):
+        png = base64.b64decode(m.group(1))
+        w, h = struct.unpack(">II", png[16:24])
+        if min(w, h) < min_px:
+            continue
+        p = dest / f"{prefix}_{len(out) + 1}.png"
+        p.write_bytes(png)
         out.append(p)
     return out
 
@@ -198,14 +203,3 @@ def python_examples(docs_dir: Path) -> list[tuple[str, str]]:
         for m in PY_EXAMPLE.finditer(md.read_text(encoding="utf-8")):
             out.append((md.relative_to(docs_dir).as_posix(), m.group(2)))
     return out
-
-
-def clean_workdir(workdir: Path) -> None:
-    """Remove a work folder's outputs (``out/``)."""
-    out = Path(workdir) / "out"
-    if out.exists():
-        shutil.rmtree(out)
-
-
-def env_for_docs() -> None:
-    os.environ.setdefault("MPLBACKEND", "Agg")

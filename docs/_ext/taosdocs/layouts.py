@@ -7,7 +7,7 @@ from pathlib import Path
 
 
 def _short(v) -> str:
-    s = repr(v) if not isinstance(v, str) else v
+    s = v if isinstance(v, str) else str(v)
     s = s.replace("\n", " ")
     return s if len(s) <= 60 else s[:57] + "..."
 
@@ -20,7 +20,12 @@ def h5_layout(path: Path, max_items: int = 60) -> str:
 
     def attrs(obj, indent):
         for k in sorted(obj.attrs):
-            lines.append(f"{indent}  @{k} = {_short(obj.attrs[k])}")
+            v = obj.attrs[k]
+            if isinstance(v, bytes):
+                v = v.decode("utf-8", "replace")
+            shown = _short(v) if (_shown(v) or not isinstance(v, str)) else "str (" + (
+                "JSON" if v[:1] in "{[" else "text") + ")"
+            lines.append(f"{indent}  @{k} = {shown}")
 
     def walk(g, indent):
         attrs(g, indent)
@@ -43,6 +48,11 @@ def h5_layout(path: Path, max_items: int = 60) -> str:
     return "\n".join(lines)
 
 
+def _shown(v) -> bool:
+    """Booleans and short words are shown as examples; paths and hashes (machine-specific) not."""
+    return isinstance(v, bool) or (isinstance(v, str) and len(v) < 40 and "/" not in v)
+
+
 def json_layout(path: Path) -> str:
     """Text tree of a JSON file: keys with the type (and length) of each value."""
     doc = json.loads(Path(path).read_text(encoding="utf-8"))
@@ -50,7 +60,7 @@ def json_layout(path: Path) -> str:
 
     def walk(v, key, indent):
         if isinstance(v, dict):
-            lines.append(f"{indent}{key}{{}}" if key else "{}")
+            lines.append(f"{indent}{key}{{}}")
             for k, x in v.items():
                 walk(x, f"{k}: ", indent + "  ")
         elif isinstance(v, list):
@@ -58,14 +68,14 @@ def json_layout(path: Path) -> str:
             while isinstance(x, list) and x:
                 depth, x = depth + 1, x[0]
             if isinstance(x, dict):
-                lines.append(f"{indent}{key}[{len(v)} x]")
+                lines.append(f"{indent}{key}[{len(v)} x {{}}], each:")
                 walk(x, "", indent + "  ")
             else:
                 lines.append(f"{indent}{key}list{'[]' * depth} of {type(x).__name__ if v else 'nothing'} "
                              f"(length {len(v)})")
         else:
             lines.append(f"{indent}{key}{type(v).__name__ if v is not None else 'null'}"
-                         f"{'  = ' + _short(v) if isinstance(v, (str, bool)) else ''}")
+                         f"{'  = ' + _short(v) if _shown(v) else ''}")
 
     walk(doc, "", "")
     return "\n".join(lines)
