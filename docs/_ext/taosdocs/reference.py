@@ -197,14 +197,15 @@ def _example(doc: dict, section: str, key: str) -> str:
 
 
 def _table(section: str, rows, doc: dict, example_file: str, missing: list[str]) -> list[str]:
-    out = ["| key | SI unit / type | note | example | meaning |", "|---|---|---|---|---|"]
+    out = ["| key | SI unit / type | note (friction: laws that use it) | example | meaning |", "|---|---|---|---|---|"]
     for key, unit, note in rows:
         meaning = MEANINGS.get(f"{section}.{key}")
         if meaning is None:
             missing.append(f"{section}.{key}")
             meaning = ""
         ex = _example(doc, section, key)
-        out.append(f"| `{key}` | {unit} | {note} | {('`' + ex + '`') if ex else ''} | {meaning} |")
+        unit_md = f"`{unit}`" if any(c in unit for c in "*_^") else unit
+        out.append(f"| `{key}` | {unit_md} | {note} | {('`' + ex + '`') if ex else ''} | {meaning} |")
     return out
 
 
