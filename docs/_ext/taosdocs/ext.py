@@ -99,7 +99,9 @@ class TaosVerification(_MarkdownDirective):
             lines = text.splitlines()
             if lines and lines[0].startswith("# "):   # this page has its own title
                 lines = lines[1:]
-            return self._render("\n".join(lines), titles=True)
+            # headings become rubrics: sections made inside a directive would land out of order
+            md = [f"```{{rubric}} {ln.lstrip('#').strip()}\n```" if ln.startswith("#") else ln for ln in lines]
+            return self._render("\n".join(md))
         return self._render("The verification table (`docs/verification.md`) is written by the verification "
                             "suite; it was not present when this site was built.")
 

@@ -115,7 +115,7 @@ def cli_markdown(prog: str) -> str:
     os.environ["COLUMNS"] = "100"
     try:
         parser = build_parser()
-        out = [f"```text\n{parser.format_help().rstrip()}\n```\n"]
+        out = [f"### {prog} (all commands)\n", f"```text\n{parser.format_help().rstrip()}\n```\n"]
         for name, sp in _subparsers(parser).items():
             out.append(f"### {prog} {name}\n")
             if sp.description:
