@@ -27,6 +27,7 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx.ext.viewcode",
     "myst_parser",
+    "sphinx-mathjax-offline",   # MathJax shipped with the site: equations render without a network
     "taosdocs.ext",
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
