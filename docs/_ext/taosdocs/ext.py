@@ -26,6 +26,22 @@ logger = logging.getLogger(__name__)
 GEN = "_generated"
 
 
+def _wrap(command: str, width: int = 88) -> str:
+    """A long command split before its options with shell line continuations."""
+    if len(command) <= width:
+        return command
+    parts = command.split(" --")
+    lines, cur = [], parts[0]
+    for p in parts[1:]:
+        if len(cur) + len(p) + 3 > width:
+            lines.append(cur)
+            cur = "    --" + p
+        else:
+            cur += " --" + p
+    lines.append(cur)
+    return " \\\n".join(lines)
+
+
 class _MarkdownDirective(SphinxDirective):
     has_content = False
 
@@ -51,7 +67,7 @@ class TaosStep(_MarkdownDirective):
         if res.exit_code != 0 or res.missing:
             raise self.error(f"guide step {step_id!r} ({step.command}) exited {res.exit_code}, missing "
                              f"{res.missing}: {res.stderr.strip()[-500:]}")
-        md = [f"```console\n$ {step.command}\n```\n"]
+        md = [f"```console\n$ {_wrap(step.command)}\n```\n"]
         if step.show_stdout and res.stdout.strip():
             lines = res.stdout.rstrip().splitlines()
             more = len(lines) > step.show_stdout
