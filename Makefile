@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEMO_MODEL ?= models/rs25_hotfire.toml
 DEMO_OUT   ?= out/greenrun
 
-.PHONY: demo test browser bench clean verification
+.PHONY: demo test browser bench clean verification docs
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "Python 3.11+ needed"'
@@ -39,5 +39,17 @@ verification: $(STAMP)
 bench: $(STAMP)
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done
 
+# The documentation site (Sphinx, warnings are errors): runs the user guide's commands on the
+# shipped models for its pictures, so it takes a few minutes. Output: docs/_build/html.
+DOCS_STAMP := $(VENV)/.docs-installed
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[docs]'
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	rm -rf docs/_build docs/_generated
+	MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
+	@echo "Documentation: docs/_build/html/index.html"
+
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out .pytest_cache docs/_build docs/_generated

@@ -16,6 +16,7 @@ import numpy as np
 
 from taos.freqresp import FrequencyResponse
 from taos.linear import gain_db, notch_hz, phase_deg
+from taos.margins import loop_margins as _loop_margins
 from taos.simplex import simplex_state_space
 
 from .system import MasvSystem, build_system
@@ -210,32 +211,15 @@ def _crossing(x, y0, y1):
 
 
 def margins_from_loop(name: str, f: np.ndarray, L: np.ndarray) -> LoopMargin:
-    """Gain and phase margins of loop transfer L sampled on ascending f (linear interpolation in
-    log f between samples). A loop that is zero everywhere (no loop) has infinite margins."""
-    if not np.any(L):
+    """Gain and phase margins of loop transfer L sampled on ascending f: the smallest over every
+    crossing that :func:`taos.margins.loop_margins` finds (interpolated between samples)."""
+    if not np.any(L):  # no loop (e.g. the TVSE loop on a rigid structure)
         return LoopMargin(name, math.inf, None, math.inf, None)
-    lf = np.log10(f)
-    gm, fgm = math.inf, None
-    im, re = L.imag, L.real
-    for i in range(f.size - 1):
-        if im[i] == 0.0 or im[i] * im[i + 1] < 0:
-            t = _crossing(None, im[i], im[i + 1])
-            r = re[i] + t * (re[i + 1] - re[i])
-            if r < 0:
-                g = -20 * math.log10(-r)
-                if g < gm:
-                    gm, fgm = g, float(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
-    mag = np.log10(np.abs(L))
-    pm, fpm = math.inf, None
-    for i in range(f.size - 1):
-        if mag[i] >= 0 > mag[i + 1] or mag[i] < 0 <= mag[i + 1]:
-            t = _crossing(None, mag[i], mag[i + 1])
-            Li = L[i] + t * (L[i + 1] - L[i])
-            p = math.degrees(np.angle(Li))
-            m = ((180.0 + p) + 180.0) % 360.0 - 180.0
-            if m < pm:
-                pm, fpm = m, float(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
-    return LoopMargin(name, float(gm), fgm, float(pm), fpm)
+    lm = _loop_margins(f, L)
+    gm = lm.min_gain_margin_db
+    k = int(np.argmin(lm.gain_margin_db)) if lm.gain_margin_db.size else None
+    pm, fpm = lm.min_phase_margin
+    return LoopMargin(name, float(gm), None if k is None else float(lm.phase_crossover_hz[k]), float(pm), fpm)
 
 
 def loop_margins(system: MasvSystem, f_lo_hz: float = 0.01, f_hi_hz: float = 1000.0,

@@ -50,6 +50,8 @@ _API = {
     "load_ascent": "taos.flight.ascent", "simulate_ascent": "taos.flight.ascent_sim",
     "load_campaign": "taos.montecarlo", "run_campaign": "taos.montecarlo",
     "load_run": "taos.viewer", "write_html": "taos.viewer", "serve": "taos.viewer",
+    "loop_margins": "taos.margins", "LoopMargins": "taos.margins",
+    "to_control": "taos.interop", "from_control_ss": "taos.interop",
 }
 
 __all__ = sorted(_API) + ["__version__"]

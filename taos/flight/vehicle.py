@@ -47,6 +47,7 @@ import scipy.signal
 
 from taos.errors import InputError
 from taos.linear import StateSpace
+from taos.margins import LoopMargins, loop_margins
 from taos.model import TvcModel, read_toml
 from taos.shipped import resolve
 from taos.simplex import LurePlant, simplex_state_space
@@ -339,12 +340,34 @@ def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None) 
 
 
 # -- margins ------------------------------------------------------------------------------
+def open_loop_state_space(flight: FlightModel, axis: str | None = None) -> StateSpace:
+    """L0(s) as a SISO state space: input ``delta_rad`` (the TVC replaced by unity, delta =
+    delta_c), output ``loop_L0`` = -delta_c, so that L0 = 1 + ... is in the negative feedback
+    convention of :func:`loop_freqresp` (the same response, exactly).
+
+    The vehicle + FCS block takes delta and its rate; with delta' = s delta,
+    C (sI - A)^-1 (B_0 + s B_1) = C (sI - A)^-1 (B_0 + A B_1) + C B_1, so the rate input folds
+    into B and D without a derivative."""
+    vf = vehicle_fcs_state_space(flight, axis)
+    o = vf.output_index("delta_cmd_rad")
+    A = vf.A
+    B0, B1 = vf.B[:, [0]], vf.B[:, [1]]
+    C, D = vf.C[[o]], vf.D[[o]]
+    if D[0, 1] != 0.0:  # an improper loop (rate feed-through to the command) has no state space
+        raise ValueError("open_loop_state_space: the FCS command feeds the engine rate straight through")
+    return StateSpace(A, B0 + A @ B1, -C, -(D[:, [0]] + C @ B1), vf.states, ("delta_rad",), ("loop_L0",))
+
+
 @dataclass(frozen=True)
 class Margins:
-    """Stability margins of an open loop L (negative feedback). Gain margins in dB at the
-    -180 deg (mod 360) crossings below (``low``) and above (``high``) the gain crossover:
-    positive = the gain may rise (high) / fall (low) by that much. Phase margin [deg] at the
-    gain crossover (0 dB)."""
+    """Stability margins of an open loop L (negative feedback), from :func:`taos.margins.loop_margins`.
+
+    Gain margins in dB, each positive: ``high_gain_margin_db`` the gain may rise by that much
+    (the smallest -20 log|L| over the -180 deg crossings where |L| < 1), ``low_gain_margin_db``
+    it may fall by that much (the smallest 20 log|L| over the crossings where |L| > 1, the
+    low-frequency crossing of a conditionally stable loop), each with its phase crossover
+    [Hz]. Phase margin [deg] the smallest over the gain crossovers (0 dB), at
+    ``gain_crossover_hz``. ``crossings`` lists every crossing."""
 
     gain_crossover_hz: float | None
     phase_margin_deg: float | None
@@ -352,47 +375,31 @@ class Margins:
     low_phase_crossover_hz: float | None
     high_gain_margin_db: float | None
     high_phase_crossover_hz: float | None
+    crossings: LoopMargins | None = None
 
     def to_dict(self) -> dict:
-        return dict(self.__dict__)
+        d = {k: v for k, v in self.__dict__.items() if k != "crossings"}
+        if self.crossings is not None:
+            d.update(self.crossings.to_dict())
+        return d
+
+
+def _margins(lm: LoopMargins) -> Margins:
+    pm, fc = lm.min_phase_margin
+    lo, flo = lm.downward
+    hi, fhi = lm.upward
+    return Margins(gain_crossover_hz=fc, phase_margin_deg=None if fc is None else pm,
+                   low_gain_margin_db=lo, low_phase_crossover_hz=flo,
+                   high_gain_margin_db=hi, high_phase_crossover_hz=fhi, crossings=lm)
 
 
 def margins(freq_hz, L) -> Margins:
     """Margins of the sampled open loop ``L`` (complex, on an increasing frequency grid [Hz]);
-    crossings located by linear interpolation in log frequency."""
-    f = np.asarray(freq_hz, float)
-    g = 20 * np.log10(np.abs(L))
-    ph = np.degrees(np.unwrap(np.angle(L)))
-    lf = np.log10(f)
+    every crossing located between samples by :func:`taos.margins.loop_margins`."""
+    return _margins(loop_margins(freq_hz, L))
 
-    def crossings(y, level):
-        out = []
-        for k in range(len(y) - 1):
-            if (y[k] - level) * (y[k + 1] - level) <= 0 and y[k] != y[k + 1]:
-                t = (level - y[k]) / (y[k + 1] - y[k])
-                out.append((10 ** (lf[k] + t * (lf[k + 1] - lf[k])), k, t))
-        return out
 
-    gc = crossings(g, 0.0)
-    fc = pm = None
-    if gc:
-        fc, k, t = gc[-1]
-        p = ph[k] + t * (ph[k + 1] - ph[k])
-        pm = float(((p + 180.0) % 360.0 + 360.0) % 360.0)
-        pm = pm - 360.0 if pm > 180.0 else pm
-    # -180 (mod 360) crossings
-    pc = []
-    for level in np.arange(-180.0 - 360.0 * 3, 360.0 * 2, 360.0):
-        pc += crossings(ph, level)
-    lo = hi = None
-    for fx, k, t in sorted(pc):
-        gx = g[k] + t * (g[k + 1] - g[k])
-        if fc is not None and fx < fc:
-            lo = (gx, fx)  # the highest crossing below crossover
-        elif hi is None and (fc is None or fx > fc):
-            hi = (-gx, fx)
-    return Margins(gain_crossover_hz=fc, phase_margin_deg=pm,
-                   low_gain_margin_db=None if lo is None else float(lo[0]),
-                   low_phase_crossover_hz=None if lo is None else float(lo[1]),
-                   high_gain_margin_db=None if hi is None else float(hi[0]),
-                   high_phase_crossover_hz=None if hi is None else float(hi[1]))
+def flight_loop_margins(flight: FlightModel, axis: str | None = None) -> Margins:
+    """Exact margins of L0 (the TVC replaced by unity) from :func:`open_loop_state_space`,
+    every crossing found by python-control."""
+    return _margins(loop_margins(open_loop_state_space(flight, axis)))

@@ -1,0 +1,238 @@
+"""Reference pages generated from the code: the CLI from its argparse parsers, the model-file keys
+from the code's own key tables (with an example value read from a shipped file)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import tomllib
+
+# What each key means. The keys themselves, their order and their units come from the code;
+# a key the code knows and this table does not is reported by the docs build (a warning, an
+# error under -W), so a new key cannot go undocumented.
+MEANINGS: dict[str, str] = {
+    # [engine]
+    "engine.mass": "engine mass m_e (the 3-D model's rigid body)",
+    "engine.inertia_pitch": "engine inertia about the gimbal, pitch axis, J_n",
+    "engine.inertia_yaw": "engine inertia about the gimbal, yaw axis, J_n",
+    "engine.rotational_stiffness": "rotational stiffness K_n of feedlines and gravity about the gimbal",
+    "engine.thrust": "thrust; sets the bearing normal load of the 3-D friction (0: hanging engine)",
+    # [actuator]
+    "actuator.moment_arm": "actuator moment arm R about the gimbal",
+    "actuator.piston_area": "piston area A",
+    "actuator.supply_pressure": "hydraulic supply pressure P_s",
+    "actuator.oil_bulk_modulus": "effective oil bulk modulus beta",
+    "actuator.trapped_volume": "oil volume V_t of both chambers and lines",
+    "actuator.piston_mass": "moving mass M_p of piston, rod and end fittings",
+    "actuator.piston_damping": "viscous damping B_p of seals and rod",
+    "actuator.loop_gain": "position-loop gain K_v (piston velocity per position error)",
+    "actuator.valve_natural_frequency": "servovalve natural frequency",
+    "actuator.valve_damping_ratio": "servovalve damping ratio",
+    "actuator.valve_order": "servovalve order, 1 or 2",
+    "actuator.flow_pressure_coefficient": "flow-pressure coefficient K_c of the servovalve",
+    "actuator.leakage_coefficient": "piston leakage coefficient C_l",
+    "actuator.pressure_feedback_gain": "dynamic pressure feedback gain K_pf (optional)",
+    "actuator.pressure_feedback_time_constant": "high-pass time constant of the pressure feedback",
+    # [structure]
+    "structure.load_stiffness": "load stiffness K_L: all compliance outside the actuator loop",
+    # [friction]
+    "friction.model": "friction law: none, coulomb-switching, coulomb-smooth, dahl, lugre, modified-lugre",
+    "friction.coulomb_torque": "Coulomb (sliding) friction torque T_c",
+    "friction.static_torque": "static (breakaway) torque T_s of the Stribeck curve",
+    "friction.stribeck_velocity": "Stribeck velocity v_s",
+    "friction.stribeck_exponent": "Stribeck shape exponent delta",
+    "friction.bristle_stiffness": "bristle (pre-sliding) stiffness sigma_0",
+    "friction.bristle_damping": "bristle damping sigma_1",
+    "friction.damping_decay_velocity": "rate above which the bristle damping decays, v_1",
+    "friction.viscous_damping": "viscous friction sigma_2",
+    "friction.vibration_velocity": "vibration rate amplitude V_d of the modified LuGre law",
+    "friction.stick_velocity": "stick band of the switching Coulomb law",
+    "friction.stick_damping": "damping that bleeds the residual rate while stuck",
+    "friction.regularization_velocity": "regularisation rate of the smooth Coulomb law",
+    "friction.dahl_exponent": "Dahl shape exponent alpha",
+    # [avionics]
+    "avionics.quantization_bits": "bits of the flight-software command word",
+    "avionics.command_range": "full range of the command word (LSB = range / 2^bits)",
+    "avionics.rounding": "'truncate' or 'round' quantisation",
+    "avionics.crossover_command": "command magnitudes of the servo-amplifier gain table",
+    "avionics.crossover_gain": "servo-amplifier gain at each command magnitude",
+    # [gimbal] (3-D)
+    "gimbal.friction_coefficient": "bearing friction coefficient mu (friction torque = mu N r_b)",
+    "gimbal.bearing_radius": "effective friction radius r_b of the spherical seat",
+    "gimbal.stiffness_file": "FEM stiffness of the two gimbal halves (.npz in fem_data/)",
+    "gimbal.line_load_stiffness": "load stiffness along the actuator lines outside the gimbal (optional)",
+    # [geometry] (3-D)
+    "geometry.pitch_structure_attach": "pitch actuator attach point on the structure (x, y, z)",
+    "geometry.pitch_engine_attach": "pitch actuator attach point on the engine (x, y, z)",
+    "geometry.yaw_structure_attach": "yaw actuator attach point on the structure (x, y, z)",
+    "geometry.yaw_engine_attach": "yaw actuator attach point on the engine (x, y, z)",
+    "geometry.engine_cg": "engine centre of mass in the gimbal frame (x, y, z)",
+    "geometry.engine_roll_inertia": "engine inertia about its own axis through the c.g.",
+    # flight file
+    "vehicle.mass": "vehicle mass (reported)",
+    "vehicle.pitch_inertia": "vehicle pitch inertia I_v about the c.g.",
+    "vehicle.yaw_inertia": "vehicle yaw inertia I_v about the c.g.",
+    "vehicle.engine_count": "number of engines n_e (all deflect alike)",
+    "vehicle.thrust_per_engine": "thrust per engine T",
+    "vehicle.gimbal_arm": "c.g. to gimbal-plane arm l_c",
+    "vehicle.engine_mass": "engine mass m_e (tail-wags-dog)",
+    "vehicle.engine_cg_offset": "gimbal to engine c.g. offset l_e",
+    "vehicle.engine_inertia": "engine inertia about the gimbal J_n",
+    "vehicle.aero_instability": "aerodynamic instability M_a (0 exo-atmospheric)",
+    "fcs.attitude_gain": "attitude gain K_p",
+    "fcs.integral_gain": "integral gain K_i",
+    "fcs.rate_gain": "rate gain K_d",
+    "fcs.lag_time_constant": "first-order lag tau of the command filter",
+    "fcs.notch_frequency": "notch filter centre frequency (0: none)",
+    "fcs.notch_zeta_num": "notch numerator damping ratio",
+    "fcs.notch_zeta_den": "notch denominator damping ratio",
+    "fcs.delay": "sensor and compute delay t_d",
+    "fcs.pade_order": "order n of the (n, n) Pade approximant of the delay",
+}
+
+SECTION_TITLES = {
+    "engine": "[engine]", "actuator": "[actuator]", "structure": "[structure]", "friction": "[friction]",
+    "avionics": "[avionics]", "gimbal": "[gimbal] (3-D model, --engine taos)",
+    "geometry": "[geometry] (3-D model, --engine taos)",
+}
+
+
+# -- CLI ----------------------------------------------------------------------------------------
+def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    for a in parser._actions:  # argparse keeps its subcommands here (no public accessor)
+        if isinstance(a, argparse._SubParsersAction):
+            return dict(a.choices)
+    return {}
+
+
+def cli_markdown(prog: str) -> str:
+    """Markdown for every subcommand of ``prog`` ("taos" or "masv"), from the parser itself."""
+    if prog == "taos":
+        from taos.cli import build_parser
+    else:
+        from masv.cli import build_parser
+    old = os.environ.get("COLUMNS")
+    os.environ["COLUMNS"] = "100"
+    try:
+        parser = build_parser()
+        out = [f"### {prog} (all commands)\n", f"```text\n{parser.format_help().rstrip()}\n```\n"]
+        for name, sp in _subparsers(parser).items():
+            out.append(f"### {prog} {name}\n")
+            if sp.description:
+                out.append(sp.description.strip() + "\n")
+            out.append(f"```text\n{sp.format_help().rstrip()}\n```\n")
+    finally:
+        if old is None:
+            os.environ.pop("COLUMNS", None)
+        else:
+            os.environ["COLUMNS"] = old
+    return "\n".join(out)
+
+
+def cli_commands(prog: str) -> list[str]:
+    if prog == "taos":
+        from taos.cli import build_parser
+    else:
+        from masv.cli import build_parser
+    return list(_subparsers(build_parser()))
+
+
+# -- model-file keys ------------------------------------------------------------------------------
+def _si(kind: str) -> str:
+    from taos.units import DIMENSIONS
+    return DIMENSIONS[kind][1]
+
+
+def model_key_table() -> dict[str, list[tuple[str, str, str]]]:
+    """section -> [(key, SI unit or kind, where the key comes from in the code)], from the code."""
+    from taos import model as M
+    from taos.taos3d import model as M3
+    out: dict[str, list[tuple[str, str, str]]] = {}
+    # [engine]: keys and kinds as parse_engine reads them; a file's unknown key is rejected by it
+    out["engine"] = [("mass", _si("mass"), ""), ("inertia_pitch", _si("inertia"), ""),
+                     ("inertia_yaw", _si("inertia"), ""), ("rotational_stiffness", _si("rotational_stiffness"), ""),
+                     ("thrust", _si("force"), "optional")]
+    act = [(k, _si(kind), chk) for k, (kind, chk) in M._ACTUATOR_FIELDS.items()]
+    act.append(("valve_order", "1 or 2", "whole number"))
+    out["actuator"] = act
+    out["structure"] = [("load_stiffness", _si("stiffness"), "positive")]
+    out["friction"] = [("model", "name", "")] + friction_keys()
+    out["avionics"] = [("quantization_bits", "bits", "0 to 32"), ("command_range", _si("angle"), "positive"),
+                       ("rounding", "'truncate' / 'round'", ""), ("crossover_command", f"list, {_si('angle')}", ""),
+                       ("crossover_gain", "list, 1", "")]
+    out["gimbal"] = [(k, "", "") for k in sorted(M3.GIMBAL_KEYS)]
+    out["geometry"] = [(k, "", "") for k in sorted(M3.GEOMETRY_KEYS)]
+    return out
+
+
+def friction_keys() -> list[tuple[str, str, str]]:
+    """(key, SI unit, laws that use it) over the friction registry."""
+    import dataclasses
+
+    from taos.friction import LAWS
+    from taos.friction import _laws as L
+    info = L._FIELD_INFO
+    users: dict[str, list[str]] = {}
+    for name, cls in LAWS.items():
+        for f in dataclasses.fields(cls):
+            users.setdefault(f.name, []).append(name)
+    return [(key, _si(kind), ", ".join(users.get(fld, []))) for fld, (key, kind, _slot) in info.items()]
+
+
+def flight_key_table() -> dict[str, list[tuple[str, str, str]]]:
+    from taos.flight import vehicle as V
+    veh = [(k, unit, chk) for k, (_f, unit, chk) in V._VEHICLE_KEYS.items()]
+    veh.insert(3, ("engine_count", "whole number", "positive"))
+    fcs = [(k, unit, chk) for k, (_f, unit, chk) in V._FCS_KEYS.items()] + [("pade_order", "0 to 6", "")]
+    return {"vehicle": veh, "fcs": fcs}
+
+
+def _example(doc: dict, section: str, key: str) -> str:
+    v = doc.get(section, {}).get(key)
+    if v is None:
+        return ""
+    if isinstance(v, list):
+        return "[" + ", ".join(str(x) for x in v) + "]"
+    return str(v)
+
+
+def _table(section: str, rows, doc: dict, example_file: str, missing: list[str]) -> list[str]:
+    out = ["| key | SI unit / type | note (friction: laws that use it) | example | meaning |", "|---|---|---|---|---|"]
+    for key, unit, note in rows:
+        meaning = MEANINGS.get(f"{section}.{key}")
+        if meaning is None:
+            missing.append(f"{section}.{key}")
+            meaning = ""
+        ex = _example(doc, section, key)
+        unit_md = f"`{unit}`" if any(c in unit for c in "*_^") else unit
+        out.append(f"| `{key}` | {unit_md} | {note} | {('`' + ex + '`') if ex else ''} | {meaning} |")
+    return out
+
+
+def model_keys_markdown(missing: list[str]) -> str:
+    """The model-file and flight-file key tables; keys without a meaning go to ``missing``."""
+    from taos.shipped import models_dir
+    mdir = models_dir()
+    doc = tomllib.loads((mdir / "rs25_hotfire.toml").read_text(encoding="utf-8"))
+    lines = ["## TVC model files (`models/rs25_*.toml`)\n",
+             "Every value is a string with its unit (any unit pint converts to the SI unit shown); "
+             "plain numbers only where the unit is 1. Examples from `models/rs25_hotfire.toml`.\n"]
+    for section, rows in model_key_table().items():
+        lines.append(f"### {SECTION_TITLES[section]}\n")
+        lines += _table(section, rows, doc, "rs25_hotfire", missing)
+        lines.append("")
+    fdoc = tomllib.loads((mdir / "flight" / "core_stage.toml").read_text(encoding="utf-8"))
+    lines += ["## Flight files (`models/flight/*.toml`)\n",
+              "Top-level keys `name`, `description`, `axis` (pitch or yaw), `tvc_model` (the TVC model "
+              "file it pairs with, relative to the flight file). Examples from `models/flight/core_stage.toml`.\n"]
+    for section, rows in flight_key_table().items():
+        lines.append(f"### [{section}]\n")
+        lines += _table(section, rows, fdoc, "core_stage", missing)
+        lines.append("")
+    return "\n".join(lines)
+
+
+def stale_meanings() -> list[str]:
+    """Meanings of keys the code no longer has."""
+    have = {f"{s}.{k}" for s, rows in {**model_key_table(), **flight_key_table()}.items() for k, _u, _n in rows}
+    return sorted(set(MEANINGS) - have)
