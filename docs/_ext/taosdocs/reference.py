@@ -166,17 +166,19 @@ def model_key_table() -> dict[str, list[tuple[str, str, str]]]:
 
 
 def friction_keys() -> list[tuple[str, str, str]]:
-    """(key, SI unit, laws that use it) over the friction registry."""
+    """(key, SI unit, laws that use it) over the friction registry: each law's parameter class
+    declares its model-file keys and units in its fields' metadata (taos.friction.param)."""
     import dataclasses
 
     from taos.friction import LAWS
-    from taos.friction import _laws as L
-    info = L._FIELD_INFO
+    kinds: dict[str, str] = {}
     users: dict[str, list[str]] = {}
-    for name, cls in LAWS.items():
-        for f in dataclasses.fields(cls):
-            users.setdefault(f.name, []).append(name)
-    return [(key, _si(kind), ", ".join(users.get(fld, []))) for fld, (key, kind, _slot) in info.items()]
+    for law_id, entry in LAWS.items():
+        for f in dataclasses.fields(entry.params):
+            key = f.metadata["key"]
+            kinds.setdefault(key, f.metadata["kind"])
+            users.setdefault(key, []).append(law_id)
+    return [(key, _si(kinds[key]), ", ".join(users[key])) for key in sorted(kinds)]
 
 
 def flight_key_table() -> dict[str, list[tuple[str, str, str]]]:
