@@ -274,6 +274,47 @@ def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
         raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
 
 
+#: ``[friction]`` key naming the shared friction parameter set of one piece of hardware
+PARAMETER_SET_KEY = "parameter_set"
+
+
+def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str) -> dict:
+    """The ``[friction]`` table with its shared parameter set merged in.
+
+    ``parameter_set = "friction/rs25_gimbal.toml"`` (a path relative to the model file, else to the
+    shipped models folder, so a copied model file still finds it) names a
+    TOML file whose ``[friction]`` table holds the law parameters of one piece of hardware
+    (bristle, Stribeck, vibration, regularisation); the model file keeps only ``model`` and the
+    torque levels of its condition. A key in both places is an error (one hardware, one value).
+    """
+    table = dict(ftab)
+    ref = table.pop(PARAMETER_SET_KEY, None)
+    if ref is None:
+        return table
+    if not isinstance(ref, str) or not ref:
+        raise InputError(src, f"friction.{PARAMETER_SET_KEY}", "a path to a friction parameter-set TOML file",
+                         got=repr(ref))
+    ppath = (Path(model_path).parent / ref).resolve()
+    if not ppath.is_file() and not Path(ref).is_absolute():
+        from .shipped import models_dir  # a copied model file still finds the shipped set
+        if (models_dir() / ref).is_file():
+            ppath = (models_dir() / ref).resolve()
+    _, pdoc = read_toml(ppath, "a readable friction parameter-set file")
+    shared = pdoc.get("friction")
+    if not isinstance(shared, Mapping):
+        raise InputError(str(ppath), "[friction]", "a [friction] table of law parameters",
+                         got="nothing (section missing)")
+    for k in sorted(shared):
+        if k in ("model", PARAMETER_SET_KEY):
+            raise InputError(str(ppath), f"friction.{k}", "law parameters only (model is chosen by the model file)",
+                             got="a model-file key")
+        if k in table:
+            raise InputError(src, f"friction.{k}", f"no value here: it is set once, in the parameter set {ref}",
+                             got="a second value for the same hardware")
+        table[k] = shared[k]
+    return table
+
+
 def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
 
@@ -291,7 +332,7 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     st = _section(doc, "structure", src)
     _check_keys(st, {"load_stiffness"}, src, "structure")
     structure = Structure(_need(st, "load_stiffness", "stiffness", src, "structure", positive=True))
-    ftab = _section(doc, "friction", src)
+    ftab = friction_table_with_parameter_set(_section(doc, "friction", src), p, src)
     law = friction_from_table(ftab, src, model=friction)
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}

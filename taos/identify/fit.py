@@ -36,6 +36,7 @@ from __future__ import annotations
 import datetime as _dt
 import math
 import re
+import tomllib
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -404,6 +405,13 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
             if mk and (section, mk.group(1)) in todo:
                 out.append(todo[(section, mk.group(1))])
                 done.add((section, mk.group(1)))
+                continue
+            if mk and section == "friction" and mk.group(1) == "parameter_set":
+                # the shared friction parameter set is named relative to the model file: keep it
+                # reachable from wherever the fitted file is written
+                ref = tomllib.loads(line.strip().split("#")[0]).get("parameter_set", "")
+                out.append(f'parameter_set = "{(Path(src).parent / ref).resolve().as_posix()}"  '
+                           f'# the shared set of {Path(src).name}')
                 continue
             if mk and section == "" and mk.group(1) == "name":
                 out.append(f'name = "{result.initial.name} (fitted)"')
