@@ -3,6 +3,7 @@ time-domain confirmation (DESIGN.md "CLI"; seed paper sections 3.1-3.2)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from taos.errors import InputError
@@ -19,7 +20,7 @@ def cmd_lco(args) -> int:
     model = load_model(args.model, friction=args.friction)
     if args.load_stiffness:
         k = to_si(args.load_stiffness, "stiffness", source="command line", field="--load-stiffness", positive=True)
-        model = model.replace(structure=Structure(k))
+        model = model.replace(structure=dataclasses.replace(model.structure, load_stiffness_N_per_m=k))
     if not (args.duration > 0 and math.isfinite(args.duration)):
         raise InputError("command line", "--duration", "a positive time in seconds", got=repr(args.duration))
     from taos.cli.basic import parse_float_list

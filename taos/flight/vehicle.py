@@ -49,7 +49,8 @@ from taos.errors import InputError
 from taos.linear import StateSpace
 from taos.model import TvcModel, read_toml
 from taos.shipped import resolve
-from taos.simplex import LurePlant, simplex_state_space
+from taos.limits import embed_limits
+from taos.simplex import LurePlant, simplex_limits, simplex_state_space
 from taos.units import Q_
 
 #: vehicle + FCS block signals
@@ -337,7 +338,8 @@ def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None) 
     return LurePlant(ss=ss, n_ext=1, cmd_c=C[ss.output_index("delta_cmd_rad")].copy(), cmd_d=np.ones(1),
                      rate_c=C[ss.output_index("omega_rad_s")].copy(),
                      applied_c=C[ss.output_index("applied_torque_Nm")].copy(),
-                     inertia_kgm2=model.engine.inertia(axis))
+                     inertia_kgm2=model.engine.inertia(axis),
+                     limits=embed_limits(simplex_limits(model, axis), n, 0))
 
 
 # -- margins ------------------------------------------------------------------------------

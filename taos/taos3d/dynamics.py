@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit, prange
 
 from .. import avionics as _av
+from .. import limits as _lim
 from . import friction3d as _f3
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
@@ -89,6 +90,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     the gimbal frame [N, N m], 6-7 F_L [N], 8-9 phi [rad], 10-11 engine angles [rad]."""
     (Y, Yinv, Ks, G, Kc, S, Satt, Eatt, Aa, bxc, bf, cxp, axes, sc) = P
     KL, Rarm, Kn, L00, L01 = sc[0], sc[1], sc[2], sc[3], sc[4]
+    lim = sc[5:]  # actuator/gimbal limits packed over one actuator's state (taos.limits)
     na = Aa.shape[0]
     Rm = np.empty((3, 3))
     _rot(x[3:7], Rm)
@@ -120,6 +122,17 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     g = np.empty(3)
     for i in range(3):
         g[i] = -W[3 + i] - Kn * (axes[0, i] * tp + axes[1, i] * ty)
+    if lim.shape[0] > 0 and lim[4] > 0.0:  # hard stops at the gimbal range (taos.limits)
+        wp = 0.0
+        wy = 0.0
+        for i in range(3):
+            wi = Rm[i, 0] * x[10] + Rm[i, 1] * x[11] + Rm[i, 2] * x[12]
+            wp += axes[0, i] * wi
+            wy += axes[1, i] * wi
+        tsp = _lim.stop_torque(tp, wp, lim[4], lim[5], lim[6])
+        tsy = _lim.stop_torque(ty, wy, lim[4], lim[5], lim[6])
+        for i in range(3):
+            g[i] += axes[0, i] * tsp + axes[1, i] * tsy
     if th < 1e-4:
         c = 1.0 / 12.0 + th * th / 720.0
     else:
@@ -160,6 +173,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
             for j in range(na):
                 s += Aa[k, j] * x[off + j]
             dx[off + k] = s
+        _lim.apply_valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
         aux[6 + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
     f = np.empty(6)
