@@ -14,7 +14,8 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
                  planar feedline/gravity spring on pitch/yaw, P the pitch/yaw projector),
                  applied as the world torque Jl(r)^-T g (Jl the SO(3) left Jacobian, so the
                  springs are exactly conservative); each actuator i pulls along its line u_i
-                 = (E_i - S_i)/L_i with F_L,i = K_L (x_p,i - (L_i - L0_i)) at E_i
+                 = (E_i - S_i)/L_i with F_L,i = K_L (x_p,i - (L_i - L0_i)) + c_L (v_p,i - L_i') at E_i
+                 (c_L the load path's structural damping, taos.model.Structure)
     actuators    the one linear actuator model (taos.actuator), x_c,i = R avionics(theta_c,i),
                  load input F_L,i
     bearing      (phi, z, T) advanced once per step by the backward-Euler bearing solve of
@@ -90,7 +91,8 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     the gimbal frame [N, N m], 6-7 F_L [N], 8-9 phi [rad], 10-11 engine angles [rad]."""
     (Y, Yinv, Ks, G, Kc, S, Satt, Eatt, Aa, bxc, bf, cxp, axes, sc) = P
     KL, Rarm, Kn, L00, L01 = sc[0], sc[1], sc[2], sc[3], sc[4]
-    lim = sc[5:]  # actuator/gimbal limits packed over one actuator's state (taos.limits)
+    cL, ivp = sc[5], int(sc[6])  # load-path damping [N s/m] and the actuator's v_p state index
+    lim = sc[7:]  # actuator/gimbal limits packed over one actuator's state (taos.limits)
     na = Aa.shape[0]
     Rm = np.empty((3, 3))
     _rot(x[3:7], Rm)
@@ -161,6 +163,13 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
         for k in range(na):
             xp += cxp[k] * x[off + k]
         F = KL * (xp - (L - (L00 if a == 0 else L01)))
+        if cL > 0.0:  # structural damping across the line: c_L (v_p - L')
+            wb = np.empty(3)
+            _cross(x[10:13], Eatt[a], wb)
+            Ld = 0.0
+            for i in range(3):
+                Ld += Ew[i] * (Rm[i, 0] * (x[7] + wb[0]) + Rm[i, 1] * (x[8] + wb[1]) + Rm[i, 2] * (x[9] + wb[2]))
+            F += cL * (x[off + ivp] - Ld / L)
         for i in range(3):
             fl[i] = F * Ew[i] / L
             Fw[i] += fl[i]
