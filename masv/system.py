@@ -63,7 +63,8 @@ def engine_axis_block(model: TvcModel, axis: str) -> StateSpace:
     motion along the line of action, gimbal minus attach point), ``gimbal_rotation_rad`` r [rad].
     Outputs: ``x_p_m``, ``theta_rad``, ``f_load_N`` = K_L (x_p - R theta - e),
     ``spring_torque_Nm`` = K_n (theta - r). States: the actuator's, ``theta_rad``, ``omega_rad_s``.
-    With e = r = 0 it is taos.simplex.simplex_state_space (the friction input left at zero).
+    With e = r = 0 it is taos.simplex.simplex_state_space (the friction input left at zero) with
+    the taos load-path damping ``[structure] load_damping_ratio`` off: MASV's damping is modal.
     """
     act = actuator_state_space(model.actuator)
     R = model.actuator.moment_arm_m
