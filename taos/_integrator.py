@@ -6,7 +6,8 @@ State equations (see :class:`taos.simplex.LurePlant`)::
     u   = avionics(c)                        post-avionics command [rad]
     w   = cw . x,  T_a = ca . x              friction relative rate [rad/s], applied torque [N m]
     (z', T_f) = friction.rates(w, z, T_a)    the law's kernel (registry entry)
-    x'  = A x + Br r(t) + bc u + bf T_f
+    x'  = A x + Br r(t) + bc u + bf T_f  (+ the actuator/gimbal limit corrections of
+                                          :mod:`taos.actuator_limits`, packed in ``lim``)
 
 Classical fourth-order Runge-Kutta with a fixed step; the external input is evaluated at the
 stage times (linear interpolation of samples, or exactly for sines). The friction kernels
@@ -25,13 +26,14 @@ import numpy as np
 from numba import njit, prange
 
 from . import avionics as _av
+from . import actuator_limits as _lim
 
 # reassociation and FMA contraction only: no-NaN/no-Inf flags would remove the stability checks
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 
 
 @njit(cache=True, fastmath=_FM, inline="always")
-def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, dx):
+def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, dx):
     n = x.shape[0]
     nr = r.shape[0]
     c = 0.0
@@ -52,6 +54,7 @@ def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, dx):
         for j in range(nr):
             s += Br[i, j] * r[j]
         dx[i] = s
+    _lim.apply(lim, x, u, dx)  # actuator/gimbal limits (taos.actuator_limits); no-op when none
     return dz, tf, u
 
 
@@ -65,20 +68,20 @@ def _finite(x, z):
 
 
 @njit(cache=True, fastmath=_FM, inline="always")
-def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
+def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
               k1, k2, k3, k4, xt):
     """Advance (x, z) by one step in place; return (z_new, T_f, u) at the step start."""
     n = x.shape[0]
-    dz1, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, k1)
+    dz1, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k1)
     for i in range(n):
         xt[i] = x[i] + 0.5 * dt * k1[i]
-    dz2, _, _ = _rates(xt, z + 0.5 * dt * dz1, rm, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, k2)
+    dz2, _, _ = _rates(xt, z + 0.5 * dt * dz1, rm, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k2)
     for i in range(n):
         xt[i] = x[i] + 0.5 * dt * k2[i]
-    dz3, _, _ = _rates(xt, z + 0.5 * dt * dz2, rm, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, k3)
+    dz3, _, _ = _rates(xt, z + 0.5 * dt * dz2, rm, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k3)
     for i in range(n):
         xt[i] = x[i] + dt * k3[i]
-    dz4, _, _ = _rates(xt, z + dt * dz3, r1, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, k4)
+    dz4, _, _ = _rates(xt, z + dt * dz3, r1, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k4)
     for i in range(n):
         x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
     z = z + dt * (dz1 + 2.0 * dz2 + 2.0 * dz3 + dz4) / 6.0
@@ -86,7 +89,7 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
 
 
 @njit(cache=True, fastmath=_FM)
-def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, x0, z0, r, dt,
+def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, z0, r, dt,
                       rec_every, y_out, aux_out):
     """Integrate over the input samples ``r`` (n_steps + 1, n_r) taken every ``dt``.
 
@@ -115,7 +118,7 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, x0, z0, r
             rm[j] = 0.5 * (r0[j] + r1[j])
         if k % rec_every == 0:
             # outputs at the step start; T_f and u from a rate evaluation there
-            dz, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp, k1)
+            dz, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k1)
             for o in range(Cy.shape[0]):
                 s = 0.0
                 for i in range(n):
@@ -127,7 +130,7 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, x0, z0, r
             rec += 1
         if k == nsteps:
             break
-        z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
+        z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
                             k1, k2, k3, k4, xt)
         if not _finite(x, z):
             return k + 1
@@ -135,7 +138,7 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, x0, z0, r
 
 
 @njit(cache=True, fastmath=_FM)
-def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, amp, freq, n_per_cycle,
+def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, n_per_cycle,
                     n_settle, n_meas, out):
     """One sine dwell: r = amp sin(2 pi f t) on every external input channel with a nonzero
     weight. Accumulates out[o] = (2/N sum y sin, 2/N sum y cos, 1/N sum y) over the
@@ -176,7 +179,7 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, amp, freq, 
                 out[o, 0] += s * s0
                 out[o, 1] += s * c0
                 out[o, 2] += s
-        z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, fid, fp, avp,
+        z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
                             k1, k2, k3, k4, xt)
         if not _finite(x, z):
             return k + 1
@@ -188,9 +191,9 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, amp, freq, 
 
 
 @njit(cache=True, parallel=True, fastmath=_FM)
-def sine_dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, amps, freqs, n_per_cycle,
+def sine_dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps, freqs, n_per_cycle,
                      n_settle, n_meas, out, status):
     """Independent sine dwells in parallel (one per entry of ``amps``/``freqs``)."""
     for b in prange(amps.shape[0]):
-        status[b] = _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, Cy, fid, fp, avp, amps[b], freqs[b],
+        status[b] = _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps[b], freqs[b],
                                     n_per_cycle[b], n_settle[b], n_meas[b], out[b])

@@ -44,7 +44,10 @@ class Engine:
 
     mass_kg : gimballed mass [kg]; inertia_pitch/yaw_kgm2 : J_n about the gimbal [kg m^2];
     rotational_stiffness_Nm_per_rad : K_n, feedlines and gravity [N m/rad];
-    thrust_N : thrust pressing the gimbal bearing [N] (0 when hanging).
+    thrust_N : thrust pressing the gimbal bearing [N] (0 when hanging);
+    gimbal_range_rad : hard stops at +-theta_max [rad] (0: none); hard_stop_stiffness_Nm_per_rad :
+    contact stiffness k_s [N m/rad]; hard_stop_damping_ratio : zeta_s of the contact on J_n [-]
+    (:mod:`taos.actuator_limits`).
     """
 
     mass_kg: float
@@ -52,6 +55,13 @@ class Engine:
     inertia_yaw_kgm2: float
     rotational_stiffness_Nm_per_rad: float
     thrust_N: float = 0.0
+    gimbal_range_rad: float = 0.0
+    hard_stop_stiffness_Nm_per_rad: float = 0.0
+    hard_stop_damping_ratio: float = 0.0
+
+    def hard_stop_damping_Nms_per_rad(self, axis: str) -> float:
+        """c_s = 2 zeta_s sqrt(k_s J_n) [N m s/rad] of the hard-stop contact."""
+        return 2.0 * self.hard_stop_damping_ratio * math.sqrt(self.hard_stop_stiffness_Nm_per_rad * self.inertia(axis))
 
     def inertia(self, axis: str) -> float:
         """J_n [kg m^2] about ``axis`` ('pitch' or 'yaw')."""
@@ -73,7 +83,9 @@ class Actuator:
     position loop gain [1/s]; K_dpf [m/(s Pa)] with time constant tau_dpf [s] is the dynamic
     pressure feedback that damps the load resonance without softening the static stiffness
     (a velocity servo with oil compressibility alone gives the load mode negative damping
-    unless K_c > A^2 K_v / K_h).
+    unless K_c > A^2 K_v / K_h). Limits (:mod:`taos.actuator_limits`, nonlinear, time domain only):
+    ``max_rate_m_per_s`` the valve flow saturation as a no-load piston rate [m/s] (0: none);
+    ``pressure_limited`` the supply-pressure limit, stall force A P_s.
     """
 
     moment_arm_m: float
@@ -91,6 +103,8 @@ class Actuator:
     leakage_coefficient_m3_per_s_Pa: float
     pressure_feedback_gain_m_per_s_Pa: float = 0.0
     pressure_feedback_time_constant_s: float = 0.0
+    max_rate_m_per_s: float = 0.0
+    pressure_limited: bool = False
 
     @property
     def oil_column_stiffness_N_per_m(self) -> float:
@@ -106,9 +120,21 @@ class Actuator:
 @dataclass(frozen=True)
 class Structure:
     """Load path outside the actuator position loop: K_L [N/m] (thrust structure, engine,
-    gimbal, actuator case and attachments in series)."""
+    gimbal, actuator case and attachments in series), and its structural damping as the
+    damping ratio zeta_L [-] of the engine on the load spring (piston held): a viscous damper
+    c_L = 2 zeta_L sqrt(K_L R^2 J_n) / R^2 [N s/m] in parallel with K_L, so that
+    F_L = K_L (x_p - R theta) + c_L (v_p - R theta'). Without it the command -> piston notch is
+    an undamped zero of unbounded depth."""
 
     load_stiffness_N_per_m: float
+    load_damping_ratio: float = 0.0
+
+    def load_damping_Ns_per_m(self, moment_arm_m, inertia_kgm2):
+        """c_L [N s/m] (works on CasADi expressions too, for fits)."""
+        if isinstance(self.load_damping_ratio, (int, float)) and self.load_damping_ratio == 0:
+            return 0.0
+        return 2.0 * self.load_damping_ratio * (self.load_stiffness_N_per_m * moment_arm_m ** 2
+                                                * inertia_kgm2) ** 0.5 / moment_arm_m ** 2
 
 
 @dataclass(frozen=True)
@@ -177,7 +203,15 @@ def _check_keys(sec: Mapping, allowed: set[str], src: str, section: str) -> None
 
 def parse_engine(doc: Mapping, src: str) -> Engine:
     s = _section(doc, "engine", src)
-    _check_keys(s, {"mass", "inertia_pitch", "inertia_yaw", "rotational_stiffness", "thrust"}, src, "engine")
+    _check_keys(s, {"mass", "inertia_pitch", "inertia_yaw", "rotational_stiffness", "thrust", "gimbal_range",
+                    "hard_stop_stiffness", "hard_stop_damping_ratio"}, src, "engine")
+    stops = {}
+    if "gimbal_range" in s:
+        stops = dict(gimbal_range_rad=_need(s, "gimbal_range", "angle", src, "engine", positive=True),
+                     hard_stop_stiffness_Nm_per_rad=_need(s, "hard_stop_stiffness", "rotational_stiffness", src,
+                                                          "engine", positive=True),
+                     hard_stop_damping_ratio=_need(s, "hard_stop_damping_ratio", "dimensionless", src, "engine",
+                                                   nonnegative=True))
     return Engine(
         mass_kg=_need(s, "mass", "mass", src, "engine", positive=True),
         inertia_pitch_kgm2=_need(s, "inertia_pitch", "inertia", src, "engine", positive=True),
@@ -186,6 +220,7 @@ def parse_engine(doc: Mapping, src: str) -> Engine:
                                               "engine", nonnegative=True),
         thrust_N=(to_si(s["thrust"], "force", source=src, field="engine.thrust", nonnegative=True)
                   if "thrust" in s else 0.0),
+        **stops,
     )
 
 
@@ -204,6 +239,7 @@ _ACTUATOR_FIELDS = {  # key -> (kind, check)
     "leakage_coefficient": ("flow_pressure", "nonnegative"),
     "pressure_feedback_gain": ("velocity_per_pressure", "nonnegative"),
     "pressure_feedback_time_constant": ("time", "nonnegative"),
+    "max_rate": ("velocity", "positive"),
 }
 _ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "supply_pressure": "supply_pressure_Pa", "oil_bulk_modulus": "oil_bulk_modulus_Pa",
@@ -214,13 +250,14 @@ _ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "flow_pressure_coefficient": "flow_pressure_coefficient_m3_per_s_Pa",
                 "leakage_coefficient": "leakage_coefficient_m3_per_s_Pa",
                 "pressure_feedback_gain": "pressure_feedback_gain_m_per_s_Pa",
-                "pressure_feedback_time_constant": "pressure_feedback_time_constant_s"}
+                "pressure_feedback_time_constant": "pressure_feedback_time_constant_s",
+                "max_rate": "max_rate_m_per_s"}
 
 
 def parse_actuator(doc: Mapping, src: str) -> Actuator:
     s = _section(doc, "actuator", src)
-    _check_keys(s, set(_ACTUATOR_FIELDS) | {"valve_order"}, src, "actuator")
-    optional = {"pressure_feedback_gain", "pressure_feedback_time_constant"}
+    _check_keys(s, set(_ACTUATOR_FIELDS) | {"valve_order", "pressure_limited"}, src, "actuator")
+    optional = {"pressure_feedback_gain", "pressure_feedback_time_constant", "max_rate"}
     kw = {_ACTUATOR_SI[k]: _need(s, k, kind, src, "actuator", **{chk: True})
           for k, (kind, chk) in _ACTUATOR_FIELDS.items() if k not in optional or k in s}
     if kw.get("pressure_feedback_gain_m_per_s_Pa", 0.0) > 0 and not kw.get(
@@ -230,7 +267,10 @@ def parse_actuator(doc: Mapping, src: str) -> Actuator:
     order = s.get("valve_order", 2)
     if order not in (1, 2) or isinstance(order, bool):
         raise InputError(src, "actuator.valve_order", "1 or 2", got=repr(order))
-    return Actuator(valve_order=int(order), **kw)
+    plim = s.get("pressure_limited", False)
+    if not isinstance(plim, bool):
+        raise InputError(src, "actuator.pressure_limited", "true or false", got=repr(plim))
+    return Actuator(valve_order=int(order), pressure_limited=plim, **kw)
 
 
 def parse_avionics(doc: Mapping, src: str) -> Avionics:
@@ -274,6 +314,47 @@ def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
         raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
 
 
+#: ``[friction]`` key naming the shared friction parameter set of one piece of hardware
+PARAMETER_SET_KEY = "parameter_set"
+
+
+def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str) -> dict:
+    """The ``[friction]`` table with its shared parameter set merged in.
+
+    ``parameter_set = "friction/rs25_gimbal.toml"`` (a path relative to the model file, else to the
+    shipped models folder, so a copied model file still finds it) names a
+    TOML file whose ``[friction]`` table holds the law parameters of one piece of hardware
+    (bristle, Stribeck, vibration, regularisation); the model file keeps only ``model`` and the
+    torque levels of its condition. A key in both places is an error (one hardware, one value).
+    """
+    table = dict(ftab)
+    ref = table.pop(PARAMETER_SET_KEY, None)
+    if ref is None:
+        return table
+    if not isinstance(ref, str) or not ref:
+        raise InputError(src, f"friction.{PARAMETER_SET_KEY}", "a path to a friction parameter-set TOML file",
+                         got=repr(ref))
+    ppath = (Path(model_path).parent / ref).resolve()
+    if not ppath.is_file() and not Path(ref).is_absolute():
+        from .shipped import models_dir  # a copied model file still finds the shipped set
+        if (models_dir() / ref).is_file():
+            ppath = (models_dir() / ref).resolve()
+    _, pdoc = read_toml(ppath, "a readable friction parameter-set file")
+    shared = pdoc.get("friction")
+    if not isinstance(shared, Mapping):
+        raise InputError(str(ppath), "[friction]", "a [friction] table of law parameters",
+                         got="nothing (section missing)")
+    for k in sorted(shared):
+        if k in ("model", PARAMETER_SET_KEY):
+            raise InputError(str(ppath), f"friction.{k}", "law parameters only (model is chosen by the model file)",
+                             got="a model-file key")
+        if k in table:
+            raise InputError(src, f"friction.{k}", f"no value here: it is set once, in the parameter set {ref}",
+                             got="a second value for the same hardware")
+        table[k] = shared[k]
+    return table
+
+
 def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
 
@@ -288,9 +369,11 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     engine = parse_engine(doc, src)
     actuator = parse_actuator(doc, src)
     st = _section(doc, "structure", src)
-    _check_keys(st, {"load_stiffness"}, src, "structure")
-    structure = Structure(_need(st, "load_stiffness", "stiffness", src, "structure", positive=True))
-    ftab = _section(doc, "friction", src)
+    _check_keys(st, {"load_stiffness", "load_damping_ratio"}, src, "structure")
+    structure = Structure(_need(st, "load_stiffness", "stiffness", src, "structure", positive=True),
+                          (_need(st, "load_damping_ratio", "dimensionless", src, "structure", nonnegative=True)
+                           if "load_damping_ratio" in st else 0.0))
+    ftab = friction_table_with_parameter_set(_section(doc, "friction", src), p, src)
     law = friction_from_table(ftab, src, model=friction)
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}

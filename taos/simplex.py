@@ -5,6 +5,7 @@ Equations (SI), built from the actuator state space of :mod:`taos.actuator`::
 
     x_c = R theta_c'                       theta_c' = avionics(theta_c)   [rad]
     F_L = K_L (x_p - R theta)              load path (structure, engine, gimbal, case)
+          + c_L (v_p - R theta')           its structural damping (:class:`taos.model.Structure`)
     J_n theta'' = R F_L - K_n theta - T_f  engine about the gimbal
     T_f = friction(theta', z, T_app),  T_app = R F_L - K_n theta
 
@@ -36,7 +37,7 @@ The rigid-translation part - m_e a_g of the engine's inertia is left to the stru
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -60,7 +61,8 @@ class LurePlant:
     ``friction_torque_Nm``. The avionics input is ``cmd_c . x + cmd_d . r`` (``r`` the external
     inputs); the friction element sees the relative rate ``rate_c . x`` [rad/s] and the applied
     torque ``applied_c . x`` [N m]. ``inertia_kgm2`` is the inertia the friction acts on
-    (for step-size checks).
+    (for step-size checks). ``limits`` packs the actuator/gimbal limits over the state
+    (:mod:`taos.actuator_limits`; empty: none).
     """
 
     ss: StateSpace
@@ -70,6 +72,7 @@ class LurePlant:
     rate_c: np.ndarray
     applied_c: np.ndarray
     inertia_kgm2: float
+    limits: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def ext_inputs(self) -> tuple[str, ...]:
@@ -96,7 +99,7 @@ def simplex_state_space(model: TvcModel, axis: str = "pitch", *, structure_input
     KL = model.structure.load_stiffness_N_per_m
     Kn = model.engine.rotational_stiffness_Nm_per_rad
     J = model.engine.inertia(axis)
-    sym = is_symbolic(act.A, R, KL, Kn, J)
+    sym = is_symbolic(act.A, R, KL, Kn, J, model.structure.load_damping_ratio)
     if sym:  # work on object arrays holding SX scalars
         import casadi as ca
         obj = lambda M: np.array([[M[i, j] for j in range(M.shape[1])] for i in range(M.shape[0])],  # noqa: E731
@@ -112,6 +115,12 @@ def simplex_state_space(model: TvcModel, axis: str = "pitch", *, structure_input
     fl = zeros(n, sym)
     fl[:na] = [KL * c for c in cxp]   # element-wise: also for CasADi scalars
     fl[ith] = -KL * R
+    cL = model.structure.load_damping_Ns_per_m(R, J)  # structural damping on the load path
+    if not (isinstance(cL, float) and cL == 0.0):
+        cvp = actC[act.output_index("v_p_m_s")]
+        for i in range(na):
+            fl[i] = fl[i] + cL * cvp[i]
+        fl[iom] = -cL * R
     A = zeros((n, n), sym)
     A[:na, :na] = actA
     bf = actB[:, act.input_index("f_load_N")]
@@ -178,7 +187,27 @@ def simplex_plant(model: TvcModel, axis: str = "pitch") -> LurePlant:
     return LurePlant(ss=full, n_ext=1, cmd_c=np.zeros(n), cmd_d=np.ones(1),
                      rate_c=ss.C[ss.output_index("omega_rad_s")].copy(),
                      applied_c=ss.C[ss.output_index("applied_torque_Nm")].copy(),
-                     inertia_kgm2=model.engine.inertia(axis))
+                     inertia_kgm2=model.engine.inertia(axis), limits=simplex_limits(model, axis))
+
+
+def simplex_limits(model: TvcModel, axis: str = "pitch") -> np.ndarray:
+    """The model's actuator and gimbal limits packed over the simplex state (:mod:`taos.actuator_limits`):
+    valve flow saturation, supply-pressure limit, hard stops at the gimbal range."""
+    from .actuator_limits import limit_rows_for_actuator, pack_limits
+    act, eng = model.actuator, model.engine
+    rows, kv = limit_rows_for_actuator(act)
+    ss = simplex_state_space(model, axis)
+    n = len(ss.states)
+    full = {k: np.concatenate([v, np.zeros(n - v.size)]) for k, v in rows.items()}
+    full["theta"] = np.zeros(n)
+    full["theta"][ss.state_index("theta_rad")] = 1.0
+    full["omega"] = np.zeros(n)
+    full["omega"][ss.state_index("omega_rad_s")] = 1.0
+    full["stop_in"] = full["omega"] / eng.inertia(axis)
+    return pack_limits(act.max_rate_m_per_s, kv * act.moment_arm_m,
+                       act.supply_pressure_Pa if act.pressure_limited else 0.0,
+                       eng.gimbal_range_rad, eng.hard_stop_stiffness_Nm_per_rad,
+                       eng.hard_stop_damping_Nms_per_rad(axis), full)
 
 
 def load_resonance_from_notch(model: TvcModel, axis: str = "pitch",

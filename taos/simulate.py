@@ -40,14 +40,14 @@ def check_step(model: TvcModel, inertia_kgm2: float, dt_s: float) -> None:
 
 
 def kernel_args(plant: LurePlant, model: TvcModel):
-    """The arrays the compiled kernels take, in order (A, Br, bc, bf, cc, dc, cw, ca)."""
+    """The arrays the compiled kernels take, in order (A, Br, bc, bf, cc, dc, cw, ca, lim)."""
     ss = plant.ss
     ne = plant.n_ext
     ic = ss.input_index("command_rad")
     ifr = ss.input_index("friction_torque_Nm")
     f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
     return (f64(ss.A), f64(ss.B[:, :ne]), f64(ss.B[:, ic]), f64(ss.B[:, ifr]), f64(plant.cmd_c),
-            f64(plant.cmd_d), f64(plant.rate_c), f64(plant.applied_c))
+            f64(plant.cmd_d), f64(plant.rate_c), f64(plant.applied_c), f64(plant.limits))
 
 
 def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: float, record_every: int = 1,

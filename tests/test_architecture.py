@@ -161,6 +161,7 @@ def test_nothing_below_the_cli_imports_it():
 #: the layers of taos/__init__.py's docstring, bottom (1) to top; masv sits on taos
 LAYERS = {
     "taos.units": 1, "taos.errors": 1, "taos.results": 1, "taos.shipped": 1, "taos.limits": 1,
+    "taos.actuator_limits": 2,
     "taos.friction": 2, "taos.avionics": 2, "taos.actuator": 2, "taos.linear": 2, "taos.model": 2,
     "taos.simplex": 3, "taos.simulate": 3, "taos.freqresp": 3, "taos.taos3d": 3, "taos.fem": 3,
     "taos._integrator": 3, "taos.profiles": 3, "taos.engine_geometry": 3, "taos.run_checks": 3,

@@ -18,7 +18,7 @@ from .conftest import MODELS, run_cli
 DEG = math.pi / 180
 
 
-def test_table_shows_stiffer_hot_fire_notch_up_and_smaller_breakaway(ambient, hotfire):
+def test_table_shows_stiffer_hot_fire_notch_up_and_breakaway_T_over_K(ambient, hotfire):
     c = compare_models(ambient, hotfire, labels=("ambient", "hot fire"))
     ka, kb = c.value("load_stiffness")
     assert (ka, kb) == (pytest.approx(115000, rel=1e-6), pytest.approx(205000, rel=1e-6))
@@ -32,7 +32,9 @@ def test_table_shows_stiffer_hot_fire_notch_up_and_smaller_breakaway(ambient, ho
     g = lambda w: (2 * math.pi * w) ** 2 - Kn / J  # noqa: E731
     assert g(nb) / g(na) == pytest.approx(kb / ka, rel=1e-6)
     ba, bb = c.value("breakaway_deflection_deg")
-    assert bb / ba == pytest.approx(ka / kb, rel=1e-9)
+    # T_c / (K_L R^2): the torque levels differ with the bearing normal load (issue 12.1)
+    tc = hotfire.friction.coulomb_torque_Nm / ambient.friction.coulomb_torque_Nm
+    assert bb / ba == pytest.approx(tc * ka / kb, rel=1e-9)
     row = next(r for r in c.rows if r.name == "load_stiffness")
     assert row.ratio == pytest.approx(205000 / 115000)
     assert "load_stiffness" in c.table() and "ratio" in c.table()

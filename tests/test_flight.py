@@ -72,3 +72,30 @@ def test_flight_file_bad_input_is_one_line(tmp_path):
     bad.write_text(FLIGHT.read_text().replace("engine_count = 4", "engine_count = 0"))
     with pytest.raises(InputError, match="vehicle.engine_count"):
         load_flight(bad)
+
+
+def test_optional_bending_mode_against_hand_calculation_and_the_fcs_notch():
+    """Issue 12.9: a first bending mode (eta'' + 2 zeta w_b eta' + w_b^2 eta = g a delta, sensed
+    with the attitude) multiplies the rigid loop by exactly 1 + g (-w^2) / (w_b^2 - w^2 + 2 j zeta
+    w_b w) when the tail-wags-dog term is off; the FCS notch at w_b takes the resonance out."""
+    import dataclasses
+
+    import numpy as np
+
+    from taos.flight.vehicle import load_flight, loop_freqresp
+    fl = load_flight(MODELS / "flight" / "core_stage.toml")
+    assert fl.vehicle.bending_frequency_hz == 0.0  # off in the shipped LCO calibration
+    rigid = dataclasses.replace(fl, vehicle=dataclasses.replace(fl.vehicle, engine_mass_kg=0.0,
+                                                                  engine_inertia_kgm2=0.0))
+    fb, zb, g = 6.0, 0.005, 0.02
+    bent = dataclasses.replace(rigid, vehicle=dataclasses.replace(rigid.vehicle, bending_frequency_hz=fb,
+                                                                    bending_damping_ratio=zb, bending_gain=g))
+    f = np.array([0.05, 0.2, 1.0, 5.0, 6.0, 8.0])
+    w, wb = 2 * np.pi * f, 2 * np.pi * fb
+    expect = loop_freqresp(rigid, f) * (1 + g * (-w ** 2) / (wb ** 2 - w ** 2 + 2j * zb * wb * w))
+    np.testing.assert_allclose(loop_freqresp(bent, f), expect, rtol=1e-9)
+    notched = dataclasses.replace(bent, fcs=dataclasses.replace(bent.fcs, notch_frequency_hz=fb,
+                                                                  notch_zeta_num=0.005, notch_zeta_den=0.5))
+    peak = abs(loop_freqresp(bent, [fb])[0]) / abs(loop_freqresp(rigid, [fb])[0])
+    assert peak == pytest.approx(math.hypot(1.0, g / (2 * zb)), rel=1e-9)  # |1 + j g / (2 zeta)| at w_b
+    assert abs(loop_freqresp(notched, [fb])[0]) < 0.05 * abs(loop_freqresp(bent, [fb])[0])

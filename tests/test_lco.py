@@ -86,14 +86,16 @@ def test_stiff_structure_no_lco_for_dahl_lugre_and_coulomb_about_halved(reports)
 def test_larger_command_amplitude_restores_stability(reports, law):
     """Paper sec. 3.2 (PTIs): above the LCO amplitude the friction degradation shrinks: at 3x
     the LCO command amplitude L0 N has positive low-frequency gain margin and phase margin
-    (stable), while at a third of it the low-frequency margin is gone; at 1 deg the loop meets
-    the typical 6 dB / 30 deg margins."""
+    (stable), while at a third of it the low-frequency margin is gone; at 1 deg most of the
+    loop's own 7.2 dB low-frequency margin is back (the -1 dB bounding avionics and the friction's
+    remaining loss take 2.6 dB) with a 30 deg phase margin. (The paper states no margin
+    requirement; the former "typical 6 dB" at 1 deg belonged to the retuned 9.5 dB loop.)"""
     p = reports["ambient", law].prediction
     a = p.stable_cycle.amplitude_rad
     hi = p.margins_at(3 * a)
     assert hi.low_gain_margin_db > 1.0 and hi.phase_margin_deg > 20
     big = p.margins_at(1.0 * DEG)
-    assert big.low_gain_margin_db >= 6.0 and big.phase_margin_deg >= 30.0
+    assert big.low_gain_margin_db >= 4.0 and big.phase_margin_deg >= 30.0
 
 
 def test_cli_lco_json_and_plots(tmp_path):
@@ -110,3 +112,79 @@ def test_cli_lco_json_and_plots(tmp_path):
                   "--json", tmp_path / "x.json")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1 and "--load-stiffness" in bad.stderr
     assert not (tmp_path / "x.json").exists()
+
+
+def test_lco_sweep_map_shows_where_the_verdict_flips(tmp_path):
+    """Issue 12.2: ``taos lco --sweep`` over the flight loop's integral gain (the calibration
+    knob) with the one Green Run friction set: at the old K_i = 0.6 1/s (low-frequency gain margin
+    9.5 dB) soft-structure Dahl has no cycle, at the shipped 0.78 1/s (7.2 dB) it has one; the
+    JSON names the flip and the loop margins, and the map is drawn."""
+    amps = ",".join(f"{a:.4g}" for a in np.degrees(AMPS))
+    freqs = ",".join(f"{f:.4g}" for f in FREQ)
+    r = run_cli("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "dahl",
+                "--sweep", "integral_gain=0.6,0.78", "--amplitudes-deg", amps, "--freq-hz", freqs,
+                "--json", "-", "--plot-map", tmp_path / "map.png")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)["sweep"]
+    assert d["lco"] == [False, True]
+    assert 0.3 < d["margin_db"][0] < 3.0 and d["margin_db"][1] == 0.0
+    assert 0.05 <= d["engine_amplitude_deg"][1] <= 0.2 and 0.1 <= d["frequency_hz"][1] <= 0.2
+    assert d["flips"] == [{"axis": "integral_gain", "between": [0.6, 0.78], "at": {}}]
+    lgm = d["loop_low_gain_margin_db"]
+    assert lgm["integral_gain=0.6"] == pytest.approx(9.46, abs=0.05)
+    assert lgm["integral_gain=0.78"] == pytest.approx(7.18, abs=0.05)
+    assert (tmp_path / "map.png").stat().st_size > 1000
+    bad = run_cli("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--sweep", "bogus=1,2", "--json", "-")
+    assert bad.returncode == 2 and "--sweep" in bad.stderr and bad.stdout == ""
+
+
+def test_smooth_coulomb_converges_to_switching_as_regularisation_shrinks(reports):
+    """Issue 12.3: the smooth (regularised) Coulomb cycle approaches the switching one as the
+    regularisation velocity v_eps shrinks (predicted command amplitude, monotone), and at the
+    shipped v_eps (0.01 deg/s, under a tenth of the cycle's peak engine rate) the time-domain cycle is
+    within 10 % of the switching form in engine amplitude. At the old 0.06 deg/s (about the
+    cycle's own peak rate) the smooth form acted as a viscous damper."""
+    import dataclasses
+    fl = load_flight(FLIGHT)
+    sw = reports["ambient", "coulomb-switching"].to_dict()
+    base = load_model(MODELS / "rs25_flight.toml", friction="coulomb-smooth")
+    assert base.friction.regularization_velocity_rad_s == pytest.approx(0.01 * DEG)
+    peak_rate = 2 * math.pi * sw["time_domain"]["frequency_hz"] * sw["time_domain"]["engine_amplitude_deg"] * DEG
+    assert base.friction.regularization_velocity_rad_s <= 0.1 * peak_rate
+    err = []
+    for veps in (0.06, 0.03, 0.01):
+        m = base.replace(friction=dataclasses.replace(base.friction, regularization_velocity_rad_s=veps * DEG))
+        d = analyse_lco(fl, m, amplitudes_rad=AMPS, freq_hz=FREQ, time_domain=False).to_dict()
+        assert d["lco"]
+        err.append(abs(d["amplitude_deg"] / sw["amplitude_deg"] - 1))
+    assert err[0] > err[1] > err[2]
+    td = analyse_lco(fl, base, amplitudes_rad=AMPS, freq_hz=FREQ, duration_s=160.0, window_s=60.0).to_dict()
+    assert abs(td["time_domain"]["engine_amplitude_deg"] / sw["time_domain"]["engine_amplitude_deg"] - 1) < 0.10
+
+
+@pytest.mark.parametrize("law", ["none", "dahl"])
+def test_flown_avionics_quantiser_cycle_prediction_and_time_domain_agree(law):
+    """Issue 12.4: with the flown 12-bit truncation (--avionics model) the describing-function
+    grid starts at half an LSB, so the quantiser's own cycle is inside the map: on the stiff
+    structure, with no friction and with Dahl, prediction and time domain both find the small
+    cycle (a few LSB of command, ~0.1 Hz) and the JSON's one verdict says so, decided by the time
+    domain. (Measured: no friction 0.0060 / 0.0057 deg at 0.105 / 0.080 Hz; Dahl 0.018 / 0.020 deg
+    at 0.113 / 0.116 Hz, prediction / time domain.)"""
+    import dataclasses
+    from taos.flight.lco import model_avionics_amplitudes_rad
+    fl = load_flight(FLIGHT)
+    m = load_model(MODELS / "rs25_flight.toml", friction=law)
+    m = m.replace(structure=dataclasses.replace(m.structure, load_stiffness_N_per_m=205000 * LBF_IN))
+    amps = model_avionics_amplitudes_rad(m)
+    assert amps[0] < m.avionics.lsb_rad
+    rep = analyse_lco(fl, m, avionics="model", freq_hz=FREQ, duration_s=240.0, window_s=100.0)
+    d = rep.to_dict()
+    assert rep.prediction.df.amplitude_rad[0] == pytest.approx(0.5 * m.avionics.lsb_rad)
+    td = d["time_domain"]
+    assert d["lco"] and td["lco"]
+    assert d["verdict"] == {"lco": True, "decided_by": "time domain", "agree": True, "prediction_lco": True,
+                            "note": None}
+    lsb = math.degrees(m.avionics.lsb_rad)
+    for a in (d["amplitude_deg"], td["amplitude_deg"]):
+        assert 0.5 * lsb < a < 6 * lsb
+    assert 0.06 <= d["frequency_hz"] <= 0.2 and 0.06 <= td["frequency_hz"] <= 0.2

@@ -37,7 +37,8 @@ def test_public_figures_in_SI(ambient, hotfire):
     lbf_in = 4.4482216152605 / 0.0254
     assert ambient.structure.load_stiffness_N_per_m == pytest.approx(115000 * lbf_in, rel=1e-9)
     assert hotfire.structure.load_stiffness_N_per_m == pytest.approx(205000 * lbf_in, rel=1e-9)
-    assert ambient.friction.coulomb_torque_Nm == pytest.approx(144000 * 4.4482216152605 * 0.0254, rel=1e-9)
+    flight = load_model(MODELS / "rs25_flight.toml")  # the paper's bounding flight torque (sec. 3.2)
+    assert flight.friction.coulomb_torque_Nm == pytest.approx(144000 * 4.4482216152605 * 0.0254, rel=1e-9)
     assert math.degrees(ambient.avionics.lsb_rad) == pytest.approx(0.005, rel=0.05)
 
 
@@ -99,3 +100,53 @@ def test_info_json_contract():
     for k in ("load_resonance_hz", "breakaway_deflection_deg", "oil_column_stiffness_N_per_m", "notch_frequency_hz"):
         assert isinstance(d[k], float)
     assert d["parameters"]["structure"]["load_stiffness_N_per_m"] > 0
+
+
+RS25 = ["rs25_ambient", "rs25_hotfire", "rs25_flight"]
+
+
+def test_one_friction_parameter_set_for_the_one_gimbal_bearing():
+    """Issue 12.1: the ambient, hot-fire and flight files describe one gimbal bearing, so its law
+    parameters (bristle stiffness and damping, Stribeck, vibration, regularisation) come from one
+    shared file that none of them repeats, and every law built from the three files carries the
+    same parameters; only the torque levels differ."""
+    from taos.friction import LAWS
+    docs = {n: tomllib.loads((MODELS / f"{n}.toml").read_text()) for n in RS25}
+    shared = tomllib.loads((MODELS / "friction" / "rs25_gimbal.toml").read_text())["friction"]
+    assert {"bristle_stiffness", "bristle_damping", "stribeck_velocity", "vibration_velocity",
+            "regularization_velocity"} <= set(shared)
+    for n, d in docs.items():
+        assert d["friction"]["parameter_set"] == "friction/rs25_gimbal.toml", n
+        assert not set(d["friction"]) & set(shared), n
+    levels = {"coulomb_torque_Nm", "static_torque_Nm"}
+    for law in LAWS:
+        laws = [load_model(MODELS / f"{n}.toml", friction=law).friction for n in RS25]
+        params = [{k: v for k, v in vars(f).items() if k not in levels} for f in laws]
+        assert params[0] == params[1] == params[2], law
+    lugre = load_model(MODELS / "rs25_ambient.toml", friction="lugre").friction
+    assert lugre.bristle_stiffness_Nm_per_rad == pytest.approx(1.3e7)  # the Green Run value
+
+
+def test_model_file_may_not_override_the_shared_friction_set(tmp_path):
+    text = (MODELS / "rs25_flight.toml").read_text()
+    p = tmp_path / "flight.toml"
+    p.write_text(text.replace('parameter_set = "friction/rs25_gimbal.toml"',
+                              f'parameter_set = "{(MODELS / "friction" / "rs25_gimbal.toml").as_posix()}"\n'
+                              'bristle_stiffness = "2.2e7 N*m/rad"'))
+    with pytest.raises(InputError) as e:
+        load_model(p)
+    assert "friction.bristle_stiffness" in str(e.value) and "parameter set" in str(e.value)
+
+
+@pytest.mark.parametrize("name", RS25)
+def test_planar_friction_level_is_mu_N_rb_as_in_taos(name):
+    """Issue 12.1: the planar torque level follows the bearing normal load exactly as the 3-D
+    TAOS model computes it (mu N r_b; N the thrust, or the engine weight when hanging): the
+    hanging ambient engine carries 1.5 % of the flight friction."""
+    from taos.taos3d.model import load_taos_model
+    m = load_model(MODELS / f"{name}.toml")
+    t3 = load_taos_model(MODELS / f"{name}.toml")
+    assert m.friction.coulomb_torque_Nm == pytest.approx(t3.coulomb_torque_Nm, rel=1e-3)
+    assert m.friction.static_torque_Nm == pytest.approx(m.friction.coulomb_torque_Nm, rel=1e-12)
+    g = tomllib.loads((MODELS / f"{name}.toml").read_text())["gimbal"]
+    assert g["friction_coefficient"] == 0.0649 and g["bearing_radius"] == "0.110 m"

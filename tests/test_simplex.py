@@ -21,6 +21,14 @@ from .conftest import MODELS, run_cli
 DEG = math.pi / 180
 
 
+@pytest.fixture(scope="module")
+def flight_soft():
+    """144,000 in-lbf on the ambient stiffness: the flight file (the ambient file now carries the
+    hanging engine's mu m g0 r_b, issue 12.1)."""
+    from taos.model import load_model
+    return load_model(MODELS / "rs25_flight.toml")
+
+
 @pytest.mark.parametrize("name", ["rs25_ambient", "rs25_hotfire"])
 def test_load_resonance_equation_1_and_piston_notch(name):
     """taos info: load_resonance_hz = sqrt((K_L R^2 + K_n)/J_n)/2pi, and the linear
@@ -80,11 +88,11 @@ def test_sine_dwell_equals_linear_without_friction(ambient):
         assert np.max(np.abs(np.degrees(np.angle(sim / ref)))) < 0.15
 
 
-def test_coulomb_friction_amplitude_dependence_section_3_1(ambient):
-    """144,000 in-lbf Coulomb friction on the ambient model at 0.2 Hz: the engine-angle gain falls
-    as the command amplitude falls, while the piston stays within 1 dB of linear and moves far
-    less than the engine (paper sec. 3.1, figs. 4-5)."""
-    m = ambient.with_friction("coulomb-switching").replace(avionics=ambient.avionics.ideal())
+def test_coulomb_friction_amplitude_dependence_section_3_1(flight_soft):
+    """144,000 in-lbf Coulomb friction on the ambient (soft) stiffness at 0.2 Hz (the flight
+    file): the engine-angle gain falls as the command amplitude falls, while the piston stays
+    within 1 dB of linear and moves far less than the engine (paper sec. 3.1, figs. 4-5)."""
+    m = flight_soft.with_friction("coulomb-switching").replace(avionics=flight_soft.avionics.ideal())
     amps = np.array([0.8, 0.4, 0.2, 0.1, 0.05])
     piston, engine = sine_dwell_grid(m, amps * DEG, [0.2], settle_cycles=1, measure_cycles=2)
     lin = linear_freqresp(m, [0.2])
@@ -140,10 +148,10 @@ def test_step_refinement_lugre_20s(ambient):
     assert np.all(np.isfinite(a.engine_rad))
 
 
-def test_switching_coulomb_sticks_without_chatter(ambient):
+def test_switching_coulomb_sticks_without_chatter(flight_soft):
     """Karnopp: below breakaway the engine is held (rate bled to zero, no sign chatter) and the
-    friction torque equals the applied torque."""
-    m = ambient.with_friction("coulomb-switching").replace(avionics=ambient.avionics.ideal())
+    friction torque equals the applied torque (144,000 in-lbf on the soft structure)."""
+    m = flight_soft.with_friction("coulomb-switching").replace(avionics=flight_soft.avionics.ideal())
     th = simulate(m, SineDwell(0.03 * DEG, 0.5, 3), record_every=1)
     eng = th.engine_rad[0]
     assert np.max(np.abs(eng)) < 1e-3 * DEG

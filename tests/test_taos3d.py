@@ -49,7 +49,10 @@ def test_rigid_body_matches_pinocchio_aba_and_crba(tm):
     """Compiled Newton-Euler = pin.aba with the chain wrench as an external force; Y = crba."""
     pmodel = engine_pin_model(tm)
     data = pmodel.createData()
-    pk = pack(dataclasses.replace(tm, gimbal=dataclasses.replace(tm.gimbal, line_load_stiffness_N_per_m=1e-12)))
+    # actuator lines off: no line stiffness, no line damping (issue 12.6)
+    base = tm.base.replace(structure=dataclasses.replace(tm.base.structure, load_damping_ratio=0.0))
+    pk = pack(dataclasses.replace(tm, base=base,
+                                  gimbal=dataclasses.replace(tm.gimbal, line_load_stiffness_N_per_m=1e-12)))
     P = pk.P
     rng = np.random.default_rng(0)
     q0 = pin.neutral(pmodel)
@@ -119,6 +122,10 @@ def test_planar_limit_matches_simplex(hot):
     3e-4 deg (achieved 6e-5 dB, 7e-5 deg: the gimbal's remaining compliance)."""
     f = np.geomspace(0.1, 20, 25)
     t = taos_model(hot, HALF * 1e4, HALF * 1e4)
+    # rigid gimbal: the line alone is the load path, so give it the planar total (the shipped line
+    # stiffness is derived for the FEM gimbal in series, issue 12.7)
+    t = dataclasses.replace(t, gimbal=dataclasses.replace(
+        t.gimbal, line_load_stiffness_N_per_m=hot.structure.load_stiffness_N_per_m))
     for axis in ("pitch", "yaw"):
         fr3 = taos_freqresp(t, f, None, axis)
         fr2 = linear_freqresp(hot, f, axis)
@@ -136,7 +143,8 @@ def test_energy_is_conserved_without_friction_and_damping(hot):
     act = dataclasses.replace(hot.actuator, loop_gain_per_s=0.0, piston_damping_Ns_per_m=0.0,
                               flow_pressure_coefficient_m3_per_s_Pa=0.0, leakage_coefficient_m3_per_s_Pa=0.0,
                               pressure_feedback_gain_m_per_s_Pa=0.0)
-    base = hot.with_friction("none").replace(actuator=act)
+    base = hot.with_friction("none").replace(actuator=act,  # and no structural damping (issue 12.6)
+                                              structure=dataclasses.replace(hot.structure, load_damping_ratio=0.0))
     t = taos_model(base, HALF, HALF)
     pk = pack(t)
     P = pk.P
@@ -219,7 +227,8 @@ def test_friction_torque_scales_with_bearing_normal_load():
     amb = taos_model(load_model("models/rs25_ambient.toml"), HALF, HALF)
     hot = taos_model(load_model("models/rs25_hotfire.toml"), HALF, HALF)
     fl = taos_model(load_model("models/rs25_flight.toml"), HALF, HALF)
-    assert hot.coulomb_torque_Nm == pytest.approx(144000 * 0.1129848, rel=1e-4)
+    # mu anchored on the paper's bounding flight torque (vacuum thrust), issue 12.1
+    assert fl.coulomb_torque_Nm == pytest.approx(144000 * 0.1129848, rel=1e-4)
     assert amb.coulomb_torque_Nm / hot.coulomb_torque_Nm == pytest.approx(3527 * 9.80665 / 1.86e6, rel=1e-9)
     assert fl.coulomb_torque_Nm / hot.coulomb_torque_Nm == pytest.approx(2279 / 1860, rel=1e-9)
 
@@ -236,7 +245,7 @@ def test_bad_gimbal_and_geometry_input_is_one_line_error(hot, tmp_path):
     p.write_text(src.replace('pitch_engine_attach = ["0.8 m"', 'pitch_engine_attach = ["0.6 m"'))
     with pytest.raises(InputError, match="geometry.pitch_engine_attach.*moment arm"):
         taos_model(load_model(p), HALF, HALF)
-    p.write_text(src.replace('friction_coefficient = 0.07952', 'friction_coefficient = "0.1 m"'))
+    p.write_text(src.replace('friction_coefficient = 0.0649', 'friction_coefficient = "0.1 m"'))
     with pytest.raises(InputError, match="gimbal.friction_coefficient"):
         taos_model(load_model(p), HALF, HALF)
     p.write_text(src.replace("../fem_data/gimbal_thrust.npz", "nope.npz"))

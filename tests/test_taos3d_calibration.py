@@ -21,3 +21,15 @@ def test_taos_notch_on_green_run_load_resonance(name):
     res = so.minimize_scalar(lambda f: abs(taos_freqresp(tm, [f]).piston[0]), bounds=(0.7 * target, 1.3 * target),
                              method="bounded", options={"xatol": 1e-5})
     assert res.x == pytest.approx(target, rel=0.01)
+
+
+@pytest.mark.parametrize("name", ["rs25_ambient", "rs25_hotfire", "rs25_flight"])
+def test_one_meaning_of_load_stiffness_line_derived_the_same_way(name):
+    """Issue 12.7: [structure] load_stiffness is the fitted total in every file; every file
+    carries the line stiffness solved the same way (3-D notch on the total's load resonance with
+    that condition's FEM gimbal in series), to 0.1 %."""
+    from taos.taos3d.calibrate import line_stiffness_for_total
+    m = load_model(MODELS / f"{name}.toml")
+    tm = load_taos_model(MODELS / f"{name}.toml")
+    assert tm.gimbal.line_load_stiffness_N_per_m is not None
+    assert tm.gimbal.line_load_stiffness_N_per_m == pytest.approx(line_stiffness_for_total(m, rtol=1e-5), rel=1e-3)

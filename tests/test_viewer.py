@@ -24,6 +24,8 @@ from taos.simulate import TimeHistory
 from taos.viewer import GimbalGeometry, load_run, offline_html, viewer_frames
 from taos.viewer.kinematics import AXES
 
+from .conftest import MODELS
+
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
                   "--disable-component-update", "--disable-sync", "--disable-quic",
                   # WebGL in headless Chromium without a GPU: SwiftShader through ANGLE
@@ -277,3 +279,23 @@ def test_3d_run_draws_gimbal_half_deflections(tmp_path):
     np.testing.assert_allclose(fr.engine_offset_m, 500.0 * (uu + ul).T, rtol=1e-9, atol=1e-12)
     assert np.max(np.abs(fr.engine_offset_m)) > 1e-4
     assert "gimbal-half deflection &times;" in offline_html(back)
+
+
+def test_viewer_reads_actuator_attach_points_from_the_model_geometry():
+    """Issue 12.9: the viewer's actuator attach points are the model file's [geometry] (one
+    definition), and a recorded run finds them through its provenance."""
+    import types
+
+    from taos.model import load_model
+    from taos.taos3d.model import parse_geometry
+    from taos.viewer.geometry import geometry_for_run, geometry_from_model
+    m = load_model(MODELS / "rs25_hotfire.toml")
+    geo = parse_geometry(m)
+    g = geometry_from_model(m)
+    for i, ax in enumerate(("pitch", "yaw")):
+        np.testing.assert_allclose(g.structure_attach_m(ax), geo.structure_attach_m[i], atol=1e-12)
+        np.testing.assert_allclose(g.engine_attach_m(ax), geo.engine_attach_m[i], atol=1e-12)
+    run = types.SimpleNamespace(provenance={"model_file": str(MODELS / "rs25_hotfire.toml")}, moment_arm_m=0.8)
+    assert geometry_for_run(run) == g
+    gone = types.SimpleNamespace(provenance={"model_file": "/nonexistent/m.toml"}, moment_arm_m=0.7)
+    assert geometry_for_run(gone).moment_arm_m == 0.7

@@ -3,7 +3,10 @@ time-domain confirmation (seed paper sections 3.1-3.2)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
+
+import numpy as np
 
 from taos.errors import InputError
 from taos.results import write_json
@@ -19,7 +22,7 @@ def cmd_lco(args) -> int:
     model = load_model(args.model, friction=args.friction)
     if args.load_stiffness:
         k = to_si(args.load_stiffness, "stiffness", source="command line", field="--load-stiffness", positive=True)
-        model = model.replace(structure=Structure(k))
+        model = model.replace(structure=dataclasses.replace(model.structure, load_stiffness_N_per_m=k))
     if not (args.duration > 0 and math.isfinite(args.duration)):
         raise InputError("command line", "--duration", "a positive time in seconds", got=repr(args.duration))
     from taos.cli.basic import parse_float_list
@@ -30,6 +33,8 @@ def cmd_lco(args) -> int:
     for name, v in (("--amplitudes-deg", amps), ("--freq-hz", freqs)):
         if v is not None and len(v) < 2:
             raise InputError("command line", name, "at least two values for the describing-function grid")
+    if args.sweep:
+        return _sweep(args, flight, model, amps, freqs)
     rep = analyse_lco(flight, model, axis=args.axis, duration_s=args.duration, avionics=args.avionics,
                       amplitudes_rad=amps, freq_hz=freqs,
                       window_s=min(120.0, 0.5 * args.duration), time_domain=not args.no_time_domain)
@@ -65,6 +70,29 @@ def cmd_lco(args) -> int:
     return 0
 
 
+def _sweep(args, flight, model, amps, freqs) -> int:
+    """``taos lco --sweep NAME=V1,V2 [--sweep NAME2=...]``: the verdict map (prediction only)."""
+    from taos.flight.lco_map import lco_map, parse_sweep
+    axes = [parse_sweep(s) for s in args.sweep]
+    if args.axis:
+        flight = dataclasses.replace(flight, axis=args.axis)
+    m = lco_map(flight, model, axes, amplitudes_rad=amps, freq_hz=freqs, avionics=args.avionics)
+    if args.plot_map:
+        from taos.plotting import save
+        save(m.plot(), args.plot_map)
+    d = {"sweep": m.to_dict(), "avionics": args.avionics}
+    if args.json:
+        write_json(args.json, d)
+    else:
+        for idx in np.ndindex(m.lco.shape):
+            where = ", ".join(f"{a.name} = {a.values[i]:.4g} {a.unit}" for a, i in zip(m.axes, idx))
+            if m.lco[idx]:
+                print(f"{where}: LCO engine {m.engine_amplitude_deg[idx]:.4f} deg at {m.frequency_hz[idx]:.3f} Hz")
+            else:
+                print(f"{where}: no LCO, margin {m.margin_db[idx]:.2f} dB")
+    return 0
+
+
 def add_parsers(sub) -> None:
     p = sub.add_parser("lco", help="flight-control limit cycle: describing-function prediction and time domain")
     p.add_argument("model", help="TVC model file, e.g. models/rs25_flight.toml")
@@ -85,4 +113,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--plot-df", metavar="PNG_OR_SVG", help="describing-function gain/phase families")
     p.add_argument("--plot-time", metavar="PNG_OR_SVG", help="engine-angle time history")
     p.add_argument("--df-out", metavar="HDF5", help="save the describing-function map")
+    p.add_argument("--sweep", action="append", metavar="NAME=V1,V2,...",
+                   help="verdict map over one or two parameters (repeat for two; prediction only): "
+                   "bristle_stiffness, coulomb_torque, load_stiffness, integral_gain, attitude_gain, rate_gain; "
+                   "values in SI or each with its unit")
+    p.add_argument("--plot-map", metavar="PNG_OR_SVG", help="with --sweep: the verdict map")
     p.set_defaults(func=cmd_lco)

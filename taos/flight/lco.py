@@ -342,6 +342,7 @@ class LcoReport:
             "margins_at_largest_amplitude": {"amplitude_deg": math.degrees(self.prediction.df.amplitude_rad[-1]),
                                              **big.to_dict()},
             "time_domain": None if self.time_domain is None else self.time_domain.to_dict(),
+            "verdict": verdict(d, None if self.time_domain is None else self.time_domain.to_dict()),
             "describing_function": {"amplitude_deg": np.degrees(self.prediction.df.amplitude_rad).tolist(),
                                     "freq_hz": self.prediction.df.freq_hz.tolist()},
             "provenance": {"model_file": self.model.source, "model_sha256": self.model.sha256,
@@ -349,6 +350,29 @@ class LcoReport:
                            "package_version": package_version()},
         })
         return d
+
+
+def model_avionics_amplitudes_rad(model: TvcModel, n: int = 15) -> np.ndarray:
+    """Default describing-function amplitudes [rad] with the flown avionics (``--avionics
+    model``): from half an LSB of the quantiser to 1 deg, so the map sees the quantiser's own
+    limit cycle (one to three LSB) as well as the friction's."""
+    lsb = model.avionics.lsb_rad
+    return np.logspace(np.log10(0.5 * lsb), np.log10(DEG), n)
+
+
+def verdict(prediction: dict, time_domain: dict | None) -> dict:
+    """The one LCO verdict of an analysis: the time domain decides when it was run (it carries
+    every harmonic and the quantiser exactly); the describing function's verdict is reported
+    beside it, with the reason when they differ."""
+    if time_domain is None:
+        return {"lco": prediction["lco"], "decided_by": "describing function", "agree": None, "note": None}
+    agree = bool(prediction["lco"]) == bool(time_domain["lco"])
+    note = None
+    if not agree:
+        note = ("the describing function keeps the fundamental only: near a gain-loss threshold "
+                "(friction floor or quantiser step) the harmonics it drops decide; the time domain decides")
+    return {"lco": bool(time_domain["lco"]), "decided_by": "time domain", "agree": agree,
+            "prediction_lco": bool(prediction["lco"]), "note": note}
 
 
 def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None,
@@ -360,13 +384,17 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
     :data:`DEFAULT_FREQ_HZ`, one settling and one measured cycle beyond the linear settling
     time (the friction hysteresis is periodic after the first reversal). ``avionics``:
     "bounding" (the paper's -1 dB gain, :func:`with_bounding_avionics`) or "model" (the model
-    file's quantisation and crossover curve, as flown)."""
+    file's quantisation and crossover curve, as flown; the default amplitudes then reach half an
+    LSB, :func:`model_avionics_amplitudes_rad`)."""
     axis = axis or flight.axis
     if avionics == "bounding":
         model = with_bounding_avionics(model)
     elif avionics != "model":
         raise ValueError(f"avionics must be 'bounding' or 'model', got {avionics!r}")
-    amps = np.radians(DEFAULT_AMPLITUDES_DEG) if amplitudes_rad is None else np.asarray(amplitudes_rad, float)
+    if amplitudes_rad is None and avionics == "model" and model.avionics.lsb_rad > 0:
+        amps = model_avionics_amplitudes_rad(model)  # the quantiser's own cycle lives below 0.01 deg
+    else:
+        amps = np.radians(DEFAULT_AMPLITUDES_DEG) if amplitudes_rad is None else np.asarray(amplitudes_rad, float)
     f = np.asarray(DEFAULT_FREQ_HZ if freq_hz is None else freq_hz, float)
     df = describing_function_map(model, amps, f, axis, settle_cycles=settle_cycles, measure_cycles=measure_cycles)
     pred = predict_lco(flight, df, axis)

@@ -50,7 +50,8 @@ from taos.linear import StateSpace
 from taos.margins import LoopMargins, loop_margins
 from taos.model import TvcModel, read_toml
 from taos.shipped import resolve
-from taos.simplex import LurePlant, simplex_state_space
+from taos.actuator_limits import embed_limits
+from taos.simplex import LurePlant, simplex_limits, simplex_state_space
 from taos.units import Q_
 
 #: vehicle + FCS block signals
@@ -66,7 +67,12 @@ class Vehicle:
     pitch/yaw_inertia_kgm2 : I_v about the c.g. [kg m^2]; engine_count : n_e;
     thrust_per_engine_N : T [N]; gimbal_arm_m : l_c, c.g. to gimbal plane [m];
     engine_mass_kg : m_e [kg]; engine_cg_offset_m : l_e, gimbal to engine c.g. [m];
-    engine_inertia_kgm2 : J_n about the gimbal [kg m^2]; aero_instability_per_s2 : M_a [1/s^2].
+    engine_inertia_kgm2 : J_n about the gimbal [kg m^2]; aero_instability_per_s2 : M_a [1/s^2];
+    optional first bending mode (0 Hz: none): bending_frequency_hz w_b / 2 pi [Hz],
+    bending_damping_ratio zeta_b [-], bending_gain g_b [-] with
+    eta'' + 2 zeta_b w_b eta' + w_b^2 eta = g_b a delta, the sensors reading theta + eta and
+    theta' + eta' (g_b: the mode's generalised TVC force times the sensor's modal slope, relative to
+    the rigid body's a; Greensite 1970, ch. 5).
     """
 
     mass_kg: float
@@ -79,6 +85,9 @@ class Vehicle:
     engine_cg_offset_m: float
     engine_inertia_kgm2: float
     aero_instability_per_s2: float = 0.0
+    bending_frequency_hz: float = 0.0
+    bending_damping_ratio: float = 0.005
+    bending_gain: float = 0.0
 
     def inertia(self, axis: str) -> float:
         return self.pitch_inertia_kgm2 if axis == "pitch" else self.yaw_inertia_kgm2
@@ -138,6 +147,9 @@ _VEHICLE_KEYS = {  # key -> (field, reference unit, check)
     "engine_cg_offset": ("engine_cg_offset_m", "m", "nonnegative"),
     "engine_inertia": ("engine_inertia_kgm2", "kg*m**2", "nonnegative"),
     "aero_instability": ("aero_instability_per_s2", "1/s**2", "nonnegative"),
+    "bending_frequency": ("bending_frequency_hz", "Hz", "nonnegative"),
+    "bending_damping_ratio": ("bending_damping_ratio", "dimensionless", "positive"),
+    "bending_gain": ("bending_gain", "dimensionless", "nonnegative"),
 }
 _FCS_KEYS = {
     "attitude_gain": ("attitude_gain", "rad/rad", "positive"),
@@ -150,7 +162,7 @@ _FCS_KEYS = {
     "delay": ("delay_s", "s", "nonnegative"),
 }
 _OPTIONAL = {"aero_instability", "lag_time_constant", "notch_frequency", "notch_zeta_num",
-             "notch_zeta_den", "delay"}
+             "notch_zeta_den", "delay", "bending_frequency", "bending_damping_ratio", "bending_gain"}
 
 
 def _value(table: Mapping, key: str, unit: str, check: str, src: str, section: str) -> float:
@@ -275,24 +287,37 @@ def vehicle_fcs_state_space(flight: FlightModel, axis: str | None = None) -> Sta
     num, den = fcs_filter_tf(f)
     Af, Bf, Cf, Df = scipy.signal.tf2ss(num, den)
     nf = Af.shape[0]
-    n = 3 + nf
+    nb = 2 if v.bending_frequency_hz > 0 else 0  # optional first bending mode (eta, eta')
+    n = 3 + nf + nb
     Aa = np.zeros((n, n))
     Aa[:3, :3] = A
     Ba = np.zeros((n, 2))
     Ba[:3] = B
+    c_u = np.concatenate([c_u, np.zeros(nf + nb)])
+    if nb:  # sensed attitude theta + eta, rate theta' + eta'; the integrator integrates the sensed attitude
+        ib = 3 + nf
+        wb = 2 * math.pi * v.bending_frequency_hz
+        Aa[ib, ib + 1] = 1.0
+        Aa[ib + 1, ib] = -wb * wb
+        Aa[ib + 1, ib + 1] = -2 * v.bending_damping_ratio * wb
+        Ba[ib + 1, 0] = v.bending_gain * a
+        Aa[2, ib] = 1.0
+        c_u[ib] = f.attitude_gain
+        c_u[ib + 1] = f.rate_gain_s
     if nf:
-        Aa[3:, 3:] = Af
-        Aa[3:, :3] = np.outer(Bf[:, 0], c_u)
-        Ba[3:] = np.outer(Bf[:, 0], d_u)
+        Aa[3:3 + nf, 3:3 + nf] = Af
+        Aa[3:3 + nf, :] += np.outer(Bf[:, 0], c_u)
+        Ba[3:3 + nf] = np.outer(Bf[:, 0], d_u)
     C = np.zeros((3, n))
     D = np.zeros((3, 2))
-    C[0, :3] = -Df[0, 0] * c_u
+    C[0, :] = -Df[0, 0] * c_u
     if nf:
-        C[0, 3:] = -Cf[0]
+        C[0, 3:3 + nf] += -Cf[0]
     D[0] = -Df[0, 0] * d_u
     C[1, :3], D[1] = c_th, d_th
     C[2, :3], D[2] = c_q, d_q
-    states = ("xi_rad", "xi_rate_rad_s", "int_attitude_rad_s") + tuple(f"filter_{i}" for i in range(nf))
+    states = (("xi_rad", "xi_rate_rad_s", "int_attitude_rad_s") + tuple(f"filter_{i}" for i in range(nf))
+              + (("bending_eta", "bending_eta_rate") if nb else ()))
     return StateSpace(Aa, Ba, C, D, states, VF_INPUTS, VF_OUTPUTS)
 
 
@@ -336,7 +361,8 @@ def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None) 
     return LurePlant(ss=ss, n_ext=1, cmd_c=C[ss.output_index("delta_cmd_rad")].copy(), cmd_d=np.ones(1),
                      rate_c=C[ss.output_index("omega_rad_s")].copy(),
                      applied_c=C[ss.output_index("applied_torque_Nm")].copy(),
-                     inertia_kgm2=model.engine.inertia(axis))
+                     inertia_kgm2=model.engine.inertia(axis),
+                     limits=embed_limits(simplex_limits(model, axis), n, 0))
 
 
 # -- margins ------------------------------------------------------------------------------

@@ -398,6 +398,10 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
     if result.initial.friction.name != file_law:
         todo[("friction", "model")] = (result.initial.friction.name,
                                        f'# law used by the fit (--friction; the file had "{file_law}")')
+    ref = doc.get("friction", {}).get("parameter_set")
+    if ref:  # the shared friction set is named relative to the model file: keep it reachable
+        toml_set(doc, "friction", "parameter_set", (Path(src).parent / str(ref)).resolve().as_posix(),
+                 f"the shared set of {Path(src).name}")
     if "name" in doc:
         toml_set(doc, "", "name", f"{result.initial.name} (fitted)")
     for (section, key), (value, comment) in todo.items():

@@ -89,6 +89,8 @@ def _p(name, section, key, part, fld, kind, unit, **kw):
 #: name -> FitParam
 PARAMETERS: dict[str, FitParam] = {p.name: p for p in (
     _p("load_stiffness", "structure", "load_stiffness", "structure", "load_stiffness_N_per_m", "stiffness", "lbf/in"),
+    _p("load_damping_ratio", "structure", "load_damping_ratio", "structure", "load_damping_ratio", "dimensionless",
+       "", lo=1e-2, hi=1e2),
     _p("coulomb_torque", "friction", "coulomb_torque", "friction", "coulomb_torque_Nm", "torque", "in*lbf"),
     _p("bristle_stiffness", "friction", "bristle_stiffness", "friction", "bristle_stiffness_Nm_per_rad",
        "rotational_stiffness", "N*m/rad", lo=1e-3, hi=1e3),

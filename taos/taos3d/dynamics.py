@@ -14,7 +14,8 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
                  planar feedline/gravity spring on pitch/yaw, P the pitch/yaw projector),
                  applied as the world torque Jl(r)^-T g (Jl the SO(3) left Jacobian, so the
                  springs are exactly conservative); each actuator i pulls along its line u_i
-                 = (E_i - S_i)/L_i with F_L,i = K_L (x_p,i - (L_i - L0_i)) at E_i
+                 = (E_i - S_i)/L_i with F_L,i = K_L (x_p,i - (L_i - L0_i)) + c_L (v_p,i - L_i') at E_i
+                 (c_L the load path's structural damping, taos.model.Structure)
     actuators    the one linear actuator model (taos.actuator), x_c,i = R avionics(theta_c,i),
                  load input F_L,i
     bearing      (phi, z, T) advanced once per step by the friction law's backward-Euler
@@ -39,6 +40,7 @@ import numpy as np
 from numba import njit, prange
 
 from .. import avionics as _av
+from .. import actuator_limits as _lim
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 N_BODY = 13  # p (3), quaternion (4), v (6)
@@ -90,6 +92,8 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     the gimbal frame [N, N m], 6-7 F_L [N], 8-9 phi [rad], 10-11 engine angles [rad]."""
     (Y, Yinv, Ks, G, Kc, S, Satt, Eatt, Aa, bxc, bf, cxp, axes, sc) = P
     KL, Rarm, Kn, L00, L01 = sc[0], sc[1], sc[2], sc[3], sc[4]
+    cL, ivp = sc[5], int(sc[6])  # load-path damping [N s/m] and the actuator's v_p state index
+    lim = sc[7:]  # actuator/gimbal limits packed over one actuator's state (taos.actuator_limits)
     na = Aa.shape[0]
     Rm = np.empty((3, 3))
     _rot(x[3:7], Rm)
@@ -121,6 +125,17 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     g = np.empty(3)
     for i in range(3):
         g[i] = -W[3 + i] - Kn * (axes[0, i] * tp + axes[1, i] * ty)
+    if lim.shape[0] > 0 and lim[4] > 0.0:  # hard stops at the gimbal range (taos.actuator_limits)
+        wp = 0.0
+        wy = 0.0
+        for i in range(3):
+            wi = Rm[i, 0] * x[10] + Rm[i, 1] * x[11] + Rm[i, 2] * x[12]
+            wp += axes[0, i] * wi
+            wy += axes[1, i] * wi
+        tsp = _lim.stop_torque(tp, wp, lim[4], lim[5], lim[6])
+        tsy = _lim.stop_torque(ty, wy, lim[4], lim[5], lim[6])
+        for i in range(3):
+            g[i] += axes[0, i] * tsp + axes[1, i] * tsy
     if th < 1e-4:
         c = 1.0 / 12.0 + th * th / 720.0
     else:
@@ -149,6 +164,13 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
         for k in range(na):
             xp += cxp[k] * x[off + k]
         F = KL * (xp - (L - (L00 if a == 0 else L01)))
+        if cL > 0.0:  # structural damping across the line: c_L (v_p - L')
+            wb = np.empty(3)
+            _cross(x[10:13], Eatt[a], wb)
+            Ld = 0.0
+            for i in range(3):
+                Ld += Ew[i] * (Rm[i, 0] * (x[7] + wb[0]) + Rm[i, 1] * (x[8] + wb[1]) + Rm[i, 2] * (x[9] + wb[2]))
+            F += cL * (x[off + ivp] - Ld / L)
         for i in range(3):
             fl[i] = F * Ew[i] / L
             Fw[i] += fl[i]
@@ -161,6 +183,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
             for j in range(na):
                 s += Aa[k, j] * x[off + j]
             dx[off + k] = s
+        _lim.apply_valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
         aux[6 + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
     f = np.empty(6)

@@ -42,6 +42,18 @@ class Packed:
     n_act: int
 
 
+def actuator_limits(tm: TaosModel) -> np.ndarray:
+    """The actuator and gimbal limits (:mod:`taos.actuator_limits`) packed over one actuator's state:
+    valve flow saturation and supply-pressure limit per actuator, hard stops per axis (the
+    stop damping from the pitch inertia; the 3-D engine is axisymmetric about its axis)."""
+    from ..actuator_limits import limit_rows_for_actuator, pack_limits
+    act, eng = tm.base.actuator, tm.base.engine
+    rows, kv = limit_rows_for_actuator(act)
+    return pack_limits(act.max_rate_m_per_s, kv * act.moment_arm_m,
+                       act.supply_pressure_Pa if act.pressure_limited else 0.0, eng.gimbal_range_rad,
+                       eng.hard_stop_stiffness_Nm_per_rad, eng.hard_stop_damping_Nms_per_rad("pitch"), rows)
+
+
 def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     """Pack a TAOS model for :mod:`taos.taos3d.dynamics` (SI arrays)."""
     f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
@@ -56,6 +68,8 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     L0 = [float(np.linalg.norm(geo.engine_attach_m[i] - geo.structure_attach_m[i])) for i in range(2)]
     sc = np.array([tm.line_load_stiffness_N_per_m, tm.base.actuator.moment_arm_m,
                    tm.base.engine.rotational_stiffness_Nm_per_rad, L0[0], L0[1]])
+    cL = tm.base.structure.load_damping_Ns_per_m(tm.base.actuator.moment_arm_m, tm.base.engine.inertia("pitch"))
+    sc = np.concatenate([sc, [cL, act.states.index("v_p_m_s")], actuator_limits(tm)])
     P = (f64(Y), f64(np.linalg.inv(Y)), f64(Ks), f64(G), f64(Kc), f64(S), f64(geo.structure_attach_m),
          f64(geo.engine_attach_m), f64(act.A), f64(act.B[:, act.input_index("x_c_m")]),
          f64(act.B[:, act.input_index("f_load_N")]), f64(act.C[act.output_index("x_p_m")]),

@@ -17,7 +17,7 @@ from pathlib import Path
 from ..errors import InputError
 from ..results import atomic_write
 from .base import BaseVisualizer
-from .geometry import GimbalGeometry
+from .geometry import GimbalGeometry, geometry_for_run
 from .kinematics import ViewerFrames, viewer_frames
 from .meshcat_backend import MeshcatVisualizer, OfflineWindow, legend_html, live_visualizer
 
@@ -72,7 +72,7 @@ def offline_html(th, *, angle_scale: float = 1.0, deflection_scale: float | None
     also selects a time)."""
     fr = viewer_frames(th, geometry, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps,
                        gimbal_scale=gimbal_scale)
-    v = MeshcatVisualizer(geometry or GimbalGeometry(moment_arm_m=float(th.moment_arm_m)),
+    v = MeshcatVisualizer(geometry or geometry_for_run(th),
                           window=OfflineWindow(title=_title(th), legend_html=legend_html(fr)))
     v.load_scene()
     v.play(fr, autoplay=paused_at_s is None)
@@ -92,7 +92,7 @@ def serve(th, *, angle_scale: float = 1.0, deflection_scale: float | None = None
     Calls ``on_ready(url)`` once the scene is loaded; returns 0 after shutting the server down."""
     fr = viewer_frames(th, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps,
                        gimbal_scale=gimbal_scale)
-    vis, proc = live_visualizer(GimbalGeometry(moment_arm_m=float(th.moment_arm_m)))
+    vis, proc = live_visualizer(geometry_for_run(th))
     stop = stop or threading.Event()
     old = {}
     if threading.current_thread() is threading.main_thread():

@@ -174,3 +174,30 @@ def thrust_structure(g: GimbalGeometry) -> trimesh.Trimesh:
         trimesh.creation.cylinder(0.1, segment=((0, 0, g.gimbal_height_m / 2), (0, 0, zt)), sections=16),
     ]
     return trimesh.util.concatenate(beams)
+
+
+def geometry_from_model(model) -> GimbalGeometry:
+    """Display geometry whose actuator attach points are the model file's ``[geometry]`` (the
+    3-D TAOS model's, :func:`taos.taos3d.model.parse_geometry`): moment arm, structure attach
+    height and engine attach depth from the pitch actuator's points, not repeated here."""
+    from taos.taos3d.model import parse_geometry
+    geo = parse_geometry(model)
+    S, E = geo.structure_attach_m[0], geo.engine_attach_m[0]
+    return GimbalGeometry(moment_arm_m=float(np.hypot(E[0], E[1])), structure_attach_height_m=float(S[2]),
+                          engine_attach_depth_m=float(-E[2]))
+
+
+def geometry_for_run(th) -> GimbalGeometry:
+    """Display geometry of a recorded run: the ``[geometry]`` of the model file named in its
+    provenance when that file is readable and has one, else the defaults with the run's moment arm."""
+    src = (getattr(th, "provenance", None) or {}).get("model_file")
+    if src:
+        from taos.errors import InputError
+        from taos.model import load_model
+        try:
+            m = load_model(src)
+            if "geometry" in m.extra:
+                return geometry_from_model(m)
+        except InputError:  # a moved or edited model file: fall back to the defaults
+            pass
+    return GimbalGeometry(moment_arm_m=float(th.moment_arm_m))

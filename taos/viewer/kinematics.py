@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .geometry import GimbalGeometry
+from .geometry import GimbalGeometry, geometry_for_run
 
 AXES = ("pitch", "yaw")
 
@@ -148,7 +148,7 @@ def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: fl
         Gimbal-half deflection exaggeration g [-] for 3-D runs; default: the peak drawn near
         3 cm (1-2-5 steps).
     """
-    g = geometry or GimbalGeometry(moment_arm_m=float(th.moment_arm_m))
+    g = geometry or geometry_for_run(th)
     t = np.asarray(th.t_s, float)
     theta = _axis_arrays(th, "engine_rad")
     xp = _axis_arrays(th, "piston_m")
