@@ -83,7 +83,11 @@ def engine_axis_block(model: TvcModel, axis: str, engine_cg_offset_m: float = 0.
     motion along the line of action, gimbal minus attach point), ``gimbal_rotation_rad`` r [rad],
     ``gimbal_accel_m_s2`` a [m/s^2] (gimbal acceleration along d). Outputs: ``x_p_m``,
     ``theta_rad``, ``load_force_N`` = K_L (x_p - R theta - e), ``spring_torque_Nm`` =
-    K_n (theta - r), ``twd_force_N`` = -m_e l_e theta'' [N]. ``engine_cg_offset_m`` l_e [m]."""
+    K_n (theta - r), ``twd_force_N`` = -m_e l_e theta'' [N]. ``engine_cg_offset_m`` l_e [m].
+    The taos load-path damping (``[structure] load_damping_ratio``) is off here: MASV's structural
+    damping is modal (the structure's own damping ratios)."""
+    import dataclasses
+    model = model.replace(structure=dataclasses.replace(model.structure, load_damping_ratio=0.0))
     ss = simplex_state_space(model, axis, structure_inputs=True, engine_cg_offset_m=engine_cg_offset_m)
     ii = [ss.input_index(n) for n in BLOCK_INPUTS]
     oo = [ss.output_index(n) for n in BLOCK_OUTPUTS]

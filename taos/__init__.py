@@ -15,9 +15,9 @@ The public API, by task (each name is importable from ``taos``)::
 Layers, bottom to top (none imports a layer above it):
 
 1. ``units``, ``errors``, ``results``, ``shipped``, ``limits`` - units, one-line input errors, output files, documented limits;
-2. ``friction``, ``avionics``, ``actuator``, ``linear``, ``model`` - component models;
+2. ``friction``, ``avionics``, ``actuator``, ``actuator_limits``, ``linear``, ``margins``, ``model`` - component models;
 3. ``simplex``, ``simulate``, ``freqresp``, ``taos3d``, ``fem``, ``run_checks`` - the planar and 3-D models;
-4. ``flight``, ``identify``, ``montecarlo`` - analyses built on them;
+4. ``flight``, ``identify``, ``montecarlo``, ``interop`` - analyses built on them;
 5. ``plotting``, ``viewer`` - drawing only;
 6. ``cli`` - the ``taos`` command and the Green Run report.
 

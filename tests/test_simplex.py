@@ -51,7 +51,14 @@ def test_load_resonance_equation_1_and_piston_notch(name):
     f = np.linspace(0.5 * wl, 2 * wl, 4001)
     g = np.abs(linear_freqresp(m, f).piston)
     assert f[np.argmin(g)] == pytest.approx(wl, rel=4e-4)
-    assert d["notch_frequency_hz"] == pytest.approx(wl, rel=1e-7)
+    # the shipped load path carries 0.5 % structural damping (a damped zero, checked exactly in
+    # tests/test_load_path.py), which moves the notch by ~1e-4 w_L; without it the notch is w_L
+    assert d["notch_frequency_hz"] == pytest.approx(wl, rel=3e-4)
+    import dataclasses
+
+    from taos.simplex import load_resonance_from_notch
+    undamped = m.replace(structure=dataclasses.replace(m.structure, load_damping_ratio=0.0))
+    assert load_resonance_from_notch(undamped) == pytest.approx(wl, rel=1e-7)
 
 
 def test_hot_fire_notch_above_ambient(ambient, hotfire):
@@ -78,13 +85,14 @@ def test_pressure_feedback_keeps_static_stiffness(ambient):
 
 def test_sine_dwell_equals_linear_without_friction(ambient):
     """Friction off, small avionics effects off: time-domain sine dwell = exact linear response
-    within 0.003 dB and 0.15 deg from 0.1 to 20 Hz (achieved 1.0e-3 dB, 0.047 deg)."""
+    within 0.01 dB and 0.15 deg from 0.1 to 20 Hz (achieved 6.7e-3 dB at 5.3 Hz, beside the now
+    finite -28 dB notch, 1.3e-4 dB elsewhere; 0.047 deg)."""
     m = ambient.with_friction("none").replace(avionics=ambient.avionics.ideal())
     f = np.array([0.1, 0.3, 1.0, 2.0, 4.0, 5.3, 7.0, 10.0, 14.0, 20.0])
     piston, engine = sine_dwell_grid(m, [0.4 * DEG], f)
     lin = linear_freqresp(m, f)
     for sim, ref in ((piston[0], lin.piston), (engine[0], lin.engine)):
-        assert np.max(np.abs(gain_db(sim) - gain_db(ref))) < 0.003
+        assert np.max(np.abs(gain_db(sim) - gain_db(ref))) < 0.01
         assert np.max(np.abs(np.degrees(np.angle(sim / ref)))) < 0.15
 
 

@@ -79,7 +79,8 @@ def _sweep(args, flight, model, amps, freqs) -> int:
     m = lco_map(flight, model, axes, amplitudes_rad=amps, freq_hz=freqs, avionics=args.avionics)
     if args.plot_map:
         from taos.plotting import save
-        save(m.plot(), args.plot_map)
+        from taos.plotting.lco_map import plot_lco_map
+        save(plot_lco_map(m), args.plot_map)
     d = {"sweep": m.to_dict(), "avionics": args.avionics}
     if args.json:
         write_json(args.json, d)

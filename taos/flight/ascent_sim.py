@@ -252,9 +252,11 @@ class WindowResult:
                 "friction_band_amplitude_deg": num(self.friction_band_amplitude_rad)}
 
 
-def analysis_windows(h: AscentHistory, axis: str, settle_s: float = 20.0) -> list[tuple[str, float, float]]:
+def analysis_windows(h: AscentHistory, axis: str, settle_s: float = 15.0, min_quiet_s: float = 20.0
+                     ) -> list[tuple[str, float, float]]:
     """(kind, start, end) of the post-separation windows: each PTI window, and each quiescent
-    stretch between them (starting ``settle_s`` after separation or after a PTI ends)."""
+    stretch of at least ``min_quiet_s`` between them (starting ``settle_s`` after separation or
+    after a PTI ends)."""
     t0 = max(h.separation_time_s, float(h.t_s[0]))
     t_end = float(h.t_s[-1])
     out = []
@@ -262,11 +264,11 @@ def analysis_windows(h: AscentHistory, axis: str, settle_s: float = 20.0) -> lis
     for a, b in sorted(h.pti_windows[axis]):
         if b <= t0 or a >= t_end:
             continue
-        if a - cursor >= 30.0:
+        if a - cursor >= min_quiet_s:
             out.append(("quiescent", cursor, a))
         out.append(("pti", max(a, t0), min(b, t_end)))
         cursor = b + settle_s
-    if t_end - cursor >= 30.0:
+    if t_end - cursor >= min_quiet_s:
         out.append(("quiescent", cursor, t_end))
     return out
 
@@ -283,8 +285,10 @@ def analyse_ascent(h: AscentHistory, linear: AscentHistory | None = None, axes=N
     """Measure each post-separation window of ``h`` (:func:`analysis_windows`). Quiescent
     windows: the command oscillation (LCO if above ``threshold_rad`` and not decaying). PTI
     windows, when the same run without friction (``linear``) is given: the friction-induced part
-    of the command (h - linear) at the frequency of the nearest quiescent LCO, which is what a
-    limit cycle riding on the PTI would show."""
+    of the command (h - linear) at the frequency of the preceding quiescent window's oscillation
+    (the nearest one if none precedes), over the second half of the window (the first half still
+    carries the decay of the cycle the PTI broke up): what a limit cycle riding on the PTI would
+    show."""
     res = []
     for ax in axes or h.axes:
         wins = analysis_windows(h, ax)
@@ -301,10 +305,11 @@ def analyse_ascent(h: AscentHistory, linear: AscentHistory | None = None, axes=N
             band = None
             f = None
             if quiet:
-                near = min(quiet, key=lambda q: min(abs(q.start_s - b), abs(q.end_s - a)))
+                before = [q for q in quiet if q.end_s <= a + 1e-9]
+                near = before[-1] if before else min(quiet, key=lambda q: abs(q.start_s - b))
                 f = near.freq_hz
             if linear is not None and f:
-                sel = (h.t_s >= a) & (h.t_s <= b)
+                sel = (h.t_s >= 0.5 * (a + b)) & (h.t_s <= b)
                 d = h.signal("command_rad", ax)[sel] - linear.signal("command_rad", ax)[sel]
                 band = _harmonic(h.t_s[sel], d, f)
             res.append(WindowResult(ax, kind, a, b, False, float("nan"), float("nan"), f or float("nan"), band))

@@ -133,10 +133,6 @@ class LcoMap:
                 "margin_db": grid(self.margin_db), "loop_low_gain_margin_db": self.loop_low_gain_margin_db,
                 "flips": self.flips()}
 
-    def plot(self, **kwargs):
-        from taos.plotting import lco_map
-        return lco_map.plot_lco_map(self, **kwargs)
-
 
 def lco_map(flight: FlightModel, model: TvcModel, axes, *, amplitudes_rad=None, freq_hz=None,
             avionics: str = "bounding") -> LcoMap:
