@@ -105,10 +105,14 @@ def cmd_freqresp(args) -> int:
     if args.json:
         write_json(args.json, d)
     else:
-        print(f"{'freq_hz':>9} {'piston dB':>10} {'piston deg':>11} {'engine dB':>10} {'engine deg':>11}")
+        print(f"{'freq_hz':>9} {'piston dB':>10} {'piston deg':>11} {'engine dB':>10} {'engine deg':>11}"
+              "   (piston x_p/(R theta_c); phase continuous from low frequency)")
         for i, f in enumerate(d["freq_hz"]):
-            print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} "
-                  f"{d['engine']['gain_db'][i]:10.3f} {d['engine']['phase_deg'][i]:11.2f}")
+            eg, ep = d["engine"]["gain_db"][i], d["engine"]["phase_deg"][i]
+            eng = f"{eg:10.3f} {ep:11.2f}" if eg is not None else f"{'engine held':>22s}"
+            print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} {eng}")
+        if d.get("note"):
+            print(d["note"])
     if args.plot:
         from taos.plotting import save
         save(fr.plot(resonance_hz=model.load_resonance_hz(args.axis)), args.plot)
