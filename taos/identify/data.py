@@ -244,7 +244,7 @@ def _read_hdf5(path: Path, src: str) -> tuple[dict, dict, dict]:
                     labels[f"{ax}_{sig}"] = "/" + key
             meta.setdefault("engine_angle_reference", "absolute")
             meta.setdefault("synthetic", True)
-            meta = {k: v for k, v in meta.items() if k not in ("axes", "moment_arm_m")}
+            meta = {k: v for k, v in meta.items() if k != "axes"}
         else:
             for sig in SIGNALS:
                 if sig in h5:

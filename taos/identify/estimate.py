@@ -84,12 +84,29 @@ class MeasuredResponse:
         return FrequencyResponse(self.freq_hz, self.piston_m_per_rad / moment_arm_m, eng, amp, self.axis,
                                  friction_model="data", provenance={"source": self.source, "method": self.method})
 
-    def to_dict(self) -> dict:
+    def phase_deg(self, h) -> np.ndarray:
+        """Phase of ``h`` at these points [deg], continuous from the lowest frequency over all
+        points in frequency order (dwells at 0.4 and 0.8 deg lie on one curve, as the test
+        steps the amplitude up with frequency; :func:`taos.linear.phase_deg_continuous`)."""
+        from taos.linear import phase_deg_continuous
+        return phase_deg_continuous(self.freq_hz, np.asarray(h))
+
+    def to_dict(self, moment_arm_m: float | None = None) -> dict:
+        """JSON: ``piston`` is x_p / (R theta_c) (the project's piston convention) when the
+        moment arm is known (argument, or ``meta['moment_arm_m']``), else null;
+        ``piston_in_per_deg`` is x_p / theta_c in in/deg, named by its unit. Phases are
+        continuous from low frequency (:meth:`phase_deg`)."""
         def gp(h):
             return None if h is None else {"gain_db": (20 * np.log10(np.abs(h))).tolist(),
-                                           "phase_deg": np.degrees(np.angle(h)).tolist()}
+                                           "phase_deg": self.phase_deg(h).tolist()}
+        R = moment_arm_m if moment_arm_m is not None else self.meta.get("moment_arm_m")
         return {"axis": self.axis, "method": self.method, "source": self.source, "condition": self.condition,
+                "excitation": self.meta.get("excitation"),
                 "freq_hz": self.freq_hz.tolist(), "amplitude_deg": np.degrees(self.amplitude_rad).tolist(),
+                "piston_definition": "x_p / (R theta_c), dimensionless" if R else
+                "x_p / (R theta_c) needs the moment arm (taos estimate --model MODEL); see piston_in_per_deg",
+                "moment_arm_m": R,
+                "piston": gp(self.piston_m_per_rad / R) if R else None,
                 "piston_in_per_deg": gp(self.piston_m_per_rad / 0.0254 * math.pi / 180),
                 "engine": gp(self.engine), "coherence_piston": self.coherence_piston.tolist(),
                 "coherence_engine": None if self.coherence_engine is None else self.coherence_engine.tolist(),
@@ -425,5 +442,6 @@ def estimate(data: TestData, method: str = "auto", **kwargs) -> list[MeasuredRes
         e = by_axis[r.axis]
         if chosen == "h1" and e.kind == "sweep":
             r = replace(r, amplitude_rad=np.full(r.freq_hz.shape, e.amplitude_rad))
-        res.append(replace(r, meta={**r.meta, "excitation": e.to_dict(), "method_forced": method != "auto"}))
+        extra = {"moment_arm_m": float(data.metadata["moment_arm_m"])} if "moment_arm_m" in data.metadata else {}
+        res.append(replace(r, meta={**r.meta, "excitation": e.to_dict(), "method_forced": method != "auto", **extra}))
     return res
