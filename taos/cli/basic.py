@@ -30,8 +30,21 @@ def model_from_args(args) -> TvcModel:
     return load_model(args.model, friction=getattr(args, "friction", None))
 
 
-def info_dict(model: TvcModel) -> dict:
-    """Parameters in SI and derived figures (the ``taos info`` JSON)."""
+def merit_dict(model: TvcModel, axes=AXES, steps: bool = True) -> dict:
+    """Figures of merit per axis (:mod:`taos.merit`): frequency figures from the linear
+    response, and (``steps``) step, threshold and hysteresis figures by simulation."""
+    from taos.merit import frequency_merit, step_merit
+    out = {}
+    for ax in axes:
+        d = frequency_merit(model, ax).to_dict()
+        if steps:
+            d["step"] = step_merit(model, ax).to_dict()
+        out[ax] = d
+    return out
+
+
+def info_dict(model: TvcModel, steps: bool = True) -> dict:
+    """Parameters in SI and derived figures (the ``taos info`` JSON), with the figures of merit."""
     from dataclasses import asdict
 
     from taos.simplex import load_resonance_from_notch, simplex_state_space
@@ -53,6 +66,7 @@ def info_dict(model: TvcModel) -> dict:
         "load_stiffness_rotational_Nm_per_rad": model.structure.load_stiffness_N_per_m * model.actuator.moment_arm_m ** 2,
         "stall_force_N": model.actuator.stall_force_N,
         "avionics_lsb_deg": math.degrees(av.lsb_rad),
+        "figures_of_merit": merit_dict(model, steps=steps),
         "linear_modes": [{"freq_hz": float(abs(x) / (2 * math.pi)),
                           "damping_ratio": float(-x.real / abs(x)) if abs(x) > 0 else 1.0} for x in p],
         "parameters": {
@@ -79,6 +93,19 @@ def cmd_info(args) -> int:
         print(f"  oil column        {d['oil_column_stiffness_N_per_m']:.4g} N/m")
         print(f"  friction          {model.friction.name}, {model.friction.coulomb_torque_Nm:.5g} N m")
         print(f"  avionics LSB      {d['avionics_lsb_deg']:.5f} deg")
+        for ax, fm in d["figures_of_merit"].items():
+            e, st = fm["engine"], fm.get("step")
+            bw = "none below 50 Hz" if e["bandwidth_3db_hz"] is None else f"{e['bandwidth_3db_hz']:.2f} Hz"
+            p90 = "none" if e["phase_90_hz"] is None else f"{e['phase_90_hz']:.2f} Hz"
+            print(f"  {ax} engine       -3 dB {bw}, -90 deg {p90}, peak {e['peak_gain_db']:+.2f} dB at "
+                  f"{e['peak_freq_hz']:.2f} Hz (linear, relative to low frequency)")
+            print(f"  {ax} notch        {fm['notch_hz']:.3f} Hz, load resonance {fm['load_resonance_hz']:.3f} Hz")
+            if st:
+                rt = "n/a" if st["rise_time_s"] is None else f"{1e3 * st['rise_time_s']:.1f} ms"
+                ov = "n/a" if st["overshoot_pct"] is None else f"{st['overshoot_pct']:.1f} %"
+                print(f"  {ax} step {st['step_amplitude_deg']:g} deg  rise (10-90 %) {rt}, overshoot {ov}, threshold "
+                      f"{st['threshold_deg']:.4f} deg, hysteresis {st['hysteresis_deg']:.4f} deg, null shift "
+                      f"{st['null_shift_deg']:.4f} deg ({st['friction_model']})")
     return 0
 
 
@@ -102,6 +129,9 @@ def cmd_freqresp(args) -> int:
         fr = sine_dwell_freqresp(model, freqs, amp_rad, args.axis)
     d = fr.to_dict()
     d["provenance"].update({"model_file": model.source})
+    if not args.cross:
+        from taos.merit import frequency_merit
+        d["figures_of_merit"] = frequency_merit(model, args.axis).to_dict()
     if args.json:
         write_json(args.json, d)
     else:
