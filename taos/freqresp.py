@@ -40,17 +40,43 @@ ENGINE_HELD_RATIO = 1e-4
 
 
 def linear_phase_reference(model: TvcModel, freq_hz, axis: str = "pitch", f_min_hz: float = 1e-3,
-                           points_per_decade: int = 400) -> tuple[np.ndarray, np.ndarray]:
+                           points_per_decade: int = 100, max_step_deg: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
     """Continuous phase [deg] of the linear command -> piston and command -> engine responses
-    at ``freq_hz``: the exact response on a dense log grid from ``f_min_hz`` (where the phase
-    is near 0) merged with the requested points, unwrapped in frequency order."""
+    at ``freq_hz``: the exact response on a log grid from ``f_min_hz`` (where the phase is near
+    0) merged with the requested points, refined (bisection in log f) wherever the phase moves
+    more than ``max_step_deg`` between neighbours, then unwrapped in frequency order. The
+    refinement follows a lightly damped notch's +180 deg turn, which a fixed grid could read
+    as -180 deg; an undamped notch (a sign flip at any resolution) is taken as +180 deg."""
     f = np.atleast_1d(np.asarray(freq_hz, float))
     hi = max(float(f.max()), f_min_hz * 10)
-    grid = np.logspace(math.log10(f_min_hz), math.log10(hi), int(points_per_decade * math.log10(hi / f_min_hz)) + 2)
-    allf = np.concatenate([grid, f])
-    h = simplex_state_space(model, axis).freqresp(allf, "command_rad", ["x_p_m", "theta_rad"])
-    ref = [phase_deg_continuous(allf, h[:, k])[grid.size:] for k in range(2)]
-    return ref[0], ref[1]
+    ss = simplex_state_space(model, axis)
+
+    def resp(x):
+        return ss.freqresp(x, "command_rad", ["x_p_m", "theta_rad"])
+
+    grid = np.unique(np.concatenate([np.logspace(math.log10(f_min_hz), math.log10(hi),
+                                                 int(points_per_decade * math.log10(hi / f_min_hz)) + 2), f]))
+    h = resp(grid)
+    for _ in range(40):
+        step = np.abs(np.angle(h[1:] / h[:-1]))
+        bad = np.flatnonzero(np.max(step, axis=1) > math.radians(max_step_deg))
+        bad = bad[grid[bad + 1] / grid[bad] > 1 + 1e-12]
+        if bad.size == 0:
+            break
+        mid = np.sqrt(grid[bad] * grid[bad + 1])
+        hm = resp(mid)
+        grid = np.concatenate([grid, mid])
+        h = np.concatenate([h, hm])
+        o = np.argsort(grid)
+        grid, h = grid[o], h[o]
+    d = np.angle(h[1:] / h[:-1])
+    # an undamped notch (zeros on the j-w axis: the load resonance with no damping outside the
+    # servo) flips the sign of H between neighbours however fine the grid: take +180 deg, the
+    # limit of any positive damping (zeros in the left half-plane)
+    d = np.where(np.abs(d) > math.radians(179.0), math.pi, d)
+    ph = np.degrees(np.angle(h[:1]) + np.concatenate([np.zeros((1, 2)), np.cumsum(d, axis=0)]))
+    idx = np.searchsorted(grid, f)
+    return ph[idx, 0], ph[idx, 1]
 
 
 @dataclass(frozen=True, eq=False)

@@ -145,7 +145,19 @@ def cmd_freqresp(args) -> int:
             print(d["note"])
     if args.plot:
         from taos.plotting import save
-        save(fr.plot(resonance_hz=model.load_resonance_hz(args.axis)), args.plot)
+        from taos.plotting import bode
+        from taos.plotting.spec import bode_axes
+        if args.engine == "taos":
+            fig = fr.plot(resonance_hz=model.load_resonance_hz(args.axis))
+        else:   # the linear response as a dense curve, not straight lines between the listed points
+            fd = np.logspace(math.log10(min(freqs) / 1.5), math.log10(max(freqs) * 1.5), 400)
+            dense = linear_freqresp(model, fd, args.axis)
+            fig = bode.plot_freqresp([dense] + ([] if fr.amplitude_rad is None else [fr]),
+                                     resonance_hz=model.load_resonance_hz(args.axis))
+            if fr.amplitude_rad is None:
+                bode.draw_response(bode_axes(fig), fr, 1.0, color="k", label="listed points", gid="points",
+                                   marker="o", linestyle="none", ref=dense)
+        save(fig, args.plot)
     return 0
 
 

@@ -69,14 +69,14 @@ def _parse_bounds(items) -> dict:
 
 
 def cmd_estimate(args) -> int:
-    R = None
+    model = None
     if getattr(args, "model", None):
         from taos.model import load_model
-        R = load_model(args.model).actuator.moment_arm_m
+        model = load_model(args.model)
     data, responses = _estimate(args.data, args)
     d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
          "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
-         "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict(R) for r in responses]}
+         "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict(model=model) for r in responses]}
     if args.json:
         write_json(args.json, d)
     out = sys.stderr if args.json == "-" else sys.stdout
@@ -171,7 +171,8 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser("estimate", help="frequency responses estimated from a vectoring record (CSV/HDF5)")
     p.add_argument("data", help="time-history file (.csv with 'signal [unit]' header or sidecar .toml, or .h5)")
-    p.add_argument("--model", help="model file: its moment arm gives the piston as x_p/(R theta_c)")
+    p.add_argument("--model", help="model file: its moment arm gives the piston as x_p/(R theta_c) and its linear "
+                   "phase the branch of each point (phase continuous from low frequency)")
     est_opts(p)
     p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
     p.set_defaults(func=cmd_estimate)

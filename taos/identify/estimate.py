@@ -84,21 +84,31 @@ class MeasuredResponse:
         return FrequencyResponse(self.freq_hz, self.piston_m_per_rad / moment_arm_m, eng, amp, self.axis,
                                  friction_model="data", provenance={"source": self.source, "method": self.method})
 
-    def phase_deg(self, h) -> np.ndarray:
-        """Phase of ``h`` at these points [deg], continuous from the lowest frequency over all
-        points in frequency order (dwells at 0.4 and 0.8 deg lie on one curve, as the test
-        steps the amplitude up with frequency; :func:`taos.linear.phase_deg_continuous`)."""
+    def phase_deg(self, h, reference_deg=None) -> np.ndarray:
+        """Phase of ``h`` at these points [deg], continuous from low frequency: on the branch of
+        ``reference_deg`` (a model's continuous phase at these points) when given, else
+        unwrapped over all points in frequency order (dwells at 0.4 and 0.8 deg lie on one
+        curve, as the test steps the amplitude up with frequency;
+        :func:`taos.linear.phase_deg_continuous`). Sparse points far apart cannot be unwrapped
+        without a reference: give the model (``taos estimate --model``)."""
         from taos.linear import phase_deg_continuous
-        return phase_deg_continuous(self.freq_hz, np.asarray(h))
+        return phase_deg_continuous(self.freq_hz, np.asarray(h), reference_deg)
 
-    def to_dict(self, moment_arm_m: float | None = None) -> dict:
+    def to_dict(self, moment_arm_m: float | None = None, model=None) -> dict:
         """JSON: ``piston`` is x_p / (R theta_c) (the project's piston convention) when the
         moment arm is known (argument, or ``meta['moment_arm_m']``), else null;
         ``piston_in_per_deg`` is x_p / theta_c in in/deg, named by its unit. Phases are
-        continuous from low frequency (:meth:`phase_deg`)."""
-        def gp(h):
+        continuous from low frequency (:meth:`phase_deg`; on ``model``'s branch when given,
+        whose moment arm then also defines the piston)."""
+        rp = re = None
+        if model is not None and len(self):
+            from taos.freqresp import linear_phase_reference
+            rp, re = linear_phase_reference(model, self.freq_hz, self.axis)
+            moment_arm_m = model.actuator.moment_arm_m
+
+        def gp(h, ref=None):
             return None if h is None else {"gain_db": (20 * np.log10(np.abs(h))).tolist(),
-                                           "phase_deg": self.phase_deg(h).tolist()}
+                                           "phase_deg": self.phase_deg(h, ref).tolist()}
         R = moment_arm_m if moment_arm_m is not None else self.meta.get("moment_arm_m")
         return {"axis": self.axis, "method": self.method, "source": self.source, "condition": self.condition,
                 "excitation": self.meta.get("excitation"),
@@ -106,9 +116,10 @@ class MeasuredResponse:
                 "piston_definition": "x_p / (R theta_c), dimensionless" if R else
                 "x_p / (R theta_c) needs the moment arm (taos estimate --model MODEL); see piston_in_per_deg",
                 "moment_arm_m": R,
-                "piston": gp(self.piston_m_per_rad / R) if R else None,
-                "piston_in_per_deg": gp(self.piston_m_per_rad / 0.0254 * math.pi / 180),
-                "engine": gp(self.engine), "coherence_piston": self.coherence_piston.tolist(),
+                "phase_reference": "model" if rp is not None else "data (unwrapped from the lowest frequency)",
+                "piston": gp(self.piston_m_per_rad / R, rp) if R else None,
+                "piston_in_per_deg": gp(self.piston_m_per_rad / 0.0254 * math.pi / 180, rp),
+                "engine": gp(self.engine, re), "coherence_piston": self.coherence_piston.tolist(),
                 "coherence_engine": None if self.coherence_engine is None else self.coherence_engine.tolist(),
                 "engine_dc_observable": self.engine_dc_observable}
 
