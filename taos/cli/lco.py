@@ -4,6 +4,7 @@ time-domain confirmation (DESIGN.md "CLI"; seed paper sections 3.1-3.2)."""
 from __future__ import annotations
 
 import math
+import sys
 
 from taos.errors import InputError
 from taos.results import write_json
@@ -47,19 +48,20 @@ def cmd_lco(args) -> int:
         rep.prediction.df.to_hdf5(args.df_out)
     if args.json:
         write_json(args.json, d)
-    else:
-        td = d["time_domain"] or {}
-        if d["lco"]:
-            print(f"LCO predicted: command {d['amplitude_deg']:.4f} deg (engine {d['engine_amplitude_deg']:.4f} deg) "
-                  f"at {d['frequency_hz']:.4f} Hz, {'stable' if d['stable'] else 'unstable'}")
+    out = sys.stderr if args.json == "-" else sys.stdout   # the verdict is always shown
+    td = d["time_domain"] or {}
+    v = d["verdict"]
+    print(v["text"], file=out)
+    if v["nearest_margin"]:
+        print(f"margin meant: {v['margin_meaning']}", file=out)
+    if td:
+        if td["lco"]:
+            print(f"time domain:   command {td['amplitude_deg']:.4f} deg (engine {td['engine_amplitude_deg']:.4f} deg) "
+                  f"at {td['frequency_hz']:.4f} Hz", file=out)
         else:
-            print(f"no LCO predicted; remaining margin {d['margin_db']:.2f} dB")
-        if td:
-            if td["lco"]:
-                print(f"time domain:   command {td['amplitude_deg']:.4f} deg (engine {td['engine_amplitude_deg']:.4f} deg) "
-                      f"at {td['frequency_hz']:.4f} Hz")
-            else:
-                print(f"time domain:   no sustained oscillation (final {td['final_amplitude_deg']:.2g} deg)")
+            print(f"time domain:   no sustained oscillation (final {td['final_amplitude_deg']:.2g} deg)", file=out)
+    print("loop margins of L0 N(A, .) over the command amplitude A (low GM: how far the gain may fall):", file=out)
+    print(rep.verdict().table_text(), file=out)
     return 0
 
 

@@ -343,6 +343,8 @@ class LcoReport:
 
     def to_dict(self) -> dict:
         d = self.prediction.to_dict()
+        if d["lco"]:   # with a cycle there is no margin left to state: null, not 0.0
+            d["margin_db"] = None
         fl = self.prediction.flight
         big = self.prediction.margins_by_amplitude[-1]
         d.update({
@@ -352,6 +354,7 @@ class LcoReport:
             "margins_at_largest_amplitude": {"amplitude_deg": math.degrees(self.prediction.df.amplitude_rad[-1]),
                                              **big.to_dict()},
             "time_domain": None if self.time_domain is None else self.time_domain.to_dict(),
+            "verdict": self.verdict().to_dict(),
             "describing_function": {"amplitude_deg": np.degrees(self.prediction.df.amplitude_rad).tolist(),
                                     "freq_hz": self.prediction.df.freq_hz.tolist()},
             "provenance": {"model_file": self.model.source, "model_sha256": self.model.sha256,
@@ -359,6 +362,11 @@ class LcoReport:
                            "package_version": package_version()},
         })
         return d
+
+    def verdict(self):
+        """The verdict in plain words with its margin table (:mod:`taos.flight.lco_verdict`)."""
+        from taos.flight.lco_verdict import lco_verdict
+        return lco_verdict(self)
 
     def plot(self, **kwargs):
         return self.prediction.plot(**kwargs)
