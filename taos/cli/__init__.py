@@ -14,7 +14,7 @@ import sys
 from taos.errors import InputError, SimulationUnstable
 
 #: subcommand modules, in help order
-COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco"]
+COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.export"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -176,6 +176,15 @@ def cmd_simulate(args) -> int:
         th = simulate(model, profile, dt_s=args.dt, progress=True)
     th.to_hdf5(args.out)
     print(f"wrote {args.out} ({th.t_s.size} samples, {', '.join(th.axes)})")
+    if str(args.profile).lower().endswith((".csv", ".txt", ".h5", ".hdf5")):   # a replayed record
+        from taos.identify.data import load_test_data
+        from taos.identify.replay import compare_replay
+        for r in compare_replay(load_test_data(args.profile), th):
+            d = r.to_dict()
+            eng = ("" if d["engine_rms_error_deg"] is None else
+                   f", engine {d['engine_rms_error_deg']:.4f} deg ({100 * d['engine_relative_rms_error']:.1f} %)")
+            print(f"replay {r.axis}: model - test RMS piston {d['piston_rms_error_in']:.5f} in "
+                  f"({100 * d['piston_relative_rms_error']:.1f} %){eng}")
     return 0
 
 
@@ -205,7 +214,9 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser("simulate", help="time history of a command profile, to HDF5")
     p.add_argument("model")
-    p.add_argument("--profile", required=True, help="profile file (TOML), e.g. models/profiles/greenrun_two_axis.toml")
+    p.add_argument("--profile", required=True, help="profile file (TOML), e.g. models/profiles/greenrun_two_axis.toml, "
+                   "or a measured record (.csv/.h5, e.g. models/data/greenrun_hotfire_synthetic.csv) whose commands "
+                   "are replayed and compared with its piston and engine angles")
     p.add_argument("--out", required=True, help="HDF5 file to write")
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
     p.add_argument("--friction", help="swap the friction law")
