@@ -152,8 +152,10 @@ def cmd_freqresp(args) -> int:
         else:   # the linear response as a dense curve, not straight lines between the listed points
             fd = np.logspace(math.log10(min(freqs) / 1.5), math.log10(max(freqs) * 1.5), 400)
             dense = linear_freqresp(model, fd, args.axis)
+            from taos.simplex import load_resonance_from_notch   # the one notch finder every command uses
             fig = bode.plot_freqresp([dense] + ([] if fr.amplitude_rad is None else [fr]),
-                                     resonance_hz=model.load_resonance_hz(args.axis))
+                                     resonance_hz=model.load_resonance_hz(args.axis),
+                                     notch_hz=load_resonance_from_notch(model, args.axis))
             if fr.amplitude_rad is None:
                 bode.draw_response(bode_axes(fig), fr, 1.0, color="k", label="listed points", gid="points",
                                    marker="o", linestyle="none", ref=dense)
