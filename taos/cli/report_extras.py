@@ -105,7 +105,7 @@ def extras_html(s: dict) -> str:
 <table><tr><th>axis</th><th>engine −3 dB</th><th>engine −90°</th><th>engine peak</th><th>piston peak</th>
 <th>w_L / notch</th><th>rise 10–90 %</th><th>overshoot</th><th>threshold</th><th>hysteresis</th></tr>{''.join(rows)}</table>
 <p class="note">Frequency figures from the exact linear response (gains relative to the low-frequency gain; lowest
-−3 dB and −90° crossings). Step figures by simulating the full model ({_h(s.get('friction_model', ''))} friction,
+−3 dB and −90° crossings; planar simplex model). Step figures by simulating the full simplex model ({_h(s.get('friction_model', ''))} friction,
 avionics): a {_fmt(step_amp, 'g')} deg step (rise time, overshoot), the smallest step that moves the engine half
 way (threshold), and a slow ±0.2 deg triangle (hysteresis: engine angle down minus up at zero command).</p>"""]
     if "spec" in s:
