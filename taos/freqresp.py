@@ -1,7 +1,17 @@
 """Frequency responses of the TVC: exact linear, and amplitude-dependent by sine dwell.
 
-Command -> piston is reported as x_p / (R theta_c) (piston position in engine-angle units)
-and command -> engine as theta / theta_c, both dimensionless complex gains.
+Conventions (the same in every command, table, plot and JSON; README "Conventions"):
+
+* command -> piston is x_p / (R theta_c) (piston position in engine-angle units,
+  dimensionless; 0 dB at low frequency); where x_p / theta_c in in/deg is offered too, the
+  key names the unit (``piston_in_per_deg``);
+* command -> engine is theta / theta_c;
+* phase is continuous from low frequency (:func:`taos.linear.phase_deg_continuous`): model
+  responses take the branch of the linear model's continuous phase
+  (:func:`linear_phase_reference`, computed on a dense grid from 1 mHz);
+* below breakaway the engine does not move: a sine-dwell engine response whose fundamental
+  is below :data:`ENGINE_HELD_RATIO` of the command is reported as "engine held" (gain and
+  phase null, ``engine_held`` true), not as -330 dB.
 
 The sine-dwell response (the describing function of the nonlinear TVC) simulates
 theta_c = A sin(w t) from rest, lets the transient settle for at least ``settle_cycles``
@@ -19,17 +29,63 @@ import numpy as np
 
 from . import _integrator as _ig
 from .errors import SimulationUnstable
-from .linear import gain_db, phase_deg
+from .linear import gain_db, phase_deg_continuous
 from .model import TvcModel
 from .simplex import simplex_plant, simplex_state_space
 from .simulate import DEFAULT_DT_S, check_step, kernel_args
+
+
+#: engine fundamental below this fraction of the command (-80 dB) = engine held by friction
+ENGINE_HELD_RATIO = 1e-4
+
+
+def linear_phase_reference(model: TvcModel, freq_hz, axis: str = "pitch", f_min_hz: float = 1e-3,
+                           points_per_decade: int = 100, max_step_deg: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous phase [deg] of the linear command -> piston and command -> engine responses
+    at ``freq_hz``: the exact response on a log grid from ``f_min_hz`` (where the phase is near
+    0) merged with the requested points, refined (bisection in log f) wherever the phase moves
+    more than ``max_step_deg`` between neighbours, then unwrapped in frequency order. The
+    refinement follows a lightly damped notch's +180 deg turn, which a fixed grid could read
+    as -180 deg; an undamped notch (a sign flip at any resolution) is taken as +180 deg."""
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    hi = max(float(f.max()), f_min_hz * 10)
+    ss = simplex_state_space(model, axis)
+
+    def resp(x):
+        return ss.freqresp(x, "command_rad", ["x_p_m", "theta_rad"])
+
+    grid = np.unique(np.concatenate([np.logspace(math.log10(f_min_hz), math.log10(hi),
+                                                 int(points_per_decade * math.log10(hi / f_min_hz)) + 2), f]))
+    h = resp(grid)
+    for _ in range(40):
+        step = np.abs(np.angle(h[1:] / h[:-1]))
+        bad = np.flatnonzero(np.max(step, axis=1) > math.radians(max_step_deg))
+        bad = bad[grid[bad + 1] / grid[bad] > 1 + 1e-12]
+        if bad.size == 0:
+            break
+        mid = np.sqrt(grid[bad] * grid[bad + 1])
+        hm = resp(mid)
+        grid = np.concatenate([grid, mid])
+        h = np.concatenate([h, hm])
+        o = np.argsort(grid)
+        grid, h = grid[o], h[o]
+    d = np.angle(h[1:] / h[:-1])
+    # an undamped notch (zeros on the j-w axis: the load resonance with no damping outside the
+    # servo) flips the sign of H between neighbours however fine the grid: take +180 deg, the
+    # limit of any positive damping (zeros in the left half-plane)
+    d = np.where(np.abs(d) > math.radians(179.0), math.pi, d)
+    ph = np.degrees(np.angle(h[:1]) + np.concatenate([np.zeros((1, 2)), np.cumsum(d, axis=0)]))
+    idx = np.searchsorted(grid, f)
+    return ph[idx, 0], ph[idx, 1]
 
 
 @dataclass(frozen=True, eq=False)
 class FrequencyResponse:
     """Command -> piston and command -> engine responses of one axis.
 
-    ``amplitude_rad`` is None for the linear response."""
+    ``amplitude_rad`` is None for the linear response. ``piston_phase_ref_deg`` /
+    ``engine_phase_ref_deg`` (optional) are the linear model's continuous phase at the same
+    frequencies, used to put each point on its continuous branch (module docstring)."""
 
     freq_hz: np.ndarray
     piston: np.ndarray
@@ -39,19 +95,48 @@ class FrequencyResponse:
     engine_model: str = "simplex"
     friction_model: str = "none"
     provenance: dict = field(default_factory=dict)
+    piston_phase_ref_deg: np.ndarray | None = None
+    engine_phase_ref_deg: np.ndarray | None = None
+
+    def piston_phase_deg(self) -> np.ndarray:
+        """Continuous piston phase [deg] (module docstring)."""
+        return phase_deg_continuous(self.freq_hz, self.piston, self.piston_phase_ref_deg)
+
+    def engine_phase_deg(self) -> np.ndarray:
+        """Continuous engine phase [deg]; NaN where the engine is held."""
+        ph = phase_deg_continuous(self.freq_hz, self.engine, self.engine_phase_ref_deg)
+        return np.where(self.engine_held(), np.nan, ph)
+
+    def engine_held(self) -> np.ndarray:
+        """True where the engine's fundamental is below :data:`ENGINE_HELD_RATIO` of the
+        command (friction holds the engine; only sine dwells can show it)."""
+        e = np.abs(np.asarray(self.engine, complex))
+        if self.amplitude_rad is None or "->" in self.axis:   # linear or cross-axis: never "held"
+            return np.zeros(e.shape, bool)
+        return e < ENGINE_HELD_RATIO
 
     def to_dict(self) -> dict:
-        """The JSON contract of ``taos freqresp`` (these keys are kept from release to release)."""
-        return {
+        """The JSON contract of ``taos freqresp``; engine gain and phase are null
+        where the engine is held (``engine_held``)."""
+        held = self.engine_held()
+        eg = gain_db(np.where(held, 1.0, self.engine))
+        nul = lambda a: [None if hk else float(x) for x, hk in zip(a, held)]  # noqa: E731
+        d = {
             "freq_hz": [float(f) for f in self.freq_hz],
             "amplitude_deg": None if self.amplitude_rad is None else math.degrees(self.amplitude_rad),
             "axis": self.axis,
             "engine_model": self.engine_model,
             "friction_model": self.friction_model,
-            "piston": {"gain_db": gain_db(self.piston).tolist(), "phase_deg": phase_deg(self.piston).tolist()},
-            "engine": {"gain_db": gain_db(self.engine).tolist(), "phase_deg": phase_deg(self.engine).tolist()},
+            "piston_definition": "x_p / (R theta_c), dimensionless; phase continuous from low frequency",
+            "piston": {"gain_db": gain_db(self.piston).tolist(), "phase_deg": self.piston_phase_deg().tolist()},
+            "engine": {"gain_db": nul(eg), "phase_deg": nul(self.engine_phase_deg())},
+            "engine_held": held.tolist(),
             "provenance": self.provenance,
         }
+        if held.any():
+            d["note"] = ("engine held: below breakaway the friction holds the engine (fundamental below "
+                         f"{ENGINE_HELD_RATIO:g} of the command); its gain and phase are null, not a number")
+        return d
 
 
 def linear_freqresp(model: TvcModel, freq_hz, axis: str = "pitch") -> FrequencyResponse:
@@ -59,8 +144,11 @@ def linear_freqresp(model: TvcModel, freq_hz, axis: str = "pitch") -> FrequencyR
     ss = simplex_state_space(model, axis)
     h = ss.freqresp(freq_hz, "command_rad", ["x_p_m", "theta_rad"])
     R = model.actuator.moment_arm_m
-    return FrequencyResponse(np.atleast_1d(np.asarray(freq_hz, float)), h[:, 0] / R, h[:, 1], None, axis,
-                             friction_model="none", provenance={"model_sha256": model.sha256, "method": "linear"})
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    rp, re = linear_phase_reference(model, f, axis)
+    return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, axis,
+                             friction_model="none", provenance={"model_sha256": model.sha256, "method": "linear"},
+                             piston_phase_ref_deg=rp, engine_phase_ref_deg=re)
 
 
 def settle_time_s(model: TvcModel, axis: str = "pitch", decades: float = 4.0) -> float:
@@ -108,7 +196,10 @@ def sine_dwell_freqresp(model: TvcModel, freq_hz, amplitude_rad: float, axis: st
                         **kwargs) -> FrequencyResponse:
     """Amplitude-dependent response at one command amplitude (see :func:`sine_dwell_grid`)."""
     piston, engine = sine_dwell_grid(model, [amplitude_rad], freq_hz, axis, **kwargs)
-    return FrequencyResponse(np.atleast_1d(np.asarray(freq_hz, float)), piston[0], engine[0],
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    rp, re = linear_phase_reference(model, f, axis)
+    return FrequencyResponse(f, piston[0], engine[0],
                              float(amplitude_rad), axis, friction_model=model.friction.name,
                              provenance={"model_sha256": model.sha256, "method": "sine-dwell",
-                                         "dt_max_s": kwargs.get("dt_max_s", DEFAULT_DT_S)})
+                                         "dt_max_s": kwargs.get("dt_max_s", DEFAULT_DT_S)},
+                             piston_phase_ref_deg=rp, engine_phase_ref_deg=re)

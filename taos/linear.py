@@ -169,6 +169,27 @@ def sampled_notch_hz(freq_hz, h) -> float:
     return float(10 ** np.clip(-b / (2 * a), x[0], x[2])) if a > 0 else float(f[k])
 
 
+def phase_deg_continuous(freq_hz, h, reference_deg=None) -> np.ndarray:
+    """Phase of h [deg] continuous from low frequency: the project's one phase convention.
+
+    Without ``reference_deg`` the points are sorted by frequency, unwrapped in that order
+    and the lowest-frequency point lies in (-180, 180] (right for measured points that start
+    at low frequency). With ``reference_deg`` (the continuous phase of a reference response at
+    the same frequencies, e.g. the linear model's from :func:`taos.freqresp.linear_phase_reference`)
+    each point takes the 360-deg branch nearest the reference, so sparse points far from low
+    frequency (a single 7 Hz point, a cross-axis response) read as on the continuous curve."""
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    hh = np.atleast_1d(np.asarray(h, complex))
+    ph = np.angle(hh)
+    if reference_deg is not None:
+        ref = np.radians(np.atleast_1d(np.asarray(reference_deg, float)))
+        return np.degrees(ph + 2 * np.pi * np.round((ref - ph) / (2 * np.pi)))
+    order = np.argsort(f, kind="stable")
+    out = np.empty_like(ph)
+    out[order] = np.unwrap(ph[order])
+    return np.degrees(out)
+
+
 def balancing_scale(ss: StateSpace) -> np.ndarray:
     """Diagonal state scaling s (x = diag(s) x') that balances a numeric A (LAPACK gebal)."""
     _, (sc, _perm) = scipy.linalg.matrix_balance(np.asarray(ss.A, float), permute=False, separate=True)

@@ -192,6 +192,35 @@ class Circular:
                           np.where(on, ramp * self.amplitude_rad * np.cos(w * t), 0.0)])
 
 
+@dataclass(frozen=True, eq=False)
+class Recorded:
+    """A measured command record replayed: theta_c(t) by linear interpolation of the samples
+    (``t_s`` from 0, ``command_rad``), zero outside the record."""
+
+    t_s: np.ndarray
+    command_rad: np.ndarray
+    name: str = ""
+
+    @property
+    def duration_s(self) -> float:
+        return float(self.t_s[-1])
+
+    def __call__(self, t):
+        return np.interp(np.asarray(t, float), self.t_s, self.command_rad, left=0.0, right=0.0)
+
+
+def profile_from_record(data) -> "TwoAxis | Recorded":
+    """The commands of a :class:`taos.identify.data.TestData` record as a profile (both axes
+    as :class:`TwoAxis` when the record has yaw; time shifted to start at 0)."""
+    t = np.asarray(data.t_s, float) - float(data.t_s[0])
+    parts = {ax: Recorded(t, np.asarray(data.command_rad[i], float), f"{data.source} ({ax})")
+             for i, ax in enumerate(data.axes)}
+    name = f"recorded commands of {data.source}"
+    if "yaw" in parts:
+        return TwoAxis(parts.get("pitch", Step(0.0, 0.0, 1e-9)), parts["yaw"], name)
+    return Recorded(t, parts["pitch"].command_rad, name)
+
+
 def is_two_axis(profile) -> bool:
     return isinstance(profile, (TwoAxis, Circular))
 
@@ -306,13 +335,18 @@ def profile_from_table(tab: dict, src: str, sec: str):
 
 def load_profile(path: str | Path):
     """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
-    ``[pitch]`` and/or ``[yaw]`` tables (two-axis). Every value is checked against the
-    documented limits of :mod:`taos.limits` (gimbal range, frequencies, durations, cycles)."""
+    ``[pitch]`` and/or ``[yaw]`` tables (two-axis); or a measured record (``.csv``/``.h5``,
+    :func:`taos.identify.data.load_test_data`) whose commands are replayed
+    (:func:`profile_from_record`). Every value is checked against the documented limits of
+    :mod:`taos.limits` (gimbal range, frequencies, durations, cycles)."""
     from .errors import check_keys
     from .limits import check_duration
     from .model import read_toml
     from .shipped import resolve
 
+    if Path(str(path)).suffix.lower() in (".csv", ".txt", ".h5", ".hdf5"):   # a measured record: replay it
+        from .identify.data import load_test_data
+        return profile_from_record(load_test_data(path))
     path = resolve(path, "profile")
     src = str(path)
     _, doc = read_toml(path, "a readable profile file")

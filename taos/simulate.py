@@ -80,6 +80,13 @@ class TimeHistory:
     quantisation and crossover gain), ``piston_m``, ``engine_rad``, ``friction_torque_Nm``,
     ``friction_state_rad``, ``load_force_N``; ``provenance`` (model file hash, package
     version, solver settings, friction law, profile).
+
+    Optional hydraulic signals (:data:`OPTIONAL_ARRAYS`, None when a model does not record
+    them): ``load_pressure_Pa`` P_L (actuator state), ``spool_flow_m_s`` the servovalve's
+    no-load flow over piston area q = K_q x_v / A (the spool position in piston-rate units:
+    the spool stroke itself needs the valve flow gain K_q, which the model does not carry),
+    ``supply_pressure_Pa`` P_s (constant in the model: an ideal supply). The chamber
+    pressures of a symmetric actuator follow as (P_s +- P_L) / 2.
     """
 
     t_s: np.ndarray
@@ -93,9 +100,13 @@ class TimeHistory:
     load_force_N: np.ndarray
     moment_arm_m: float
     provenance: dict = field(default_factory=dict)
+    load_pressure_Pa: np.ndarray | None = None
+    spool_flow_m_s: np.ndarray | None = None
+    supply_pressure_Pa: np.ndarray | None = None
 
     ARRAYS = ("command_rad", "command_avionics_rad", "piston_m", "engine_rad", "friction_torque_Nm",
               "friction_state_rad", "load_force_N")
+    OPTIONAL_ARRAYS = ("load_pressure_Pa", "spool_flow_m_s", "supply_pressure_Pa")
 
     def to_hdf5(self, path) -> None:
         """Write atomically: /t_s, /<axis>/<array>, provenance as root attributes."""
@@ -109,6 +120,9 @@ class TimeHistory:
                     g = h5.create_group(ax)
                     for name in self.ARRAYS:
                         g.create_dataset(name, data=getattr(self, name)[i], compression="gzip", track_times=False)
+                    for name in self.OPTIONAL_ARRAYS:
+                        if getattr(self, name) is not None:
+                            g.create_dataset(name, data=getattr(self, name)[i], compression="gzip", track_times=False)
                 self._write_extra(h5)
         atomic_write(path, write)
 
@@ -120,6 +134,8 @@ class TimeHistory:
         with h5py.File(path, "r") as h5:
             axes = tuple(str(h5.attrs["axes"]).split(","))
             arrays = {n: np.vstack([h5[ax][n][()] for ax in axes]) for n in cls.ARRAYS}
+            arrays.update({n: np.vstack([h5[ax][n][()] for ax in axes]) for n in cls.OPTIONAL_ARRAYS
+                           if all(n in h5[ax] for ax in axes)})
             prov = {k: v for k, v in h5.attrs.items() if k not in ("axes", "moment_arm_m")}
             return cls(t_s=h5["t_s"][()], axes=axes, moment_arm_m=float(h5.attrs["moment_arm_m"]),
                        provenance=prov, **arrays, **cls._read_extra(h5))
@@ -128,6 +144,19 @@ class TimeHistory:
     def _read_extra(cls, h5: h5py.File) -> dict:
         """Hook for subclasses: extra constructor arguments read from the file."""
         return {}
+
+
+def _with_spool_output(plant: LurePlant) -> LurePlant:
+    """The plant with the servovalve state ``q_m_s`` as an extra output (recorded only)."""
+    import dataclasses
+
+    from .linear import StateSpace
+    ss = plant.ss
+    row = np.zeros((1, ss.A.shape[0]))
+    row[0, ss.state_index("q_m_s")] = 1.0
+    ext = StateSpace(ss.A, ss.B, np.vstack([ss.C, row]), np.vstack([ss.D, np.zeros((1, ss.D.shape[1]))]),
+                     ss.states, ss.inputs, ss.outputs + ("q_m_s",))
+    return dataclasses.replace(plant, ss=ext)
 
 
 def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
@@ -159,15 +188,18 @@ def simulate(model: TvcModel, profile, *, dt_s: float = DEFAULT_DT_S, record_eve
     t = np.arange(n + 1) * dt_s
     cmd = np.atleast_2d(profile(t))
     axes = ("pitch", "yaw") if is_two_axis(profile) else ("pitch",)
-    out = {k: [] for k in TimeHistory.ARRAYS}
+    out = {k: [] for k in TimeHistory.ARRAYS + TimeHistory.OPTIONAL_ARRAYS}
     it = axes
     if progress:
         from tqdm import tqdm
         it = tqdm(axes, desc="simplex", unit="axis")
     for i, ax in enumerate(it):
-        plant = simplex_plant(model, ax)
+        plant = _with_spool_output(simplex_plant(model, ax))
         y, aux = integrate_plant(plant, model, cmd[i][:, None], dt_s, record_every)
         o = plant.ss.output_index
+        out["load_pressure_Pa"].append(y[:, o("p_load_Pa")])
+        out["spool_flow_m_s"].append(y[:, o("q_m_s")])
+        out["supply_pressure_Pa"].append(np.full(y.shape[0], model.actuator.supply_pressure_Pa))
         out["command_rad"].append(cmd[i][::record_every])
         out["command_avionics_rad"].append(aux[:, 2])
         out["piston_m"].append(y[:, o("x_p_m")])

@@ -14,12 +14,13 @@ from tests.conftest import MODELS, ROOT, run_cli
 from tests.test_viewer import engine_mask, screenshot
 
 HOTFIRE = MODELS / "rs25_hotfire.toml"
+DATA = MODELS / "data" / "greenrun_hotfire_synthetic.csv"
 
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
     out = tmp_path_factory.mktemp("greenrun") / "report"
-    r = run_cli("greenrun", HOTFIRE, "--out", out)
+    r = run_cli("greenrun", HOTFIRE, "--out", out, "--data", DATA)
     assert r.returncode == 0, r.stderr
     return out, r
 
@@ -128,3 +129,90 @@ def test_greenrun_with_the_3d_engine(tmp_path):
     s = _json.loads((out / "summary.json").read_text())
     assert s["engine_model"] == "taos"
     assert "taos engine model" in (out / "index.html").read_text()
+
+
+def test_report_shows_figures_of_merit_and_spec_mask_result(report, hotfire, tmp_path):
+    """Figures of merit (issue 17 point 3) and the spec-mask verdict in summary.json, the page and
+    on the plots; the merit figures checked against independent references."""
+    out, _ = report
+    s = json.loads((out / "summary.json").read_text())
+    fm = s["figures_of_merit"]["pitch"]
+    e = fm["engine"]
+    # issue 17's hand readings of the hot-fire linear engine response: +11.7 dB at 4.92 Hz, -90 deg at 4.74 Hz
+    assert e["low_frequency_gain_db"] + e["peak_gain_db"] == pytest.approx(11.7, abs=0.05)
+    assert e["peak_freq_hz"] == pytest.approx(4.92, abs=0.02) and e["phase_90_hz"] == pytest.approx(4.74, abs=0.02)
+    assert 6.5 < e["bandwidth_3db_hz"] < 7.6
+    assert fm["notch_hz"] == pytest.approx(s["notch_frequency_hz"]["pitch"], rel=1e-9)
+    st = fm["step"]
+    assert 0.01 < st["rise_time_s"] < 0.2 and st["overshoot_pct"] >= 0 and st["threshold_deg"] > 0
+    assert s["spec_pass"] is False      # the notional servo peaks ~ +12 dB: the mask's 4-5 Hz bounds fail
+    fails = s["spec"]["pitch"]["failures"]
+    assert fails and all("engine gain" in f for f in fails)
+    page = (out / "index.html").read_text()
+    assert 'id="figures-of-merit"' in page and 'id="spec-mask"' in page and "FAIL" in page
+    assert f"{e['peak_gain_db']:+.2f} dB at {e['peak_freq_hz']:.2f} Hz" in page
+    img = screenshot((out / "index.html").as_uri(), tmp_path / "merit.png", budget_ms=4000, offline=True,
+                     size=(1200, 2400))
+    below_view = img[1100:]                      # the sections after the 3-D view
+    red = (below_view[..., 0] > 170) & (below_view[..., 1] < 90) & (below_view[..., 2] < 90)   # FAIL in red
+    dark = (below_view < 120).all(axis=2)
+    assert red.sum() > 200 and dark.mean() > 0.005, "figures of merit / spec-mask tables not rendered"
+
+
+def test_report_overlays_the_measured_record_on_the_model(report):
+    out, _ = report
+    s = json.loads((out / "summary.json").read_text())
+    td = s["test_data"]
+    assert td["source"].endswith("greenrun_hotfire_synthetic.csv")
+    pts = td["axes"]["pitch"]["points"]
+    assert td["axes"]["pitch"]["excitation"]["kind"] == "dwell" and len(pts) == 7
+    # the synthetic record was made by this model: test and model agree at every dwell
+    for p in pts:
+        assert p["piston_gain_db"] == pytest.approx(p["model_piston_gain_db"], abs=0.3)
+        assert p["engine_gain_db"] == pytest.approx(p["model_engine_gain_db"], abs=0.3)
+    assert "Test record vs model" in (out / "index.html").read_text()
+
+
+def test_every_command_reports_the_same_piston_gain_and_phase(report, tmp_path):
+    """One convention (issue 17 point 2): info, freqresp, estimate and the Green Run summary give
+    the same gain (0.01 dB) and continuous phase (0.1 deg) for the same model and frequency."""
+    out, _ = report
+    s = json.loads((out / "summary.json").read_text())
+    freqs = sorted({x["freq_hz"] for x in s["sine_dwell"]["pitch"]})
+    r = run_cli("freqresp", HOTFIRE, "--amplitude-deg", "0.4", "--freq-hz", ",".join(map(str, freqs)), "--json", "-")
+    assert r.returncode == 0, r.stderr
+    fr = json.loads(r.stdout)
+    sd = {x["freq_hz"]: x for x in s["sine_dwell"]["pitch"] if abs(x["amplitude_deg"] - 0.4) < 1e-9}
+    for i, f in enumerate(fr["freq_hz"]):
+        assert fr["piston"]["gain_db"][i] == pytest.approx(sd[f]["piston_gain_db"], abs=0.01)
+        assert fr["piston"]["phase_deg"][i] == pytest.approx(sd[f]["piston_phase_deg"], abs=0.1)
+        assert fr["engine"]["phase_deg"][i] == pytest.approx(sd[f]["engine_phase_deg"], abs=0.1)
+    assert sd[10.0]["engine_phase_deg"] < -180          # continuous past -180, not +150
+    # info's figures of merit against freqresp --linear at those frequencies
+    r = run_cli("info", HOTFIRE, "--json", "-")
+    info = json.loads(r.stdout)["figures_of_merit"]["pitch"]["engine"]
+    r = run_cli("freqresp", HOTFIRE, "--linear", "--freq-hz", f"{info['peak_freq_hz']},{info['phase_90_hz']}",
+                "--json", "-")
+    lin = json.loads(r.stdout)
+    assert lin["engine"]["gain_db"][0] == pytest.approx(info["low_frequency_gain_db"] + info["peak_gain_db"], abs=0.01)
+    assert lin["engine"]["phase_deg"][1] == pytest.approx(-90.0, abs=0.1)
+    assert lin["figures_of_merit"]["engine"] == info
+    # estimate of a simulated record (taos simulate) against freqresp's sine dwell, friction none
+    prof = tmp_path / "dwells.toml"
+    prof.write_text('type = "sequence"\n' + "".join(
+        f'[[segments]]\ntype = "sine_dwell"\namplitude = "0.4 deg"\nfrequency = "{f} Hz"\ncycles = {n}\n'
+        for f, n in ((2, 24), (10, 100))))
+    run = tmp_path / "run.h5"
+    r = run_cli("simulate", HOTFIRE, "--friction", "none", "--profile", prof, "--out", run)
+    assert r.returncode == 0, r.stderr
+    r = run_cli("estimate", run, "--model", HOTFIRE, "--json", "-")
+    est = json.loads(r.stdout)["responses"][0]
+    assert est["piston_definition"].startswith("x_p / (R theta_c)")
+    r = run_cli("freqresp", HOTFIRE, "--friction", "none", "--amplitude-deg", "0.4", "--freq-hz", "2,10", "--json", "-")
+    sdw = json.loads(r.stdout)
+    for k in range(2):
+        assert est["freq_hz"][k] == pytest.approx(sdw["freq_hz"][k], rel=1e-4)
+        for resp in ("piston", "engine"):
+            assert est[resp]["gain_db"][k] == pytest.approx(sdw[resp]["gain_db"][k], abs=0.01)
+            assert est[resp]["phase_deg"][k] == pytest.approx(sdw[resp]["phase_deg"][k], abs=0.1)
+    assert est["engine"]["phase_deg"][1] < -180

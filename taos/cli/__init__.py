@@ -16,7 +16,8 @@ import traceback
 from taos.errors import InputError, Interrupted, SimulationUnstable
 
 #: subcommand modules, in help order
-COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.montecarlo"]
+COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.export",
+            "taos.cli.montecarlo"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -31,8 +31,21 @@ def model_from_args(args) -> TvcModel:
     return load_model(args.model, friction=getattr(args, "friction", None))
 
 
-def info_dict(model: TvcModel) -> dict:
-    """Parameters in SI and derived figures (the ``taos info`` JSON)."""
+def merit_dict(model: TvcModel, axes=AXES, steps: bool = True) -> dict:
+    """Figures of merit per axis (:mod:`taos.merit`): frequency figures from the linear
+    response, and (``steps``) step, threshold and hysteresis figures by simulation."""
+    from taos.merit import frequency_merit, step_merit
+    out = {}
+    for ax in axes:
+        d = frequency_merit(model, ax).to_dict()
+        if steps:
+            d["step"] = step_merit(model, ax).to_dict()
+        out[ax] = d
+    return out
+
+
+def info_dict(model: TvcModel, steps: bool = True) -> dict:
+    """Parameters in SI and derived figures (the ``taos info`` JSON), with the figures of merit."""
     from dataclasses import asdict
 
     from taos.simplex import load_resonance_from_notch, simplex_state_space
@@ -54,6 +67,7 @@ def info_dict(model: TvcModel) -> dict:
         "load_stiffness_rotational_Nm_per_rad": model.structure.load_stiffness_N_per_m * model.actuator.moment_arm_m ** 2,
         "stall_force_N": model.actuator.stall_force_N,
         "avionics_lsb_deg": math.degrees(av.lsb_rad),
+        "figures_of_merit": merit_dict(model, steps=steps),
         "linear_modes": [{"freq_hz": float(abs(x) / (2 * math.pi)),
                           "damping_ratio": float(-x.real / abs(x)) if abs(x) > 0 else 1.0} for x in p],
         "parameters": {
@@ -82,6 +96,19 @@ def cmd_info(args) -> int:
         print(f"  oil column        {d['oil_column_stiffness_N_per_m']:.4g} N/m")
         print(f"  friction          {model.friction.name}, {model.friction.coulomb_torque_Nm:.5g} N m")
         print(f"  avionics LSB      {d['avionics_lsb_deg']:.5f} deg")
+        for ax, fm in d["figures_of_merit"].items():
+            e, st = fm["engine"], fm.get("step")
+            bw = "none below 50 Hz" if e["bandwidth_3db_hz"] is None else f"{e['bandwidth_3db_hz']:.2f} Hz"
+            p90 = "none" if e["phase_90_hz"] is None else f"{e['phase_90_hz']:.2f} Hz"
+            print(f"  {ax} engine       -3 dB {bw}, -90 deg {p90}, peak {e['peak_gain_db']:+.2f} dB at "
+                  f"{e['peak_freq_hz']:.2f} Hz (linear, relative to low frequency)")
+            print(f"  {ax} notch        {fm['notch_hz']:.3f} Hz, load resonance {fm['load_resonance_hz']:.3f} Hz")
+            if st:
+                rt = "n/a" if st["rise_time_s"] is None else f"{1e3 * st['rise_time_s']:.1f} ms"
+                ov = "n/a" if st["overshoot_pct"] is None else f"{st['overshoot_pct']:.1f} %"
+                print(f"  {ax} step {st['step_amplitude_deg']:g} deg  rise (10-90 %) {rt}, overshoot {ov}, threshold "
+                      f"{st['threshold_deg']:.4f} deg, hysteresis {st['hysteresis_deg']:.4f} deg, null shift "
+                      f"{st['null_shift_deg']:.4f} deg ({st['friction_model']})")
     return 0
 
 
@@ -119,16 +146,37 @@ def cmd_freqresp(args) -> int:
     d["provenance"]["solver"] = {"method": "linear (exact)" if amp_rad is None else "rk4 sine dwell",
                                  "engine": args.engine}
     d["provenance"]["seeds"] = "none (deterministic)"
+    if not args.cross:
+        from taos.merit import frequency_merit
+        d["figures_of_merit"] = frequency_merit(model, args.axis).to_dict()
     if args.json:
         write_json(args.json, d)
     else:
-        print(f"{'freq_hz':>9} {'piston dB':>10} {'piston deg':>11} {'engine dB':>10} {'engine deg':>11}")
+        print(f"{'freq_hz':>9} {'piston dB':>10} {'piston deg':>11} {'engine dB':>10} {'engine deg':>11}"
+              "   (piston x_p/(R theta_c); phase continuous from low frequency)")
         for i, f in enumerate(d["freq_hz"]):
-            print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} "
-                  f"{d['engine']['gain_db'][i]:10.3f} {d['engine']['phase_deg'][i]:11.2f}")
+            eg, ep = d["engine"]["gain_db"][i], d["engine"]["phase_deg"][i]
+            eng = f"{eg:10.3f} {ep:11.2f}" if eg is not None else f"{'engine held':>22s}"
+            print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} {eng}")
+        if d.get("note"):
+            print(d["note"])
     if args.plot:
-        from taos.plotting import bode, save
-        save(bode.plot_freqresp([fr], resonance_hz=model.load_resonance_hz(args.axis)), args.plot)
+        from taos.plotting import save
+        from taos.plotting import bode
+        from taos.plotting.spec import bode_axes
+        if args.engine == "taos":
+            fig = bode.plot_freqresp([fr], resonance_hz=model.load_resonance_hz(args.axis))
+        else:   # the linear response as a dense curve, not straight lines between the listed points
+            fd = np.logspace(math.log10(min(freqs) / 1.5), math.log10(max(freqs) * 1.5), 400)
+            dense = linear_freqresp(model, fd, args.axis)
+            from taos.simplex import load_resonance_from_notch   # the one notch finder every command uses
+            fig = bode.plot_freqresp([dense] + ([] if fr.amplitude_rad is None else [fr]),
+                                     resonance_hz=model.load_resonance_hz(args.axis),
+                                     notch_hz=load_resonance_from_notch(model, args.axis))
+            if fr.amplitude_rad is None:
+                bode.draw_response(bode_axes(fig), fr, 1.0, color="k", label="listed points", gid="points",
+                                   marker="o", linestyle="none", ref=dense)
+        save(fig, args.plot)
     return 0
 
 
@@ -153,6 +201,15 @@ def cmd_simulate(args) -> int:
     th.provenance.update(input_provenance(args.profile, "profile", th.provenance))
     th.to_hdf5(args.out)
     print(f"wrote {args.out} ({th.t_s.size} samples, {', '.join(th.axes)})")
+    if str(args.profile).lower().endswith((".csv", ".txt", ".h5", ".hdf5")):   # a replayed record
+        from taos.identify.data import load_test_data
+        from taos.identify.replay import compare_replay
+        for r in compare_replay(load_test_data(args.profile), th):
+            d = r.to_dict()
+            eng = ("" if d["engine_rms_error_deg"] is None else
+                   f", engine {d['engine_rms_error_deg']:.4f} deg ({100 * d['engine_relative_rms_error']:.1f} %)")
+            print(f"replay {r.axis}: model - test RMS piston {d['piston_rms_error_in']:.5f} in "
+                  f"({100 * d['piston_relative_rms_error']:.1f} %){eng}")
     return 0
 
 
@@ -183,7 +240,9 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser("simulate", help="time history of a command profile, to HDF5")
     p.add_argument("model")
-    p.add_argument("--profile", required=True, help="profile file (TOML), e.g. models/profiles/greenrun_two_axis.toml")
+    p.add_argument("--profile", required=True, help="profile file (TOML), e.g. models/profiles/greenrun_two_axis.toml, "
+                   "or a measured record (.csv/.h5, e.g. models/data/greenrun_hotfire_synthetic.csv) whose commands "
+                   "are replayed and compared with its piston and engine angles")
     p.add_argument("--out", required=True, help="HDF5 file to write")
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
     p.add_argument("--friction", help="swap the friction law")

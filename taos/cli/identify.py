@@ -8,9 +8,7 @@ import math
 import sys
 
 from taos.errors import InputError
-from taos.linear import gain_db
 from taos.results import write_json
-from taos.units import from_si
 
 AXES = ("pitch", "yaw")
 
@@ -61,26 +59,64 @@ def _outputs(args, *names) -> None:
             check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
 
 
+def _parse_bounds(items) -> dict:
+    """--bounds 'NAME=LO:HI' (each with a unit) -> {name: (lo_si, hi_si)}."""
+    from taos.identify.surrogate import PARAMETERS
+    from taos.units import to_si
+
+    out = {}
+    for it in items or []:
+        if "=" not in it or ":" not in it.split("=", 1)[1]:
+            raise InputError("command line", "--bounds", "NAME=LOW:HIGH with units, like "
+                             "load_stiffness='50000 lbf/in:400000 lbf/in'", got=repr(it))
+        k, v = (x.strip() for x in it.split("=", 1))
+        if k not in PARAMETERS:
+            raise InputError("command line", "--bounds", "a name from " + ", ".join(PARAMETERS), got=repr(k))
+        p = PARAMETERS[k]
+        lo_s, hi_s = (x.strip() for x in v.split(":", 1))
+        lo, hi = (to_si(x if p.kind != "dimensionless" else float(x), p.kind, source="command line",
+                        field=f"--bounds {k}", positive=True) for x in (lo_s, hi_s))
+        if not lo < hi:
+            raise InputError("command line", f"--bounds {k}", "LOW below HIGH", got=repr(v))
+        out[k] = (lo, hi)
+    return out
+
+
 def cmd_estimate(args) -> int:
     _outputs(args, "json")
+    model = None
+    if getattr(args, "model", None):
+        from taos.model import load_model
+        model = load_model(args.model)
     data, responses = _estimate(args.data, args)
     d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
          "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
-         "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict() for r in responses]}
+         "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict(model=model) for r in responses]}
     from taos.results import output_provenance
-    d["provenance"] = {**output_provenance(inputs=[("data", args.data)]), "method": args.method,
-                       "nperseg": args.nperseg, "seeds": "none (deterministic)"}
+    d["provenance"] = {**output_provenance([model] if model is not None else [], inputs=[("data", args.data)]),
+                       "method": args.method, "nperseg": args.nperseg, "seeds": "none (deterministic)"}
     if args.json:
         write_json(args.json, d)
-    else:
-        for r in responses:
-            print(f"{r.axis} ({r.method}), {len(r)} points")
-            print(f"{'freq_hz':>9} {'amp_deg':>8} {'piston dB':>10} {'deg':>8} {'coh':>6}")
-            in_per_deg = from_si(1.0, "m/rad", "in/deg")
+    out = sys.stderr if args.json == "-" else sys.stdout
+    if not args.json or args.json == "-":
+        for r, rd in zip(responses, d["responses"]):
+            ex = rd.get("excitation") or {}
+            forced = " (forced by --method)" if r.meta.get("method_forced") else ""
+            print(f"{r.axis}: {ex.get('kind', '?')} -- {ex.get('reason', '')}", file=out)
+            print(f"{r.axis} ({r.method}{forced}), {len(r)} points", file=out)
+            pk = "piston" if rd["piston"] else "piston_in_per_deg"
+            pl = "x_p/(R theta_c)" if rd["piston"] else "x_p/theta_c in/deg"
+            hdr = f"{'freq_hz':>9} {'amp_deg':>8} {'piston dB':>10} {'deg':>8} {'coh':>6}"
+            if rd["engine"]:
+                hdr += f" {'engine dB':>10} {'deg':>8} {'coh':>6}"
+            print(hdr + f"   (piston {pl}; phase continuous from low frequency)", file=out)
             for k in range(len(r)):
-                h = r.piston_m_per_rad[k] * in_per_deg
-                print(f"{r.freq_hz[k]:9.4g} {math.degrees(r.amplitude_rad[k]):8.3g} {float(gain_db(h)):10.3f} "
-                      f"{math.degrees(math.atan2(h.imag, h.real)):8.2f} {r.coherence_piston[k]:6.3f}")
+                row = (f"{r.freq_hz[k]:9.4g} {math.degrees(r.amplitude_rad[k]):8.3g} {rd[pk]['gain_db'][k]:10.3f} "
+                       f"{rd[pk]['phase_deg'][k]:8.2f} {r.coherence_piston[k]:6.3f}")
+                if rd["engine"]:
+                    row += (f" {rd['engine']['gain_db'][k]:10.3f} {rd['engine']['phase_deg'][k]:8.2f} "
+                            f"{r.coherence_engine[k]:6.3f}")
+                print(row, file=out)
     return 0
 
 
@@ -98,6 +134,7 @@ def cmd_fit(args) -> int:
     model = load_model(args.model, friction=args.friction)
     free = [s.strip() for s in args.free.split(",") if s.strip()]
     start = _parse_start(args.start, model)
+    bounds = _parse_bounds(args.bounds)
     responses, labels = [], []
     for path in args.data:                       # read and validate everything before any output
         _, rs = _estimate(path, args)
@@ -105,8 +142,9 @@ def cmd_fit(args) -> int:
         labels.append(str(path))
     res = fit_frequency_response(model, responses, free, start=start, starts=args.starts,
                                  use_engine=not args.no_engine, min_coherence=args.min_coherence,
-                                 correct=None if not args.no_correction else False)
+                                 correct=None if not args.no_correction else False, bounds=bounds)
     d = res.to_dict()
+    adequacy = res.adequacy()
     d["model_file"] = model.source
     from taos.results import output_provenance
     d["provenance"] = {**output_provenance([model], [("data", p) for p in args.data]), "starts": args.starts,
@@ -125,6 +163,10 @@ def cmd_fit(args) -> int:
     print(res.table(), file=out)
     if args.out_model:
         print(f"wrote {args.out_model}", file=out)
+    if not adequacy.ok:
+        print(adequacy.message(), file=sys.stderr if out is sys.stdout else out)
+        if args.strict:
+            return 4
     return 0
 
 
@@ -193,12 +235,15 @@ def cmd_compare(args) -> int:
 def add_parsers(sub) -> None:
     def est_opts(p):
         p.add_argument("--method", choices=("auto", "dwell", "h1"), default="auto",
-                       help="sine-dwell correlation or H1 (Welch) estimate; auto: dwell if the commands are dwells")
+                       help="sine-dwell correlation or H1 (Welch) estimate; auto: classify each command (dwell, sweep, "
+                       "multisine), say why, and refuse when unsure")
         p.add_argument("--axis", choices=AXES + ("both",), default="both")
         p.add_argument("--nperseg", type=int, help="H1 segment length in samples")
 
     p = sub.add_parser("estimate", help="frequency responses estimated from a vectoring record (CSV/HDF5)")
     p.add_argument("data", help="time-history file (.csv with 'signal [unit]' header or sidecar .toml, or .h5)")
+    p.add_argument("--model", help="model file: its moment arm gives the piston as x_p/(R theta_c) and its linear "
+                   "phase the branch of each point (phase continuous from low frequency)")
     est_opts(p)
     p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
     p.set_defaults(func=cmd_estimate)
@@ -214,6 +259,12 @@ def add_parsers(sub) -> None:
     p.add_argument("--no-engine", action="store_true", help="fit the piston responses only")
     p.add_argument("--no-correction", action="store_true", help="skip the time-domain defect correction")
     p.add_argument("--min-coherence", type=float, default=0.5)
+    p.add_argument("--bounds", action="append", metavar="NAME=LOW:HIGH",
+                   help="bounds with units, e.g. --bounds 'load_stiffness=50000 lbf/in:400000 lbf/in' (repeatable; "
+                        "default 0.05 to 20 times the start, see the JSON 'bounds')")
+    p.add_argument("--strict", action="store_true",
+                   help="exit 4 when the model cannot explain the data (verdict 'inadequate'); without it the "
+                        "verdict is a WARNING in the text and 'adequacy' in the JSON")
     p.add_argument("--out-model", metavar="TOML", help="write the fitted model file here")
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="save data vs fit and residuals")
     p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 
 import numpy as np
 
@@ -15,7 +16,7 @@ from taos.results import write_json
 def cmd_lco(args) -> int:
     from taos.flight.vehicle import load_flight
     from taos.flight.lco import analyse_lco
-    from taos.model import Structure, load_model
+    from taos.model import load_model
     from taos.units import to_si
 
     flight = load_flight(args.flight)
@@ -54,19 +55,20 @@ def cmd_lco(args) -> int:
         from taos.results import output_provenance
         d.setdefault("provenance", {}).update(output_provenance([model], [("flight", flight.source)]))
         write_json(args.json, d)
-    else:
-        td = d["time_domain"] or {}
-        if d["lco"]:
-            print(f"LCO predicted: command {d['amplitude_deg']:.4f} deg (engine {d['engine_amplitude_deg']:.4f} deg) "
-                  f"at {d['frequency_hz']:.4f} Hz, {'stable' if d['stable'] else 'unstable'}")
+    out = sys.stderr if args.json == "-" else sys.stdout   # the verdict is always shown
+    td = d["time_domain"] or {}
+    v = d["verdict"]
+    print(v["text"], file=out)
+    if v["nearest_margin"]:
+        print(f"margin meant: {v['margin_meaning']}", file=out)
+    if td:
+        if td["lco"]:
+            print(f"time domain:   command {td['amplitude_deg']:.4f} deg (engine {td['engine_amplitude_deg']:.4f} deg) "
+                  f"at {td['frequency_hz']:.4f} Hz", file=out)
         else:
-            print(f"no LCO predicted; remaining margin {d['margin_db']:.2f} dB")
-        if td:
-            if td["lco"]:
-                print(f"time domain:   command {td['amplitude_deg']:.4f} deg (engine {td['engine_amplitude_deg']:.4f} deg) "
-                      f"at {td['frequency_hz']:.4f} Hz")
-            else:
-                print(f"time domain:   no sustained oscillation (final {td['final_amplitude_deg']:.2g} deg)")
+            print(f"time domain:   no sustained oscillation (final {td['final_amplitude_deg']:.2g} deg)", file=out)
+    print("loop margins of L0 N(A, .) over the command amplitude A (low GM: how far the gain may fall):", file=out)
+    print(rep.verdict().table_text(), file=out)
     return 0
 
 

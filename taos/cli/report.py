@@ -45,6 +45,7 @@ OUTPUTS = ("index.html", "summary.json", "greenrun.h5")
 #: keyframes of the embedded 3-D view (fps lowered for long runs) and samples per plotted trace
 MAX_VIEW_FRAMES = 4000
 MAX_PLOT_POINTS = 20000
+DEFAULT_SPEC = models_dir() / "specs" / "tvc_actuator_notional.toml"
 AXES = ("pitch", "yaw")
 
 
@@ -134,10 +135,6 @@ def _db(h) -> float:
     return float(gain_db(h))
 
 
-def _deg(h) -> float:
-    return math.degrees(math.atan2(h.imag, h.real))
-
-
 def _write_h5(path: Path, th, linear: dict, dwell: dict, run: dict) -> None:
     th.to_hdf5(path)
     with h5py.File(path, "a") as h5:
@@ -166,7 +163,8 @@ def _write_h5(path: Path, th, linear: dict, dwell: dict, run: dict) -> None:
 
 def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, friction: str | None = None,
                     engine: str = "simplex", progress: bool = True, dt_s: float = 2e-4,
-                    view_angle_scale: float = 5.0, view_fps: float = 100.0, allow_unstable: bool = False) -> Path:
+                    view_angle_scale: float = 5.0, view_fps: float = 100.0, allow_unstable: bool = False,
+                    spec_path=DEFAULT_SPEC, data_path=None) -> Path:
     """Build the Green Run report folder ``out_dir`` (see the module docstring); returns its path.
 
     Parameters
@@ -191,6 +189,13 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     view_fps : float
         Keyframe rate of the embedded 3-D view [1/s]; lowered so that the view holds at most
         :data:`MAX_VIEW_FRAMES` keyframes (the page stays under 15 MB for any run length).
+    spec_path : str or Path, optional
+        Spec mask (:mod:`taos.spec`) checked against each axis' linear response and marked on
+        the Bode plots; default ``models/specs/tvc_actuator_notional.toml``; None: no check.
+    data_path : str or Path, optional
+        A measured record (e.g. ``models/data/greenrun_hotfire_synthetic.csv``): its estimated
+        responses (:func:`taos.identify.estimate.estimate`) are overlaid on the Bode plots and
+        tabulated beside the model's.
     allow_unstable : bool
         Run a model whose linear block is unstable (else refused, exit 3) and skip the envelope check.
 
@@ -200,6 +205,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     from tqdm import tqdm
 
     from taos.cli.basic import info_dict
+    from taos.cli.report_extras import decorate_bode, extras_summary
     from taos.freqresp import FrequencyResponse, linear_freqresp, sine_dwell_grid
     from taos.model import load_model
     from taos.plotting import bode, timehist
@@ -221,6 +227,9 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
                          got=type(profile).__name__)
     run_checks.check_run(model, profile, dt_s)
     run_checks.check_linear_stability(model, allow=allow_unstable)
+    from taos.cli.report_extras import data_responses, spec_results
+    specs = spec_results(model, spec_path)
+    test = data_responses(data_path, model) if data_path is not None else None
     info = info_dict(model)
     R = model.actuator.moment_arm_m
     if engine == "taos":
@@ -287,9 +296,11 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
         step("plots")
         figs = {}
         for ax in AXES:
-            figs[f"bode_{ax}"] = _png(bode.plot_freqresp(
-                [linear[ax]] + dwell_fr[ax], resonance_hz=wl[ax], notch_hz=notch[ax], length_unit="in",
-                moment_arm_m=R, data=run.get(ax), data_label="two-axis run", title=f"{ax}: command → piston and engine ({model.name})"))
+            fig = bode.plot_freqresp(
+                [linear[ax]] + dwell_fr[ax], resonance_hz=wl[ax], notch_hz=notch[ax],
+                data=run.get(ax), data_label="two-axis run", title=f"{ax}: command → piston and engine ({model.name})")
+            decorate_bode(fig, specs.get(ax), test, ax, linear[ax], R)
+            figs[f"bode_{ax}"] = _png(fig)
         figs["timehist"] = _png(timehist.plot_timehistory(decimated(th, MAX_PLOT_POINTS), "in", "deg"))
         zoom = decimated(th, MAX_PLOT_POINTS, t_range_s=(0.0, 4.0))
         figs["timehist_zoom"] = _png(timehist.plot_timehistory(
@@ -303,6 +314,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
 
         step("write")
         summary = _summary(model, info, th, notch, wl, dwell, run, ppath)
+        summary.update(extras_summary(info, specs, test, dwell, model))
         page = _page(model, summary, figs, view, view_angle_scale, dwell, run)
         text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
         write_output_folder(out, {
@@ -317,19 +329,34 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
 
 
 def _summary(model, info, th, notch, wl, dwell, run, ppath) -> dict:
+    from taos.freqresp import linear_phase_reference
+    from taos.linear import phase_deg_continuous
     from taos.units import from_si
 
     fr = model.friction
     dw = {}
     for ax, d in dwell.items():
+        if not len(d["freq_hz"]):
+            dw[ax] = []
+            continue
+        rp, re = linear_phase_reference(model, d["freq_hz"], ax)
+        pp = [phase_deg_continuous(d["freq_hz"], d["piston"][i], rp) for i in range(len(d["amplitude_rad"]))]
+        pe = [phase_deg_continuous(d["freq_hz"], d["engine"][i], re) for i in range(len(d["amplitude_rad"]))]
         dw[ax] = [{"amplitude_deg": math.degrees(a), "freq_hz": float(f),
-                   "piston_gain_db": _db(d["piston"][i, j]), "piston_phase_deg": _deg(d["piston"][i, j]),
-                   "engine_gain_db": _db(d["engine"][i, j]), "engine_phase_deg": _deg(d["engine"][i, j])}
+                   "piston_gain_db": _db(d["piston"][i, j]), "piston_phase_deg": float(pp[i][j]),
+                   "engine_gain_db": _db(d["engine"][i, j]), "engine_phase_deg": float(pe[i][j])}
                   for i, a in enumerate(d["amplitude_rad"]) for j, f in enumerate(d["freq_hz"])]
-    rn = {ax: [{"amplitude_deg": math.degrees(r.amplitude_rad), "freq_hz": float(f),
-                "piston_gain_db": _db(r.piston[j]), "engine_gain_db": _db(r.engine[j]),
-                "engine_phase_deg": _deg(r.engine[j])}
-               for r in rs for j, f in enumerate(r.freq_hz)] for ax, rs in run.items()}
+    rn = {}
+    for ax, rs in run.items():
+        rows = []
+        for r in rs:
+            rp, re = linear_phase_reference(model, r.freq_hz, ax)
+            pp, pe = phase_deg_continuous(r.freq_hz, r.piston, rp), phase_deg_continuous(r.freq_hz, r.engine, re)
+            rows += [{"amplitude_deg": math.degrees(r.amplitude_rad), "freq_hz": float(f),
+                      "piston_gain_db": _db(r.piston[j]), "piston_phase_deg": float(pp[j]),
+                      "engine_gain_db": _db(r.engine[j]), "engine_phase_deg": float(pe[j])}
+                     for j, f in enumerate(r.freq_hz)]
+        rn[ax] = rows
     return {
         "model_file": str(model.source), "model_name": model.name, "model_sha256": model.sha256,
         "profile_file": str(ppath), "profile": th.provenance.get("profile", ""),
@@ -362,10 +389,12 @@ _CSS = """body{font:14px/1.45 system-ui,sans-serif;margin:24px auto;max-width:11
 h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccd}
 table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #ccd;padding:3px 8px;text-align:right}
 th{background:#eef}td:first-child,th:first-child{text-align:left}img{max-width:100%}
-.note{color:#555;font-size:12px}iframe{width:100%;height:620px;border:1px solid #ccd}"""
+.note{color:#555;font-size:12px}iframe{width:100%;height:620px;border:1px solid #ccd}
+.pass{color:#1a7f37}.fail{color:#c62828}tr.fail td{background:#fdecea}"""
 
 
 def _page(model, s, figs, view, scale, dwell, run) -> str:
+    from taos.cli.report_extras import extras_html
     rows = [
         ("load resonance w_L (pitch / yaw)", f"{s['load_resonance_hz']['pitch']:.3f} / {s['load_resonance_hz']['yaw']:.3f} Hz"),
         ("piston notch, linear (pitch / yaw)", f"{s['notch_frequency_hz']['pitch']:.3f} / {s['notch_frequency_hz']['yaw']:.3f} Hz"),
@@ -411,6 +440,7 @@ def _page(model, s, figs, view, scale, dwell, run) -> str:
 <p class="note">Engine angle exaggerated ×{scale:g}; load-path deflection x_p − Rθ exaggerated as shown in the legend. Play, pause,
 time and speed (timeScale) are under “Open Controls” → Animations.</p>
 <iframe title="3-D gimbal animation" srcdoc="{srcdoc}"></iframe>
+{extras_html(s)}
 <h2>Frequency response: pitch</h2>
 <img alt="pitch Bode plot" src="{figs['bode_pitch']}">
 <h2>Frequency response: yaw</h2>
@@ -419,7 +449,9 @@ time and speed (timeScale) are under “Open Controls” → Animations.</p>
 describing function at the profile amplitudes (friction and avionics included). Open circles: the
 response read off the two-axis run, dwell by dwell (last two cycles). Triangle: the linear
 command → piston notch; dashed vertical: load resonance w_L = sqrt((K_L R² + K_n)/J_n).
-Piston gain is x_p/θ_c in in/deg.</p>
+Piston gain is x_p/(R θ_c) (dimensionless, 0 dB at low frequency); phase is continuous from low
+frequency. Grey bars: spec-mask bounds; green circle / red cross: the linear response passes / fails.
+Squares: the measured record (when given), estimated from its dwells.</p>
 <h2>Sine-dwell points</h2>{''.join(dwell_tables)}
 <h2>Time history</h2>
 <img alt="time history" src="{figs['timehist']}">

@@ -44,8 +44,11 @@ def cmd_view(args) -> int:
 def cmd_greenrun(args) -> int:
     from taos.cli.report import greenrun_report
 
+    from taos.cli.report import DEFAULT_SPEC
+    spec = None if args.spec == "none" else (args.spec or DEFAULT_SPEC)
     out = greenrun_report(args.model, args.out, profile_path=args.profile, friction=args.friction,
-                          engine=args.engine, progress=not args.quiet, allow_unstable=args.allow_unstable)
+                          engine=args.engine, progress=not args.quiet, allow_unstable=args.allow_unstable,
+                          spec_path=spec, data_path=args.data)
     print(f"wrote {out / 'index.html'} and {out / 'greenrun.h5'}")
     return 0
 
@@ -71,6 +74,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--out", default="out/greenrun", help="report folder (default out/greenrun)")
     p.add_argument("--profile", default=None, help="profile (default models/profiles/greenrun_two_axis.toml)")
     p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels")
+    p.add_argument("--spec", help="spec mask (TOML) marked pass/fail on the plots and in summary.json "
+                   "(default models/specs/tvc_actuator_notional.toml; 'none' for no check)")
+    p.add_argument("--data", help="measured record overlaid on the model (e.g. models/data/greenrun_hotfire_synthetic.csv)")
     p.add_argument("--engine", choices=("simplex", "taos"), default="simplex",
                    help="simplex (planar) or taos (3-D engine, FEM gimbal halves)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -333,6 +333,8 @@ class LcoReport:
 
     def to_dict(self) -> dict:
         d = self.prediction.to_dict()
+        if d["lco"]:   # with a cycle there is no margin left to state: null, not 0.0
+            d["margin_db"] = None
         fl = self.prediction.flight
         big = self.prediction.margins_by_amplitude[-1]
         d.update({
@@ -342,7 +344,8 @@ class LcoReport:
             "margins_at_largest_amplitude": {"amplitude_deg": math.degrees(self.prediction.df.amplitude_rad[-1]),
                                              **big.to_dict()},
             "time_domain": None if self.time_domain is None else self.time_domain.to_dict(),
-            "verdict": verdict(d, None if self.time_domain is None else self.time_domain.to_dict()),
+            "verdict": {**decision(d, None if self.time_domain is None else self.time_domain.to_dict()),
+                        **self.verdict().to_dict()},
             "describing_function": {"amplitude_deg": np.degrees(self.prediction.df.amplitude_rad).tolist(),
                                     "freq_hz": self.prediction.df.freq_hz.tolist()},
             "provenance": {"model_file": self.model.source, "model_sha256": self.model.sha256,
@@ -351,6 +354,10 @@ class LcoReport:
         })
         return d
 
+    def verdict(self):
+        """The verdict in plain words with its margin table (:mod:`taos.flight.lco_verdict`)."""
+        from taos.flight.lco_verdict import lco_verdict
+        return lco_verdict(self)
 
 def model_avionics_amplitudes_rad(model: TvcModel, n: int = 15) -> np.ndarray:
     """Default describing-function amplitudes [rad] with the flown avionics (``--avionics
@@ -360,7 +367,7 @@ def model_avionics_amplitudes_rad(model: TvcModel, n: int = 15) -> np.ndarray:
     return np.logspace(np.log10(0.5 * lsb), np.log10(DEG), n)
 
 
-def verdict(prediction: dict, time_domain: dict | None) -> dict:
+def decision(prediction: dict, time_domain: dict | None) -> dict:
     """The one LCO verdict of an analysis: the time domain decides when it was run (it carries
     every harmonic and the quantiser exactly); the describing function's verdict is reported
     beside it, with the reason when they differ."""

@@ -34,6 +34,8 @@ class Row:
     unit: str
     value_a: float
     value_b: float
+    text_a: str = ""      # a non-numeric entry (the friction law's name) instead of a value
+    text_b: str = ""
 
     @property
     def ratio(self) -> float:
@@ -60,13 +62,15 @@ class Comparison:
                 lines.append(f"[{r.group}]")
                 group = r.group
             ratio = f"{r.ratio:9.4g}" if math.isfinite(r.ratio) else f"{'-':>9s}"
-            lines.append(f"{r.name:{w}s} {r.value_a:16.6g} {r.value_b:16.6g} {ratio}  {r.unit}")
+            cell = lambda v, t: f"{t:>16s}" if t else (f"{v:16.6g}" if math.isfinite(v) else f"{'-':>16s}")  # noqa: E731
+            lines.append(f"{r.name:{w}s} {cell(r.value_a, r.text_a)} {cell(r.value_b, r.text_b)} {ratio}  {r.unit}")
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
         return {"labels": list(self.labels),
                 "models": [m.source for m in self.models],
-                "rows": [{"group": r.group, "name": r.name, "unit": r.unit, "a": _num(r.value_a), "b": _num(r.value_b),
+                "rows": [{"group": r.group, "name": r.name, "unit": r.unit, "a": r.text_a or _num(r.value_a),
+                          "b": r.text_b or _num(r.value_b),
                           "ratio": r.ratio if math.isfinite(r.ratio) else None} for r in self.rows],
                 "data": [[d.to_dict() for d in ds] for ds in self.data], **self.meta}
 
@@ -114,7 +118,7 @@ def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
         fa, fb = _numeric_fields(getattr(model_a, part)), _numeric_fields(getattr(model_b, part))
         for k in fa:
             rows.append(Row(part, k, _unit_of(k), fa[k], fb.get(k, math.nan)))
-    rows.append(Row("friction", "model", f"{model_a.friction.name} | {model_b.friction.name}", math.nan, math.nan))
+    rows.append(Row("friction", "model", "-", math.nan, math.nan, model_a.friction.name, model_b.friction.name))
     fa, fb = _numeric_fields(model_a.friction), _numeric_fields(model_b.friction)
     for k in list(fa) + [k for k in fb if k not in fa]:
         rows.append(Row("friction", k, _unit_of(k), fa.get(k, math.nan), fb.get(k, math.nan)))

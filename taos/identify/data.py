@@ -7,7 +7,10 @@ absolute reference). :func:`load_test_data` reads such a record into :class:`Tes
 Signals (canonical names, unit kind)::
 
     time [time], pitch_command, yaw_command [angle], pitch_piston, yaw_piston [length],
-    pitch_engine, yaw_engine [angle]
+    pitch_engine, yaw_engine [angle]; optional hydraulic signals: pitch_load_pressure,
+    yaw_load_pressure [pressure] (P_L), pitch_spool, yaw_spool [velocity] (servovalve
+    opening as its no-load piston rate K_q x_v / A, as :class:`taos.simulate.TimeHistory`
+    records it), supply_pressure [pressure]
 
 CSV layout: optional leading ``#`` lines holding TOML metadata (``# condition = "hot fire"``,
 ``# engine_angle_reference = "relative"``, ``# synthetic = true``), then a header row whose
@@ -57,7 +60,14 @@ SIGNALS = {
     "yaw_piston": ("length", "m", "'in'"),
     "pitch_engine": ("angle", "rad", "'deg'"),
     "yaw_engine": ("angle", "rad", "'deg'"),
+    "pitch_load_pressure": ("pressure", "Pa", "'psi'"),
+    "yaw_load_pressure": ("pressure", "Pa", "'psi'"),
+    "pitch_spool": ("velocity", "m/s", "'in/s'"),
+    "yaw_spool": ("velocity", "m/s", "'in/s'"),
+    "supply_pressure": ("pressure", "Pa", "'psi'"),
 }
+#: optional per-axis hydraulic signals: (signal suffix, TestData field, CSV unit)
+HYDRAULIC = (("load_pressure", "load_pressure_Pa", "psi"), ("spool", "spool_flow_m_s", "in/s"))
 MIN_SAMPLES = 16
 IRREGULAR_TOL = 1e-3
 
@@ -85,6 +95,9 @@ class TestData:
     synthetic: bool = False
     resampled: bool = False
     metadata: dict = field(default_factory=dict)
+    load_pressure_Pa: np.ndarray | None = None
+    spool_flow_m_s: np.ndarray | None = None
+    supply_pressure_Pa: np.ndarray | None = None
 
     @property
     def sample_rate_hz(self) -> float:
@@ -109,6 +122,13 @@ class TestData:
             if self.engine_rad is not None:
                 cols.append(self.engine_rad[i] * af)
                 names.append(f"{ax}_engine [{angle_unit}]")
+            for sig, fld, unit in HYDRAULIC:
+                if getattr(self, fld) is not None:
+                    cols.append(getattr(self, fld)[i] / float(Q_(1.0, unit).to(SIGNALS[f"{ax}_{sig}"][1]).magnitude))
+                    names.append(f"{ax}_{sig} [{unit}]")
+        if self.supply_pressure_Pa is not None:
+            cols.append(self.supply_pressure_Pa / float(Q_(1.0, "psi").to("Pa").magnitude))
+            names.append("supply_pressure [psi]")
         meta = {"condition": self.condition, "synthetic": self.synthetic,
                 "engine_angle_reference": "absolute" if self.engine_absolute else "relative",
                 **{k: v for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool))}}
@@ -282,9 +302,16 @@ def _read_hdf5(path: Path, src: str) -> tuple[dict, dict, dict]:
                         raise InputError(src, "/" + key, "a dataset of the taos simulate layout", got="missing")
                     out[f"{ax}_{sig}"] = np.asarray(h5[key][()], float)
                     labels[f"{ax}_{sig}"] = "/" + key
+                for sig, name in (("load_pressure", "load_pressure_Pa"), ("spool", "spool_flow_m_s")):
+                    if f"{ax}/{name}" in h5:
+                        out[f"{ax}_{sig}"] = np.asarray(h5[f"{ax}/{name}"][()], float)
+                        labels[f"{ax}_{sig}"] = f"/{ax}/{name}"
+                if f"{ax}/supply_pressure_Pa" in h5 and "supply_pressure" not in out:
+                    out["supply_pressure"] = np.asarray(h5[f"{ax}/supply_pressure_Pa"][()], float)
+                    labels["supply_pressure"] = f"/{ax}/supply_pressure_Pa"
             meta.setdefault("engine_angle_reference", "absolute")
             meta.setdefault("synthetic", True)
-            meta = {k: v for k, v in meta.items() if k not in ("axes", "moment_arm_m")}
+            meta = {k: v for k, v in meta.items() if k != "axes"}
         else:
             for sig in SIGNALS:
                 if sig in h5:
@@ -368,7 +395,15 @@ def load_test_data(path, *, resample: bool = True) -> TestData:
         t = tn
         resampled = True
     stack = lambda kind: np.vstack([sig[f"{ax}_{kind}"] for ax in axes])  # noqa: E731
-    return TestData(source=src, t_s=t, axes=axes, command_rad=stack("command"), piston_m=stack("piston"),
+    hyd = {}
+    for name, fld, _ in HYDRAULIC:
+        have = [f"{ax}_{name}" in sig for ax in axes]
+        if any(have) and not all(have):
+            miss = axes[have.index(False)]
+            raise InputError(src, f"{miss}_{name}", f"{name} for every commanded axis or none", got="none")
+        hyd[fld] = stack(name) if all(have) else None
+    return TestData(supply_pressure_Pa=sig.get("supply_pressure"), **hyd,
+                    source=src, t_s=t, axes=axes, command_rad=stack("command"), piston_m=stack("piston"),
                     engine_rad=stack("engine") if all(has_engine) else None,
                     engine_absolute=(ref == "absolute"), condition=str(meta.get("condition", "")),
                     synthetic=bool(meta.get("synthetic", False)), resampled=resampled,
@@ -386,4 +421,8 @@ def from_time_history(th, *, engine_offset_rad=None, condition: str = "", source
     return TestData(source=source, t_s=np.asarray(th.t_s, float), axes=tuple(th.axes),
                     command_rad=np.asarray(th.command_rad, float), piston_m=np.asarray(th.piston_m, float),
                     engine_rad=eng, engine_absolute=engine_offset_rad is None, condition=condition,
-                    synthetic=synthetic, metadata={})
+                    synthetic=synthetic, metadata={"moment_arm_m": float(th.moment_arm_m)},
+                    load_pressure_Pa=getattr(th, "load_pressure_Pa", None),
+                    spool_flow_m_s=getattr(th, "spool_flow_m_s", None),
+                    supply_pressure_Pa=None if getattr(th, "supply_pressure_Pa", None) is None
+                    else np.asarray(th.supply_pressure_Pa)[0])

@@ -86,14 +86,42 @@ class MeasuredResponse:
         return FrequencyResponse(self.freq_hz, self.piston_m_per_rad / moment_arm_m, eng, amp, self.axis,
                                  friction_model="data", provenance={"source": self.source, "method": self.method})
 
-    def to_dict(self) -> dict:
-        def gp(h):
+    def phase_deg(self, h, reference_deg=None) -> np.ndarray:
+        """Phase of ``h`` at these points [deg], continuous from low frequency: on the branch of
+        ``reference_deg`` (a model's continuous phase at these points) when given, else
+        unwrapped over all points in frequency order (dwells at 0.4 and 0.8 deg lie on one
+        curve, as the test steps the amplitude up with frequency;
+        :func:`taos.linear.phase_deg_continuous`). Sparse points far apart cannot be unwrapped
+        without a reference: give the model (``taos estimate --model``)."""
+        from taos.linear import phase_deg_continuous
+        return phase_deg_continuous(self.freq_hz, np.asarray(h), reference_deg)
+
+    def to_dict(self, moment_arm_m: float | None = None, model=None) -> dict:
+        """JSON: ``piston`` is x_p / (R theta_c) (the project's piston convention) when the
+        moment arm is known (argument, or ``meta['moment_arm_m']``), else null;
+        ``piston_in_per_deg`` is x_p / theta_c in in/deg, named by its unit. Phases are
+        continuous from low frequency (:meth:`phase_deg`; on ``model``'s branch when given,
+        whose moment arm then also defines the piston)."""
+        rp = re = None
+        if model is not None and len(self):
+            from taos.freqresp import linear_phase_reference
+            rp, re = linear_phase_reference(model, self.freq_hz, self.axis)
+            moment_arm_m = model.actuator.moment_arm_m
+
+        def gp(h, ref=None):
             return None if h is None else {"gain_db": gain_db(h).tolist(),
-                                           "phase_deg": np.degrees(np.angle(h)).tolist()}
+                                           "phase_deg": self.phase_deg(h, ref).tolist()}
+        R = moment_arm_m if moment_arm_m is not None else self.meta.get("moment_arm_m")
         return {"axis": self.axis, "method": self.method, "source": self.source, "condition": self.condition,
+                "excitation": self.meta.get("excitation"),
                 "freq_hz": self.freq_hz.tolist(), "amplitude_deg": np.degrees(self.amplitude_rad).tolist(),
-                "piston_in_per_deg": gp(self.piston_m_per_rad * from_si(1.0, "m/rad", "in/deg")),
-                "engine": gp(self.engine), "coherence_piston": self.coherence_piston.tolist(),
+                "piston_definition": "x_p / (R theta_c), dimensionless" if R else
+                "x_p / (R theta_c) needs the moment arm (taos estimate --model MODEL); see piston_in_per_deg",
+                "moment_arm_m": R,
+                "phase_reference": "model" if rp is not None else "data (unwrapped from the lowest frequency)",
+                "piston": gp(self.piston_m_per_rad / R, rp) if R else None,
+                "piston_in_per_deg": gp(self.piston_m_per_rad * from_si(1.0, "m/rad", "in/deg"), rp),
+                "engine": gp(self.engine, re), "coherence_piston": self.coherence_piston.tolist(),
                 "coherence_engine": None if self.coherence_engine is None else self.coherence_engine.tolist(),
                 "engine_dc_observable": self.engine_dc_observable}
 
@@ -124,7 +152,11 @@ def _rising_crossings(t, u, hyst):
 
 def detect_dwells(t_s, command_rad, *, period_tol: float = 0.02, min_cycles: int = 3) -> list[DwellSegment]:
     """Sine-dwell segments of a command: runs of upward zero crossings with a constant
-    period (within ``period_tol``), at least ``min_cycles`` cycles."""
+    period, at least ``min_cycles`` cycles.
+
+    A run continues while every period stays within ``period_tol`` of the run's *first*
+    period (not merely of its neighbour), so the slowly changing period of a logarithmic
+    sweep (about k/f per cycle, 1 % at 8 Hz for 0.5-14 Hz in 40 s) never passes as a dwell."""
     t = np.asarray(t_s, float)
     u = np.asarray(command_rad, float)
     amp = np.max(np.abs(u)) if u.size else 0.0
@@ -137,13 +169,117 @@ def detect_dwells(t_s, command_rad, *, period_tol: float = 0.02, min_cycles: int
     P = np.diff(tc)
     start = 0
     for k in range(1, P.size + 1):
-        if k == P.size or abs(P[k] / P[k - 1] - 1.0) > period_tol:
+        if k == P.size or abs(P[k] / P[start] - 1.0) > period_tol:
             ncyc = k - start
-            if ncyc >= min_cycles:
+            if ncyc >= min_cycles and abs(_period_drift(P[start:k])) <= 0.25 * period_tol:
                 t0, t1 = tc[start], tc[k]
                 segs.append(DwellSegment(float(t0), float(t1), float(ncyc / (t1 - t0)), int(ncyc)))
             start = k
     return segs
+
+
+def _period_drift(P) -> float:
+    """Relative change of the period over a run of periods, from a least-squares line
+    (0 for a dwell up to crossing jitter; about n k / f for n cycles of a log sweep)."""
+    P = np.asarray(P, float)
+    if P.size < 2:
+        return 0.0
+    slope = np.polyfit(np.arange(P.size), P, 1)[0]
+    return float(slope * (P.size - 1) / P.mean())
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """What a command record is, and why: ``kind`` is 'dwell', 'sweep', 'multisine' or
+    'unknown'; ``reason`` one sentence with the evidence; ``method`` the estimator it calls for
+    ('dwell', 'h1' or None when unsure); ``amplitude_rad`` the command's sine amplitude (the
+    envelope of a sweep, the dwell amplitudes' maximum, the peak of a multisine)."""
+
+    axis: str
+    kind: str
+    reason: str
+    method: str | None
+    freq_range_hz: tuple[float, float] = (math.nan, math.nan)
+    amplitude_rad: float = math.nan
+
+    def to_dict(self) -> dict:
+        return {"axis": self.axis, "kind": self.kind, "reason": self.reason, "method": self.method,
+                "freq_range_hz": [None if not math.isfinite(x) else x for x in self.freq_range_hz],
+                "amplitude_deg": math.degrees(self.amplitude_rad) if math.isfinite(self.amplitude_rad) else None}
+
+
+def classify_excitation(t_s, command_rad, axis: str = "pitch", *, dwell_fraction: float = 0.8,
+                        monotone_fraction: float = 0.95, line_power: float = 0.95) -> Excitation:
+    """Classify one command as sine dwells, a sweep or a multisine, with the evidence.
+
+    Rules (in order), from the upward zero crossings (instantaneous frequency f_k = 1/P_k)
+    and the record's periodogram:
+
+    * **dwell** when constant-period runs (:func:`detect_dwells`) hold at least
+      ``dwell_fraction`` of all cycles;
+    * **sweep** when f_k moves one way in at least ``monotone_fraction`` of the cycles and
+      spans more than a factor 1.5 (logarithmic if log f is closer to a line in time than f);
+    * **multisine** when at most a few dozen spectral lines (peaks above 1 % of the largest,
+      +-1 bin) hold at least ``line_power`` of the command's power;
+    * else **unknown**: the caller refuses to guess (force ``--method``).
+    """
+    t = np.asarray(t_s, float)
+    u = np.asarray(command_rad, float)
+    u0 = u - np.mean(u)
+    amp_pk = float(np.max(np.abs(u))) if u.size else 0.0
+    if amp_pk <= 0:
+        return Excitation(axis, "unknown", "the command is identically zero", None)
+    tc = _rising_crossings(t, u, 0.05 * amp_pk)
+    if tc.size < 4:
+        return Excitation(axis, "unknown", f"only {tc.size} upward zero crossings (too few cycles to tell)", None)
+    P = np.diff(tc)
+    f_inst = 1.0 / P
+    segs = detect_dwells(t, u)
+    dwell_cycles = sum(s.cycles for s in segs)
+    frac = dwell_cycles / P.size
+    fr = (float(f_inst.min()), float(f_inst.max()))
+    if frac >= dwell_fraction:
+        fl = ", ".join(f"{s.freq_hz:.3g}" for s in segs)
+        return Excitation(axis, "dwell", f"{len(segs)} constant-period segment(s) at {fl} Hz hold {frac:.0%} of "
+                          f"the {P.size} cycles", "dwell", (min(s.freq_hz for s in segs), max(s.freq_hz for s in segs)),
+                          amp_pk)
+    df = np.diff(f_inst)
+    up = float(np.mean(df > 0)) if df.size else 0.0
+    mono = max(up, 1.0 - up)
+    span = fr[1] / fr[0]
+    if mono >= monotone_fraction and span > 1.5:
+        tm = 0.5 * (tc[1:] + tc[:-1])
+        r2 = {}
+        for name, y in (("logarithmic", np.log(f_inst)), ("linear", f_inst)):
+            c = np.polyfit(tm, y, 1)
+            res = y - np.polyval(c, tm)
+            r2[name] = 1.0 - float(np.sum(res ** 2) / max(np.sum((y - y.mean()) ** 2), 1e-300))
+        kind = max(r2, key=r2.get)
+        env = float(np.percentile(np.abs(u0), 99.9))
+        return Excitation(axis, "sweep", f"instantaneous frequency {'rises' if up >= 0.5 else 'falls'} in {mono:.0%} "
+                          f"of {P.size} cycles from {fr[0]:.3g} to {fr[1]:.3g} Hz ({kind} sweep: R^2 = {r2[kind]:.4f}); "
+                          f"only {frac:.0%} of the cycles sit in constant-period runs", "h1", fr, env)
+    spec = np.abs(np.fft.rfft(u0)) ** 2
+    fbin = np.fft.rfftfreq(u0.size, float(np.median(np.diff(t))))
+    pk = np.flatnonzero((spec > 0.01 * spec.max()) & (spec >= np.roll(spec, 1)) & (spec >= np.roll(spec, -1)))
+    pk = pk[pk > 0]
+    near = np.zeros(spec.size, bool)
+    for k in pk:
+        near[max(k - 1, 0):k + 2] = True
+    share = float(spec[near].sum() / max(spec.sum(), 1e-300))
+    if 2 <= pk.size <= 64 and share >= line_power:
+        return Excitation(axis, "multisine", f"{pk.size} spectral lines from {fbin[pk].min():.3g} to "
+                          f"{fbin[pk].max():.3g} Hz hold {share:.0%} of the command power; zero crossings are neither "
+                          f"constant-period ({frac:.0%} of cycles) nor monotone ({mono:.0%})", "h1",
+                          (float(fbin[pk].min()), float(fbin[pk].max())), amp_pk)
+    return Excitation(axis, "unknown", f"not dwells ({frac:.0%} of {P.size} cycles at a constant period), not a sweep "
+                      f"(frequency monotone in {mono:.0%} of cycles, span x{span:.2g}), not a multisine "
+                      f"({pk.size} lines hold {share:.0%} of the power)", None, fr, amp_pk)
+
+
+def classify_record(data: TestData) -> list[Excitation]:
+    """:func:`classify_excitation` of each commanded axis of a record."""
+    return [classify_excitation(data.t_s, data.command_rad[i], ax) for i, ax in enumerate(data.axes)]
 
 
 def _lsq_harmonics(t, ys, freqs):
@@ -284,11 +420,41 @@ def estimate_h1(data: TestData, axes=None, *, nperseg: int | None = None, window
     return out
 
 
+def choose_method(data: TestData, method: str = "auto") -> tuple[str, list[Excitation]]:
+    """The estimator for a record and the per-axis evidence (:func:`classify_excitation`).
+
+    ``method`` 'dwell' or 'h1' forces it (the evidence is still returned); 'auto' takes the
+    classification and refuses (:class:`InputError`, naming the axis and the evidence) when an
+    axis is 'unknown' or the axes call for different estimators."""
+    if method not in ("auto", "dwell", "h1"):
+        raise InputError("command line", "--method", "auto, dwell or h1", got=repr(method))
+    exc = classify_record(data)
+    if method != "auto":
+        return method, exc
+    for e in exc:
+        if e.method is None:
+            raise InputError(data.source, f"{e.axis}_command", "sine dwells, a sweep or a multisine (or force "
+                             "--method dwell|h1)", got=f"unsure: {e.reason}")
+    methods = {e.method for e in exc}
+    if len(methods) > 1:
+        raise InputError(data.source, "(commands)", "one kind of excitation on every axis (or force --method)",
+                         got="; ".join(f"{e.axis}: {e.kind}" for e in exc))
+    return methods.pop(), exc
+
+
 def estimate(data: TestData, method: str = "auto", **kwargs) -> list[MeasuredResponse]:
-    """Dwell estimate where the commands are sine dwells, else H1 (``method`` 'dwell', 'h1'
-    or 'auto')."""
-    if method == "dwell" or (method == "auto" and all(detect_dwells(data.t_s, c) for c in data.command_rad)):
-        return estimate_dwells(data, **kwargs)
-    if method in ("h1", "auto"):
-        return estimate_h1(data, **kwargs)
-    raise InputError("command line", "--method", "auto, dwell or h1", got=repr(method))
+    """Responses of a record by the estimator :func:`choose_method` picks (``method`` 'auto',
+    or forced 'dwell'/'h1'). Each response's ``meta['excitation']`` holds what was detected
+    and why; for a sweep the H1 points carry the sweep's envelope amplitude (the amplitude
+    the describing function sees), not the bin's share of the power."""
+    chosen, exc = choose_method(data, method)
+    out = estimate_dwells(data, **kwargs) if chosen == "dwell" else estimate_h1(data, **kwargs)
+    by_axis = {e.axis: e for e in exc}
+    res = []
+    for r in out:
+        e = by_axis[r.axis]
+        if chosen == "h1" and e.kind == "sweep":
+            r = replace(r, amplitude_rad=np.full(r.freq_hz.shape, e.amplitude_rad))
+        extra = {"moment_arm_m": float(data.metadata["moment_arm_m"])} if "moment_arm_m" in data.metadata else {}
+        res.append(replace(r, meta={**r.meta, "excitation": e.to_dict(), "method_forced": method != "auto", **extra}))
+    return res

@@ -74,10 +74,25 @@ class FitResult:
     method: str = "casadi-ipopt"
     absolute_sigma: bool = False
     history: list = field(default_factory=list)
+    lower_si: np.ndarray | None = None
+    upper_si: np.ndarray | None = None
 
     @property
     def dof(self) -> int:
         return max(1, self.n_residuals - len(self.names))
+
+    @property
+    def at_bound(self) -> tuple[str, ...]:
+        """Parameters that ended on a bound (their standard errors mean nothing)."""
+        from taos.identify.adequacy import parameters_at_bound
+        if self.lower_si is None:
+            return ()
+        return parameters_at_bound(self.names, self.values, self.lower_si, self.upper_si)
+
+    def adequacy(self, **kwargs):
+        """The model-adequacy verdict (:mod:`taos.identify.adequacy`)."""
+        from taos.identify.adequacy import assess
+        return assess(self.cost, self.n_residuals, len(self.names), self.at_bound, **kwargs)
 
     def units(self) -> list[str]:
         return [PARAMETERS[n].unit for n in self.names]
@@ -97,9 +112,15 @@ class FitResult:
 
     def to_dict(self) -> dict:
         ci = self.confidence_interval(0.95)
+        lo = self.lower_si if self.lower_si is not None else np.full(len(self.names), np.nan)
+        hi = self.upper_si if self.upper_si is not None else np.full(len(self.names), np.nan)
         return {
+            "adequacy": self.adequacy().to_dict(),
             "parameters": {n: {"value_si": float(self.values[i]), "std_error_si": float(self.std_errors[i]),
                                "start_si": float(self.start_values[i]), "ci95_si": ci[i].tolist(),
+                               "bounds_si": [float(lo[i]), float(hi[i])],
+                               "bounds": [self.eng(i, float(lo[i])), self.eng(i, float(hi[i]))],
+                               "at_bound": n in self.at_bound,
                                "unit": PARAMETERS[n].unit or "1", "value": self.eng(i),
                                "std_error": abs(self.eng(i, self.values[i] + self.std_errors[i]) - self.eng(i)),
                                "si_unit": _si_unit(PARAMETERS[n].kind)}
@@ -116,15 +137,19 @@ class FitResult:
         }
 
     def table(self) -> str:
-        lines = [f"{'parameter':24s} {'start':>14s} {'fitted':>14s} {'std error':>12s}  unit"]
+        lines = [f"{'parameter':24s} {'start':>14s} {'fitted':>14s} {'std error':>12s} {'bounds':>25s}  unit"]
+        atb = self.at_bound
         for i, n in enumerate(self.names):
             se = abs(self.eng(i, self.values[i] + self.std_errors[i]) - self.eng(i))
-            lines.append(f"{n:24s} {self.eng(i, self.start_values[i]):14.6g} {self.eng(i):14.6g} {se:12.3g}  "
-                         f"{PARAMETERS[n].unit or '-'}")
+            b = (f"[{self.eng(i, float(self.lower_si[i])):.4g}, {self.eng(i, float(self.upper_si[i])):.4g}]"
+                 if self.lower_si is not None else "")
+            lines.append(f"{n:24s} {self.eng(i, self.start_values[i]):14.6g} {self.eng(i):14.6g} {se:12.3g} "
+                         f"{b:>25s}  {PARAMETERS[n].unit or '-'}" + ("  AT BOUND" if n in atb else ""))
         for ax, v in self.notch_hz.items():
             lines.append(f"notch ({ax}) {v:.4f} Hz, load resonance {self.load_resonance_hz[ax]:.4f} Hz")
         lines.append(f"residual rms {math.sqrt(2 * self.cost / self.n_residuals):.3g} (sigma units), "
                      f"{self.n_residuals} residuals, {self.corrections} defect corrections, {self.wall_s:.2f} s")
+        lines.append(self.adequacy().message())
         return "\n".join(lines)
 
     def write_model(self, path, data_label: str = "") -> None:
@@ -159,6 +184,7 @@ class FitProblem:
     axes: np.ndarray
     freq_hz: np.ndarray
     amp_rad: np.ndarray
+    bounds: dict | None = None   # name -> (lower, upper) [SI]; default PARAMETERS' lo/hi x start
 
     def __post_init__(self):
         import casadi as ca
@@ -188,8 +214,21 @@ class FitProblem:
         opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-10,
                 "ipopt.acceptable_iter": 5, "ipopt.acceptable_tol": 1e-7, "ipopt.max_iter": 200}
         self.solver = ca.nlpsol("s", "ipopt", nlp, opts)
-        self.lbx = np.concatenate([[p.lo for p in self.params], np.full(nu, -30.0)])
-        self.ubx = np.concatenate([[p.hi for p in self.params], np.full(nu, 6.0)])
+        lo, hi = self.scaled_bounds()
+        self.lbx = np.concatenate([lo, np.full(nu, -30.0)])
+        self.ubx = np.concatenate([hi, np.full(nu, 6.0)])
+
+    def scaled_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) of the scaled parameters s = p / p_start."""
+        b = self.bounds or {}
+        lo = np.array([b[p.name][0] / r if p.name in b else p.lo for p, r in zip(self.params, self.sur.p_ref)])
+        hi = np.array([b[p.name][1] / r if p.name in b else p.hi for p, r in zip(self.params, self.sur.p_ref)])
+        if np.any(lo >= 1.0) or np.any(hi <= 1.0):
+            k = int(np.flatnonzero((lo >= 1.0) | (hi <= 1.0))[0])
+            raise InputError("command line", "--bounds", f"bounds of {self.params[k].name} around its start value",
+                             got=f"[{lo[k] * self.sur.p_ref[k]:.6g}, {hi[k] * self.sur.p_ref[k]:.6g}] SI, start "
+                                 f"{self.sur.p_ref[k]:.6g}")
+        return lo, hi
 
     @property
     def p_ref(self) -> np.ndarray:
@@ -268,7 +307,7 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
                            seed: int = 0, use_engine: bool = True, min_coherence: float = 0.5,
                            sigma_floor: float = 1e-3, correct: bool | None = None, max_corrections: int = 6,
                            correction_tol: float = 1e-4, absolute_sigma: bool = False,
-                           problem: FitProblem | None = None) -> FitResult:
+                           problem: FitProblem | None = None, bounds: dict | None = None) -> FitResult:
     """Fit ``free`` parameters of ``model`` to measured responses (module docstring).
 
     Parameters
@@ -288,13 +327,16 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
         friction).
     problem : FitProblem, optional
         A built problem to reuse (same model, free set and points).
+    bounds : dict name -> (lower, upper) SI, optional
+        Bounds of free parameters (default: :data:`taos.identify.surrogate.PARAMETERS`' lo/hi
+        times the start value). The result reports them and flags any value that ends on one.
     """
     t0 = time.perf_counter()
     data = tuple(data)
     free = tuple(free)
     m0 = _apply(model, list((start or {}).keys()), list((start or {}).values()))
     axes, f, A, hx, he, wx, we = _stack_points(data, use_engine, min_coherence, sigma_floor)
-    prob = problem or FitProblem(m0, free, axes, f, A)
+    prob = problem or FitProblem(m0, free, axes, f, A, bounds)
     P = _pack(hx, he, wx, we)
     rng = np.random.default_rng(seed)
     best = None
@@ -355,7 +397,7 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
                      notch_hz={a: load_resonance_from_notch(mfit, a) for a in ax_set},
                      load_resonance_hz={a: mfit.load_resonance_hz(a) for a in ax_set}, corrections=ncorr,
                      starts=max(1, starts), wall_s=time.perf_counter() - t0, absolute_sigma=absolute_sigma,
-                     history=history)
+                     history=history, lower_si=prob.lbx[:npar] * prob.p_ref, upper_si=prob.ubx[:npar] * prob.p_ref)
 
 
 # -- writing the fitted model ------------------------------------------------------------------

@@ -91,8 +91,12 @@ def draw_response(ax, fr, scale: float, *, color, label: str, gid: str = "respon
         rf = np.asarray(ref.freq_hz, float)
         rp, re = (rf, phase_deg(ref.piston)), (rf, phase_deg(ref.engine))
     ax[1, 0].plot(f, phase_deg(fr.piston, f, rp), **kw)
-    ax[0, 1].plot(f, gain_db(fr.engine), label=label, **kw)
-    ax[1, 1].plot(f, phase_deg(fr.engine, f, re), **kw)
+    held = fr.engine_held() if hasattr(fr, "engine_held") else np.zeros(f.size, bool)
+    ax[0, 1].plot(f, np.where(held, np.nan, gain_db(fr.engine)), label=label, **kw)
+    ax[1, 1].plot(f, np.where(held, np.nan, phase_deg(fr.engine, f, re)), **kw)
+    if held.any():  # no motion is not a number: say so on the plot
+        ax[0, 1].text(0.02, 0.04, f"engine held (no motion) at {', '.join(f'{x:g}' for x in f[held])} Hz, "
+                      f"{label}", transform=ax[0, 1].transAxes, fontsize=8, color=kw["color"], gid="engine-held")
 
 
 def mark_resonance(ax, resonance_hz: float, color="0.3", label_prefix: str = "") -> None:

@@ -15,7 +15,8 @@ from ..units import from_si
 def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
     """Nichols chart (phase [deg] vs gain [dB]) of L0 N(A, .) at several command amplitudes of
     ``pred`` (a :class:`taos.flight.lco.LcoPrediction`), the loop without friction (L0 alone), the
-    critical point (-180 deg, 0 dB) and the predicted limit cycles. Returns the figure."""
+    critical point (-180 deg, 0 dB), the exclusion zone (+-6 dB, +-30 deg around it), frequency
+    marks on every locus (labelled on L0) and the predicted limit cycles. Returns the figure."""
     fig, ax = (plt.subplots(figsize=(7, 6)) if ax is None else (ax.figure, ax))
     df = pred.df
     f = np.logspace(np.log10(df.freq_hz[0]), np.log10(df.freq_hz[-1]), n_freq)
@@ -26,11 +27,32 @@ def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
         ph -= 360.0 * np.round((ph[len(ph) // 2] + 180.0) / 360.0)  # the branch around -180
         ax.plot(ph, gain_db(h, 1e-6), **kw)
 
+    # exclusion zone: the usual 6 dB / 30 deg margin box around the critical point
+    ax.add_patch(plt.Rectangle((-210, -6), 60, 12, facecolor="tab:red", alpha=0.12, edgecolor="tab:red",
+                               linestyle="--", gid="exclusion-zone", label="exclusion zone (6 dB, 30 deg)"))
+    marks = [x for x in (0.03, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0) if f[0] <= x <= f[-1]]
+
+    def mark(h_of, color, text: bool):
+        hm = h_of(np.asarray(marks))
+        hf = h_of(f)
+        ph_f = np.degrees(np.unwrap(np.angle(hf)))
+        ph_f -= 360.0 * np.round((ph_f[len(ph_f) // 2] + 180.0) / 360.0)
+        ph_m = np.interp(np.log10(marks), np.log10(f), ph_f)
+        g_m = 20 * np.log10(np.maximum(np.abs(hm), 1e-6))
+        ax.plot(ph_m, g_m, "o", ms=3.5, color=color, gid="frequency-marks")
+        if text:
+            for x, y, fm in zip(ph_m, g_m, marks):
+                ax.annotate(f"{fm:g} Hz", (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
+
     draw(pred.loop(f), color="k", lw=2, label="L0 (TVC = 1)")
+    if marks:
+        mark(pred.loop, "k", True)
     cmap = plt.get_cmap("plasma")
     for i, a in enumerate(amps):
-        draw(pred.open_loop(a, f), color=cmap(i / max(len(amps) - 1, 1)), lw=1,
-             label=f"L0 N, A = {math.degrees(a):.3g} deg")
+        col = cmap(i / max(len(amps) - 1, 1))
+        draw(pred.open_loop(a, f), color=col, lw=1, label=f"L0 N, A = {math.degrees(a):.3g} deg")
+        if marks:
+            mark(lambda x, a=a: pred.open_loop(a, x), col, False)
     ax.plot([-180], [0], "r+", ms=14, mew=2, label="critical point")
     for c in pred.cycles:
         ax.plot([-180], [0], "o", mfc="none", mec="g" if c.stable else "m", ms=12,

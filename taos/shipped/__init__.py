@@ -17,7 +17,7 @@ from pathlib import Path
 
 #: sub-folder of models/ for each kind of input file
 KIND_FOLDERS = {"model": "", "profile": "profiles", "flight": "flight", "masv": "masv",
-                "campaign": "montecarlo", "data": "data"}
+                "campaign": "montecarlo", "data": "data", "spec": "specs"}
 
 
 def _package_dir(name: str) -> Path | None:

@@ -1,0 +1,168 @@
+"""The limit-cycle verdict in words a reviewer can sign, with the evidence beside it.
+
+From a :class:`taos.flight.lco.LcoReport` (describing-function prediction and time-domain run):
+
+* ``text``: one sentence, e.g. "limit cycle expected: 0.17 deg command (engine 0.11 deg),
+  0.11 Hz, self-sustaining (stable by Loeb's test); vehicle attitude +-0.02 deg, rate
+  +-0.01 deg/s". An unstable (Loeb) harmonic-balance solution is a *threshold*: motion smaller
+  than it decays, larger grows, so it is not reported as a limit cycle. Without any solution
+  the text names the margin meant: the smallest distance in dB between 0 dB and the gain
+  of L0 N(A, .) at its -180 deg (mod 360) crossings over all command amplitudes of the map,
+  with the amplitude and frequency where it occurs, and whether the loop gain would have to
+  rise or fall by it.
+* ``margin_table``: for each describing-function amplitude, the loop margins of L0 N(A, .)
+  (:func:`taos.flight.vehicle.margins`): the low-frequency gain margin (how far the gain may
+  fall, which friction does as the amplitude falls) and its frequency, the high-frequency gain
+  margin, the phase margin and the gain-crossover frequency.
+* ``motion``: the vehicle motion of the cycle: attitude amplitude |G_att(j w)| |N| A with
+  G_att the engine-deflection -> attitude response of the vehicle with its FCS
+  (:func:`taos.flight.vehicle.vehicle_fcs_state_space`, inputs delta and delta' = j w delta),
+  and the attitude-rate amplitude w times that; from the time-domain run too when it shows a
+  cycle (least-squares fundamental of the attitude over the final window).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+MARGIN_MEANING = ("smallest distance [dB] from 0 dB of the gain of L0 N(A, .) at its -180 deg (mod 360) "
+                  "crossings, over all command amplitudes A of the describing-function map: how far the loop gain "
+                  "would have to move for a limit cycle to appear")
+
+
+@dataclass(frozen=True)
+class CycleMotion:
+    """Vehicle motion during a limit cycle (SI)."""
+
+    source: str
+    freq_hz: float
+    command_amplitude_rad: float
+    engine_amplitude_rad: float
+    attitude_amplitude_rad: float
+    attitude_rate_amplitude_rad_s: float
+
+    def to_dict(self) -> dict:
+        return {"source": self.source, "frequency_hz": self.freq_hz,
+                "command_amplitude_deg": math.degrees(self.command_amplitude_rad),
+                "engine_amplitude_deg": math.degrees(self.engine_amplitude_rad),
+                "attitude_amplitude_deg": math.degrees(self.attitude_amplitude_rad),
+                "attitude_rate_amplitude_deg_s": math.degrees(self.attitude_rate_amplitude_rad_s)}
+
+
+@dataclass(frozen=True)
+class NearestMargin:
+    """Where the loop comes closest to a cycle without one."""
+
+    margin_db: float
+    amplitude_rad: float
+    freq_hz: float
+    direction: str  # "rise" or "fall": what the loop gain would have to do
+
+    def to_dict(self) -> dict:
+        return {"margin_db": self.margin_db, "amplitude_deg": math.degrees(self.amplitude_rad),
+                "frequency_hz": self.freq_hz, "loop_gain_would_have_to": self.direction}
+
+
+@dataclass(frozen=True)
+class LcoVerdict:
+    kind: str            # "limit-cycle", "threshold-only" or "none"
+    text: str
+    margin_table: tuple[dict, ...]
+    nearest: NearestMargin | None
+    motion: tuple[CycleMotion, ...]
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, "text": self.text, "margin_meaning": MARGIN_MEANING,
+                "nearest_margin": None if self.nearest is None else self.nearest.to_dict(),
+                "margin_table": list(self.margin_table), "cycle_motion": [m.to_dict() for m in self.motion]}
+
+    def table_text(self) -> str:
+        lines = [f"{'A [deg]':>9} {'low GM [dB]':>11} {'at [Hz]':>8} {'high GM [dB]':>12} {'PM [deg]':>9} "
+                 f"{'crossover [Hz]':>14}"]
+        f = lambda x, s: "-".rjust(int(s.split(".")[0])) if x is None else format(x, s)  # noqa: E731
+        for r in self.margin_table:
+            lines.append(f"{r['amplitude_deg']:9.3g} {f(r['low_gain_margin_db'], '11.2f')} "
+                         f"{f(r['low_phase_crossover_hz'], '8.3f')} {f(r['high_gain_margin_db'], '12.2f')} "
+                         f"{f(r['phase_margin_deg'], '9.1f')} {f(r['gain_crossover_hz'], '14.3f')}")
+        return "\n".join(lines)
+
+
+def attitude_per_engine(flight, freq_hz, axis: str) -> np.ndarray:
+    """Vehicle attitude per engine deflection, xi / delta (j w) [-], with the FCS closed around
+    the vehicle as in the flight loop (inputs delta and delta' = j w delta)."""
+    from taos.flight.vehicle import VF_INPUTS, vehicle_fcs_state_space
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    h = vehicle_fcs_state_space(flight, axis).freqresp(f, list(VF_INPUTS), "attitude_rad")
+    return h[:, 0] + 2j * np.pi * f * h[:, 1]
+
+
+def nearest_margin(pred, n_amp: int = 60, n_freq: int = 600) -> NearestMargin | None:
+    """The smallest |gain| of L0 N(A, .) at a -180 deg crossing over the map (MARGIN_MEANING)."""
+    df = pred.df
+    amps = np.exp(np.linspace(math.log(df.amplitude_rad[0]), math.log(df.amplitude_rad[-1]), n_amp))
+    f = np.logspace(math.log10(df.freq_hz[0]), math.log10(df.freq_hz[-1]), n_freq)
+    L0 = pred.loop(f)
+    best = None
+    for a in amps:
+        L = L0 * df(a, f)
+        g = 20 * np.log10(np.abs(L))
+        e = (np.degrees(np.unwrap(np.angle(L))) + 180.0 + 180.0) % 360.0 - 180.0
+        k = np.flatnonzero((np.sign(e[:-1]) != np.sign(e[1:])) & (np.abs(e[:-1]) < 90) & (np.abs(e[1:]) < 90))
+        for j in k:
+            t = e[j] / (e[j] - e[j + 1])
+            gx = g[j] + t * (g[j + 1] - g[j])
+            fx = 10 ** (math.log10(f[j]) + t * (math.log10(f[j + 1]) - math.log10(f[j])))
+            if best is None or abs(gx) < best.margin_db:
+                best = NearestMargin(abs(float(gx)), float(a), float(fx), "rise" if gx < 0 else "fall")
+    return best
+
+
+def lco_verdict(report) -> LcoVerdict:
+    """The verdict of a :class:`taos.flight.lco.LcoReport` (module docstring)."""
+    pred = report.prediction
+    fl, axis = pred.flight, pred.axis
+    table = tuple({"amplitude_deg": math.degrees(a), **m.to_dict()}
+                  for a, m in zip(pred.df.amplitude_rad, pred.margins_by_amplitude))
+    motion = []
+    c = pred.stable_cycle
+    if c is not None:
+        att = abs(attitude_per_engine(fl, [c.freq_hz], axis)[0]) * c.engine_amplitude_rad
+        motion.append(CycleMotion("describing function", c.freq_hz, c.amplitude_rad, c.engine_amplitude_rad, att,
+                                  2 * math.pi * c.freq_hz * att))
+    td, h = report.time_domain, report.history
+    if td is not None and td.lco and h is not None:
+        from taos.flight.lco import _fit
+        m = h.t_s >= h.t_s[-1] - td.window_s
+        att, _ = _fit(h.t_s[m], h.attitude_rad[m], td.freq_hz)
+        motion.append(CycleMotion("time domain", td.freq_hz, td.amplitude_rad, td.engine_amplitude_rad, att,
+                                  2 * math.pi * td.freq_hz * att))
+    if c is not None:
+        mo = motion[0]
+        text = (f"limit cycle expected: {math.degrees(c.amplitude_rad):.3g} deg command (engine "
+                f"{math.degrees(c.engine_amplitude_rad):.3g} deg), {c.freq_hz:.3g} Hz, self-sustaining (stable by "
+                f"Loeb's test); vehicle attitude +-{math.degrees(mo.attitude_amplitude_rad):.3g} deg, rate "
+                f"+-{math.degrees(mo.attitude_rate_amplitude_rad_s):.3g} deg/s")
+        if td is not None:
+            text += ("; the time-domain run confirms it" if td.lco else
+                     "; the time-domain run did NOT settle into it (check the seed and duration)")
+        return LcoVerdict("limit-cycle", text, table, None, tuple(motion))
+    near = nearest_margin(pred)
+    if pred.cycles:
+        u = min(pred.cycles, key=lambda x: x.amplitude_rad)
+        text = (f"no self-sustaining limit cycle: an unstable harmonic-balance solution at "
+                f"{math.degrees(u.amplitude_rad):.3g} deg command, {u.freq_hz:.3g} Hz is a threshold (smaller "
+                f"motion decays, larger grows)")
+        kind = "threshold-only"
+    else:
+        text = "no limit cycle expected"
+        kind = "none"
+        if near is not None:
+            text += (f": the loop gain would have to {near.direction} by {near.margin_db:.2f} dB for one to appear "
+                     f"(closest at {math.degrees(near.amplitude_rad):.3g} deg command, {near.freq_hz:.3g} Hz)")
+    if td is not None and td.lco:
+        text += (f"; BUT the time-domain run oscillates at {math.degrees(td.amplitude_rad):.3g} deg, "
+                 f"{td.freq_hz:.3g} Hz")
+    return LcoVerdict(kind, text, table, near, tuple(motion))

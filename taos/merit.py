@@ -1,0 +1,204 @@
+"""Figures of merit of a TVC axis, as an actuator specification states them.
+
+Frequency domain (:func:`frequency_merit`, from the exact linear response on a dense log
+grid, :func:`taos.freqresp.linear_freqresp`; phase continuous from low frequency):
+
+* ``bandwidth_3db_hz``: the lowest frequency at which the gain falls 3 dB below its
+  low-frequency value (linear interpolation of dB in log f between grid points);
+* ``phase_90_hz``: the lowest frequency at which the phase reaches -90 deg;
+* ``peak_gain_db`` and ``peak_freq_hz``: the largest gain relative to the low-frequency
+  value and where it occurs (refined by a parabola in log f through the three grid points
+  around the maximum);
+* ``load_resonance_hz`` w_L = sqrt((K_L R^2 + K_n) / J_n) and ``notch_hz``, the minimum of
+  the command -> piston gain (:func:`taos.simplex.load_resonance_from_notch`, the one notch
+  finder every command uses).
+
+Reported for command -> engine (theta / theta_c) and command -> piston (x_p / (R theta_c)).
+
+Time domain (:func:`step_merit`, by simulating the full nonlinear simplex model,
+:func:`taos.simulate.simulate`, with its friction and avionics):
+
+* ``rise_time_s``: 10 % to 90 % of the final engine angle after a step of
+  ``step_amplitude_rad``; ``overshoot_pct``: (peak - final) / final;
+* ``threshold_deg``: the smallest command step after which the engine settles at least half
+  way to the command (bisection between 0 and the step amplitude; with Coulomb friction it
+  sits near the breakaway deflection T_c / (K_L R^2), DESIGN.md "Why stiffness decides the
+  limit cycle", plus the avionics quantisation);
+* ``hysteresis_deg``: a slow triangle +-A (``hysteresis_amplitude_rad``, ramp rate
+  ``ramp_rate_rad_s``, slow enough that the servo's velocity lag is small): the engine angle on
+  the way down minus on the way up at zero command
+  (the friction dead band the engine lags by: about 2 T_c / (K_L R^2 + K_n) for Coulomb
+  friction);
+* ``null_shift_deg``: the engine angle left at zero command after the triangle
+  (0 -> +A -> -A -> +A -> 0, each level held 0.2 s) returns.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .model import TvcModel
+
+
+def _none(x):
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+@dataclass(frozen=True)
+class ResponseMerit:
+    """Frequency figures of one response (SI, Hz, dB relative to the low-frequency gain)."""
+
+    response: str
+    low_frequency_gain_db: float
+    bandwidth_3db_hz: float | None
+    phase_90_hz: float | None
+    peak_gain_db: float
+    peak_freq_hz: float
+
+    def to_dict(self) -> dict:
+        return {k: (_none(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
+
+
+@dataclass(frozen=True)
+class FrequencyMerit:
+    """Frequency-domain figures of merit of one axis (module docstring)."""
+
+    axis: str
+    engine: ResponseMerit
+    piston: ResponseMerit
+    load_resonance_hz: float
+    notch_hz: float
+    f_range_hz: tuple[float, float]
+
+    def to_dict(self) -> dict:
+        return {"axis": self.axis, "engine": self.engine.to_dict(), "piston": self.piston.to_dict(),
+                "load_resonance_hz": self.load_resonance_hz, "notch_hz": self.notch_hz,
+                "f_range_hz": list(self.f_range_hz),
+                "definition": "linear response; gains relative to the low-frequency gain; -3 dB and -90 deg: "
+                              "lowest crossing; piston x_p/(R theta_c); phase continuous from low frequency"}
+
+
+def _first_crossing(x, y, level) -> float | None:
+    """Lowest x where y first falls to ``level`` (linear in log x between samples), or None."""
+    below = np.flatnonzero(y <= level)
+    if below.size == 0:
+        return None
+    k = int(below[0])
+    if k == 0:
+        return float(x[0])
+    lx0, lx1 = math.log10(x[k - 1]), math.log10(x[k])
+    t = (y[k - 1] - level) / (y[k - 1] - y[k])
+    return float(10 ** (lx0 + t * (lx1 - lx0)))
+
+
+def response_merit(name: str, freq_hz, h, phase_deg) -> ResponseMerit:
+    """Figures of a response sampled on a dense, increasing log grid (module docstring)."""
+    f = np.asarray(freq_hz, float)
+    g = 20 * np.log10(np.abs(h))
+    g0 = float(g[0])
+    rel = g - g0
+    k = int(np.argmax(rel))
+    pk_f, pk_g = float(f[k]), float(rel[k])
+    if 0 < k < f.size - 1:
+        x = np.log10(f[k - 1:k + 2])
+        a, b, c = np.polyfit(x, rel[k - 1:k + 2], 2)
+        if a < 0:
+            xv = float(np.clip(-b / (2 * a), x[0], x[2]))
+            pk_f, pk_g = 10 ** xv, float(np.polyval([a, b, c], xv))
+    return ResponseMerit(name, g0, _first_crossing(f, rel, -3.0), _first_crossing(f, np.asarray(phase_deg), -90.0),
+                         pk_g, pk_f)
+
+
+def frequency_merit(model: TvcModel, axis: str = "pitch", f_min_hz: float = 0.01, f_max_hz: float = 50.0,
+                    n: int = 1500) -> FrequencyMerit:
+    """Frequency figures of merit of ``axis`` from the exact linear response (module docstring)."""
+    from .freqresp import linear_freqresp
+    from .simplex import load_resonance_from_notch
+
+    f = np.logspace(math.log10(f_min_hz), math.log10(f_max_hz), n)
+    fr = linear_freqresp(model, f, axis)
+    return FrequencyMerit(axis, response_merit("engine", f, fr.engine, fr.engine_phase_deg()),
+                          response_merit("piston", f, fr.piston, fr.piston_phase_deg()),
+                          model.load_resonance_hz(axis), load_resonance_from_notch(model, axis), (f_min_hz, f_max_hz))
+
+
+@dataclass(frozen=True)
+class StepMerit:
+    """Time-domain figures of merit of one axis (module docstring); angles in deg."""
+
+    axis: str
+    step_amplitude_deg: float
+    rise_time_s: float | None
+    overshoot_pct: float | None
+    threshold_deg: float
+    hysteresis_deg: float
+    null_shift_deg: float
+    hysteresis_amplitude_deg: float
+    friction_model: str
+
+    def to_dict(self) -> dict:
+        return {k: (_none(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
+
+
+def _engine_step(model, axis, amp_rad, t_step=0.2, hold=1.5, dt_s=2e-4):
+    from .profiles import Step
+    from .simulate import simulate
+    th = simulate(_axis_model(model, axis), Step(amp_rad, t_step, hold), dt_s=dt_s, record_every=1, duration_s=t_step + hold)
+    return th.t_s, th.engine_rad[0]
+
+
+def _axis_model(model: TvcModel, axis: str) -> TvcModel:
+    """A model whose pitch axis is ``axis`` (single-axis profiles drive pitch)."""
+    if axis == "pitch":
+        return model
+    import dataclasses
+    e = model.engine
+    return dataclasses.replace(model, engine=dataclasses.replace(e, inertia_pitch_kgm2=e.inertia_yaw_kgm2))
+
+
+def step_merit(model: TvcModel, axis: str = "pitch", *, step_amplitude_rad: float = math.radians(0.5),
+               hysteresis_amplitude_rad: float = math.radians(0.2), ramp_rate_rad_s: float = math.radians(0.05),
+               threshold_tol_rad: float = math.radians(0.002), dt_s: float = 2e-4) -> StepMerit:
+    """Step, threshold and hysteresis figures of ``axis`` by simulation (module docstring)."""
+    from .profiles import MultiRamp
+    from .simulate import simulate
+
+    t, th = _engine_step(model, axis, step_amplitude_rad, dt_s=dt_s)
+    t0 = 0.2
+    m = t >= t0
+    tt, yy = t[m] - t0, th[m]
+    final = float(np.mean(yy[-max(10, yy.size // 10):]))
+    rise = over = None
+    if abs(final) > 0:
+        s = yy / final
+        i10 = np.flatnonzero(s >= 0.1)
+        i90 = np.flatnonzero(s >= 0.9)
+        if i10.size and i90.size:
+            rise = float(tt[i90[0]] - tt[i10[0]])
+        over = float(100.0 * max(0.0, (np.max(s) - 1.0)))
+
+    def moves(a):
+        _, e = _engine_step(model, axis, a, hold=1.0, dt_s=dt_s)
+        return float(np.mean(e[-200:])) >= 0.5 * a
+
+    lo, hi = 0.0, step_amplitude_rad
+    if not moves(hi):
+        lo = hi = math.nan
+    else:
+        while hi - lo > threshold_tol_rad:
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if moves(mid) else (mid, hi)
+    A = hysteresis_amplitude_rad
+    prof = MultiRamp((A, -A, A, 0.0), ramp_rate_rad_s, hold_s=0.2)
+    h = simulate(_axis_model(model, axis), prof, dt_s=dt_s, record_every=5, duration_s=prof.duration_s)
+    e, tk = h.engine_rad[0], h.t_s
+    t_down0 = A / ramp_rate_rad_s + 0.2 + A / ramp_rate_rad_s        # command passes 0 going down
+    t_up0 = t_down0 + A / ramp_rate_rad_s + 0.2 + A / ramp_rate_rad_s  # and going up again
+    e_down = float(np.interp(t_down0, tk, e))
+    e_up = float(np.interp(t_up0, tk, e))
+    null = float(e[-1])
+    return StepMerit(axis, math.degrees(step_amplitude_rad), rise, over, math.degrees(hi),
+                     math.degrees(e_down - e_up), math.degrees(null), math.degrees(A), model.friction.name)
