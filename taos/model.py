@@ -316,6 +316,8 @@ def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
 
 #: ``[friction]`` key naming the shared friction parameter set of one piece of hardware
 PARAMETER_SET_KEY = "parameter_set"
+#: key of a parameter set: the torque level its load-proportional values hold at
+REFERENCE_TORQUE_KEY = "reference_torque"
 
 
 def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str) -> dict:
@@ -344,6 +346,8 @@ def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str)
     if not isinstance(shared, Mapping):
         raise InputError(str(ppath), "[friction]", "a [friction] table of law parameters",
                          got="nothing (section missing)")
+    shared = dict(shared)
+    ref_torque = shared.pop(REFERENCE_TORQUE_KEY, None)
     for k in sorted(shared):
         if k in ("model", PARAMETER_SET_KEY):
             raise InputError(str(ppath), f"friction.{k}", "law parameters only (model is chosen by the model file)",
@@ -352,7 +356,34 @@ def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str)
             raise InputError(src, f"friction.{k}", f"no value here: it is set once, in the parameter set {ref}",
                              got="a second value for the same hardware")
         table[k] = shared[k]
+    if ref_torque is not None:
+        _scale_to_torque_level(table, ref_torque, str(ppath), src)
     return table
+
+
+def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> None:
+    """Scale the set's load-proportional parameters (bristle stiffness and damping, viscous and
+    stick damping: the torque-like fields other than the torque levels) from the set's
+    ``reference_torque`` to this file's ``coulomb_torque``, in place. Friction proportional to the
+    bearing normal load scales every one of them alike, so the pre-sliding angle T_c / sigma_0 and
+    the law's shape stay those of the hardware; this is what the 3-D model does with the normal
+    load (:meth:`taos.friction.FrictionLaw.scaled`), here applied to the planar torque level."""
+    import dataclasses as _dc
+
+    from .friction import LAWS
+    from .units import DIMENSIONS
+
+    ref = to_si(ref_torque, "torque", source=set_src, field=f"friction.{REFERENCE_TORQUE_KEY}", positive=True)
+    if "coulomb_torque" not in table:
+        raise InputError(src, "friction.coulomb_torque", "this condition's torque level (the parameter set is "
+                         "scaled to it)", got="nothing (key missing)")
+    level = to_si(table["coulomb_torque"], "torque", source=src, field="friction.coulomb_torque", nonnegative=True)
+    kinds = {f.metadata["key"]: f.metadata["kind"] for e in LAWS.values() for f in _dc.fields(e.params)
+             if f.metadata.get("torque_like") and f.metadata["key"] not in ("coulomb_torque", "static_torque")}
+    for key, kind in kinds.items():
+        if key in table:
+            v = to_si(table[key], kind, source=set_src, field=f"friction.{key}", nonnegative=True)
+            table[key] = f"{v * level / ref!r} {DIMENSIONS[kind][1]}"
 
 
 def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
