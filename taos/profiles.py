@@ -335,18 +335,14 @@ def profile_from_table(tab: dict, src: str, sec: str):
 
 def load_profile(path: str | Path):
     """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
-    ``[pitch]`` and/or ``[yaw]`` tables (two-axis); or a measured record (``.csv``/``.h5``,
-    :func:`taos.identify.data.load_test_data`) whose commands are replayed
-    (:func:`profile_from_record`). Every value is checked against the documented limits of
+    ``[pitch]`` and/or ``[yaw]`` tables (two-axis). (A measured record is replayed through
+    :func:`profile_from_record`; the CLI reads it.) Every value is checked against the documented limits of
     :mod:`taos.limits` (gimbal range, frequencies, durations, cycles)."""
     from .errors import check_keys
     from .limits import check_duration
     from .model import read_toml
     from .shipped import resolve
 
-    if Path(str(path)).suffix.lower() in (".csv", ".txt", ".h5", ".hdf5"):   # a measured record: replay it
-        from .identify.data import load_test_data
-        return profile_from_record(load_test_data(path))
     path = resolve(path, "profile")
     src = str(path)
     _, doc = read_toml(path, "a readable profile file")

@@ -284,7 +284,7 @@ CASES = [
     C("npz missing", lambda t: fr("--freq-hz", "1", "--linear", "--engine", "taos", model=fem_model(t, t / "none.npz"))),
     # flight files ---------------------------------------------------------------------------------
     C("flight missing", lambda t: ["lco", str(AMBIENT), "--flight", str(t / "nope.toml"), "--json", "OUT/out.json"]),
-    C("flight section typo", lambda t: ["lco", str(AMBIENT), "--flight", str(flight_with(t, "[fcs]", "[fsc]")),
+    C("flight section typo", lambda t: ["lco", str(AMBIENT), "--flight", str(flight_with(t, "\n[fcs]", "\n[fsc]")),
                                         "--json", "OUT/out.json"], expect_in_line=("did you mean 'fcs'",)),
     C("flight vehicle is a number", lambda t: ["lco", str(AMBIENT), "--flight", str(flight_with(t, "[vehicle]", "vehicle = 5\n[vehicle_x]")),
                                                "--json", "OUT/out.json"]),

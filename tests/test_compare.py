@@ -26,11 +26,12 @@ def test_table_shows_stiffer_hot_fire_notch_up_and_breakaway_T_over_K(ambient, h
     wa, wb = c.value("load_resonance_pitch_hz")
     assert nb > na and wa == pytest.approx(ambient.load_resonance_hz()) and wb == pytest.approx(hotfire.load_resonance_hz())
     # the notch of the state-space response (an independent computation) sits at w_L, and
-    # w^2 - K_n/J scales with K_L (paper eq. 1): the notch search reaches ~1e-9
-    assert na == pytest.approx(wa, rel=1e-7) and nb == pytest.approx(wb, rel=1e-7)
+    # w^2 - K_n/J scales with K_L (paper eq. 1); the 0.5 % load-path damping moves the (damped)
+    # zero by ~1e-4 w_L (exact damped zero: tests/test_load_path.py)
+    assert na == pytest.approx(wa, rel=3e-4) and nb == pytest.approx(wb, rel=3e-4)
     J, Kn = ambient.engine.inertia_pitch_kgm2, ambient.engine.rotational_stiffness_Nm_per_rad
     g = lambda w: (2 * math.pi * w) ** 2 - Kn / J  # noqa: E731
-    assert g(nb) / g(na) == pytest.approx(kb / ka, rel=1e-6)
+    assert g(nb) / g(na) == pytest.approx(kb / ka, rel=2e-4)  # damped zeros: ~1e-4
     ba, bb = c.value("breakaway_deflection_deg")
     # T_c / (K_L R^2): the torque levels differ with the bearing normal load (issue 12.1)
     tc = hotfire.friction.coulomb_torque_Nm / ambient.friction.coulomb_torque_Nm

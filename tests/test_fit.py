@@ -162,7 +162,8 @@ def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
     source = (MODELS / "rs25_hotfire.toml").read_text().splitlines()
     kept = set(text.splitlines())
     changed = [x for x in source if x not in kept]
-    assert [x.split("=")[0].strip() for x in changed] == ["name", "load_stiffness", "model"], changed
+    # parameter_set is rewritten to an absolute path so the fitted file still reaches the shared set
+    assert [x.split("=")[0].strip() for x in changed] == ["name", "load_stiffness", "model", "parameter_set"], changed
     back = load_model(out)
     assert back.structure.load_stiffness_N_per_m == pytest.approx(r.values[0], rel=1e-5)
     assert back.actuator == truth.actuator and back.engine == truth.engine
@@ -191,5 +192,5 @@ def test_demo_datasets_reproduce_the_paper_direction_hot_fire_stiffer(tmp_path):
     assert k_hot > 1.5 * k_amb and n_hot > 1.2 * n_amb
     # achieved: K_L -1.3e-3 (ambient), 5e-6 (hot fire); T_c 2.6e-3
     assert abs(k_amb / 115000 - 1) < 5e-3 and abs(k_hot / 205000 - 1) < 5e-3
-    assert abs(res_hot.eng(1) / 144000 - 1) < 0.02
+    assert abs(res_hot.eng(1) / 117525 - 1) < 0.02   # the data's true_coulomb_torque (hot-fire mu N r_b)
     assert load_model(tmp_path / "amb.toml").structure.load_stiffness_N_per_m == pytest.approx(k_amb * LBF_IN, rel=1e-5)

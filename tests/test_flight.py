@@ -4,6 +4,8 @@ Lur'e plant against the loop margins."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 

@@ -73,8 +73,8 @@ def test_notch_marker_sits_at_the_computed_notch_and_resonance_line_at_w_L(lin, 
         (vl,) = gid_lines(a, "load-resonance")
         assert vl.get_xdata()[0] == pytest.approx(wl)
     # the notch is the load resonance (paper sec. 2.2): with the piston still the engine is the
-    # undamped oscillator J, K_L R^2 + K_n (the bounded search reaches ~1e-9)
-    assert notch == pytest.approx(wl, rel=1e-7)
+    # oscillator J, K_L R^2 + K_n, with the 0.5 % load-path damping a damped zero ~1e-4 from w_L
+    assert notch == pytest.approx(wl, rel=3e-4)
     plt.close(fig)
     fig = bode.plot_freqresp([lin], notch_hz=notch)
     (mk,) = gid_lines(fig.axes[0], "notch")

@@ -182,7 +182,7 @@ def cmd_freqresp(args) -> int:
 
 def cmd_simulate(args) -> int:
     from taos import run_checks
-    from taos.profiles import load_profile
+    from taos.cli.records import load_profile
     from taos.results import check_output_file, input_provenance
     from taos.simulate import simulate
 

@@ -36,7 +36,8 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.linear import gain_db, notch_hz
-from taos.profiles import Sequence, SineDwell, TwoAxis, load_profile
+from taos.profiles import Sequence, SineDwell, TwoAxis
+from taos.cli.records import load_profile
 from taos.shipped import models_dir
 
 DEFAULT_PROFILE = models_dir() / "profiles" / "greenrun_two_axis.toml"

@@ -30,6 +30,7 @@ import numpy as np
 import scipy.optimize
 
 from taos.avionics import Avionics
+from taos.flight._harmonics import harmonic_amplitudes as _fit
 from taos.flight.describing import DescribingFunctionMap, describing_function_map
 from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
 from taos.linear import gain_db
@@ -279,12 +280,6 @@ class MeasuredOscillation:
                 "window_s": self.window_s}
 
 
-def _fit(t, y, f):
-    """Least-squares amplitudes of the harmonics 1 and 3 of frequency f [Hz] (with offset)."""
-    w = 2 * math.pi * f
-    M = np.column_stack([np.sin(w * t), np.cos(w * t), np.sin(3 * w * t), np.cos(3 * w * t), np.ones_like(t)])
-    c = np.linalg.lstsq(M, y, rcond=None)[0]
-    return math.hypot(c[0], c[1]), math.hypot(c[2], c[3])
 
 
 def measure_oscillation(h: FlightHistory, window_s: float = 120.0, threshold_rad: float = 0.004 * DEG

@@ -35,6 +35,16 @@ MEANINGS: dict[str, str] = {
     "actuator.pressure_feedback_time_constant": "high-pass time constant of the pressure feedback",
     # [structure]
     "structure.load_stiffness": "load stiffness K_L: all compliance outside the actuator loop",
+    "structure.load_damping_ratio": "structural damping ratio of the load path (finite notch depth)",
+    "actuator.max_rate": "piston rate limit: valve flow saturation (time domain only)",
+    "actuator.pressure_limited": "whether the load pressure is limited to the supply pressure (stall force)",
+    "engine.gimbal_range": "gimbal range: the hard stops, modelled as a stiff damped contact",
+    "engine.hard_stop_stiffness": "rotational stiffness of the hard-stop contact",
+    "engine.hard_stop_damping_ratio": "damping ratio of the hard-stop contact",
+    "friction.parameter_set": "the shared friction parameter set of the bearing (a TOML file)",
+    "vehicle.bending_frequency": "first bending mode frequency (0: no bending mode)",
+    "vehicle.bending_damping_ratio": "damping ratio of the first bending mode",
+    "vehicle.bending_gain": "bending-mode slope gain at the sensor and gimbal (rigid-body units)",
     # [friction]
     "friction.model": "friction law: none, coulomb-switching, coulomb-smooth, dahl, lugre, modified-lugre",
     "friction.coulomb_torque": "Coulomb (sliding) friction torque T_c",
@@ -151,12 +161,16 @@ def model_key_table() -> dict[str, list[tuple[str, str, str]]]:
     # [engine]: keys and kinds as parse_engine reads them; a file's unknown key is rejected by it
     out["engine"] = [("mass", _si("mass"), ""), ("inertia_pitch", _si("inertia"), ""),
                      ("inertia_yaw", _si("inertia"), ""), ("rotational_stiffness", _si("rotational_stiffness"), ""),
-                     ("thrust", _si("force"), "optional")]
+                     ("thrust", _si("force"), "optional"), ("gimbal_range", _si("angle"), "optional"),
+                     ("hard_stop_stiffness", _si("rotational_stiffness"), "optional"),
+                     ("hard_stop_damping_ratio", "1", "optional")]
     act = [(k, _si(kind), chk) for k, (kind, chk) in M._ACTUATOR_FIELDS.items()]
     act.append(("valve_order", "1 or 2", "whole number"))
+    if not any(k == "pressure_limited" for k, _, _ in act):
+        act.append(("pressure_limited", "true or false", "optional"))
     out["actuator"] = act
-    out["structure"] = [("load_stiffness", _si("stiffness"), "positive")]
-    out["friction"] = [("model", "name", "")] + friction_keys()
+    out["structure"] = [("load_stiffness", _si("stiffness"), "positive"), ("load_damping_ratio", "1", "optional")]
+    out["friction"] = [("model", "name", ""), ("parameter_set", "path", "shared set")] + friction_keys()
     out["avionics"] = [("quantization_bits", "bits", "0 to 32"), ("command_range", _si("angle"), "positive"),
                        ("rounding", "'truncate' / 'round'", ""), ("crossover_command", f"list, {_si('angle')}", ""),
                        ("crossover_gain", "list, 1", "")]
