@@ -118,13 +118,19 @@ def test_one_friction_parameter_set_for_the_one_gimbal_bearing():
     for n, d in docs.items():
         assert d["friction"]["parameter_set"] == "friction/rs25_gimbal.toml", n
         assert not set(d["friction"]) & set(shared), n
-    levels = {"coulomb_torque_Nm", "static_torque_Nm"}
+    # the load-proportional parameters (torque-like: bristle stiffness and damping, viscous and
+    # stick damping) scale with the torque level, as the 3-D model scales them with the normal
+    # load; divided by the torque level they are one set, and the others are identical
+    import dataclasses
     for law in LAWS:
         laws = [load_model(MODELS / f"{n}.toml", friction=law).friction for n in RS25]
-        params = [{k: v for k, v in vars(f).items() if k not in levels} for f in laws]
-        assert params[0] == params[1] == params[2], law
-    lugre = load_model(MODELS / "rs25_ambient.toml", friction="lugre").friction
-    assert lugre.bristle_stiffness_Nm_per_rad == pytest.approx(1.3e7)  # the Green Run value
+        params = [{f.name: (getattr(x, f.name) / x.coulomb_torque_Nm if f.metadata["torque_like"]
+                            else getattr(x, f.name)) for f in dataclasses.fields(x)} for x in laws]
+        for a in params[1:]:
+            assert a.keys() == params[0].keys() and all(a[k] == pytest.approx(params[0][k], rel=1e-12)
+                                                        for k in a), law
+    lugre = load_model(MODELS / "rs25_flight.toml", friction="lugre").friction
+    assert lugre.bristle_stiffness_Nm_per_rad == pytest.approx(1.3e7)  # the Green Run value, at 144,000 in-lbf
 
 
 def test_model_file_may_not_override_the_shared_friction_set(tmp_path):
