@@ -28,7 +28,8 @@ browser:
 	  else echo "chromium missing: run 'sudo apt-get install chromium' for the browser tests"; fi; }
 
 # pytest exits 5 when it collects no tests; treat that as success, anything else as is.
-test: $(STAMP) browser
+# the documentation is built (sphinx -W: no warnings) as part of the tests
+test: $(STAMP) browser docs
 	@$(BIN)/python -m pytest -q -p no:cacheprovider tests; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
 
