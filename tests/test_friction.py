@@ -166,5 +166,7 @@ def test_registry_law_analytic_describing_function_matches_simulation(hotfire, n
         tol = 3e-3 if not law.has_state else 3e-7
         assert abs(num - exact) <= tol * abs(exact) + 1e-9 * law.coulomb_torque_Nm, (V, f, num, exact)
         checked += 1
-    if checked == 0:
-        pytest.skip(f"{name}: no analytic describing function")
+    if checked == 0:  # no analytic describing function: the simulated one is still passive, Re N >= 0
+        for V, f in ((0.05, 1.0), (0.3, 5.0)):
+            num = law.numeric_describing_function(V, f, cycles=12, steps_per_cycle=4000)
+            assert num.real >= -1e-9 * max(law.coulomb_torque_Nm, 1.0) / V, (name, V, f, num)
