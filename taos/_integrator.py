@@ -25,7 +25,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from . import avionics as _av
+from . import _avionics_kernels as _av
 from . import actuator_limits as _lim
 
 # reassociation and FMA contraction only: no-NaN/no-Inf flags would remove the stability checks

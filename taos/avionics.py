@@ -13,17 +13,16 @@ Command path (seed paper section 2.3)::
   the default has a valley of 0.95 (-0.45 dB... -1.1 dB with the paper's bounding) in the
   low-amplitude region tending to 1.0 at large commands.
 
-Both maps are numba kernels over a packed parameter vector so the time-domain integrator
-applies them in the loop (closed flight loop) or to a whole command array (open loop).
+Both maps are numba kernels over a packed parameter vector (:mod:`taos._avionics_kernels`,
+the single definition) so the time-domain integrator applies them in the loop (closed
+flight loop) or to a whole command array (open loop).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 # packed layout: [bits, lsb_rad, rounding(0/1), n_table, amp_0..amp_{n-1}, gain_0..gain_{n-1}]
 
@@ -66,6 +65,8 @@ class Avionics:
 
     def __call__(self, command_rad):
         """Apply the command path to a command value or array [rad]."""
+        from ._avionics_kernels import apply_array
+
         c = np.asarray(command_rad, float)
         out = apply_array(np.ascontiguousarray(c.ravel()), self.pack()).reshape(c.shape)
         return float(out) if out.ndim == 0 else out
@@ -75,39 +76,10 @@ class Avionics:
         return Avionics()
 
 
-@njit(cache=True)
-def apply(c, p):
-    """Command path for one value ``c`` [rad] with packed parameters ``p``."""
-    lsb = p[1]
-    if lsb > 0.0:
-        q = c / lsb
-        if p[2] > 0.5:
-            q = math.floor(q + 0.5)
-        else:
-            q = float(int(q))  # truncation toward zero
-        c = q * lsb
-    n = int(p[3])
-    if n == 0:
-        return c
-    a = abs(c)
-    ia = 4          # amplitudes p[4 : 4+n], gains p[4+n : 4+2n]
-    ig = 4 + n
-    if a <= p[ia]:
-        g = p[ig]
-    elif a >= p[ia + n - 1]:
-        g = p[ig + n - 1]
-    else:
-        i = 0
-        while p[ia + i + 1] < a:
-            i += 1
-        w = (a - p[ia + i]) / (p[ia + i + 1] - p[ia + i])
-        g = p[ig + i] + w * (p[ig + i + 1] - p[ig + i])
-    return g * c
-
-
-@njit(cache=True)
-def apply_array(c, p):
-    out = np.empty_like(c)
-    for i in range(c.shape[0]):
-        out[i] = apply(c[i], p)
-    return out
+def __getattr__(name: str):
+    """``apply`` and ``apply_array``: the compiled kernels (:mod:`taos._avionics_kernels`),
+    imported on first use so that loading a model does not import numba."""
+    if name in ("apply", "apply_array"):
+        from . import _avionics_kernels
+        return getattr(_avionics_kernels, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

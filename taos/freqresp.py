@@ -17,7 +17,11 @@ The sine-dwell response (the describing function of the nonlinear TVC) simulates
 theta_c = A sin(w t) from rest, lets the transient settle for at least ``settle_cycles``
 and ``settle_time_s`` (default from the slowest linear pole), and correlates the outputs
 with sin and cos over ``measure_cycles`` whole cycles (steps per cycle an integer, so the
-rectangle rule is exact for the fundamental of a periodic signal).
+rectangle rule is exact for the fundamental of a periodic signal). With ``method="shoot"``
+the dwell is measured instead from the periodic steady state found by shooting
+(:mod:`taos.steady`), which starts on the exact linear orbit and skips the settling
+transient. A list of amplitudes is one parallel call (:func:`sine_dwell_family`, the
+N(A, w) map).
 """
 
 from __future__ import annotations
@@ -27,7 +31,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _integrator as _ig
 from .errors import SimulationUnstable
 from .linear import gain_db, phase_deg_continuous
 from .model import TvcModel
@@ -158,28 +161,76 @@ def settle_time_s(model: TvcModel, axis: str = "pitch", decades: float = 4.0) ->
     return decades * math.log(10) / sigma
 
 
-def sine_dwell_grid(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,
-                    dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
-                    settle_s: float | None = None, min_steps_per_cycle: int = 64):
-    """Sine-dwell responses over a grid of amplitudes x frequencies, in parallel.
+#: how a sine dwell reaches the periodic orbit it measures (``taos freqresp --steady``)
+STEADY_METHODS = ("settle", "shoot")
 
-    Returns (piston, engine) complex arrays of shape (n_amp, n_freq)."""
-    amps = np.atleast_1d(np.asarray(amplitudes_rad, float))
-    f = np.atleast_1d(np.asarray(freq_hz, float))
+
+@dataclass(frozen=True, eq=False)
+class DwellPoints:
+    """Sine-dwell responses at paired (amplitude, frequency) points: complex ``piston``
+    (x_p / (R theta_c)) and ``engine`` (theta / theta_c); with ``method="shoot"`` also the
+    final scaled residual of the one-period map [-], the periods integrated and whether
+    shooting converged (:mod:`taos.steady`); for settled dwells these are None."""
+
+    piston: np.ndarray
+    engine: np.ndarray
+    method: str = "settle"
+    residual: np.ndarray | None = None
+    periods: np.ndarray | None = None
+    converged: np.ndarray | None = None
+
+
+def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,
+                      dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
+                      settle_s: float | None = None, min_steps_per_cycle: int = 64, method: str = "settle",
+                      tol: float = 1e-6, k_rre: int = 4, max_cycles: int = 8) -> DwellPoints:
+    """Sine dwells at paired points (``amplitudes_rad`` [rad], ``freq_hz`` [Hz], equal
+    lengths), all in one parallel call of the compiled kernel; each dwell is independent, so a
+    point's result does not depend on the other points (bit for bit).
+
+    ``method="settle"``: from rest through at least ``settle_cycles`` cycles and ``settle_s``
+    [s] (default: four decades of the slowest linear mode), then ``measure_cycles`` measured
+    cycles. ``method="shoot"``: the periodic steady state by shooting (:mod:`taos.steady`, to
+    the scaled residual ``tol``, ``k_rre`` + 1 periods per extrapolation, at most
+    ``max_cycles`` extrapolations, then integration for the settling budget), measured over
+    ``measure_cycles`` cycles. Steps: at most ``dt_max_s`` [s] and at least
+    ``min_steps_per_cycle`` per cycle, an integer number per cycle."""
+    if method not in STEADY_METHODS:
+        raise ValueError(f"method must be one of {STEADY_METHODS}, got {method!r}")
+    A = np.atleast_1d(np.asarray(amplitudes_rad, float))
+    F = np.atleast_1d(np.asarray(freq_hz, float))
     plant = simplex_plant(model, axis)
     check_step(model, plant.inertia_kgm2, dt_max_s)
     ts = settle_time_s(model, axis) if settle_s is None else settle_s
-    A, F = np.meshgrid(amps, f, indexing="ij")
-    A, F = A.ravel(), F.ravel()
     npc = np.maximum(np.ceil(1.0 / (F * dt_max_s)), min_steps_per_cycle).astype(np.int64)
-    nset = (np.maximum(settle_cycles, np.ceil(ts * F)) * npc).astype(np.int64)
+    nbud = np.maximum(settle_cycles, np.ceil(ts * F)).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
     o = plant.ss.output_index
     Cy = np.ascontiguousarray(plant.ss.C[[o("x_p_m"), o("theta_rad")]])
+    args = kernel_args(plant, model)
+    kern = (model.friction.entry.rates, model.friction.pack(), model.avionics.pack())
     out = np.zeros((A.size, 2, 3))
     status = np.full(A.size, -1, np.int64)
-    _ig.sine_dwell_batch(*kernel_args(plant, model), Cy, model.friction.entry.rates, model.friction.pack(),
-                         model.avionics.pack(), A, F, npc, nset, nmeas, out, status)
+    extra = {}
+    if method == "settle":
+        from . import _integrator as _ig
+
+        _ig.sine_dwell_batch(*args, Cy, *kern, A, F, npc, nbud * npc, nmeas, out, status)
+    else:
+        from . import steady
+
+        Am, Br, bc, cc, dc = args[0], args[1], args[2], args[4], args[5]
+        x0, mag = steady.linear_orbit_start(Am + np.outer(bc, cc), Br.sum(axis=1) + bc * dc.sum(), A, F)
+        n = Am.shape[0]
+        nz = 1 if model.friction.has_state else 0
+        y0 = np.zeros((A.size, n + 1))
+        y0[:, :n] = x0
+        scale = np.ones((A.size, n + 1))
+        scale[:, :n] = np.maximum(mag, 1e-9 * np.maximum(mag.max(axis=1, keepdims=True), 1e-300))
+        info = np.zeros((A.size, len(steady.INFO)))
+        steady.shoot_batch(*args, Cy, *kern, A, F, npc, nbud, nmeas, y0, scale, nz, tol, k_rre, max_cycles,
+                           out, info, status)
+        extra = {"residual": info[:, 0], "periods": info[:, 1].astype(np.int64), "converged": info[:, 3] > 0.5}
     bad = np.flatnonzero(status >= 0)
     if bad.size:
         b = bad[0]
@@ -188,18 +239,72 @@ def sine_dwell_grid(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch
     # fundamental: y ~ a sin + b cos  ->  complex gain (a + j b) / A relative to A sin
     h = (out[:, :, 0] + 1j * out[:, :, 1]) / A[:, None]
     R = model.actuator.moment_arm_m
+    return DwellPoints(h[:, 0] / R, h[:, 1], method, **extra)
+
+
+def sine_dwell_grid(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", **kwargs):
+    """Sine-dwell responses over a grid of amplitudes x frequencies in one parallel call
+    (:func:`sine_dwell_points`, whose settings it takes). Returns (piston, engine) complex
+    arrays of shape (n_amp, n_freq)."""
+    amps = np.atleast_1d(np.asarray(amplitudes_rad, float))
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    A, F = np.meshgrid(amps, f, indexing="ij")
+    pts = sine_dwell_points(model, A.ravel(), F.ravel(), axis, **kwargs)
     shape = (amps.size, f.size)
-    return (h[:, 0] / R).reshape(shape), h[:, 1].reshape(shape)
+    return pts.piston.reshape(shape), pts.engine.reshape(shape)
+
+
+def sine_dwell_family(model: TvcModel, freq_hz, amplitudes_rad, axis: str = "pitch",
+                      **kwargs) -> list[FrequencyResponse]:
+    """One response per command amplitude [rad] at ``freq_hz`` [Hz], every dwell of the
+    family in one parallel call (:func:`sine_dwell_points`, whose settings it takes): the
+    describing-function map N(A, w) of the ``taos freqresp --amplitude-deg A1,A2,...`` call.
+    Each row equals the single-amplitude call bit for bit. With ``method="shoot"`` the
+    provenance carries the largest shooting residual and whether every dwell converged."""
+    amps = np.atleast_1d(np.asarray(amplitudes_rad, float))
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    A, F = np.meshgrid(amps, f, indexing="ij")
+    pts = sine_dwell_points(model, A.ravel(), F.ravel(), axis, **kwargs)
+    shape = (amps.size, f.size)
+    piston, engine = pts.piston.reshape(shape), pts.engine.reshape(shape)
+    rp, re = linear_phase_reference(model, f, axis)
+    prov = {"model_sha256": model.sha256, "method": "sine-dwell", "steady_state": pts.method,
+            "dt_max_s": kwargs.get("dt_max_s", DEFAULT_DT_S)}
+    fam = []
+    for i, a in enumerate(amps):
+        p = dict(prov)
+        if pts.residual is not None:
+            p.update({"shooting_max_residual": float(pts.residual.reshape(shape)[i].max()),
+                      "shooting_converged": bool(pts.converged.reshape(shape)[i].all()),
+                      "shooting_periods": int(pts.periods.reshape(shape)[i].sum())})
+        fam.append(FrequencyResponse(f, piston[i], engine[i], float(a), axis, friction_model=model.friction.name,
+                                     provenance=p, piston_phase_ref_deg=rp, engine_phase_ref_deg=re))
+    return fam
+
+
+def family_to_dict(family: list[FrequencyResponse]) -> dict:
+    """The ``taos freqresp`` JSON of several amplitudes: the single-amplitude keys, with
+    ``amplitude_deg`` a list and each gain, phase and ``engine_held`` an (amplitude x
+    frequency) list of rows, each row exactly the single-amplitude call's."""
+    rows = [fr.to_dict() for fr in family]
+    d = dict(rows[0])
+    d["amplitude_deg"] = [r["amplitude_deg"] for r in rows]
+    for k in ("piston", "engine"):
+        d[k] = {q: [r[k][q] for r in rows] for q in ("gain_db", "phase_deg")}
+    d["engine_held"] = [r["engine_held"] for r in rows]
+    notes = [r["note"] for r in rows if "note" in r]
+    if notes:
+        d["note"] = notes[0]
+    else:
+        d.pop("note", None)
+    if any("shooting_max_residual" in r["provenance"] for r in rows):
+        d["provenance"] = dict(rows[0]["provenance"])
+        for q in ("shooting_max_residual", "shooting_converged", "shooting_periods"):
+            d["provenance"][q] = [r["provenance"][q] for r in rows]
+    return d
 
 
 def sine_dwell_freqresp(model: TvcModel, freq_hz, amplitude_rad: float, axis: str = "pitch",
                         **kwargs) -> FrequencyResponse:
-    """Amplitude-dependent response at one command amplitude (see :func:`sine_dwell_grid`)."""
-    piston, engine = sine_dwell_grid(model, [amplitude_rad], freq_hz, axis, **kwargs)
-    f = np.atleast_1d(np.asarray(freq_hz, float))
-    rp, re = linear_phase_reference(model, f, axis)
-    return FrequencyResponse(f, piston[0], engine[0],
-                             float(amplitude_rad), axis, friction_model=model.friction.name,
-                             provenance={"model_sha256": model.sha256, "method": "sine-dwell",
-                                         "dt_max_s": kwargs.get("dt_max_s", DEFAULT_DT_S)},
-                             piston_phase_ref_deg=rp, engine_phase_ref_deg=re)
+    """Amplitude-dependent response at one command amplitude [rad] (:func:`sine_dwell_family`)."""
+    return sine_dwell_family(model, freq_hz, [amplitude_rad], axis, **kwargs)[0]

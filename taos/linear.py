@@ -7,9 +7,9 @@ assembled from pieces (actuator, load path, engine, vehicle) by name rather than
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
-import scipy.linalg
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,6 +43,11 @@ class StateSpace:
     def state_index(self, name: str) -> int:
         return self.states.index(name)
 
+    @cached_property
+    def balance_scale(self) -> np.ndarray:
+        """The diagonal scaling of :func:`balancing_scale`, computed once per system."""
+        return balancing_scale(self)
+
     def poles(self) -> np.ndarray:
         """Eigenvalues of A [1/s]."""
         return np.linalg.eigvals(self.A)
@@ -61,16 +66,15 @@ class StateSpace:
         B = self.B[:, ii]
         C = self.C[oo, :]
         D = self.D[np.ix_(oo, ii)]
-        # diagonal balancing: the states mix Pa and m
-        H, (sc, _perm) = scipy.linalg.matrix_balance(self.A, permute=False, separate=True)
+        # diagonal balancing: the states mix Pa and m; then all frequencies in one batched solve
+        sc = self.balance_scale
+        H = self.A / sc[:, None] * sc[None, :]
         Bq = B / sc[:, None]
         Cq = C * sc[None, :]
         n = self.A.shape[0]
-        out = np.empty((f.size, len(oo), len(ii)), complex)
-        eye = np.eye(n)
-        for k, fk in enumerate(f):
-            s = 2j * np.pi * fk
-            out[k] = Cq @ scipy.linalg.solve(s * eye - H, Bq) + D
+        M = (2j * np.pi * f)[:, None, None] * np.eye(n)[None] - H[None]
+        X = np.linalg.solve(M, np.broadcast_to(Bq.astype(complex), (f.size, n, len(ii))))
+        out = Cq[None] @ X + D[None]
         if isinstance(outputs, str):
             out = out[:, 0, :]
         if isinstance(inputs, str):
@@ -88,9 +92,10 @@ class StateSpace:
 
 def is_symbolic(*values) -> bool:
     """True if any value is a CasADi symbol/expression (SX or MX)."""
-    try:
-        import casadi as ca
-    except ImportError:  # pragma: no cover - casadi is a dependency
+    import sys
+
+    ca = sys.modules.get("casadi")
+    if ca is None:  # no CasADi expression exists before casadi is imported (keeps start-up light)
         return False
     return any(isinstance(v, (ca.SX, ca.MX)) for v in values)
 
@@ -131,24 +136,35 @@ def notch_hz(abs_gain, f_lo_hz: float, f_hi_hz: float, n_grid: int = 400, xatol:
 
     ``abs_gain`` maps an array of F frequencies [Hz] to |H| (any unit), shape (F,) for one
     response (the result is then a float) or (F, m) for m responses evaluated together (an (m,)
-    array). The minimum of a log grid of ``n_grid`` points is refined by a bounded scalar search
-    in log10 f between the grid's neighbours (tolerance ``xatol`` in log10 f). The one notch
-    finder for responses that can be evaluated at any frequency; :func:`sampled_notch_hz` is the
-    one for sampled responses."""
-    import scipy.optimize
-
+    array). The minimum of a log grid of ``n_grid`` points is refined by golden-section search
+    in log10 f between the grid's neighbours, all responses at once (tolerance ``xatol`` in
+    log10 f). The one notch finder for responses that can be evaluated at any frequency;
+    :func:`sampled_notch_hz` is the one for sampled responses."""
     grid = np.linspace(np.log10(f_lo_hz), np.log10(f_hi_hz), n_grid)
     g = np.asarray(abs_gain(10 ** grid), float)
     cols = g.reshape(grid.size, -1)
-    out = np.empty(cols.shape[1])
-    for j in range(cols.shape[1]):
-        k = int(np.argmin(cols[:, j]))
-        lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    m = cols.shape[1]
+    k = np.argmin(cols, axis=0)
+    a = grid[np.maximum(k - 1, 0)]
+    b = grid[np.minimum(k + 1, grid.size - 1)]
+    jj = np.arange(m)
 
-        def at(lf, j=j):
-            return float(np.asarray(abs_gain(np.array([10 ** lf])), float).reshape(-1)[j])
-        res = scipy.optimize.minimize_scalar(at, bounds=(lo, hi), method="bounded", options={"xatol": xatol})
-        out[j] = 10 ** res.x
+    def at(lf):  # |H_j| at log10 f = lf[j], every response j in one call
+        return np.asarray(abs_gain(10 ** lf), float).reshape(lf.size, m)[jj, jj]
+
+    r = (np.sqrt(5.0) - 1.0) / 2.0
+    c, d = b - r * (b - a), a + r * (b - a)
+    gc, gd = at(c), at(d)
+    while np.max(b - a) > xatol:
+        left = gc < gd     # the minimum lies in [a, d]: shrink from the right
+        b = np.where(left, d, b)
+        a = np.where(left, a, c)
+        c_new = np.where(left, b - r * (b - a), d)
+        d_new = np.where(left, c, a + r * (b - a))
+        g_new = at(np.where(left, c_new, d_new))
+        gc, gd = np.where(left, g_new, gd), np.where(left, gc, g_new)
+        c, d = c_new, d_new
+    out = 10 ** (0.5 * (a + b))
     return float(out[0]) if g.ndim == 1 else out
 
 
@@ -191,9 +207,34 @@ def phase_deg_continuous(freq_hz, h, reference_deg=None) -> np.ndarray:
 
 
 def balancing_scale(ss: StateSpace) -> np.ndarray:
-    """Diagonal state scaling s (x = diag(s) x') that balances a numeric A (LAPACK gebal)."""
-    _, (sc, _perm) = scipy.linalg.matrix_balance(np.asarray(ss.A, float), permute=False, separate=True)
-    return sc
+    """Diagonal state scaling s (x = diag(s) x') that balances a numeric A: powers of two
+    making each state's off-diagonal row and column 1-norms of diag(s)^-1 A diag(s) comparable
+    (Parlett & Reinsch, "Balancing a matrix for calculation of eigenvalues and eigenvectors",
+    Numer. Math. 13 (1969); the scaling iteration of LAPACK xGEBAL without permutation)."""
+    M = np.abs(np.asarray(ss.A, float))
+    n = M.shape[0]
+    np.fill_diagonal(M, 0.0)
+    s = np.ones(n)
+    for _ in range(100):
+        done = True
+        for i in range(n):
+            c = M[:, i].sum()
+            r = M[i, :].sum()
+            if c == 0.0 or r == 0.0:
+                continue
+            tot, f = c + r, 1.0
+            while c < r / 2.0:
+                c, r, f = c * 2.0, r / 2.0, f * 2.0
+            while c >= r * 2.0:
+                c, r, f = c / 2.0, r * 2.0, f / 2.0
+            if c + r < 0.95 * tot:
+                done = False
+                s[i] *= f
+                M[:, i] *= f
+                M[i, :] /= f
+        if done:
+            break
+    return s
 
 
 def freqresp_symbolic(ss: StateSpace, w_rad_s: float, inputs, outputs, scale: np.ndarray | None = None):

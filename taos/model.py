@@ -370,7 +370,7 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
     load (:meth:`taos.friction.FrictionLaw.scaled`), here applied to the planar torque level."""
     import dataclasses as _dc
 
-    from .friction import LAWS
+    from .friction import param_classes
     from .units import DIMENSIONS
 
     ref = to_si(ref_torque, "torque", source=set_src, field=f"friction.{REFERENCE_TORQUE_KEY}", positive=True)
@@ -378,7 +378,7 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
         raise InputError(src, "friction.coulomb_torque", "this condition's torque level (the parameter set is "
                          "scaled to it)", got="nothing (key missing)")
     level = to_si(table["coulomb_torque"], "torque", source=src, field="friction.coulomb_torque", nonnegative=True)
-    kinds = {f.metadata["key"]: f.metadata["kind"] for e in LAWS.values() for f in _dc.fields(e.params)
+    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
              if f.metadata.get("torque_like") and f.metadata["key"] not in ("coulomb_torque", "static_torque")}
     for key, kind in kinds.items():
         if key in table:

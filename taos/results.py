@@ -25,9 +25,10 @@ import subprocess
 from functools import cache
 from importlib import metadata
 from pathlib import Path
-from typing import Callable, Mapping
+from typing import TYPE_CHECKING, Callable, Mapping
 
-import h5py
+if TYPE_CHECKING:  # h5py is imported where a file is written (start-up of the CLI)
+    import h5py
 
 from .errors import InputError
 

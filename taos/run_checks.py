@@ -78,19 +78,21 @@ MAX_DWELL_STEPS = 5e7
 
 
 def check_dwell(model, freqs_hz, dt_s: float = 2e-4, axis: str = "pitch", source: str = "command line",
-                field: str = "--freq-hz", min_steps_per_cycle: int = 64) -> None:
-    """The integration steps a sine-dwell grid will take (settling over the slowest linear mode,
-    then two measured cycles; :func:`taos.freqresp.sine_dwell_grid`) within MAX_DWELL_STEPS."""
+                field: str = "--freq-hz", min_steps_per_cycle: int = 64, n_amplitudes: int = 1) -> None:
+    """The integration steps a sine-dwell grid of ``n_amplitudes`` x ``freqs_hz`` will take at
+    most (settling over the slowest linear mode, then two measured cycles;
+    :func:`taos.freqresp.sine_dwell_points`; shooting's fallback has the same budget) within
+    MAX_DWELL_STEPS."""
     from .freqresp import settle_time_s
 
     ts = settle_time_s(model, axis)
     total = 0.0
     for f in np.atleast_1d(freqs_hz):
         npc = max(math.ceil(1.0 / (f * dt_s)), min_steps_per_cycle)
-        total += (max(2.0, math.ceil(ts * f)) + 2.0) * npc
+        total += (max(2.0, math.ceil(ts * f)) + 2.0) * npc * n_amplitudes
     if total > MAX_DWELL_STEPS:
         raise InputError(source, field, f"sine-dwell frequencies needing at most {MAX_DWELL_STEPS:.0e} integration "
-                         f"steps (settling {ts:.3g} s, then two cycles)", got=f"{total:.3g} steps")
+                         f"steps (settling {ts:.3g} s, then two cycles, per amplitude)", got=f"{total:.3g} steps")
 
 
 def check_run(model, profile, dt_s: float, *, source: str = "command line", field: str = "--dt") -> None:

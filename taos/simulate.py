@@ -11,10 +11,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import h5py
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from . import _integrator as _ig
+if TYPE_CHECKING:
+    import h5py
+
 from .errors import SimulationUnstable
 from .model import TvcModel
 from .profiles import is_two_axis
@@ -63,6 +66,8 @@ def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: floa
     y = np.empty((nrec, plant.ss.C.shape[0]))
     aux = np.empty((nrec, 3))
     x0 = np.zeros(n) if x0 is None else np.asarray(x0, float)
+    from . import _integrator as _ig
+
     status = _ig.integrate_samples(*kernel_args(plant, model), np.ascontiguousarray(plant.ss.C),
                                    model.friction.entry.rates, model.friction.pack(), model.avionics.pack(),
                                    x0, float(z0), np.ascontiguousarray(r, dtype=np.float64), dt_s,
@@ -111,6 +116,8 @@ class TimeHistory:
     def to_hdf5(self, path) -> None:
         """Write atomically: /t_s, /<axis>/<array>, provenance as root attributes."""
         def write(tmp):
+            import h5py
+
             with h5py.File(tmp, "w") as h5:
                 h5.create_dataset("t_s", data=self.t_s, track_times=False)
                 h5.attrs["axes"] = ",".join(self.axes)
@@ -131,6 +138,8 @@ class TimeHistory:
 
     @classmethod
     def from_hdf5(cls, path) -> "TimeHistory":
+        import h5py
+
         with h5py.File(path, "r") as h5:
             axes = tuple(str(h5.attrs["axes"]).split(","))
             arrays = {n: np.vstack([h5[ax][n][()] for ax in axes]) for n in cls.ARRAYS}

@@ -4,18 +4,118 @@ One pint registry for the whole package. Model files, CLI options and reports ca
 strings such as ``"115000 lbf/in"`` or ``"144000 in*lbf"``; :func:`to_si` turns them into
 plain SI floats after checking their dimension, and :func:`from_si` formats SI floats
 back into engineering units for reports.
+
+Start-up: pint takes about a quarter of a second to import and set up, longer than a whole
+``taos info``. So the registry (``ureg``, ``Q_``) is built on first use, with its parsed
+definitions cached on disk by pint, and :func:`to_si` remembers what pint said about each
+(unit, kind) pair it has seen: the unit's dimension matches the kind and SI = a * value + b
+(``a``, ``b`` from pint). The table lives in the user cache directory, keyed by the installed
+pint, so a later run converts a known unit without importing pint. Every value goes through
+the same a * value + b whether the table was warm or cold, so results do not depend on it.
 """
 
 from __future__ import annotations
 
+import functools
+import json
 import math
-
-import pint
+import os
+import re
+from pathlib import Path
 
 from .errors import InputError
 
-ureg = pint.UnitRegistry()
-Q_ = ureg.Quantity
+
+@functools.cache
+def _registry():
+    """pint's default registry, its parsed definitions cached on disk (``cache_folder``, the
+    user cache directory); plain when no cache can be used."""
+    import pint
+
+    try:
+        ureg = pint.UnitRegistry(cache_folder=":auto:")
+    except Exception:  # an unwritable or broken cache: parse the definitions as usual
+        ureg = pint.UnitRegistry()
+    return ureg
+
+
+def __getattr__(name: str):
+    """``ureg`` (the registry) and ``Q_`` (its Quantity), built on first use."""
+    if name == "ureg":
+        return _registry()
+    if name == "Q_":
+        return _registry().Quantity
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _Q(*args):
+    return _registry().Quantity(*args)
+
+
+_NUMBER_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s+([A-Za-z][^\s].*?|[A-Za-z]|1\s*/\s*[A-Za-z].*?)\s*$")
+
+
+def _cache_file() -> Path | None:
+    """The (unit, kind) table's file: keyed by the installed pint's location, size and time."""
+    import importlib.util
+
+    try:
+        spec = importlib.util.find_spec("pint")
+        st = os.stat(spec.origin)
+    except Exception:
+        return None
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    key = f"{spec.origin}:{st.st_size}:{st.st_mtime_ns}"
+    import hashlib
+
+    return Path(base) / "taos" / f"units-{hashlib.sha256(key.encode()).hexdigest()[:16]}.json"
+
+
+@functools.cache
+def _table() -> dict:
+    f = _cache_file()
+    try:
+        d = json.loads(f.read_text()) if f is not None else {}
+        return d if isinstance(d, dict) else {}
+    except Exception:
+        return {}
+
+
+def _remember(key: str, ab: tuple[float, float]) -> None:
+    t = _table()
+    t[key] = list(ab)
+    f = _cache_file()
+    if f is None:
+        return
+    try:
+        f.parent.mkdir(parents=True, exist_ok=True)
+        tmp = f.with_name(f"{f.name}.{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(t))
+        os.replace(tmp, f)
+    except OSError:  # a read-only home: convert through pint every time
+        pass
+
+
+def _affine(unit: str, kind: str) -> tuple[float, float] | None:
+    """(a, b) with SI = a * value + b for ``unit`` of ``kind`` (pint's word, remembered), or
+    None if pint does not know ``unit`` as a ``kind``."""
+    key = f"{kind}|{unit}"
+    ab = _table().get(key)
+    if ab is not None:
+        return float(ab[0]), float(ab[1])
+    try:
+        q1 = _Q(1.0, unit)
+        if q1.dimensionality != _dimensionality(kind):
+            return None
+        si = DIMENSIONS[kind][1]
+        b = float(_Q(0.0, unit).to(si).magnitude)
+        a = float(q1.to(si).magnitude) - b
+    except Exception:  # pint raises several error types for unknown or odd units
+        return None
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return None
+    _remember(key, (a, b))
+    return a, b
 
 #: Named physical dimensions used by model-file fields: name -> (pint dimensionality
 #: expressed by a reference unit, SI unit string, example shown in error messages).
@@ -45,7 +145,7 @@ DIMENSIONS: dict[str, tuple[str, str, str]] = {
 
 
 def _dimensionality(kind: str):
-    return Q_(1.0, DIMENSIONS[kind][0]).dimensionality
+    return _Q(1.0, DIMENSIONS[kind][0]).dimensionality
 
 
 def to_si(value: object, kind: str, *, source: str, field: str, positive: bool = False,
@@ -72,22 +172,14 @@ def to_si(value: object, kind: str, *, source: str, field: str, positive: bool =
     expected = f"a {kind.replace('_', ' ')} with its unit, like {example}"
     if isinstance(value, bool):
         raise InputError(source, field, expected, got=repr(value))
-    if isinstance(value, (int, float)):
-        if kind != "dimensionless":
-            raise InputError(source, field, expected, got=f"{value!r} (no unit)")
-        q = Q_(float(value), "dimensionless")
-    elif isinstance(value, str):
-        try:
-            q = Q_(value)
-        except Exception:  # pint raises several error types for unparsable text
-            raise InputError(source, field, expected, got=repr(value)) from None
-        if not isinstance(q, pint.Quantity):
-            q = Q_(float(q), "dimensionless")
+    m = _NUMBER_UNIT.match(value) if isinstance(value, str) else None
+    ab = _affine(m.group(2), kind) if m else None
+    if kind == "dimensionless" and isinstance(value, (int, float)):
+        out = float(value)
+    elif ab is not None:   # "<number> <unit>": the remembered (or freshly asked) pint conversion
+        out = ab[0] * float(m.group(1)) + ab[1]
     else:
-        raise InputError(source, field, expected, got=repr(value))
-    if q.dimensionality != _dimensionality(kind):
-        raise InputError(source, field, expected, got=f"{value!r} ({q.dimensionality})")
-    out = float(q.to(si_unit).magnitude)
+        out = _to_si_pint(value, kind, expected, source, field)
     if not math.isfinite(out):
         raise InputError(source, field, expected + " (finite)", got=repr(value))
     if positive and not out > 0.0:
@@ -97,7 +189,29 @@ def to_si(value: object, kind: str, *, source: str, field: str, positive: bool =
     return out
 
 
+def _to_si_pint(value: object, kind: str, expected: str, source: str, field: str) -> float:
+    """The general path of :func:`to_si`: pint parses the whole value."""
+    import pint
+
+    if isinstance(value, (int, float)):
+        if kind != "dimensionless":
+            raise InputError(source, field, expected, got=f"{value!r} (no unit)")
+        q = _Q(float(value), "dimensionless")
+    elif isinstance(value, str):
+        try:
+            q = _Q(value)
+        except Exception:  # pint raises several error types for unparsable text
+            raise InputError(source, field, expected, got=repr(value)) from None
+        if not isinstance(q, pint.Quantity):
+            q = _Q(float(q), "dimensionless")
+    else:
+        raise InputError(source, field, expected, got=repr(value))
+    if q.dimensionality != _dimensionality(kind):
+        raise InputError(source, field, expected, got=f"{value!r} ({q.dimensionality})")
+    return float(q.to(DIMENSIONS[kind][1]).magnitude)
+
+
 def from_si(value: float, si_unit: str, unit: str) -> float:
     """Convert an SI float to ``unit`` (e.g. ``from_si(k, 'N/m', 'lbf/in')``)."""
-    return float(Q_(value, si_unit).to(unit).magnitude)
+    return float(_Q(value, si_unit).to(unit).magnitude)
 

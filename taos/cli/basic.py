@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 import sys
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from taos.errors import InputError
-from taos.model import TvcModel, load_model
 from taos.results import write_json
+
+if TYPE_CHECKING:  # the model layer is imported when a command runs, not for --help
+    from taos.model import TvcModel
 
 AXES = ("pitch", "yaw")
 ENGINES = ("simplex", "taos")
@@ -28,6 +30,8 @@ def parse_float_list(text: str, option: str) -> list[float]:
 
 
 def model_from_args(args) -> TvcModel:
+    from taos.model import load_model
+
     return load_model(args.model, friction=getattr(args, "friction", None))
 
 
@@ -47,6 +51,8 @@ def merit_dict(model: TvcModel, axes=AXES, steps: bool = True) -> dict:
 def info_dict(model: TvcModel, steps: bool = True) -> dict:
     """Parameters in SI and derived figures (the ``taos info`` JSON), with the figures of merit."""
     from dataclasses import asdict
+
+    import numpy as np
 
     from taos.simplex import load_resonance_from_notch, simplex_state_space
 
@@ -84,7 +90,7 @@ def info_dict(model: TvcModel, steps: bool = True) -> dict:
 
 def cmd_info(args) -> int:
     model = model_from_args(args)
-    d = info_dict(model)
+    d = info_dict(model, steps=args.steps)
     if args.json:
         from taos.results import output_provenance
         d["provenance"] = output_provenance([model])
@@ -113,7 +119,9 @@ def cmd_info(args) -> int:
 
 
 def cmd_freqresp(args) -> int:
-    from taos.freqresp import linear_freqresp, sine_dwell_freqresp
+    import numpy as np
+
+    from taos.freqresp import family_to_dict, linear_freqresp, sine_dwell_family
 
     from taos import limits, run_checks
     from taos.results import check_output_file
@@ -124,26 +132,31 @@ def cmd_freqresp(args) -> int:
         if getattr(args, opt) not in (None, "-"):
             check_output_file(getattr(args, opt), f"--{opt}", suf)
     model = model_from_args(args)
-    amp_rad = None
+    amps_rad: list[float] = []
     if args.amplitude_deg is not None and not args.linear:
-        amp = parse_float_list(args.amplitude_deg, "--amplitude-deg")
-        if len(amp) != 1:
-            raise InputError("command line", "--amplitude-deg", "one amplitude in deg", got=args.amplitude_deg)
-        amp_rad = math.radians(amp[0])
-        limits.check_amplitude(amp_rad, model, "--amplitude-deg")
+        amps_rad = [math.radians(a) for a in parse_float_list(args.amplitude_deg, "--amplitude-deg")]
+        for a in amps_rad:
+            limits.check_amplitude(a, model, "--amplitude-deg")
+        if args.engine == "taos" and args.steady == "shoot":
+            raise InputError("command line", "--steady", "settle with --engine taos (shooting is for the "
+                             "simplex engine)", got="shoot")
         run_checks.check_linear_stability(model, (args.axis,), allow=args.allow_unstable)
-        run_checks.check_dwell(model, freqs, axis=args.axis)
+        run_checks.check_dwell(model, freqs, axis=args.axis, n_amplitudes=len(amps_rad))
     if args.engine == "taos":
         from taos.taos3d import taos_freqresp, taos_model
-        fr = taos_freqresp(taos_model(model), freqs, amp_rad, args.axis, cross=args.cross)
-    elif amp_rad is None:
-        fr = linear_freqresp(model, freqs, args.axis)
-    else:
-        fr = sine_dwell_freqresp(model, freqs, amp_rad, args.axis)
-    d = fr.to_dict()
+        tm = taos_model(model)
+        fam = [taos_freqresp(tm, freqs, a, args.axis, cross=args.cross) for a in (amps_rad or [None])]
+    elif not amps_rad:
+        fam = [linear_freqresp(model, freqs, args.axis)]
+    else:   # every amplitude x frequency dwell in one parallel call
+        fam = sine_dwell_family(model, freqs, amps_rad, args.axis, method=args.steady)
+    fr = fam[0]
+    d = family_to_dict(fam) if len(fam) > 1 else fr.to_dict()
     from taos.results import output_provenance
     d["provenance"].update(output_provenance([model]))
-    d["provenance"]["solver"] = {"method": "linear (exact)" if amp_rad is None else "rk4 sine dwell",
+    d["provenance"]["solver"] = {"method": "linear (exact)" if not amps_rad else
+                                 ("rk4 sine dwell, periodic steady state by shooting" if args.steady == "shoot"
+                                  else "rk4 sine dwell, settled from rest"),
                                  "engine": args.engine}
     d["provenance"]["seeds"] = "none (deterministic)"
     if not args.cross:
@@ -152,12 +165,14 @@ def cmd_freqresp(args) -> int:
     if args.json:
         write_json(args.json, d)
     else:
-        print(f"{'freq_hz':>9} {'piston dB':>10} {'piston deg':>11} {'engine dB':>10} {'engine deg':>11}"
-              "   (piston x_p/(R theta_c); phase continuous from low frequency)")
-        for i, f in enumerate(d["freq_hz"]):
-            eg, ep = d["engine"]["gain_db"][i], d["engine"]["phase_deg"][i]
-            eng = f"{eg:10.3f} {ep:11.2f}" if eg is not None else f"{'engine held':>22s}"
-            print(f"{f:9.4g} {d['piston']['gain_db'][i]:10.3f} {d['piston']['phase_deg'][i]:11.2f} {eng}")
+        print(f"{'amp_deg':>8} {'freq_hz':>9} {'piston dB':>10} {'piston deg':>11} {'engine dB':>10} "
+              f"{'engine deg':>11}   (piston x_p/(R theta_c); phase continuous from low frequency)")
+        for r in (f.to_dict() for f in fam):
+            amp = "linear" if r["amplitude_deg"] is None else f"{r['amplitude_deg']:.4g}"
+            for i, f in enumerate(r["freq_hz"]):
+                eg, ep = r["engine"]["gain_db"][i], r["engine"]["phase_deg"][i]
+                eng = f"{eg:10.3f} {ep:11.2f}" if eg is not None else f"{'engine held':>22s}"
+                print(f"{amp:>8} {f:9.4g} {r['piston']['gain_db'][i]:10.3f} {r['piston']['phase_deg'][i]:11.2f} {eng}")
         if d.get("note"):
             print(d["note"])
     if args.plot:
@@ -165,12 +180,12 @@ def cmd_freqresp(args) -> int:
         from taos.plotting import bode
         from taos.plotting.spec import bode_axes
         if args.engine == "taos":
-            fig = bode.plot_freqresp([fr], resonance_hz=model.load_resonance_hz(args.axis))
+            fig = bode.plot_freqresp(fam, resonance_hz=model.load_resonance_hz(args.axis))
         else:   # the linear response as a dense curve, not straight lines between the listed points
             fd = np.logspace(math.log10(min(freqs) / 1.5), math.log10(max(freqs) * 1.5), 400)
             dense = linear_freqresp(model, fd, args.axis)
             from taos.simplex import load_resonance_from_notch   # the one notch finder every command uses
-            fig = bode.plot_freqresp([dense] + ([] if fr.amplitude_rad is None else [fr]),
+            fig = bode.plot_freqresp([dense] + ([] if fr.amplitude_rad is None else fam),
                                      resonance_hz=model.load_resonance_hz(args.axis),
                                      notch_hz=load_resonance_from_notch(model, args.axis))
             if fr.amplitude_rad is None:
@@ -223,12 +238,18 @@ def add_parsers(sub) -> None:
 
     p = sub.add_parser("info", help="parameters in SI and derived figures")
     common(p)
+    p.add_argument("--steps", action="store_true", help="also the step, threshold and hysteresis figures of merit "
+                   "(simulated on the nonlinear model; without it info is linear analysis only and starts in a blink)")
     p.set_defaults(func=cmd_info)
 
     p = sub.add_parser("freqresp", help="command -> piston and engine frequency response")
     common(p)
     p.add_argument("--freq-hz", required=True, help="comma-separated frequencies, e.g. 0.1,0.5,1,2,5")
-    p.add_argument("--amplitude-deg", help="command amplitude for the sine-dwell (nonlinear) response")
+    p.add_argument("--amplitude-deg", help="command amplitude(s) for the sine-dwell (nonlinear) response; a "
+                   "comma-separated list gives the whole N(A, w) map in one call (JSON: amplitude x frequency rows)")
+    p.add_argument("--steady", choices=("settle", "shoot"), default="settle",
+                   help="how each dwell reaches its periodic orbit: settle (integrate from rest through the "
+                   "settling time, default) or shoot (periodic steady state by shooting, simplex engine)")
     p.add_argument("--linear", action="store_true", help="exact linear response (no friction, unity avionics)")
     p.add_argument("--axis", choices=AXES, default="pitch")
     p.add_argument("--engine", choices=ENGINES, default="simplex",

@@ -143,7 +143,7 @@ class DescribingFunctionMap:
 
 def describing_function_map(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,
                             settle_cycles: int = 2, measure_cycles: int = 2, settle_s: float | None = None,
-                            dt_max_s: float = DEFAULT_DT_S) -> DescribingFunctionMap:
+                            dt_max_s: float = DEFAULT_DT_S, method: str = "settle") -> DescribingFunctionMap:
     """N(A, w) by sine dwell on the nonlinear simplex model (friction and avionics in the path).
 
     Parameters
@@ -154,13 +154,16 @@ def describing_function_map(model: TvcModel, amplitudes_rad, freq_hz, axis: str 
     settle_cycles, measure_cycles, settle_s, dt_max_s : sine-dwell settings
         (:func:`taos.freqresp.sine_dwell_grid`; settle at least ``settle_s`` [s], default four
         decades of the slowest linear mode).
+    method : 'settle' or 'shoot'
+        How each dwell reaches its periodic orbit (:func:`taos.freqresp.sine_dwell_points`;
+        'shoot': the periodic steady state by shooting, :mod:`taos.steady`).
     """
     amps = np.sort(np.atleast_1d(np.asarray(amplitudes_rad, float)))
     f = np.sort(np.atleast_1d(np.asarray(freq_hz, float)))
     piston, engine = sine_dwell_grid(model, amps, f, axis, dt_max_s=dt_max_s, settle_cycles=settle_cycles,
-                                     measure_cycles=measure_cycles, settle_s=settle_s)
+                                     measure_cycles=measure_cycles, settle_s=settle_s, method=method)
     prov = {"model_file": model.source, "model_sha256": model.sha256, "package_version": package_version(),
-            "method": "sine-dwell", "dt_max_s": dt_max_s, "settle_cycles": settle_cycles,
+            "method": "sine-dwell", "steady_state": method, "dt_max_s": dt_max_s, "settle_cycles": settle_cycles,
             "measure_cycles": measure_cycles, "settle_s": settle_s}
     return DescribingFunctionMap(amps, f, engine, piston, model.friction.name, axis,
                                  model.structure.load_stiffness_N_per_m, prov)

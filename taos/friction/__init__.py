@@ -17,7 +17,6 @@ and call :func:`register` with a :class:`FrictionLawEntry`. The tests parametris
 registry then cover it.
 """
 
-from . import _builtin  # noqa: F401  (registers the built-in laws)
 from ._laws import (
     CoulombSmooth,
     CoulombSwitching,
@@ -32,11 +31,28 @@ from ._laws import (
     friction_keys,
     param,
 )
-from ._vector import coeff_bearing_step
-from .registry import LAWS, FrictionLawEntry, get, ids, register, unregister
+from ._laws import BUILTIN_PARAMS
+from .registry import LAWS, FrictionLawEntry, declare_builtins, get, ids, param_classes, params_of, register, unregister
+
+
+def _register_builtin_entries() -> None:
+    from . import _builtin  # noqa: F401  (registers the built-in laws' entries and kernels)
+
+
+declare_builtins(BUILTIN_PARAMS, _register_builtin_entries)
+
+
+def __getattr__(name: str):
+    """``coeff_bearing_step`` (a numba kernel) is imported on first use: loading a model does not
+    import numba."""
+    if name == "coeff_bearing_step":
+        from ._vector import coeff_bearing_step
+        return coeff_bearing_step
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "LAWS", "CoulombSmooth", "CoulombSwitching", "Dahl", "FrictionLaw", "FrictionLawEntry", "LuGre", "coeff_bearing_step",
     "ModifiedLuGre", "NoFriction", "coulomb_describing_function", "dahl_angle_df", "friction_from_table",
-    "friction_keys", "get", "ids", "param", "register", "unregister",
+    "friction_keys", "get", "ids", "param", "param_classes", "params_of", "register", "unregister",
 ]

@@ -37,7 +37,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..units import to_si
-from . import _kernels as K
+from . import _slots as K
 from . import registry
 
 
@@ -56,7 +56,7 @@ def _info(f: dataclasses.Field) -> dict:
 def friction_keys() -> frozenset[str]:
     """Every key a ``[friction]`` table may hold (besides ``model``): the keys of every
     registered law."""
-    return frozenset(_info(f)["key"] for e in registry.LAWS.values() for f in dataclasses.fields(e.params))
+    return frozenset(_info(f)["key"] for cls in registry.param_classes().values() for f in dataclasses.fields(cls))
 
 
 @dataclass(frozen=True)
@@ -124,7 +124,9 @@ class FrictionLaw(abc.ABC):
 
     def response(self, v: np.ndarray, dt: float, z0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Torque [N m] and state [rad] for a prescribed rate history ``v`` [rad/s] every ``dt`` [s]."""
-        return K.prescribed_rate_response(self.entry.rates, self.pack(), np.ascontiguousarray(v, float),
+        from ._kernels import prescribed_rate_response
+
+        return prescribed_rate_response(self.entry.rates, self.pack(), np.ascontiguousarray(v, float),
                                           float(dt), float(z0))
 
     def numeric_describing_function(self, rate_amplitude: float, freq_hz: float,
@@ -427,14 +429,19 @@ class ModifiedLuGre(LuGre):
         return (2.0 / math.pi) * np.arcsin(np.minimum(1.0, v / vd))
 
 
+#: the built-in laws' parameter classes by id (their kernels register with them in
+#: :mod:`._builtin`, loaded on first use of a kernel)
+BUILTIN_PARAMS = {cls.name: cls for cls in (NoFriction, CoulombSwitching, CoulombSmooth, Dahl, LuGre, ModifiedLuGre)}
+
+
 def friction_from_table(table: dict, source: str, model: str | None = None,
                         section: str = "friction") -> FrictionLaw:
     """Build the law named by ``table['model']`` (or ``model``, the ``--friction`` override,
     which keeps the table's torque levels and parameters) from its registry entry."""
     name = model if model is not None else table.get("model")
-    entry = registry.get(name, source if model is None else "command line",
-                         f"{section}.model" if model is None else "--friction")
+    params = registry.params_of(name, source if model is None else "command line",
+                                f"{section}.model" if model is None else "--friction")
     from ..errors import check_keys
 
     check_keys(table, set(friction_keys()) | {"model"}, source, section)
-    return entry.params.from_table(table, source, section)
+    return params.from_table(table, source, section)

@@ -24,41 +24,56 @@ vector ``p`` (float64, C-contiguous, the law's :meth:`pack`), chain compliance `
 [rad/(N m)], trial bearing increment ``d`` [rad], step ``dt`` [s].
 
 An unknown id stops with :class:`~taos.errors.InputError` naming it and the known ids.
+
+Nothing here imports numba until a kernel is needed: the built-in laws' parameter classes are
+known without their kernels (:func:`params_of`, :func:`param_classes`; model loading and
+``taos info`` use these), and their entries, whose kernels are compiled C callbacks loaded from
+numba's cache, are registered on the first :func:`get` (or ``LAWS`` lookup) of any law.
 """
 
 from __future__ import annotations
 
-import types as _pytypes
-import warnings
+import functools
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Callable
-
-from numba import cfunc
-from numba import types as nt
-from numba.core.ccallback import CFunc
-from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..errors import InputError
 
 if TYPE_CHECKING:
     from ._laws import FrictionLaw
 
-# first-class function arguments are marked experimental in numba; they are this design
-warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+#: the kernel fields of an entry and their signature names (:func:`signatures`):
+#: rates: (dz/dt [rad/s], T_f [N m]) = rates(v, z, t_app, p);
+#: zdot3: (dz0, dz1) [rad/s] = zdot3(w0, w1, z0, z1, p);
+#: torque3: (T0, T1) [N m] = torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p);
+#: bearing_step: (w0, w1, z0, z1, T0, T1) = bearing_step(p, Kc, d0, d1, z0, z1, dt)
+KERNELS = {"rates": "RATES_SIG", "zdot3": "ZDOT3_SIG", "torque3": "TORQUE3_SIG", "bearing_step": "BEARING_SIG"}
 
-_f8 = nt.float64
-_p = nt.float64[::1]
-#: (dz/dt [rad/s], T_f [N m]) = rates(v, z, t_app, p)
-RATES_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _p)
-#: (dz0, dz1) [rad/s] = zdot3(w0, w1, z0, z1, p)
-ZDOT3_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _f8, _p)
-#: (T0, T1) [N m] = torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p)
-TORQUE3_SIG = nt.UniTuple(_f8, 2)(_f8, _f8, _f8, _f8, _f8, _f8, _f8, _f8, _p)
-#: (w0, w1, z0, z1, T0, T1) = bearing_step(p, Kc, d0, d1, z0, z1, dt)
-BEARING_SIG = nt.UniTuple(_f8, 6)(_p, nt.float64[:, ::1], _f8, _f8, _f8, _f8, _f8)
 
-_SIGS = {"rates": RATES_SIG, "zdot3": ZDOT3_SIG, "torque3": TORQUE3_SIG,
-         "bearing_step": BEARING_SIG}
+@functools.cache
+def signatures() -> dict:
+    """The numba signatures of the kernels, by signature name (numba imported here)."""
+    import warnings
+
+    from numba import types as nt
+    from numba.core.errors import NumbaExperimentalFeatureWarning
+
+    # first-class function arguments are marked experimental in numba; they are this design
+    warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+    f8 = nt.float64
+    p = nt.float64[::1]
+    return {"RATES_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, p),
+            "ZDOT3_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, f8, p),
+            "TORQUE3_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, f8, f8, f8, f8, f8, p),
+            "BEARING_SIG": nt.UniTuple(f8, 6)(p, nt.float64[:, ::1], f8, f8, f8, f8, f8)}
+
+
+def __getattr__(name: str):
+    """``RATES_SIG``, ``ZDOT3_SIG``, ``TORQUE3_SIG``, ``BEARING_SIG``: the kernel signatures."""
+    if name in KERNELS.values():
+        return signatures()[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,13 +105,52 @@ class FrictionLawEntry:
 
 
 _REGISTRY: dict[str, FrictionLawEntry] = {}
+_BUILTINS: dict = {"params": {}, "loader": None, "loaded": False}
+
+
+def declare_builtins(params: dict, loader: Callable[[], None]) -> None:
+    """The built-in laws: their parameter classes by id, and the function that registers their
+    entries (called once, on the first lookup of an entry; :mod:`taos.friction` declares them)."""
+    _BUILTINS["params"] = dict(params)
+    _BUILTINS["loader"] = loader
+
+
+def _load_builtins() -> None:
+    """Register the built-in laws' entries (compiles or loads their C callbacks)."""
+    if not _BUILTINS["loaded"] and _BUILTINS["loader"] is not None:
+        _BUILTINS["loaded"] = True
+        _BUILTINS["loader"]()
+
+
+def _builtin_params() -> dict:
+    return _BUILTINS["params"]
+
+
+class _Laws(Mapping):
+    """id -> entry, read-only; the built-in entries are registered on first lookup."""
+
+    def __getitem__(self, law_id: str) -> FrictionLawEntry:
+        if law_id not in _REGISTRY and law_id in _builtin_params():
+            _load_builtins()
+        return _REGISTRY[law_id]
+
+    def __iter__(self):
+        return iter(ids())
+
+    def __len__(self) -> int:
+        return len(ids())
+
+
 #: id -> entry (read-only view of the registry)
-LAWS = _pytypes.MappingProxyType(_REGISTRY)
+LAWS = _Laws()
 
 
 def _compiled(fn, sig, law_id: str, name: str):
     """A numba C callback with signature ``sig`` for ``fn`` (a CFunc, a numba dispatcher or a
     plain function that numba can compile)."""
+    from numba import cfunc
+    from numba.core.ccallback import CFunc
+
     if isinstance(fn, CFunc):
         if fn._sig != sig:
             raise InputError("friction registry", f"{law_id}.{name}", f"a kernel with signature {sig}",
@@ -113,12 +167,14 @@ def register(entry: FrictionLawEntry, *, replace_existing: bool = False, builtin
     stored entry. Its parameter class must name the same id (``params.name``)."""
     if not entry.id or not isinstance(entry.id, str):
         raise InputError("friction registry", "id", "a non-empty law id", got=repr(entry.id))
+    if not builtin:
+        _load_builtins()
     if entry.id in _REGISTRY and (not replace_existing or _REGISTRY[entry.id].builtin):
         raise InputError("friction registry", entry.id, "an id not yet registered", got="a duplicate")
     if getattr(entry.params, "name", None) != entry.id:
         raise InputError("friction registry", f"{entry.id}.params", f"a parameter class with name = {entry.id!r}",
                          got=repr(getattr(entry.params, "name", None)))
-    compiled = {k: _compiled(getattr(entry, k), sig, entry.id, k) for k, sig in _SIGS.items()}
+    compiled = {k: _compiled(getattr(entry, k), signatures()[s], entry.id, k) for k, s in KERNELS.items()}
     stored = replace(entry, builtin=builtin, **compiled)
     _REGISTRY[entry.id] = stored
     return stored
@@ -135,15 +191,31 @@ def unregister(law_id: str) -> None:
 def get(law_id: str, source: str = "friction registry", field: str = "friction.model") -> FrictionLawEntry:
     """The entry of ``law_id``; an unknown id raises :class:`InputError` naming the known ids."""
     try:
-        return _REGISTRY[law_id]
+        return LAWS[law_id]
     except (KeyError, TypeError):
-        raise InputError(source, field, "a friction law id, one of " + ", ".join(_REGISTRY),
+        raise InputError(source, field, "a friction law id, one of " + ", ".join(ids()),
                          got=repr(law_id)) from None
 
 
 def ids() -> tuple[str, ...]:
-    """The registered law ids, in registration order."""
-    return tuple(_REGISTRY)
+    """The law ids: the built-in ones, then those registered at run time, in order."""
+    return tuple(dict.fromkeys((*_builtin_params(), *_REGISTRY)))
+
+
+def param_classes() -> dict[str, type]:
+    """id -> parameter class of every law, without loading any kernel."""
+    return {i: (_REGISTRY[i].params if i in _REGISTRY else _builtin_params()[i]) for i in ids()}
+
+
+def params_of(law_id: str, source: str = "friction registry", field: str = "friction.model") -> type:
+    """The parameter class of ``law_id`` (no kernel is loaded); an unknown id raises
+    :class:`InputError` naming the known ids."""
+    classes = param_classes()
+    try:
+        return classes[law_id]
+    except (KeyError, TypeError):
+        raise InputError(source, field, "a friction law id, one of " + ", ".join(classes),
+                         got=repr(law_id)) from None
 
 
 def entry_of(law: "FrictionLaw") -> FrictionLawEntry:

@@ -289,17 +289,18 @@ def _apply(model: TvcModel, names, values) -> TvcModel:
 
 
 def simulate_points(model: TvcModel, axes, freq_hz, amp_rad) -> tuple[np.ndarray, np.ndarray]:
-    """Sine-dwell responses of the full nonlinear model at the points (hx [m/rad], he)."""
-    from taos.freqresp import sine_dwell_grid
+    """Sine-dwell responses of the full nonlinear model at the points (hx [m/rad], he): every
+    point of an axis in one parallel call (:func:`taos.freqresp.sine_dwell_points`, the path
+    of ``taos freqresp`` and of the LCO describing-function map)."""
+    from taos.freqresp import sine_dwell_points
     hx = np.empty(freq_hz.size, complex)
     he = np.empty(freq_hz.size, complex)
     R = model.actuator.moment_arm_m
     for ax in np.unique(axes):
-        for a in np.unique(amp_rad[axes == ax]):
-            idx = np.flatnonzero((axes == ax) & (amp_rad == a))
-            p, e = sine_dwell_grid(model, [a], freq_hz[idx], str(ax))
-            hx[idx] = p[0] * R
-            he[idx] = e[0]
+        idx = np.flatnonzero(axes == ax)
+        pts = sine_dwell_points(model, amp_rad[idx], freq_hz[idx], str(ax))
+        hx[idx] = pts.piston * R
+        he[idx] = pts.engine
     return hx, he
 
 

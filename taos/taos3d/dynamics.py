@@ -39,7 +39,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .. import avionics as _av
+from .. import _avionics_kernels as _av
 from .. import actuator_limits as _lim
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
