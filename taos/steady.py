@@ -24,7 +24,8 @@ the same compiled RK4 step as every other run, :func:`taos._integrator._rk4_step
 3. Converged when the scaled residual max_i |G_i| / s_i <= ``tol`` (s_i: the linear orbit's
    amplitude of state i; for the friction state the largest |z| seen over the first period).
    Otherwise (no finite extrapolation, or ``max_cycles`` spent) fall back to integration:
-   plain periods from the last point, up to the settling budget of the settled dwell.
+   plain periods from the last point until the periods integrated in all reach the settled
+   dwell's budget (so a dwell that does not converge costs what settling costs).
 
 The response is then measured over ``n_meas`` steps (whole cycles) from the periodic start,
 with the same correlation as the settled dwell, and the final scaled residual is reported.
@@ -184,7 +185,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
     if not converged:
         # fallback: integrate on from the last point for the settling budget
         cur = Y[0].copy()
-        for _ in range(n_budget):
+        for _ in range(max(n_budget - periods, 1)):   # the settled dwell's budget, all told
             for j in range(n):
                 x[j] = cur[j]
             z0 = cur[n] if nz else 0.0

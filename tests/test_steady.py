@@ -91,4 +91,4 @@ def test_shooting_family_reports_its_residual(tmp_path):
     d = json.loads((tmp_path / "s.json").read_text())
     assert d["provenance"]["steady_state"] == "shoot"
     assert len(d["provenance"]["shooting_max_residual"]) == 2
-    assert all(x <= 1e-6 for x in d["provenance"]["shooting_max_residual"])
+    assert all(x <= 1e-4 for x in d["provenance"]["shooting_max_residual"])

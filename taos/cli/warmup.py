@@ -1,7 +1,8 @@
-"""Compile and cache the numba kernels once (``python -m taos.cli.warmup``; run by ``make``).
+"""Compile and cache every numba kernel once (``python -m taos.cli.warmup``; run by ``make test``).
 
-The integrator kernels take tens of seconds to compile on a cold cache; doing it at install
-time keeps the first ``taos greenrun`` and the test suite's first simulation fast.
+The integrator kernels take tens of seconds to compile on a cold cache and are cached on disk
+after their first use. ``make demo`` does not warm up: the Green Run compiles just the
+kernels it uses. ``make test`` warms every kernel first, so that no test pays a compile.
 """
 
 from __future__ import annotations
