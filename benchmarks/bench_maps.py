@@ -13,6 +13,8 @@
    difference to full settling and to a long (60 s) settling reference.
 
 Run:  .venv/bin/python benchmarks/bench_maps.py [--quick]
+      (TAOS_BEFORE=/path/to/previous/checkout adds the previous version's start-up, run from
+      that source tree on this venv)
 """
 
 from __future__ import annotations
@@ -49,6 +51,17 @@ def wall(cmd, repeat=1):
     return statistics.median(times)
 
 
+def wall_env(cmd, repeat, env):
+    """As :func:`wall` with ``env``, after one untimed run (the other checkout compiles its kernels)."""
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env)
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
 def csv(v):
     return ",".join(f"{x:g}" for x in v)
 
@@ -70,10 +83,22 @@ def main(quick=False):
     t_np = wall([sys.executable, "-c", "import numpy, scipy.integrate"], n)
     t_help = wall(TAOS + ["--help"], n)
     t_info = wall(TAOS + ["info", MODEL], n)
+    before = os.environ.get("TAOS_BEFORE")   # a checkout of the previous version, run on this venv
+    if before:
+        env = dict(os.environ, PYTHONPATH=before)
+        old = [sys.executable, "-m", "taos"]
+        tb_help = wall_env(old + ["--help"], n, env)
+        tb_info = wall_env(old + ["info", MODEL], n, env)
     print("### Start-up (median of %d, warm)\n" % n)
     print("| command | wall [s] |\n|---|---|")
     print(f"| python -c pass | {t_bare:.3f} |\n| python -c 'import numpy, scipy.integrate' (plain script) | {t_np:.3f} |")
-    print(f"| taos --help | {t_help:.3f} |\n| taos info {MODEL} | {t_info:.3f} |\n")
+    print(f"| taos --help | {t_help:.3f} |\n| taos info {MODEL} | {t_info:.3f} |")
+    if before:
+        print(f"| previous version ({before}): taos --help | {tb_help:.3f} |\n"
+              f"| previous version: taos info {MODEL} (with its simulated step figures) | {tb_info:.3f} |")
+        t_steps = wall(TAOS + ["info", MODEL, "--steps"], n)
+        print(f"| taos info {MODEL} --steps (the same figures as the previous version) | {t_steps:.3f} |")
+    print()
 
     m = load_model(MODEL, friction=LAW)
     ts = settle_time_s(m)

@@ -66,6 +66,9 @@ STEPS: tuple[Step, ...] = (
     Step("freqresp", "taos freqresp rs25_hotfire --freq-hz 0.5,1,2,4,7,10,14 --amplitude-deg 0.4 "
          "--plot out/bode_hotfire.png --json out/freqresp_hotfire.json",
          outputs=("out/bode_hotfire.png", "out/freqresp_hotfire.json"), figures=("out/bode_hotfire.png",)),
+    Step("freqresp_map", "taos freqresp rs25_hotfire --freq-hz 0.5,1,2,4,7,10 --amplitude-deg 0.05,0.1,0.4 "
+         "--steady shoot --plot out/df_map.png --json out/df_map.json",
+         outputs=("out/df_map.png", "out/df_map.json"), figures=("out/df_map.png",)),
     Step("simulate", "taos simulate rs25_hotfire --profile step_pitch --out out/step_pitch.h5",
          outputs=("out/step_pitch.h5",)),
     Step("view", "taos view out/step_pitch.h5 --html out/step_pitch.html",
