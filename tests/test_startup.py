@@ -1,0 +1,64 @@
+"""Start-up stays light: what ``taos --help`` and ``taos info`` import (a structural guard, not
+a timing; the times are in benchmarks/RESULTS.md, ``benchmarks/bench_maps.py``).
+
+``taos info`` is linear analysis: it must not import numba (compiled kernels), scipy, pint
+(its unit table is remembered after the first run), h5py, casadi or matplotlib.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+HEAVY = ("numba", "scipy", "pint", "h5py", "casadi", "matplotlib", "meshcat", "pinocchio", "dask")
+
+PROBE = """
+import contextlib, io, json, sys
+from taos.cli import main
+with contextlib.redirect_stdout(io.StringIO()):
+    rc = main(sys.argv[1:])
+print(json.dumps({"rc": rc, "loaded": [m for m in %r if m in sys.modules]}))
+""" % (HEAVY,)
+
+
+def _loaded(tmp_path, *argv):
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))   # a fresh unit table
+    r = subprocess.run([sys.executable, "-c", PROBE, *argv], capture_output=True, text=True, env=env, timeout=300)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_help_imports_nothing_heavy(tmp_path):
+    d = _loaded(tmp_path, "--help")
+    assert d["loaded"] == []
+
+
+def test_info_is_linear_analysis_without_kernels(tmp_path):
+    first = _loaded(tmp_path, "info", "rs25_hotfire")   # a cold unit table asks pint once
+    assert first["rc"] == 0 and "numba" not in first["loaded"]
+    again = _loaded(tmp_path, "info", "rs25_hotfire")
+    assert again == {"rc": 0, "loaded": []}
+
+
+def test_info_steps_adds_the_simulated_figures(tmp_path):
+    out = tmp_path / "info.json"
+    r = subprocess.run([sys.executable, "-m", "taos", "info", "rs25_hotfire", "--steps", "--json", str(out)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    fm = json.loads(out.read_text())["figures_of_merit"]["pitch"]
+    assert fm["step"]["threshold_deg"] > 0 and fm["engine"]["bandwidth_3db_hz"] > 0
+
+
+def test_unit_table_gives_what_pint_gives():
+    """The remembered conversion (a value + b per unit) equals pint's own parse of the string."""
+    import pint
+
+    from taos.units import DIMENSIONS, to_si
+    ureg = pint.UnitRegistry()
+    for text, kind in (("115000 lbf/in", "stiffness"), ("144000 in*lbf", "torque"), ("3000 psi", "pressure"),
+                       ("15 in**2", "area"), ("-0.4 deg", "angle"), ("40 1/s", "rate"), ("1e-12 m**3/s/Pa",
+                       "flow_pressure"), ("0.02 s", "time"), ("120 Hz", "frequency")):
+        ref = ureg.Quantity(text).to(DIMENSIONS[kind][1]).magnitude
+        assert abs(to_si(text, kind, source="t", field="f") - ref) <= 4e-16 * abs(ref)
