@@ -38,7 +38,8 @@ def cmd_lco(args) -> int:
         return _sweep(args, flight, model, amps, freqs)
     rep = analyse_lco(flight, model, axis=args.axis, duration_s=args.duration, avionics=args.avionics,
                       amplitudes_rad=amps, freq_hz=freqs,
-                      window_s=min(120.0, 0.5 * args.duration), time_domain=not args.no_time_domain)
+                      window_s=min(120.0, 0.5 * args.duration), time_domain=not args.no_time_domain,
+                      steady=args.steady)
     d = rep.to_dict()
     d["avionics"] = args.avionics
     if args.plot or args.plot_df or args.plot_time:
@@ -111,6 +112,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--freq-hz", help="describing-function frequencies (default 10 from 0.03 to 2 Hz)")
     p.add_argument("--duration", type=float, default=300.0, help="time-domain run [s] (default 300)")
     p.add_argument("--no-time-domain", action="store_true", help="prediction only")
+    p.add_argument("--steady", choices=("settle", "shoot"), default="settle",
+                   help="describing-function dwells settled from rest (default) or on the periodic steady state "
+                   "found by shooting")
     p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="Nichols chart with the predicted LCO")
     p.add_argument("--plot-df", metavar="PNG_OR_SVG", help="describing-function gain/phase families")

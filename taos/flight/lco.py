@@ -380,14 +380,16 @@ def decision(prediction: dict, time_domain: dict | None) -> dict:
 def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None,
                 amplitudes_rad=None, freq_hz=None, duration_s: float = 300.0, window_s: float = 120.0,
                 attitude0_rad: float = 0.2 * DEG, settle_cycles: int = 1, measure_cycles: int = 1,
-                avionics: str = "bounding", time_domain: bool = True) -> LcoReport:
+                avionics: str = "bounding", time_domain: bool = True, steady: str = "settle") -> LcoReport:
     """Describing-function map, harmonic-balance prediction and (optionally) the time-domain
     run for one flight file and TVC model. Defaults: :data:`DEFAULT_AMPLITUDES_DEG` x
     :data:`DEFAULT_FREQ_HZ`, one settling and one measured cycle beyond the linear settling
     time (the friction hysteresis is periodic after the first reversal). ``avionics``:
     "bounding" (the paper's -1 dB gain, :func:`with_bounding_avionics`) or "model" (the model
     file's quantisation and crossover curve, as flown; the default amplitudes then reach half an
-    LSB, :func:`model_avionics_amplitudes_rad`)."""
+    LSB, :func:`model_avionics_amplitudes_rad`). ``steady``: how each dwell of the map reaches
+    its periodic orbit ("settle", or "shoot": the periodic steady state by shooting,
+    :func:`taos.freqresp.sine_dwell_points`)."""
     axis = axis or flight.axis
     if avionics == "bounding":
         model = with_bounding_avionics(model)
@@ -398,7 +400,8 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
     else:
         amps = np.radians(DEFAULT_AMPLITUDES_DEG) if amplitudes_rad is None else np.asarray(amplitudes_rad, float)
     f = np.asarray(DEFAULT_FREQ_HZ if freq_hz is None else freq_hz, float)
-    df = describing_function_map(model, amps, f, axis, settle_cycles=settle_cycles, measure_cycles=measure_cycles)
+    df = describing_function_map(model, amps, f, axis, settle_cycles=settle_cycles, measure_cycles=measure_cycles,
+                                 method=steady)
     pred = predict_lco(flight, df, axis)
     hist = meas = None
     if time_domain:
