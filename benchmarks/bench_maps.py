@@ -51,13 +51,14 @@ def wall(cmd, repeat=1):
     return statistics.median(times)
 
 
-def wall_env(cmd, repeat, env):
-    """As :func:`wall` with ``env``, after one untimed run (the other checkout compiles its kernels)."""
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env)
+def wall_env(cmd, repeat, env, cwd):
+    """As :func:`wall` with ``env`` in ``cwd`` (``python -m`` puts the working folder first on
+    the path), after one untimed run (the other checkout compiles its kernels)."""
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env, cwd=cwd)
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env)
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env, cwd=cwd)
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
 
@@ -87,8 +88,8 @@ def main(quick=False):
     if before:
         env = dict(os.environ, PYTHONPATH=before)
         old = [sys.executable, "-m", "taos"]
-        tb_help = wall_env(old + ["--help"], n, env)
-        tb_info = wall_env(old + ["info", MODEL], n, env)
+        tb_help = wall_env(old + ["--help"], n, env, before)
+        tb_info = wall_env(old + ["info", MODEL], n, env, before)
     print("### Start-up (median of %d, warm)\n" % n)
     print("| command | wall [s] |\n|---|---|")
     print(f"| python -c pass | {t_bare:.3f} |\n| python -c 'import numpy, scipy.integrate' (plain script) | {t_np:.3f} |")
