@@ -204,13 +204,20 @@ def cmd_simulate(args) -> int:
     check_output_file(args.out, "--out")
     model = model_from_args(args)
     profile = load_profile(args.profile)
-    run_checks.check_run(model, profile, args.dt)
+    dt = args.dt
+    if dt is None:   # each engine's own default step
+        if args.engine == "taos":
+            from taos.taos3d.simulate import DEFAULT_DT_S
+        else:
+            from taos.simulate import DEFAULT_DT_S
+        dt = DEFAULT_DT_S
+    run_checks.check_run(model, profile, dt)
     run_checks.check_linear_stability(model, allow=args.allow_unstable)
     if args.engine == "taos":
         from taos.taos3d import simulate_taos, taos_model
-        th = simulate_taos(taos_model(model), profile, dt_s=args.dt)
+        th = simulate_taos(taos_model(model), profile, dt_s=dt)
     else:
-        th = simulate(model, profile, dt_s=args.dt, progress=sys.stderr.isatty())
+        th = simulate(model, profile, dt_s=dt, progress=sys.stderr.isatty())
     if not args.allow_unstable:
         run_checks.check_envelope(th, model)
     th.provenance.update(input_provenance(args.profile, "profile", th.provenance))
@@ -267,7 +274,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--out", required=True, help="HDF5 file to write")
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
     p.add_argument("--friction", help="swap the friction law")
-    p.add_argument("--dt", type=float, default=2e-4, help="integration step [s] (default 2e-4)")
+    p.add_argument("--dt", type=float, default=None, help="integration step [s] (default: the engine's own, 2e-4 "
+                   "simplex, 4e-4 taos)")
     p.add_argument("--allow-unstable", action="store_true",
                    help="run a model whose linear block is unstable, and do not stop at the envelope")
     p.set_defaults(func=cmd_simulate)
