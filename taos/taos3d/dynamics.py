@@ -23,13 +23,22 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
                  as the first-class function ``fid``; :mod:`taos.friction._vector`), given
                  the pose at the step end
 
-Time stepping: classical RK4 for (q, v, actuators) with T held over the step, then the
-implicit bearing update (a first-order split in T only; T is bounded by the friction level,
-so holding it for a step costs O(dt T_dot), never the stiff chain spring). The stiff
-chain-rotation / bristle-damping time constant (Kc (sigma_1 + sigma_2), ~1e-4 s or less)
-never enters the explicit part, so the step is set by the oil column and the engine's
-translational modes on the chain (omega dt < 2.8 for RK4). Quaternions are renormalised
-after each step. With friction off (T = 0) the scheme is plain RK4.
+Time stepping: classical RK4 for (q, v, actuators) with T extrapolated linearly over the
+step from its last two values (T(t) = T_n + (t - t_n)/dt (T_n - T_{n-1}); the first step of
+a run holds T), then the implicit bearing update (T_{n+1} from the pose at the step end). The
+split in T is explicit: the extrapolation removes its first-order lag where T is smooth, and
+T is bounded by the friction level, so the stiff chain spring never enters the explicit part.
+The stiff chain-rotation / bristle-damping time constant (Kc (sigma_1 + sigma_2), ~1e-4 s or
+less) is inside the implicit bearing solve, so the step is set by the oil column and the
+engine's translational modes on the chain (|lambda|max 2463 rad/s on the hot-fire model:
+omega dt < 2.8 for RK4 allows 1.1 ms) and by accuracy: the default 4e-4 s
+(:data:`taos.taos3d.simulate.DEFAULT_DT_S`) matches the error of the former held-T scheme at
+2e-4 s against a 2.5e-5 s reference (benchmarks/bench_taos3d.py, tests/test_taos3d_speed.py).
+Quaternions are renormalised after each step. With friction off (T = 0) the scheme is plain
+RK4.
+
+The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays); the
+recorded step reuses its derivative as the first RK4 stage.
 """
 
 from __future__ import annotations
@@ -238,25 +247,30 @@ def pose_psi(x, P):
 
 
 @njit(cache=True, fastmath=_FM)
-def step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
-    """One step: RK4 on (q, v, actuators) with T = bs[4:6] held, then the bearing update.
-    ``bs`` = (phi0, phi1, z0, z1, T0, T1) is updated in place; c0/cm/c1 are the
-    pre-avionics commands (2,) at the step start, middle and end."""
+def step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
+    """One step: RK4 on (q, v, actuators) with the bearing torque T(t) = T_n + (t - t_n)/dt
+    (dT0, dT1) [N m] (T_n = bs[4:6]; dT the previous step's change, the linear extrapolation),
+    then the bearing update. ``bs`` = (phi0, phi1, z0, z1, T0, T1) is updated in place;
+    c0/cm/c1 are the pre-avionics commands (2,) at the step start, middle and end;
+    ``k1_ready``: k1 already holds the derivative at the step start (from the record)."""
     n = x.shape[0]
     T0, T1 = bs[4], bs[5]
-    rhs(x, T0, T1, _av.apply(c0[0], avp), _av.apply(c0[1], avp), P, k1, aux)
+    if not k1_ready:
+        rhs(x, T0, T1, _av.apply(c0[0], avp), _av.apply(c0[1], avp), P, k1, aux)
     um0, um1 = _av.apply(cm[0], avp), _av.apply(cm[1], avp)
+    h = 0.5 * dt
     for i in range(n):
-        xt[i] = x[i] + 0.5 * dt * k1[i]
-    rhs(xt, T0, T1, um0, um1, P, k2, aux)
+        xt[i] = x[i] + h * k1[i]
+    rhs(xt, T0 + 0.5 * dT0, T1 + 0.5 * dT1, um0, um1, P, k2, aux)
     for i in range(n):
-        xt[i] = x[i] + 0.5 * dt * k2[i]
-    rhs(xt, T0, T1, um0, um1, P, k3, aux)
+        xt[i] = x[i] + h * k2[i]
+    rhs(xt, T0 + 0.5 * dT0, T1 + 0.5 * dT1, um0, um1, P, k3, aux)
     for i in range(n):
         xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0, T1, _av.apply(c1[0], avp), _av.apply(c1[1], avp), P, k4, aux)
+    rhs(xt, T0 + dT0, T1 + dT1, _av.apply(c1[0], avp), _av.apply(c1[1], avp), P, k4, aux)
+    h6 = dt / 6.0
     for i in range(n):
-        x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
+        x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
     qn = math.sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6])
     for i in range(3, 7):
         x[i] /= qn
@@ -268,10 +282,10 @@ def step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
     bs[3] = z1
     bs[4] = t0
     bs[5] = t1
-    ok = math.isfinite(t0) and math.isfinite(t1) and math.isfinite(z0) and math.isfinite(z1)
+    s = t0 + t1 + z0 + z1  # a NaN or an infinity anywhere makes the sum non-finite
     for i in range(n):
-        ok = ok and math.isfinite(x[i])
-    return ok
+        s += x[i]
+    return math.isfinite(s)
 
 
 @njit(cache=True, fastmath=_FM)
@@ -306,7 +320,8 @@ def _record(x, bs, c, P, avp, aux, dxs, out):
 def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     """Integrate over command samples ``r`` (n_steps + 1, 2) [rad] every ``dt`` [s],
     recording :data:`REC` every ``rec_every`` steps into ``out``. Returns -1 or the first
-    step whose state became non-finite. ``x0``/``bs0`` are updated to the final state."""
+    step whose state became non-finite. ``x0``/``bs0`` are updated to the final state
+    (a continuation call starts with T held over its first step, no extrapolation)."""
     n = x0.shape[0]
     x = x0
     bs = bs0
@@ -321,19 +336,25 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     c1 = np.empty(2)
     nsteps = r.shape[0] - 1
     rec = 0
+    dT0 = 0.0
+    dT1 = 0.0
     for k in range(nsteps + 1):
         kn = min(k + 1, nsteps)
         for j in range(2):
             c0[j] = r[k, j]
             c1[j] = r[kn, j]
             cm[j] = 0.5 * (c0[j] + c1[j])
-        if k % rec_every == 0:
-            _record(x, bs, c0, P, avp, aux, k1, out[rec])
+        ready = k % rec_every == 0
+        if ready:
+            _record(x, bs, c0, P, avp, aux, k1, out[rec])  # k1 = the derivative at the step start
             rec += 1
         if k == nsteps:
             break
-        if not step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
+        Tp0, Tp1 = bs[4], bs[5]
+        if not step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready):
             return k + 1
+        dT0 = bs[4] - Tp0
+        dT1 = bs[5] - Tp1
     return -1
 
 
@@ -359,6 +380,8 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
         for j in range(3):
             out[o, j] = 0.0
     w = 2.0 * math.pi
+    dT0 = 0.0
+    dT1 = 0.0
     for k in range(nset + nmeas):
         t = k * dt
         for j in range(2):
@@ -374,8 +397,11 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
                 out[o, 0] += y * s
                 out[o, 1] += y * c
                 out[o, 2] += y
-        if not step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
+        Tp0, Tp1 = bs[4], bs[5]
+        if not step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset):
             return k + 1
+        dT0 = bs[4] - Tp0
+        dT1 = bs[5] - Tp1
     for o in range(4):
         out[o, 0] *= 2.0 / nmeas
         out[o, 1] *= 2.0 / nmeas
