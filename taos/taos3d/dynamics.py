@@ -59,7 +59,7 @@ REC = ("theta_pitch", "theta_yaw", "xp_pitch", "xp_yaw", "fl_pitch", "fl_yaw", "
        "w_fx", "w_fy", "w_fz", "w_mx", "w_my", "w_mz", "px", "py", "pz")
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _logq(q, r):
     """Rotation vector of the unit quaternion q (xyzw) into r; returns the angle."""
     r0, r1, r2, th = _logq4(q[0], q[1], q[2], q[3])
@@ -69,7 +69,7 @@ def _logq(q, r):
     return th
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _logq4(qx, qy, qz, qw):
     """Rotation vector (r0, r1, r2) [rad] and angle [rad] of the unit quaternion (xyzw)."""
     s = 1.0 if qw >= 0 else -1.0
@@ -82,12 +82,12 @@ def _logq4(qx, qy, qz, qw):
     return f * qx, f * qy, f * qz, a
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _row6(M, i, a0, a1, a2, a3, a4, a5):
     return M[i, 0] * a0 + M[i, 1] * a1 + M[i, 2] * a2 + M[i, 3] * a3 + M[i, 4] * a4 + M[i, 5] * a5
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _mv6(M, a0, a1, a2, a3, a4, a5):
     """M (6, 6) times the vector (a0..a5), as a tuple (scalar locals: no heap arrays)."""
     return (_row6(M, 0, a0, a1, a2, a3, a4, a5), _row6(M, 1, a0, a1, a2, a3, a4, a5),
@@ -95,12 +95,16 @@ def _mv6(M, a0, a1, a2, a3, a4, a5):
             _row6(M, 4, a0, a1, a2, a3, a4, a5), _row6(M, 5, a0, a1, a2, a3, a4, a5))
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _cross3(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(cache=True, fastmath=_FM)
+#: the actuator rate/pressure limits (taos.actuator_limits), the same source compiled inline here
+_valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.apply_valve_pressure.py_func)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always", _nrt=False)
 def rhs(x, T0, T1, u0, u1, P, dx, aux):
     """State derivative dx of the TAOS engine + actuators with bearing torque (T0, T1) [N m]
     and post-avionics commands (u0, u1) [rad]. ``aux`` receives: 0-5 chain wrench W at O in
@@ -202,7 +206,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
             for j in range(na):
                 s += Aa[k, j] * x[off + j]
             dx[off + k] = s
-        _lim.apply_valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
+        _valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
         aux[6 + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
     Yv0, Yv1, Yv2, Yv3, Yv4, Yv5 = _mv6(Y, vx, vy, vz, wx, wy, wz)
@@ -236,7 +240,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     aux[11] = ty
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def pose_psi(x, P):
     """psi = G e: the bearing angles that carry no torque at the current pose [rad]."""
     G = P[3]
@@ -246,7 +250,7 @@ def pose_psi(x, P):
     return p0, p1
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     """One step: RK4 on (q, v, actuators) with the bearing torque T(t) = T_n + (t - t_n)/dt
     (dT0, dT1) [N m] (T_n = bs[4:6]; dT the previous step's change, the linear extrapolation),
@@ -288,7 +292,7 @@ def step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, a
     return math.isfinite(s)
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def _record(x, bs, c, P, avp, aux, dxs, out):
     rhs(x, bs[4], bs[5], _av.apply(c[0], avp), _av.apply(c[1], avp), P, dxs, aux)
     na = P[8].shape[0]
@@ -316,7 +320,7 @@ def _record(x, bs, c, P, avp, aux, dxs, out):
         out[20 + i] = x[i]
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy")
 def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     """Integrate over command samples ``r`` (n_steps + 1, 2) [rad] every ``dt`` [s],
     recording :data:`REC` every ``rec_every`` steps into ``out``. Returns -1 or the first
@@ -358,7 +362,7 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     return -1
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy")
 def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
     """Two sines (pitch amp[0] sin(2 pi freq[0] t), yaw amp[1] sin(2 pi freq[1] t)) from rest;
     Fourier coefficients at ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw) over
@@ -409,7 +413,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
     return -1
 
 
-@njit(cache=True, parallel=True, fastmath=_FM)
+@njit(cache=True, parallel=True, fastmath=_FM, error_model="numpy")
 def dwell_batch(P, fid, fp, avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out, status):
     """Independent two-axis dwells in parallel (rows of ``amps``/``freqs`` (n, 2))."""
     for b in prange(amps.shape[0]):
