@@ -33,7 +33,8 @@ less) is inside the implicit bearing solve, so the step is set by the oil column
 engine's translational modes on the chain (|lambda|max 2463 rad/s on the hot-fire model:
 omega dt < 2.8 for RK4 allows 1.1 ms) and by accuracy: the default 4e-4 s
 (:data:`taos.taos3d.simulate.DEFAULT_DT_S`) matches the error of the former held-T scheme at
-2e-4 s against a 2.5e-5 s reference (benchmarks/bench_taos3d.py, tests/test_taos3d_speed.py).
+2e-4 s against a 2.5e-5 s reference (benchmarks/bench_taos3d.py, tests/test_taos3d_step.py);
+a quantised command enters every stage as its mean over the step (:func:`stage_inputs`).
 Quaternions are renormalised after each step. With friction off (T = 0) the scheme is plain
 RK4.
 
@@ -250,18 +251,33 @@ def pose_psi(x, P):
     return p0, p1
 
 
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def stage_inputs(c0, cm, c1, avp):
+    """Post-avionics commands [rad] for the RK4 stages (start, middle, end; pitch and yaw) of a
+    step with pre-avionics commands c0/cm/c1 (2,) at its start, middle and end. A quantised
+    command path is piecewise constant in time: every stage then takes its mean over the step
+    (:func:`taos.avionics.apply_mean`), which places its jumps in time to first order
+    (sampled at the stages, a jump would move to a stage point: an O(dt) error)."""
+    if avp[1] > 0.0:
+        a0 = _av.apply_mean(c0[0], c1[0], avp)
+        a1 = _av.apply_mean(c0[1], c1[1], avp)
+        return a0, a1, a0, a1, a0, a1
+    return (_av.apply(c0[0], avp), _av.apply(c0[1], avp), _av.apply(cm[0], avp), _av.apply(cm[1], avp),
+            _av.apply(c1[0], avp), _av.apply(c1[1], avp))
+
+
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
+def step(x, bs, dT0, dT1, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     """One step: RK4 on (q, v, actuators) with the bearing torque T(t) = T_n + (t - t_n)/dt
     (dT0, dT1) [N m] (T_n = bs[4:6]; dT the previous step's change, the linear extrapolation),
     then the bearing update. ``bs`` = (phi0, phi1, z0, z1, T0, T1) is updated in place;
-    c0/cm/c1 are the pre-avionics commands (2,) at the step start, middle and end;
-    ``k1_ready``: k1 already holds the derivative at the step start (from the record)."""
+    ``u`` the stage commands (:func:`stage_inputs`); ``k1_ready``: k1 already holds the
+    derivative at the step start (from the record, with the same inputs)."""
     n = x.shape[0]
     T0, T1 = bs[4], bs[5]
     if not k1_ready:
-        rhs(x, T0, T1, _av.apply(c0[0], avp), _av.apply(c0[1], avp), P, k1, aux)
-    um0, um1 = _av.apply(cm[0], avp), _av.apply(cm[1], avp)
+        rhs(x, T0, T1, u[0], u[1], P, k1, aux)
+    um0, um1 = u[2], u[3]
     h = 0.5 * dt
     for i in range(n):
         xt[i] = x[i] + h * k1[i]
@@ -271,7 +287,7 @@ def step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, a
     rhs(xt, T0 + 0.5 * dT0, T1 + 0.5 * dT1, um0, um1, P, k3, aux)
     for i in range(n):
         xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0 + dT0, T1 + dT1, _av.apply(c1[0], avp), _av.apply(c1[1], avp), P, k4, aux)
+    rhs(xt, T0 + dT0, T1 + dT1, u[4], u[5], P, k4, aux)
     h6 = dt / 6.0
     for i in range(n):
         x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -293,8 +309,10 @@ def step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, a
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def _record(x, bs, c, P, avp, aux, dxs, out):
-    rhs(x, bs[4], bs[5], _av.apply(c[0], avp), _av.apply(c[1], avp), P, dxs, aux)
+def _record(x, bs, c, u0, u1, P, avp, aux, dxs, out):
+    """Record :data:`REC` at the state x with the commands c (2,) [rad] (post-avionics u0, u1 as
+    the first RK4 stage takes them); dxs receives the derivative there."""
+    rhs(x, bs[4], bs[5], u0, u1, P, dxs, aux)
     na = P[8].shape[0]
     cxp = P[11]
     out[0] = aux[10]
@@ -348,14 +366,15 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
             c0[j] = r[k, j]
             c1[j] = r[kn, j]
             cm[j] = 0.5 * (c0[j] + c1[j])
+        u = stage_inputs(c0, cm, c1, avp)
         ready = k % rec_every == 0
         if ready:
-            _record(x, bs, c0, P, avp, aux, k1, out[rec])  # k1 = the derivative at the step start
+            _record(x, bs, c0, u[0], u[1], P, avp, aux, k1, out[rec])  # k1 = the derivative at the step start
             rec += 1
         if k == nsteps:
             break
         Tp0, Tp1 = bs[4], bs[5]
-        if not step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready):
+        if not step(x, bs, dT0, dT1, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready):
             return k + 1
         dT0 = bs[4] - Tp0
         dT1 = bs[5] - Tp1
@@ -392,8 +411,9 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
             c0[j] = amp[j] * math.sin(w * freq[j] * t)
             cm[j] = amp[j] * math.sin(w * freq[j] * (t + 0.5 * dt))
             c1[j] = amp[j] * math.sin(w * freq[j] * (t + dt))
+        u = stage_inputs(c0, cm, c1, avp)
         if k >= nset:
-            _record(x, bs, c0, P, avp, aux, k1, rec)
+            _record(x, bs, c0, u[0], u[1], P, avp, aux, k1, rec)
             s = math.sin(w * fmeas * t)
             c = math.cos(w * fmeas * t)
             for o in range(4):
@@ -402,7 +422,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
                 out[o, 1] += y * c
                 out[o, 2] += y
         Tp0, Tp1 = bs[4], bs[5]
-        if not step(x, bs, dT0, dT1, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset):
+        if not step(x, bs, dT0, dT1, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset):
             return k + 1
         dT0 = bs[4] - Tp0
         dT1 = bs[5] - Tp1
