@@ -106,33 +106,6 @@ def apply(c, p):
 
 
 @njit(cache=True)
-def apply_mean(c0, c1, p):
-    """Mean of :func:`apply` over a command ramping linearly from ``c0`` to ``c1`` [rad] (one
-    integration step). With quantisation the command path is piecewise constant in the
-    command (bins of one LSB, edges at k LSB for truncation, (k + 1/2) LSB for rounding; the
-    crossover gain is a function of the quantised value), so the mean is the bin values
-    weighted by the fraction of the ramp in each bin: an integrator that uses it for a step
-    places the output's jumps exactly in time (to first order) instead of at its stage points."""
-    lo = min(c0, c1)
-    hi = max(c0, c1)
-    lsb = p[1]
-    if lsb <= 0.0 or hi - lo <= 0.0:
-        return apply(0.5 * (lo + hi), p)
-    off = 0.5 if p[2] > 0.5 else 0.0
-    k = math.floor(lo / lsb - off) + 1.0
-    b = (k + off) * lsb  # first bin edge above lo
-    a = lo
-    s = 0.0
-    while b < hi:
-        s += (b - a) * apply(0.5 * (a + b), p)
-        a = b
-        k += 1.0
-        b = (k + off) * lsb
-    s += (hi - a) * apply(0.5 * (a + hi), p)
-    return s / (hi - lo)
-
-
-@njit(cache=True)
 def apply_array(c, p):
     out = np.empty_like(c)
     for i in range(c.shape[0]):

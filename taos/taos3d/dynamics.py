@@ -251,16 +251,44 @@ def pose_psi(x, P):
     return p0, p1
 
 
+@njit(cache=True, error_model="numpy")
+def command_mean(c0, c1, p):
+    """Mean of the avionics command path (:func:`taos.avionics.apply`, packed parameters ``p``)
+    over a command ramping linearly from ``c0`` to ``c1`` [rad] (one integration step) [rad].
+    With quantisation the command path is piecewise constant in the
+    command (bins of one LSB, edges at k LSB for truncation, (k + 1/2) LSB for rounding; the
+    crossover gain is a function of the quantised value), so the mean is the bin values
+    weighted by the fraction of the ramp in each bin: an integrator that uses it for a step
+    places the output's jumps exactly in time (to first order) instead of at its stage points."""
+    lo = min(c0, c1)
+    hi = max(c0, c1)
+    lsb = p[1]
+    if lsb <= 0.0 or hi - lo <= 0.0:
+        return _av.apply(0.5 * (lo + hi), p)
+    off = 0.5 if p[2] > 0.5 else 0.0
+    k = math.floor(lo / lsb - off) + 1.0
+    b = (k + off) * lsb  # first bin edge above lo
+    a = lo
+    s = 0.0
+    while b < hi:
+        s += (b - a) * _av.apply(0.5 * (a + b), p)
+        a = b
+        k += 1.0
+        b = (k + off) * lsb
+    s += (hi - a) * _av.apply(0.5 * (a + hi), p)
+    return s / (hi - lo)
+
+
 @njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def stage_inputs(c0, cm, c1, avp):
     """Post-avionics commands [rad] for the RK4 stages (start, middle, end; pitch and yaw) of a
     step with pre-avionics commands c0/cm/c1 (2,) at its start, middle and end. A quantised
     command path is piecewise constant in time: every stage then takes its mean over the step
-    (:func:`taos.avionics.apply_mean`), which places its jumps in time to first order
+    (:func:`command_mean`), which places its jumps in time to first order
     (sampled at the stages, a jump would move to a stage point: an O(dt) error)."""
     if avp[1] > 0.0:
-        a0 = _av.apply_mean(c0[0], c1[0], avp)
-        a1 = _av.apply_mean(c0[1], c1[1], avp)
+        a0 = command_mean(c0[0], c1[0], avp)
+        a1 = command_mean(c0[1], c1[1], avp)
         return a0, a1, a0, a1, a0, a1
     return (_av.apply(c0[0], avp), _av.apply(c0[1], avp), _av.apply(cm[0], avp), _av.apply(cm[1], avp),
             _av.apply(c1[0], avp), _av.apply(c1[1], avp))
