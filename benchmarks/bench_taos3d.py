@@ -91,7 +91,8 @@ def errors(a, b):
 
 
 def accuracy(prof):
-    print(f"[accuracy] {T_ACC:g} s of the run, records every 10 ms, against dt = {REF_DT:g} s (this kernel): max |d theta| deg, "
+    print(f"[accuracy] {T_ACC:g} s of the run, records every 10 ms, against dt = {REF_DT:g} s (this kernel): "
+          f"max |d theta| deg, "
           f"max |d x_p| mm, max |d F_L| N, max |d T_f| N m, rms |d theta| deg")
     for law in (FRICTION, "coulomb-smooth"):
         tm = load_taos_model(MODEL, friction=law)
@@ -126,7 +127,8 @@ def mujoco_xml(tm, dt):
              stiffness="{eng.rotational_stiffness_Nm_per_rad}" range="-{lim} {lim}" limited="true"/>
       <joint name="yaw" type="hinge" axis="{ax(YAW_AXIS)}" frictionloss="{tc}"
              stiffness="{eng.rotational_stiffness_Nm_per_rad}" range="-{lim} {lim}" limited="true"/>
-      <inertial pos="{ax(cg)}" mass="{eng.mass_kg}" fullinertia="{J[0, 0]} {J[1, 1]} {J[2, 2]} {J[0, 1]} {J[0, 2]} {J[1, 2]}"/>
+      <inertial pos="{ax(cg)}" mass="{eng.mass_kg}"
+                fullinertia="{J[0, 0]} {J[1, 1]} {J[2, 2]} {J[0, 1]} {J[0, 2]} {J[1, 2]}"/>
     </body>
   </worldbody>
   <actuator>
