@@ -23,23 +23,21 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
                  as the first-class function ``fid``; :mod:`taos.friction._vector`), given
                  the pose at the step end
 
-Time stepping: classical RK4 for (q, v, actuators) with T extrapolated linearly over the
-step from its last two values (T(t) = T_n + (t - t_n)/dt (T_n - T_{n-1}); the first step of
-a run holds T), then the implicit bearing update (T_{n+1} from the pose at the step end). The
-split in T is explicit: the extrapolation removes its first-order lag where T is smooth, and
-T is bounded by the friction level, so the stiff chain spring never enters the explicit part.
-The stiff chain-rotation / bristle-damping time constant (Kc (sigma_1 + sigma_2), ~1e-4 s or
-less) is inside the implicit bearing solve, so the step is set by the oil column and the
-engine's translational modes on the chain (|lambda|max 2463 rad/s on the hot-fire model:
-omega dt < 2.8 for RK4 allows 1.1 ms) and by accuracy: the default 4e-4 s
-(:data:`taos.taos3d.simulate.DEFAULT_DT_S`) matches the error of the former held-T scheme at
-2e-4 s against a 2.5e-5 s reference (benchmarks/bench_taos3d.py, tests/test_taos3d_step.py);
-a quantised command enters every stage as its mean over the step (:func:`stage_inputs`).
-Quaternions are renormalised after each step. With friction off (T = 0) the scheme is plain
-RK4.
+Time stepping: classical RK4 for (q, v, actuators) with T held over the step, then the
+implicit bearing update (a first-order split in T only; T is bounded by the friction level,
+so holding it for a step costs O(dt T_dot), never the stiff chain spring). The stiff
+chain-rotation / bristle-damping time constant (Kc (sigma_1 + sigma_2), ~1e-4 s or less)
+never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
+the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
+omega dt < 2.8 for RK4); accuracy sets the default 2e-4 s. A quantised command is piecewise
+constant in time: every stage takes its mean over the step (:func:`stage_inputs`,
+:func:`command_mean`), which removes the first-order error of sampling its jumps at the
+stage points (tests/test_taos3d_step.py, benchmarks/bench_taos3d.py). Quaternions are
+renormalised after each step. With friction off (T = 0) the scheme is plain RK4.
 
-The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays); the
-recorded step reuses its derivative as the first RK4 stage.
+The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays), and the
+step's kernels allocate nothing and are compiled without reference counting (``_nrt=False``);
+the recorded step reuses its derivative as the first RK4 stage.
 """
 
 from __future__ import annotations
@@ -295,10 +293,9 @@ def stage_inputs(c0, cm, c1, avp):
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def step(x, bs, dT0, dT1, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
-    """One step: RK4 on (q, v, actuators) with the bearing torque T(t) = T_n + (t - t_n)/dt
-    (dT0, dT1) [N m] (T_n = bs[4:6]; dT the previous step's change, the linear extrapolation),
-    then the bearing update. ``bs`` = (phi0, phi1, z0, z1, T0, T1) is updated in place;
+def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
+    """One step: RK4 on (q, v, actuators) with the bearing torque T = bs[4:6] held, then the
+    bearing update. ``bs`` = (phi0, phi1, z0, z1, T0, T1) is updated in place;
     ``u`` the stage commands (:func:`stage_inputs`); ``k1_ready``: k1 already holds the
     derivative at the step start (from the record, with the same inputs)."""
     n = x.shape[0]
@@ -309,13 +306,13 @@ def step(x, bs, dT0, dT1, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_re
     h = 0.5 * dt
     for i in range(n):
         xt[i] = x[i] + h * k1[i]
-    rhs(xt, T0 + 0.5 * dT0, T1 + 0.5 * dT1, um0, um1, P, k2, aux)
+    rhs(xt, T0, T1, um0, um1, P, k2, aux)
     for i in range(n):
         xt[i] = x[i] + h * k2[i]
-    rhs(xt, T0 + 0.5 * dT0, T1 + 0.5 * dT1, um0, um1, P, k3, aux)
+    rhs(xt, T0, T1, um0, um1, P, k3, aux)
     for i in range(n):
         xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0 + dT0, T1 + dT1, u[4], u[5], P, k4, aux)
+    rhs(xt, T0, T1, u[4], u[5], P, k4, aux)
     h6 = dt / 6.0
     for i in range(n):
         x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -370,8 +367,7 @@ def _record(x, bs, c, u0, u1, P, avp, aux, dxs, out):
 def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     """Integrate over command samples ``r`` (n_steps + 1, 2) [rad] every ``dt`` [s],
     recording :data:`REC` every ``rec_every`` steps into ``out``. Returns -1 or the first
-    step whose state became non-finite. ``x0``/``bs0`` are updated to the final state
-    (a continuation call starts with T held over its first step, no extrapolation)."""
+    step whose state became non-finite. ``x0``/``bs0`` are updated to the final state."""
     n = x0.shape[0]
     x = x0
     bs = bs0
@@ -386,8 +382,6 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     c1 = np.empty(2)
     nsteps = r.shape[0] - 1
     rec = 0
-    dT0 = 0.0
-    dT1 = 0.0
     for k in range(nsteps + 1):
         kn = min(k + 1, nsteps)
         for j in range(2):
@@ -401,11 +395,8 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
             rec += 1
         if k == nsteps:
             break
-        Tp0, Tp1 = bs[4], bs[5]
-        if not step(x, bs, dT0, dT1, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready):
+        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready):
             return k + 1
-        dT0 = bs[4] - Tp0
-        dT1 = bs[5] - Tp1
     return -1
 
 
@@ -431,8 +422,6 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
         for j in range(3):
             out[o, j] = 0.0
     w = 2.0 * math.pi
-    dT0 = 0.0
-    dT1 = 0.0
     for k in range(nset + nmeas):
         t = k * dt
         for j in range(2):
@@ -449,11 +438,8 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
                 out[o, 0] += y * s
                 out[o, 1] += y * c
                 out[o, 2] += y
-        Tp0, Tp1 = bs[4], bs[5]
-        if not step(x, bs, dT0, dT1, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset):
+        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset):
             return k + 1
-        dT0 = bs[4] - Tp0
-        dT1 = bs[5] - Tp1
     for o in range(4):
         out[o, 0] *= 2.0 / nmeas
         out[o, 1] *= 2.0 / nmeas

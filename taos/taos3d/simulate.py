@@ -27,7 +27,7 @@ from ..simulate import SolverSettings, TimeHistory, provenance
 from . import dynamics as _dy
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
 
-DEFAULT_DT_S = 4e-4  # RK4 + extrapolated bearing torque: the accuracy of the former 2e-4 s (taos3d.dynamics)
+DEFAULT_DT_S = 2e-4
 
 
 @dataclass(frozen=True, eq=False)
