@@ -253,11 +253,11 @@ def pose_psi(x, P):
 def command_mean(c0, c1, p):
     """Mean of the avionics command path (:func:`taos.avionics.apply`, packed parameters ``p``)
     over a command ramping linearly from ``c0`` to ``c1`` [rad] (one integration step) [rad].
-    With quantisation the command path is piecewise constant in the
-    command (bins of one LSB, edges at k LSB for truncation, (k + 1/2) LSB for rounding; the
-    crossover gain is a function of the quantised value), so the mean is the bin values
-    weighted by the fraction of the ramp in each bin: an integrator that uses it for a step
-    places the output's jumps exactly in time (to first order) instead of at its stage points."""
+    With quantisation the command path is piecewise constant in the command (bins of one LSB,
+    edges at k LSB for truncation, (k + 1/2) LSB for rounding; the crossover gain is a
+    function of the quantised value), so the mean is the bin values weighted by the fraction
+    of the ramp in each bin: an integrator that uses it for a step places the output's jumps
+    in time to first order instead of at its stage points."""
     lo = min(c0, c1)
     hi = max(c0, c1)
     lsb = p[1]
