@@ -27,9 +27,17 @@ Time stepping: classical RK4 for (q, v, actuators) with T held over the step, th
 implicit bearing update (a first-order split in T only; T is bounded by the friction level,
 so holding it for a step costs O(dt T_dot), never the stiff chain spring). The stiff
 chain-rotation / bristle-damping time constant (Kc (sigma_1 + sigma_2), ~1e-4 s or less)
-never enters the explicit part, so the step is set by the oil column and the engine's
-translational modes on the chain (omega dt < 2.8 for RK4). Quaternions are renormalised
-after each step. With friction off (T = 0) the scheme is plain RK4.
+never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
+the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
+omega dt < 2.8 for RK4); accuracy sets the default 2e-4 s. A quantised command is piecewise
+constant in time: every stage takes its mean over the step (:func:`stage_inputs`,
+:func:`command_mean`), which removes the first-order error of sampling its jumps at the
+stage points (tests/test_taos3d_step.py, benchmarks/bench_taos3d.py). Quaternions are
+renormalised after each step. With friction off (T = 0) the scheme is plain RK4.
+
+The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays), and the
+step's kernels allocate nothing and are compiled without reference counting (``_nrt=False``);
+the recorded step reuses its derivative as the first RK4 stage.
 """
 
 from __future__ import annotations
@@ -50,217 +58,264 @@ REC = ("theta_pitch", "theta_yaw", "xp_pitch", "xp_yaw", "fl_pitch", "fl_yaw", "
        "w_fx", "w_fy", "w_fz", "w_mx", "w_my", "w_mz", "px", "py", "pz")
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
-def _rot(q, Rm):
-    x, y, z, w = q[0], q[1], q[2], q[3]
-    Rm[0, 0] = 1 - 2 * (y * y + z * z)
-    Rm[0, 1] = 2 * (x * y - z * w)
-    Rm[0, 2] = 2 * (x * z + y * w)
-    Rm[1, 0] = 2 * (x * y + z * w)
-    Rm[1, 1] = 1 - 2 * (x * x + z * z)
-    Rm[1, 2] = 2 * (y * z - x * w)
-    Rm[2, 0] = 2 * (x * z - y * w)
-    Rm[2, 1] = 2 * (y * z + x * w)
-    Rm[2, 2] = 1 - 2 * (x * x + y * y)
-
-
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _logq(q, r):
     """Rotation vector of the unit quaternion q (xyzw) into r; returns the angle."""
-    s = 1.0 if q[3] >= 0 else -1.0
-    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2])
+    r0, r1, r2, th = _logq4(q[0], q[1], q[2], q[3])
+    r[0] = r0
+    r[1] = r1
+    r[2] = r2
+    return th
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _logq4(qx, qy, qz, qw):
+    """Rotation vector (r0, r1, r2) [rad] and angle [rad] of the unit quaternion (xyzw)."""
+    s = 1.0 if qw >= 0 else -1.0
+    n = math.sqrt(qx * qx + qy * qy + qz * qz)
+    a = 2.0 * math.atan2(n, abs(qw))
     if n < 1e-12:
-        f = 2.0 * s / max(abs(q[3]), 1e-300)
+        f = 2.0 * s / max(abs(qw), 1e-300)
     else:
-        f = 2.0 * math.atan2(n, abs(q[3])) / n * s
-    for i in range(3):
-        r[i] = f * q[i]
-    return 2.0 * math.atan2(n, abs(q[3]))
+        f = a / n * s
+    return f * qx, f * qy, f * qz, a
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
-def _cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _row6(M, i, a0, a1, a2, a3, a4, a5):
+    return M[i, 0] * a0 + M[i, 1] * a1 + M[i, 2] * a2 + M[i, 3] * a3 + M[i, 4] * a4 + M[i, 5] * a5
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _mv6(M, a0, a1, a2, a3, a4, a5):
+    """M (6, 6) times the vector (a0..a5), as a tuple (scalar locals: no heap arrays)."""
+    return (_row6(M, 0, a0, a1, a2, a3, a4, a5), _row6(M, 1, a0, a1, a2, a3, a4, a5),
+            _row6(M, 2, a0, a1, a2, a3, a4, a5), _row6(M, 3, a0, a1, a2, a3, a4, a5),
+            _row6(M, 4, a0, a1, a2, a3, a4, a5), _row6(M, 5, a0, a1, a2, a3, a4, a5))
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _cross3(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+#: the actuator rate/pressure limits (taos.actuator_limits), the same source compiled inline here
+_valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.apply_valve_pressure.py_func)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always", _nrt=False)
 def rhs(x, T0, T1, u0, u1, P, dx, aux):
     """State derivative dx of the TAOS engine + actuators with bearing torque (T0, T1) [N m]
     and post-avionics commands (u0, u1) [rad]. ``aux`` receives: 0-5 chain wrench W at O in
-    the gimbal frame [N, N m], 6-7 F_L [N], 8-9 phi [rad], 10-11 engine angles [rad]."""
-    (Y, Yinv, Ks, G, Kc, S, Satt, Eatt, Aa, bxc, bf, cxp, axes, sc) = P
-    KL, Rarm, Kn, L00, L01 = sc[0], sc[1], sc[2], sc[3], sc[4]
+    the gimbal frame [N, N m], 6-7 F_L [N], 8-9 phi [rad], 10-11 engine angles [rad].
+
+    Written with scalar locals and tuples only (no heap arrays: it runs four times a step)."""
+    Y, Yinv, Ks, G, Kc, S, Satt, Eatt, Aa, bxc, bf, cxp, axes, sc = (
+        P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11], P[12], P[13])
+    KL, Rarm, Kn = sc[0], sc[1], sc[2]
     cL, ivp = sc[5], int(sc[6])  # load-path damping [N s/m] and the actuator's v_p state index
     lim = sc[7:]  # actuator/gimbal limits packed over one actuator's state (taos.actuator_limits)
     na = Aa.shape[0]
-    Rm = np.empty((3, 3))
-    _rot(x[3:7], Rm)
-    e = np.empty(6)
-    for i in range(3):
-        e[i] = x[i]
-    r = np.empty(3)
-    th = _logq(x[3:7], r)
-    for i in range(3):
-        e[3 + i] = r[i]
+    p0, p1, p2 = x[0], x[1], x[2]
+    qx, qy, qz, qw = x[3], x[4], x[5], x[6]
+    # rotation matrix R (body -> world) of the quaternion
+    R00 = 1 - 2 * (qy * qy + qz * qz)
+    R01 = 2 * (qx * qy - qz * qw)
+    R02 = 2 * (qx * qz + qy * qw)
+    R10 = 2 * (qx * qy + qz * qw)
+    R11 = 1 - 2 * (qx * qx + qz * qz)
+    R12 = 2 * (qy * qz - qx * qw)
+    R20 = 2 * (qx * qz - qy * qw)
+    R21 = 2 * (qy * qz + qx * qw)
+    R22 = 1 - 2 * (qx * qx + qy * qy)
+    r0, r1, r2, th = _logq4(qx, qy, qz, qw)
     # bearing slip and chain wrench
-    phi0 = -(Kc[0, 0] * T0 + Kc[0, 1] * T1)
-    phi1 = -(Kc[1, 0] * T0 + Kc[1, 1] * T1)
-    for j in range(6):
-        phi0 += G[0, j] * e[j]
-        phi1 += G[1, j] * e[j]
-    d = np.empty(6)
-    for j in range(6):
-        d[j] = e[j] - S[j, 0] * phi0 - S[j, 1] * phi1
-    W = np.empty(6)
-    for i in range(6):
-        s = 0.0
-        for j in range(6):
-            s += Ks[i, j] * d[j]
-        W[i] = s
+    phi0 = (G[0, 0] * p0 + G[0, 1] * p1 + G[0, 2] * p2 + G[0, 3] * r0 + G[0, 4] * r1 + G[0, 5] * r2
+            - (Kc[0, 0] * T0 + Kc[0, 1] * T1))
+    phi1 = (G[1, 0] * p0 + G[1, 1] * p1 + G[1, 2] * p2 + G[1, 3] * r0 + G[1, 4] * r1 + G[1, 5] * r2
+            - (Kc[1, 0] * T0 + Kc[1, 1] * T1))
+    W0, W1, W2, W3, W4, W5 = _mv6(Ks, p0 - S[0, 0] * phi0 - S[0, 1] * phi1, p1 - S[1, 0] * phi0 - S[1, 1] * phi1,
+                                  p2 - S[2, 0] * phi0 - S[2, 1] * phi1, r0 - S[3, 0] * phi0 - S[3, 1] * phi1,
+                                  r1 - S[4, 0] * phi0 - S[4, 1] * phi1, r2 - S[5, 0] * phi0 - S[5, 1] * phi1)
     # generalized torque conjugate to r, then world torque Jl^-T g
-    tp = axes[0, 0] * r[0] + axes[0, 1] * r[1] + axes[0, 2] * r[2]
-    ty = axes[1, 0] * r[0] + axes[1, 1] * r[1] + axes[1, 2] * r[2]
-    g = np.empty(3)
-    for i in range(3):
-        g[i] = -W[3 + i] - Kn * (axes[0, i] * tp + axes[1, i] * ty)
+    tp = axes[0, 0] * r0 + axes[0, 1] * r1 + axes[0, 2] * r2
+    ty = axes[1, 0] * r0 + axes[1, 1] * r1 + axes[1, 2] * r2
+    g0 = -W3 - Kn * (axes[0, 0] * tp + axes[1, 0] * ty)
+    g1 = -W4 - Kn * (axes[0, 1] * tp + axes[1, 1] * ty)
+    g2 = -W5 - Kn * (axes[0, 2] * tp + axes[1, 2] * ty)
+    wx, wy, wz = x[10], x[11], x[12]
     if lim.shape[0] > 0 and lim[4] > 0.0:  # hard stops at the gimbal range (taos.actuator_limits)
-        wp = 0.0
-        wy = 0.0
-        for i in range(3):
-            wi = Rm[i, 0] * x[10] + Rm[i, 1] * x[11] + Rm[i, 2] * x[12]
-            wp += axes[0, i] * wi
-            wy += axes[1, i] * wi
+        wo0 = R00 * wx + R01 * wy + R02 * wz
+        wo1 = R10 * wx + R11 * wy + R12 * wz
+        wo2 = R20 * wx + R21 * wy + R22 * wz
+        wp = axes[0, 0] * wo0 + axes[0, 1] * wo1 + axes[0, 2] * wo2
+        wyw = axes[1, 0] * wo0 + axes[1, 1] * wo1 + axes[1, 2] * wo2
         tsp = _lim.stop_torque(tp, wp, lim[4], lim[5], lim[6])
-        tsy = _lim.stop_torque(ty, wy, lim[4], lim[5], lim[6])
-        for i in range(3):
-            g[i] += axes[0, i] * tsp + axes[1, i] * tsy
+        tsy = _lim.stop_torque(ty, wyw, lim[4], lim[5], lim[6])
+        g0 += axes[0, 0] * tsp + axes[1, 0] * tsy
+        g1 += axes[0, 1] * tsp + axes[1, 1] * tsy
+        g2 += axes[0, 2] * tsp + axes[1, 2] * tsy
     if th < 1e-4:
         c = 1.0 / 12.0 + th * th / 720.0
     else:
         c = 1.0 / (th * th) - (1.0 + math.cos(th)) / (2.0 * th * math.sin(th))
-    rg = np.empty(3)
-    _cross(r, g, rg)
-    rrg = np.empty(3)
-    _cross(r, rg, rrg)
-    Fw = np.empty(3)
-    Tw = np.empty(3)
-    for i in range(3):
-        Tw[i] = g[i] + 0.5 * rg[i] + c * rrg[i]
-        Fw[i] = -W[i]
+    rg0, rg1, rg2 = _cross3(r0, r1, r2, g0, g1, g2)
+    rrg0, rrg1, rrg2 = _cross3(r0, r1, r2, rg0, rg1, rg2)
+    Tw0 = g0 + 0.5 * rg0 + c * rrg0
+    Tw1 = g1 + 0.5 * rg1 + c * rrg1
+    Tw2 = g2 + 0.5 * rg2 + c * rrg2
+    Fw0, Fw1, Fw2 = -W0, -W1, -W2
+    vx, vy, vz = x[7], x[8], x[9]
     # actuators
-    Ew = np.empty(3)
-    lever = np.empty(3)
-    mom = np.empty(3)
-    fl = np.empty(3)
     for a in range(2):
-        for i in range(3):
-            lever[i] = Rm[i, 0] * Eatt[a, 0] + Rm[i, 1] * Eatt[a, 1] + Rm[i, 2] * Eatt[a, 2]
-            Ew[i] = x[i] + lever[i] - Satt[a, i]
-        L = math.sqrt(Ew[0] * Ew[0] + Ew[1] * Ew[1] + Ew[2] * Ew[2])
+        e0, e1, e2 = Eatt[a, 0], Eatt[a, 1], Eatt[a, 2]
+        l0 = R00 * e0 + R01 * e1 + R02 * e2  # lever R E_a
+        l1 = R10 * e0 + R11 * e1 + R12 * e2
+        l2 = R20 * e0 + R21 * e1 + R22 * e2
+        E0 = p0 + l0 - Satt[a, 0]
+        E1 = p1 + l1 - Satt[a, 1]
+        E2 = p2 + l2 - Satt[a, 2]
+        L = math.sqrt(E0 * E0 + E1 * E1 + E2 * E2)
         off = N_BODY + a * na
         xp = 0.0
         for k in range(na):
             xp += cxp[k] * x[off + k]
-        F = KL * (xp - (L - (L00 if a == 0 else L01)))
+        F = KL * (xp - (L - sc[3 + a]))
         if cL > 0.0:  # structural damping across the line: c_L (v_p - L')
-            wb = np.empty(3)
-            _cross(x[10:13], Eatt[a], wb)
-            Ld = 0.0
-            for i in range(3):
-                Ld += Ew[i] * (Rm[i, 0] * (x[7] + wb[0]) + Rm[i, 1] * (x[8] + wb[1]) + Rm[i, 2] * (x[9] + wb[2]))
+            b0, b1, b2 = _cross3(wx, wy, wz, e0, e1, e2)
+            b0 += vx
+            b1 += vy
+            b2 += vz
+            Ld = (E0 * (R00 * b0 + R01 * b1 + R02 * b2) + E1 * (R10 * b0 + R11 * b1 + R12 * b2)
+                  + E2 * (R20 * b0 + R21 * b1 + R22 * b2))
             F += cL * (x[off + ivp] - Ld / L)
-        for i in range(3):
-            fl[i] = F * Ew[i] / L
-            Fw[i] += fl[i]
-        _cross(lever, fl, mom)
-        for i in range(3):
-            Tw[i] += mom[i]
+        fl0 = F * E0 / L
+        fl1 = F * E1 / L
+        fl2 = F * E2 / L
+        Fw0 += fl0
+        Fw1 += fl1
+        Fw2 += fl2
+        m0, m1, m2 = _cross3(l0, l1, l2, fl0, fl1, fl2)
+        Tw0 += m0
+        Tw1 += m1
+        Tw2 += m2
         u = u0 if a == 0 else u1
         for k in range(na):
             s = bxc[k] * Rarm * u + bf[k] * F
             for j in range(na):
                 s += Aa[k, j] * x[off + j]
             dx[off + k] = s
-        _lim.apply_valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
+        _valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
         aux[6 + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
-    f = np.empty(6)
-    for i in range(3):
-        f[i] = Rm[0, i] * Fw[0] + Rm[1, i] * Fw[1] + Rm[2, i] * Fw[2]
-        f[3 + i] = Rm[0, i] * Tw[0] + Rm[1, i] * Tw[1] + Rm[2, i] * Tw[2]
-    v = x[7:13]
-    Yv = np.empty(6)
+    Yv0, Yv1, Yv2, Yv3, Yv4, Yv5 = _mv6(Y, vx, vy, vz, wx, wy, wz)
+    c10, c11, c12 = _cross3(wx, wy, wz, Yv0, Yv1, Yv2)
+    c20, c21, c22 = _cross3(wx, wy, wz, Yv3, Yv4, Yv5)
+    c30, c31, c32 = _cross3(vx, vy, vz, Yv0, Yv1, Yv2)
+    f0 = R00 * Fw0 + R10 * Fw1 + R20 * Fw2 - c10
+    f1 = R01 * Fw0 + R11 * Fw1 + R21 * Fw2 - c11
+    f2 = R02 * Fw0 + R12 * Fw1 + R22 * Fw2 - c12
+    f3 = R00 * Tw0 + R10 * Tw1 + R20 * Tw2 - (c20 + c30)
+    f4 = R01 * Tw0 + R11 * Tw1 + R21 * Tw2 - (c21 + c31)
+    f5 = R02 * Tw0 + R12 * Tw1 + R22 * Tw2 - (c22 + c32)
     for i in range(6):
-        s = 0.0
-        for j in range(6):
-            s += Y[i, j] * v[j]
-        Yv[i] = s
-    w = v[3:6]
-    c1 = np.empty(3)
-    _cross(w, Yv[0:3], c1)
-    c2 = np.empty(3)
-    _cross(w, Yv[3:6], c2)
-    c3 = np.empty(3)
-    _cross(v[0:3], Yv[0:3], c3)
-    for i in range(3):
-        f[i] -= c1[i]
-        f[3 + i] -= c2[i] + c3[i]
-    for i in range(6):
-        s = 0.0
-        for j in range(6):
-            s += Yinv[i, j] * f[j]
-        dx[7 + i] = s
-    for i in range(3):
-        dx[i] = Rm[i, 0] * v[0] + Rm[i, 1] * v[1] + Rm[i, 2] * v[2]
-    qx, qy, qz, qw = x[3], x[4], x[5], x[6]
-    dx[3] = 0.5 * (qw * w[0] + qy * w[2] - qz * w[1])
-    dx[4] = 0.5 * (qw * w[1] + qz * w[0] - qx * w[2])
-    dx[5] = 0.5 * (qw * w[2] + qx * w[1] - qy * w[0])
-    dx[6] = -0.5 * (qx * w[0] + qy * w[1] + qz * w[2])
-    for i in range(6):
-        aux[i] = W[i]
+        dx[7 + i] = _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
+    dx[0] = R00 * vx + R01 * vy + R02 * vz
+    dx[1] = R10 * vx + R11 * vy + R12 * vz
+    dx[2] = R20 * vx + R21 * vy + R22 * vz
+    dx[3] = 0.5 * (qw * wx + qy * wz - qz * wy)
+    dx[4] = 0.5 * (qw * wy + qz * wx - qx * wz)
+    dx[5] = 0.5 * (qw * wz + qx * wy - qy * wx)
+    dx[6] = -0.5 * (qx * wx + qy * wy + qz * wz)
+    aux[0] = W0
+    aux[1] = W1
+    aux[2] = W2
+    aux[3] = W3
+    aux[4] = W4
+    aux[5] = W5
     aux[8] = phi0
     aux[9] = phi1
     aux[10] = tp
     aux[11] = ty
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def pose_psi(x, P):
     """psi = G e: the bearing angles that carry no torque at the current pose [rad]."""
     G = P[3]
-    r = np.empty(3)
-    _logq(x[3:7], r)
-    p0 = 0.0
-    p1 = 0.0
-    for j in range(3):
-        p0 += G[0, j] * x[j] + G[0, 3 + j] * r[j]
-        p1 += G[1, j] * x[j] + G[1, 3 + j] * r[j]
+    r0, r1, r2, _ = _logq4(x[3], x[4], x[5], x[6])
+    p0 = G[0, 0] * x[0] + G[0, 1] * x[1] + G[0, 2] * x[2] + G[0, 3] * r0 + G[0, 4] * r1 + G[0, 5] * r2
+    p1 = G[1, 0] * x[0] + G[1, 1] * x[1] + G[1, 2] * x[2] + G[1, 3] * r0 + G[1, 4] * r1 + G[1, 5] * r2
     return p0, p1
 
 
-@njit(cache=True, fastmath=_FM)
-def step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
-    """One step: RK4 on (q, v, actuators) with T = bs[4:6] held, then the bearing update.
-    ``bs`` = (phi0, phi1, z0, z1, T0, T1) is updated in place; c0/cm/c1 are the
-    pre-avionics commands (2,) at the step start, middle and end."""
+@njit(cache=True, error_model="numpy")
+def command_mean(c0, c1, p):
+    """Mean of the avionics command path (:func:`taos.avionics.apply`, packed parameters ``p``)
+    over a command ramping linearly from ``c0`` to ``c1`` [rad] (one integration step) [rad].
+    With quantisation the command path is piecewise constant in the command (bins of one LSB,
+    edges at k LSB for truncation, (k + 1/2) LSB for rounding; the crossover gain is a
+    function of the quantised value), so the mean is the bin values weighted by the fraction
+    of the ramp in each bin: an integrator that uses it for a step places the output's jumps
+    in time to first order instead of at its stage points."""
+    lo = min(c0, c1)
+    hi = max(c0, c1)
+    lsb = p[1]
+    if lsb <= 0.0 or hi - lo <= 0.0:
+        return _av.apply(0.5 * (lo + hi), p)
+    off = 0.5 if p[2] > 0.5 else 0.0
+    k = math.floor(lo / lsb - off) + 1.0
+    b = (k + off) * lsb  # first bin edge above lo
+    a = lo
+    s = 0.0
+    while b < hi:
+        s += (b - a) * _av.apply(0.5 * (a + b), p)
+        a = b
+        k += 1.0
+        b = (k + off) * lsb
+    s += (hi - a) * _av.apply(0.5 * (a + hi), p)
+    return s / (hi - lo)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def stage_inputs(c0, cm, c1, avp):
+    """Post-avionics commands [rad] for the RK4 stages (start, middle, end; pitch and yaw) of a
+    step with pre-avionics commands c0/cm/c1 (2,) at its start, middle and end. A quantised
+    command path is piecewise constant in time: every stage then takes its mean over the step
+    (:func:`command_mean`), which places its jumps in time to first order
+    (sampled at the stages, a jump would move to a stage point: an O(dt) error)."""
+    if avp[1] > 0.0:
+        a0 = command_mean(c0[0], c1[0], avp)
+        a1 = command_mean(c0[1], c1[1], avp)
+        return a0, a1, a0, a1, a0, a1
+    return (_av.apply(c0[0], avp), _av.apply(c0[1], avp), _av.apply(cm[0], avp), _av.apply(cm[1], avp),
+            _av.apply(c1[0], avp), _av.apply(c1[1], avp))
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
+    """One step: RK4 on (q, v, actuators) with the bearing torque T = bs[4:6] held, then the
+    bearing update. ``bs`` = (phi0, phi1, z0, z1, T0, T1) is updated in place;
+    ``u`` the stage commands (:func:`stage_inputs`); ``k1_ready``: k1 already holds the
+    derivative at the step start (from the record, with the same inputs)."""
     n = x.shape[0]
     T0, T1 = bs[4], bs[5]
-    rhs(x, T0, T1, _av.apply(c0[0], avp), _av.apply(c0[1], avp), P, k1, aux)
-    um0, um1 = _av.apply(cm[0], avp), _av.apply(cm[1], avp)
+    if not k1_ready:
+        rhs(x, T0, T1, u[0], u[1], P, k1, aux)
+    um0, um1 = u[2], u[3]
+    h = 0.5 * dt
     for i in range(n):
-        xt[i] = x[i] + 0.5 * dt * k1[i]
+        xt[i] = x[i] + h * k1[i]
     rhs(xt, T0, T1, um0, um1, P, k2, aux)
     for i in range(n):
-        xt[i] = x[i] + 0.5 * dt * k2[i]
+        xt[i] = x[i] + h * k2[i]
     rhs(xt, T0, T1, um0, um1, P, k3, aux)
     for i in range(n):
         xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0, T1, _av.apply(c1[0], avp), _av.apply(c1[1], avp), P, k4, aux)
+    rhs(xt, T0, T1, u[4], u[5], P, k4, aux)
+    h6 = dt / 6.0
     for i in range(n):
-        x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
+        x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
     qn = math.sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6])
     for i in range(3, 7):
         x[i] /= qn
@@ -272,15 +327,17 @@ def step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
     bs[3] = z1
     bs[4] = t0
     bs[5] = t1
-    ok = math.isfinite(t0) and math.isfinite(t1) and math.isfinite(z0) and math.isfinite(z1)
+    s = t0 + t1 + z0 + z1  # a NaN or an infinity anywhere makes the sum non-finite
     for i in range(n):
-        ok = ok and math.isfinite(x[i])
-    return ok
+        s += x[i]
+    return math.isfinite(s)
 
 
-@njit(cache=True, fastmath=_FM)
-def _record(x, bs, c, P, avp, aux, dxs, out):
-    rhs(x, bs[4], bs[5], _av.apply(c[0], avp), _av.apply(c[1], avp), P, dxs, aux)
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _record(x, bs, c, u0, u1, P, avp, aux, dxs, out):
+    """Record :data:`REC` at the state x with the commands c (2,) [rad] (post-avionics u0, u1 as
+    the first RK4 stage takes them); dxs receives the derivative there."""
+    rhs(x, bs[4], bs[5], u0, u1, P, dxs, aux)
     na = P[8].shape[0]
     cxp = P[11]
     out[0] = aux[10]
@@ -306,7 +363,7 @@ def _record(x, bs, c, P, avp, aux, dxs, out):
         out[20 + i] = x[i]
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy")
 def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     """Integrate over command samples ``r`` (n_steps + 1, 2) [rad] every ``dt`` [s],
     recording :data:`REC` every ``rec_every`` steps into ``out``. Returns -1 or the first
@@ -331,17 +388,19 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
             c0[j] = r[k, j]
             c1[j] = r[kn, j]
             cm[j] = 0.5 * (c0[j] + c1[j])
-        if k % rec_every == 0:
-            _record(x, bs, c0, P, avp, aux, k1, out[rec])
+        u = stage_inputs(c0, cm, c1, avp)
+        ready = k % rec_every == 0
+        if ready:
+            _record(x, bs, c0, u[0], u[1], P, avp, aux, k1, out[rec])  # k1 = the derivative at the step start
             rec += 1
         if k == nsteps:
             break
-        if not step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
+        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready):
             return k + 1
     return -1
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, error_model="numpy")
 def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
     """Two sines (pitch amp[0] sin(2 pi freq[0] t), yaw amp[1] sin(2 pi freq[1] t)) from rest;
     Fourier coefficients at ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw) over
@@ -369,8 +428,9 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
             c0[j] = amp[j] * math.sin(w * freq[j] * t)
             cm[j] = amp[j] * math.sin(w * freq[j] * (t + 0.5 * dt))
             c1[j] = amp[j] * math.sin(w * freq[j] * (t + dt))
+        u = stage_inputs(c0, cm, c1, avp)
         if k >= nset:
-            _record(x, bs, c0, P, avp, aux, k1, rec)
+            _record(x, bs, c0, u[0], u[1], P, avp, aux, k1, rec)
             s = math.sin(w * fmeas * t)
             c = math.cos(w * fmeas * t)
             for o in range(4):
@@ -378,7 +438,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
                 out[o, 0] += y * s
                 out[o, 1] += y * c
                 out[o, 2] += y
-        if not step(x, bs, c0, cm, c1, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux):
+        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset):
             return k + 1
     for o in range(4):
         out[o, 0] *= 2.0 / nmeas
@@ -387,7 +447,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
     return -1
 
 
-@njit(cache=True, parallel=True, fastmath=_FM)
+@njit(cache=True, parallel=True, fastmath=_FM, error_model="numpy")
 def dwell_batch(P, fid, fp, avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out, status):
     """Independent two-axis dwells in parallel (rows of ``amps``/``freqs`` (n, 2))."""
     for b in prange(amps.shape[0]):

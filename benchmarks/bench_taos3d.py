@@ -1,0 +1,197 @@
+"""TAOS 3-D model speed and step accuracy, beside a MuJoCo rigid-engine peer in the same run
+(writes nothing; paste the output into benchmarks/RESULTS.md).
+
+Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
+      (the peer needs the optional extra: pip install -e .[bench], i.e. mujoco >= 3.1;
+      without it the peer is skipped with one line)
+
+1. Speed: 60 s two-axis Green Run profile (models/profiles/greenrun_two_axis.toml repeated to
+   60 s, as benchmarks/bench_taos.py), hot-fire FEM gimbal, modified-LuGre bearing, at the
+   model's default step (taos.taos3d.simulate.DEFAULT_DT_S, 2e-4 s) and at 4e-4 s; records
+   every 2 ms. Best and median of ``--repeat`` runs (the machine is shared: both are printed).
+2. Accuracy of the step: 4 s of the same run (modified LuGre, and Coulomb smooth, whose error
+   is not masked by stick-slip timing) against a 2.5e-5 s reference, at the default step and
+   at 4e-4 s, beside the former kernel's error (held bearing torque, 2e-4 s; its records are
+   stored in tests/data/taos3d_kernel_2e-4_held.npz) against the same reference.
+3. Peer: MuJoCo (mujoco.rollout, native loop, one thread) with the same rigid engine (mass,
+   c.g. and inertia of the Pinocchio model, pivot at the gimbal point O, gravity off as in
+   TAOS where it is inside K_n) on two hinges (pitch about +y, yaw about -x, the TAOS axes)
+   with dry friction (frictionloss = the bearing's Coulomb torque T_c), the feedline/gravity
+   spring K_n as joint stiffness, and two position servos (kp = K_L R^2, the line stiffness
+   at the engine; kv = kp / K_v, the actuator loop's first-order lag 1/K_v), implicitfast
+   integrator, at 1 ms and 0.1 ms, driven by the same Green Run commands. The peer has no
+   hydraulics, compliant gimbal or bearing slip: it is the cheaper model of the two.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+
+from taos.profiles import Sequence, TwoAxis, load_profile
+from taos.taos3d import load_taos_model
+from taos.taos3d import dynamics as dy
+from taos.taos3d.model import PITCH_AXIS, YAW_AXIS
+from taos.taos3d.simulate import DEFAULT_DT_S, pack, run_samples
+
+MODEL = "models/rs25_hotfire.toml"
+FRICTION = "modified-lugre"
+T_RUN = 60.0
+REC_S = 2e-3  # record interval [s]
+OLD_DT = 2e-4  # the former kernel's step (its stored records)
+ALT_DT = 4e-4  # twice the default: speed and accuracy for comparison
+REF_DT = 2.5e-5
+T_ACC = 4.0
+OLD_REF = Path(__file__).resolve().parent.parent / "tests" / "data" / "taos3d_kernel_2e-4_held.npz"
+
+
+def greenrun60():
+    p = load_profile("models/profiles/greenrun_two_axis.toml")
+    return TwoAxis(Sequence((p.pitch,) * 2), Sequence((p.yaw,) * 3), "Green Run x2, 60 s")
+
+
+def commands(profile, T, dt):
+    n = int(round(T / dt))
+    t = np.arange(n + 1) * dt
+    return t, np.ascontiguousarray(np.asarray(profile(t)).T)
+
+
+def timed(fn, repeat):
+    walls = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        walls.append(time.perf_counter() - t0)
+    return out, min(walls), statistics.median(walls)
+
+
+def taos_speed(tm, prof, dt, repeat):
+    _, cmd = commands(prof, T_RUN, dt)
+    pk = pack(tm)
+    every = int(round(REC_S / dt))
+    run_samples(tm, cmd[:11], dt, every, pk)  # compile / load the cache
+    out, best, med = timed(lambda: run_samples(tm, cmd, dt, every, pk), repeat)
+    n = len(cmd) - 1
+    print(f"[taos3d] dt {dt:g} s: 60 s Green Run in {best:.3f} s wall (best of {repeat}; median {med:.3f} s) "
+          f"= {T_RUN / best:.1f}x real time (median {T_RUN / med:.1f}x), {1e6 * best / n:.2f} us/step "
+          f"(median {1e6 * med / n:.2f}), {n} steps")
+    return out
+
+
+def errors(a, b):
+    """max |d theta| [deg], max |d x_p| [mm], max |d F_L| [N], max |d T_f| [N m], rms |d theta| [deg]."""
+    d = a - b
+    return (math.degrees(np.abs(d[:, 0:2]).max()), 1e3 * np.abs(d[:, 2:4]).max(), np.abs(d[:, 4:6]).max(),
+            np.abs(d[:, 6:8]).max(), math.degrees(np.sqrt((d[:, 0:2] ** 2).mean())))
+
+
+def accuracy(prof):
+    print(f"[accuracy] {T_ACC:g} s of the run, records every 10 ms, against dt = {REF_DT:g} s (this kernel): "
+          f"max |d theta| deg, "
+          f"max |d x_p| mm, max |d F_L| N, max |d T_f| N m, rms |d theta| deg")
+    for law in (FRICTION, "coulomb-smooth"):
+        tm = load_taos_model(MODEL, friction=law)
+
+        def run(dt):
+            _, cmd = commands(prof, T_ACC, dt)
+            return run_samples(tm, cmd, dt, int(round(0.01 / dt)))  # every 10 ms, as the stored records
+        ref = run(REF_DT)
+        rows = [(f"dt {dt:g} s (this kernel)", run(dt)) for dt in sorted({DEFAULT_DT_S, ALT_DT}, reverse=True)]
+        if OLD_REF.exists():  # records every 10 ms: theta (2), x_p (2), F_L (2), T_f (2)
+            rows.append((f"dt {OLD_DT:g} s (former kernel, T held)", np.load(OLD_REF)[law]))
+        for name, a in rows:
+            e = errors(a[:, :8], ref[:, :8])
+            print(f"    {law:15s} {name:36s} {e[0]:.2e}  {e[1]:.2e}  {e[2]:7.1f}  {e[3]:7.1f}  {e[4]:.2e}")
+
+
+def mujoco_xml(tm, dt):
+    eng, act = tm.base.engine, tm.base.actuator
+    cg = tm.geometry.engine_cg_m
+    J = tm.engine_inertia_cg
+    kp = tm.line_load_stiffness_N_per_m * act.moment_arm_m ** 2
+    kv = kp / act.loop_gain_per_s
+    tc = tm.coulomb_torque_Nm
+    lim = math.degrees(eng.gimbal_range_rad) + 1.0
+    ax = lambda a: " ".join(f"{v:g}" for v in a)  # noqa: E731
+    return f"""<mujoco model="rigid engine on two hinges (TAOS peer)">
+  <compiler angle="degree"/>
+  <option timestep="{dt}" gravity="0 0 0" integrator="implicitfast"/>
+  <worldbody>
+    <body name="engine" pos="0 0 0">
+      <joint name="pitch" type="hinge" axis="{ax(PITCH_AXIS)}" frictionloss="{tc}"
+             stiffness="{eng.rotational_stiffness_Nm_per_rad}" range="-{lim} {lim}" limited="true"/>
+      <joint name="yaw" type="hinge" axis="{ax(YAW_AXIS)}" frictionloss="{tc}"
+             stiffness="{eng.rotational_stiffness_Nm_per_rad}" range="-{lim} {lim}" limited="true"/>
+      <inertial pos="{ax(cg)}" mass="{eng.mass_kg}"
+                fullinertia="{J[0, 0]} {J[1, 1]} {J[2, 2]} {J[0, 1]} {J[0, 2]} {J[1, 2]}"/>
+    </body>
+  </worldbody>
+  <actuator>
+    <position joint="pitch" kp="{kp}" kv="{kv}"/>
+    <position joint="yaw" kp="{kp}" kv="{kv}"/>
+  </actuator>
+</mujoco>"""
+
+
+def mujoco_peer(tm, prof, repeat, taos_rec):
+    try:
+        import mujoco
+        from mujoco import rollout
+    except ImportError:
+        print("[mujoco] peer skipped: mujoco is not installed (pip install -e .[bench])")
+        return
+    for dt in (1e-3, 1e-4):
+        m = mujoco.MjModel.from_xml_string(mujoco_xml(tm, dt))
+        d = mujoco.MjData(m)
+        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        s0 = np.empty(mujoco.mj_stateSize(m, spec))
+        mujoco.mj_getState(m, d, s0, spec)
+        _, cmd = commands(prof, T_RUN, dt)
+        ctrl = np.ascontiguousarray(cmd[1:][None, :, :])  # the command at each step's end
+        rollout.rollout(m, d, s0[None], ctrl[:, :10])  # warm up
+        (state, _), best, med = timed(lambda: rollout.rollout(m, d, s0[None], ctrl), repeat)
+        n = ctrl.shape[1]
+        th = state[0, :, 1:3]  # qpos after time: pitch, yaw [rad]
+        every = int(round(REC_S / dt))
+        k = min(taos_rec.shape[0] - 1, th[every - 1::every].shape[0])
+        diff = np.degrees(np.sqrt(((th[every - 1::every][:k] - taos_rec[1:k + 1, 0:2]) ** 2).mean()))
+        print(f"[mujoco {mujoco.__version__}] dt {dt:g} s, rollout (native, 1 thread): 60 s in {best:.3f} s wall "
+              f"(best of {repeat}; median {med:.3f} s) = {T_RUN / best:.1f}x real time (median {T_RUN / med:.1f}x), "
+              f"{1e6 * best / n:.2f} us/step; peak angles {np.degrees(np.abs(th).max(axis=0)).round(3)} deg, "
+              f"rms angle difference from TAOS {diff:.3f} deg")
+        if dt == 1e-3:  # the same peer stepped from Python, as a user script would
+            d2 = mujoco.MjData(m)
+            t0 = time.perf_counter()
+            for i in range(n):
+                d2.ctrl[:] = cmd[i + 1]
+                mujoco.mj_step(m, d2)
+            w = time.perf_counter() - t0
+            print(f"[mujoco {mujoco.__version__}] dt {dt:g} s, mj_step from a Python loop: {T_RUN / w:.1f}x real time, "
+                  f"{1e6 * w / n:.2f} us/step")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args()
+    up = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+    print(f"machine load (uptime): {up}")
+    tm = load_taos_model(MODEL, friction=FRICTION)
+    print(f"model: hot fire, gimbal {tm.stiffness_source}, friction {tm.base.friction.name}, "
+          f"T_c = {tm.coulomb_torque_Nm:.0f} N m; default step {DEFAULT_DT_S:g} s; {len(dy.REC)} recorded columns")
+    prof = greenrun60()
+    rec = taos_speed(tm, prof, DEFAULT_DT_S, args.repeat)
+    taos_speed(tm, prof, ALT_DT, args.repeat)
+    mujoco_peer(tm, prof, args.repeat, rec)
+    accuracy(prof)
+    print(f"machine load (uptime): {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+
+
+if __name__ == "__main__":
+    main()
