@@ -274,8 +274,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--out", required=True, help="HDF5 file to write")
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
     p.add_argument("--friction", help="swap the friction law")
-    p.add_argument("--dt", type=float, default=None, help="integration step [s] (default: the engine's own, 2e-4 "
-                   "simplex, 4e-4 taos)")
+    p.add_argument("--dt", type=float, default=None, help="integration step [s] (default: the engine's own, 2e-4 s for "
+                   "both engines)")
     p.add_argument("--allow-unstable", action="store_true",
                    help="run a model whose linear block is unstable, and do not stop at the envelope")
     p.set_defaults(func=cmd_simulate)
