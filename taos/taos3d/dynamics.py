@@ -103,7 +103,7 @@ def _cross3(a0, a1, a2, b0, b1, b2):
 _valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.apply_valve_pressure.py_func)
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always", _nrt=False)
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def rhs(x, T0, T1, u0, u1, P, dx, aux):
     """State derivative dx of the TAOS engine + actuators with bearing torque (T0, T1) [N m]
     and post-avionics commands (u0, u1) [rad]. ``aux`` receives: 0-5 chain wrench W at O in
