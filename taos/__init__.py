@@ -41,7 +41,7 @@ _API = {
     "simulate": "taos.simulate", "TimeHistory": "taos.simulate",
     "load_profile": "taos.profiles",
     "FrictionLaw": "taos.friction", "LAWS": "taos.friction",
-    "taos_model": "taos.taos3d", "simulate_taos": "taos.taos3d", "taos_freqresp": "taos.taos3d",
+    "taos_model": "taos.taos3d", "simulate_taos": "taos.taos3d", "taos_freqresp": "taos.taos3d", "taos_freqresp_family": "taos.taos3d",
     "describing_function_map": "taos.flight.describing", "DescribingFunctionMap": "taos.flight.describing",
     "load_flight": "taos.flight.vehicle", "margins": "taos.flight.vehicle",
     "analyse_lco": "taos.flight.lco", "predict_lco": "taos.flight.lco",

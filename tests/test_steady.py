@@ -92,3 +92,16 @@ def test_shooting_family_reports_its_residual(tmp_path):
     assert d["provenance"]["steady_state"] == "shoot"
     assert len(d["provenance"]["shooting_max_residual"]) == 2
     assert all(x <= 1e-4 for x in d["provenance"]["shooting_max_residual"])
+
+
+def test_taos_family_equals_single_amplitude_calls(hotfire):
+    """The 3-D model's amplitude family is one parallel batch; each row is the single call's."""
+    from taos.taos3d import taos_freqresp, taos_freqresp_family, taos_model
+    tm = taos_model(hotfire)
+    f = [2.0, 5.0]
+    amps = [0.1 * DEG, 0.3 * DEG]
+    fam = taos_freqresp_family(tm, f, amps, settle_s=0.3)
+    for k, a in enumerate(amps):
+        one = taos_freqresp(tm, f, a, settle_s=0.3)
+        assert np.array_equal(one.engine, fam[k].engine) and np.array_equal(one.piston, fam[k].piston)
+        assert one.amplitude_rad == fam[k].amplitude_rad

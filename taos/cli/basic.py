@@ -143,9 +143,10 @@ def cmd_freqresp(args) -> int:
         run_checks.check_linear_stability(model, (args.axis,), allow=args.allow_unstable)
         run_checks.check_dwell(model, freqs, axis=args.axis, n_amplitudes=len(amps_rad))
     if args.engine == "taos":
-        from taos.taos3d import taos_freqresp, taos_model
+        from taos.taos3d import taos_freqresp, taos_freqresp_family, taos_model
         tm = taos_model(model)
-        fam = [taos_freqresp(tm, freqs, a, args.axis, cross=args.cross) for a in (amps_rad or [None])]
+        fam = (taos_freqresp_family(tm, freqs, amps_rad, args.axis, cross=args.cross) if amps_rad
+               else [taos_freqresp(tm, freqs, None, args.axis, cross=args.cross)])
     elif not amps_rad:
         fam = [linear_freqresp(model, freqs, args.axis)]
     else:   # every amplitude x frequency dwell in one parallel call

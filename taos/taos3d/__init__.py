@@ -20,11 +20,12 @@ from .simulate import (
     linear_state_space,
     simulate_taos,
     taos_freqresp,
+    taos_freqresp_family,
     two_axis_dwell,
 )
 
 __all__ = [
     "ActuatorGeometry", "GimbalParams", "TaosModel", "TaosTimeHistory", "beam_half_stiffness",
-    "engine_pin_model", "linear_state_space", "load_taos_model", "simulate_taos", "taos_freqresp",
+    "engine_pin_model", "linear_state_space", "load_taos_model", "simulate_taos", "taos_freqresp", "taos_freqresp_family",
     "taos_model", "two_axis_dwell",
 ]

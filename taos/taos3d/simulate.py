@@ -234,16 +234,35 @@ def taos_freqresp(tm: TaosModel, freq_hz, amplitude_rad: float | None = None, ax
         h = ss.freqresp(f, ss.inputs[i], [ss.outputs[o], ss.outputs[2 + o]])
         return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, label, engine_model="taos", friction_model="none",
                                  provenance={"model_sha256": tm.base.sha256, "method": "linear (taos)"})
-    amps = np.zeros((f.size, 2))
-    amps[:, i] = amplitude_rad
-    freqs = np.zeros((f.size, 2))
-    freqs[:, i] = f
-    res = _dwell(tm, amps, freqs, f, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle)
-    h = (res[:, :, 0] + 1j * res[:, :, 1]) / amplitude_rad
-    return FrequencyResponse(f, h[:, o] / R, h[:, 2 + o], float(amplitude_rad), label, engine_model="taos",
-                             friction_model=tm.base.friction.name,
-                             provenance={"model_sha256": tm.base.sha256, "method": "sine-dwell (taos)",
-                                         "dt_max_s": dt_max_s, "friction_scale": tm.friction_scale})
+    return taos_freqresp_family(tm, f, [amplitude_rad], axis, cross, dt_max_s=dt_max_s, settle_cycles=settle_cycles,
+                                measure_cycles=measure_cycles, settle_s=settle_s,
+                                min_steps_per_cycle=min_steps_per_cycle)[0]
+
+
+def taos_freqresp_family(tm: TaosModel, freq_hz, amplitudes_rad, axis: str = "pitch", cross: bool = False, *,
+                         dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
+                         settle_s: float | None = None, min_steps_per_cycle: int = 64) -> list[FrequencyResponse]:
+    """Sine-dwell responses of the TAOS model at every command amplitude [rad] x frequency
+    [Hz], all dwells in one parallel call (as :func:`taos_freqresp`, whose single-amplitude
+    result is the family's row bit for bit: each dwell is independent)."""
+    f = np.atleast_1d(np.asarray(freq_hz, float))
+    a = np.atleast_1d(np.asarray(amplitudes_rad, float))
+    i = AXES.index(axis)
+    o = 1 - i if cross else i
+    R = tm.base.actuator.moment_arm_m
+    label = f"{axis}->{AXES[o]}" if cross else axis
+    A, F = (g.ravel() for g in np.meshgrid(a, f, indexing="ij"))
+    amps = np.zeros((A.size, 2))
+    amps[:, i] = A
+    freqs = np.zeros((A.size, 2))
+    freqs[:, i] = F
+    res = _dwell(tm, amps, freqs, F, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle)
+    h = ((res[:, :, 0] + 1j * res[:, :, 1]) / A[:, None]).reshape(a.size, f.size, 4)
+    return [FrequencyResponse(f, h[k, :, o] / R, h[k, :, 2 + o], float(ak), label, engine_model="taos",
+                              friction_model=tm.base.friction.name,
+                              provenance={"model_sha256": tm.base.sha256, "method": "sine-dwell (taos)",
+                                          "dt_max_s": dt_max_s, "friction_scale": tm.friction_scale})
+            for k, ak in enumerate(a)]
 
 
 def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle):
@@ -254,14 +273,22 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     dts = 1.0 / (fmeas * npc)
     nset = (np.maximum(settle_cycles, np.ceil(ts * fmeas)) * npc).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
+    # the threads take contiguous blocks: deal the dwells out by cost, results put back in order
+    import numba
+
+    k = max(numba.get_num_threads(), 1)
+    by_cost = np.argsort(-(nset + nmeas), kind="stable")
+    perm = np.concatenate([by_cost[j::k] for j in range(k)])
+    amps, freqs = np.ascontiguousarray(np.asarray(amps, float)[perm]), np.ascontiguousarray(np.asarray(freqs, float)[perm])
+    fmeas, dts, nset, nmeas = fmeas[perm], dts[perm], nset[perm], nmeas[perm]
     out = np.zeros((fmeas.size, 4, 3))
     status = np.full(fmeas.size, -1, np.int64)
-    _dy.dwell_batch(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.ascontiguousarray(amps, float),
-                    np.ascontiguousarray(freqs, float), fmeas, dts, nset, nmeas, out, status)
+    _dy.dwell_batch(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), amps, freqs, fmeas, dts, nset, nmeas, out, status)
     bad = np.flatnonzero(status >= 0)
     if bad.size:
-        b = bad[0]
+        b = bad[np.argmin(perm[bad])]
         raise SimulationUnstable(status[b] * dts[b], f"TAOS sine dwell at {fmeas[b]:.3g} Hz")
+    out = out[np.argsort(perm)]
     return out
 
 
