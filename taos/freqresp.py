@@ -161,6 +161,18 @@ def settle_time_s(model: TvcModel, axis: str = "pitch", decades: float = 4.0) ->
     return decades * math.log(10) / sigma
 
 
+def deal_by_cost(cost) -> np.ndarray:
+    """Order for a parallel batch of independent jobs with expected ``cost`` (any unit): numba's
+    threads take contiguous blocks of a ``prange``, so the jobs are sorted by cost and dealt
+    round-robin to the threads (thread j gets the j-th, (j+k)-th, ... costliest). Returns the
+    permutation ``perm``; results come back in input order with ``np.argsort(perm)``."""
+    import numba
+
+    k = max(numba.get_num_threads(), 1)
+    by_cost = np.argsort(-np.asarray(cost, float), kind="stable")
+    return np.concatenate([by_cost[j::k] for j in range(k)])
+
+
 #: how a sine dwell reaches the periodic orbit it measures (``taos freqresp --steady``)
 STEADY_METHODS = ("settle", "shoot")
 
@@ -211,13 +223,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     Cy = np.ascontiguousarray(plant.ss.C[[o("x_p_m"), o("theta_rad")]])
     args = kernel_args(plant, model)
     kern = (model.friction.entry.rates, model.friction.pack(), model.avionics.pack())
-    # balance the parallel batch: the kernel's threads take contiguous blocks of points, so
-    # deal the points out by expected cost (each dwell is independent; results are put back)
-    import numba
-
-    k = max(numba.get_num_threads(), 1)
-    by_cost = np.argsort(-(nbud * npc + nmeas), kind="stable")
-    perm = np.concatenate([by_cost[i::k] for i in range(k)])
+    perm = deal_by_cost(nbud * npc + nmeas)   # each dwell is independent; results are put back
     A, F, npc, nbud, nmeas = A[perm], F[perm], npc[perm], nbud[perm], nmeas[perm]
     out = np.zeros((A.size, 2, 3))
     status = np.full(A.size, -1, np.int64)

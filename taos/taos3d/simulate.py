@@ -20,7 +20,7 @@ import numpy as np
 
 from ..actuator import actuator_state_space
 from ..errors import SimulationUnstable
-from ..freqresp import FrequencyResponse, settle_time_s
+from ..freqresp import FrequencyResponse, deal_by_cost, settle_time_s
 from ..linear import StateSpace
 from ..profiles import is_two_axis
 from ..simulate import SolverSettings, TimeHistory, provenance
@@ -273,12 +273,7 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     dts = 1.0 / (fmeas * npc)
     nset = (np.maximum(settle_cycles, np.ceil(ts * fmeas)) * npc).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
-    # the threads take contiguous blocks: deal the dwells out by cost, results put back in order
-    import numba
-
-    k = max(numba.get_num_threads(), 1)
-    by_cost = np.argsort(-(nset + nmeas), kind="stable")
-    perm = np.concatenate([by_cost[j::k] for j in range(k)])
+    perm = deal_by_cost(nset + nmeas)   # results put back in input order below
     amps, freqs = np.ascontiguousarray(np.asarray(amps, float)[perm]), np.ascontiguousarray(np.asarray(freqs, float)[perm])
     fmeas, dts, nset, nmeas = fmeas[perm], dts[perm], nset[perm], nmeas[perm]
     out = np.zeros((fmeas.size, 4, 3))
