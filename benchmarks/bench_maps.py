@@ -41,26 +41,25 @@ MAP_FREQ = list(np.round(np.logspace(np.log10(0.05), np.log10(15), 30), 5))
 TAOS = [str(Path(sys.executable).parent / "taos")]  # the console script, as a user runs it
 
 
-def wall(cmd, repeat=1):
-    """Median wall time [s] of a subprocess (output discarded; a failure stops the run)."""
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
-
-
-def wall_env(cmd, repeat, env, cwd):
-    """As :func:`wall` with ``env`` in ``cwd`` (``python -m`` puts the working folder first on
-    the path), after one untimed run (the other checkout compiles its kernels)."""
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env, cwd=cwd)
+def wall(cmd, repeat=1, env=None, cwd=None, warm=False):
+    """Median wall time [s] of a subprocess (output discarded; a failure stops the run), in
+    ``cwd`` with ``env`` (``python -m`` puts the working folder first on the path); ``warm``:
+    one untimed run first (another checkout compiles its kernels)."""
+    if warm:
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env, cwd=cwd)
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env, cwd=cwd)
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
+
+
+def speedup_table(title, runs, peer_s):
+    """A markdown table of ``runs`` (name -> wall [s]) beside the peer's time [s]."""
+    print(f"{title}\n\n| run | wall [s] | plain scipy script [s] | speed-up |\n|---|---|---|---|")
+    for k, v in runs.items():
+        print(f"| {k} | {v:.2f} | {peer_s:.0f} | {peer_s / v:.0f}x |")
 
 
 def csv(v):
@@ -88,8 +87,8 @@ def main(quick=False):
     if before:
         env = dict(os.environ, PYTHONPATH=before)
         old = [sys.executable, "-m", "taos"]
-        tb_help = wall_env(old + ["--help"], n, env, before)
-        tb_info = wall_env(old + ["info", MODEL], n, env, before)
+        tb_help = wall(old + ["--help"], n, env, before, warm=True)
+        tb_info = wall(old + ["info", MODEL], n, env, before, warm=True)
     print("### Start-up (median of %d, warm)\n" % n)
     print("| command | wall [s] |\n|---|---|")
     print(f"| python -c pass | {t_bare:.3f} |\n| python -c 'import numpy, scipy.integrate' (plain script) | {t_np:.3f} |")
@@ -119,20 +118,15 @@ def main(quick=False):
     job["1 call (amplitude list), shooting"] = wall(base + ["--freq-hz", csv(JOB_FREQ), "--amplitude-deg", csv(JOB_AMPS),
                                                            "--steady", "shoot"])
     peer_job = per_s * simulated_s(ts, JOB_AMPS, JOB_FREQ) + t_np
-    print(f"### User job: {len(JOB_AMPS)} amplitudes x {len(JOB_FREQ)} frequencies, {MODEL}, {LAW} (start-up included)\n")
-    print("| run | wall [s] | plain scipy script [s] | speed-up |\n|---|---|---|---|")
-    for k, v in job.items():
-        print(f"| {k} | {v:.2f} | {peer_job:.0f} | {peer_job / v:.0f}x |")
+    speedup_table(f"### User job: {len(JOB_AMPS)} amplitudes x {len(JOB_FREQ)} frequencies, {MODEL}, {LAW} "
+                  "(start-up included)", job, peer_job)
     if not quick:
         mp = {}
         mp["1 call, settled"] = wall(base + ["--freq-hz", csv(MAP_FREQ), "--amplitude-deg", csv(MAP_AMPS)])
         mp["1 call, shooting"] = wall(base + ["--freq-hz", csv(MAP_FREQ), "--amplitude-deg", csv(MAP_AMPS),
                                               "--steady", "shoot"])
         peer_map = per_s * simulated_s(ts, MAP_AMPS, MAP_FREQ) + t_np
-        print(f"\n### Map: {len(MAP_AMPS)} x {len(MAP_FREQ)} in one call (start-up included)\n")
-        print("| run | wall [s] | plain scipy script [s] | speed-up |\n|---|---|---|---|")
-        for k, v in mp.items():
-            print(f"| {k} | {v:.2f} | {peer_map:.0f} | {peer_map / v:.0f}x |")
+        speedup_table(f"\n### Map: {len(MAP_AMPS)} x {len(MAP_FREQ)} in one call (start-up included)", mp, peer_map)
     print(f"\nscipy peer: {tb:.2f} s for {4.0 if quick else 8.0:.0f} s simulated ({per_s:.3f} s per simulated s); "
           f"settling time {ts:.2f} s + 2 settling and 2 measured cycles per dwell")
 

@@ -30,11 +30,14 @@ import math
 import statistics
 import subprocess
 import time
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from taos.profiles import Sequence, TwoAxis, load_profile
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_taos import commands, greenrun60  # noqa: E402  (the same 60 s profile and sampling)
+
 from taos.taos3d import load_taos_model
 from taos.taos3d import dynamics as dy
 from taos.taos3d.model import PITCH_AXIS, YAW_AXIS
@@ -49,17 +52,6 @@ ALT_DT = 4e-4  # twice the default: speed and accuracy for comparison
 REF_DT = 2.5e-5
 T_ACC = 4.0
 OLD_REF = Path(__file__).resolve().parent.parent / "tests" / "data" / "taos3d_kernel_2e-4_held.npz"
-
-
-def greenrun60():
-    p = load_profile("models/profiles/greenrun_two_axis.toml")
-    return TwoAxis(Sequence((p.pitch,) * 2), Sequence((p.yaw,) * 3), "Green Run x2, 60 s")
-
-
-def commands(profile, T, dt):
-    n = int(round(T / dt))
-    t = np.arange(n + 1) * dt
-    return t, np.ascontiguousarray(np.asarray(profile(t)).T)
 
 
 def timed(fn, repeat):

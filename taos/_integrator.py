@@ -67,6 +67,14 @@ def _finite(x, z):
     return ok
 
 
+@njit(cache=True, inline="always")
+def work_buffers(n, nr):
+    """Scratch of one RK4 integration: the stages k1..k4 and the trial state (n,), the input
+    at the step start, middle and end (nr,)."""
+    return (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
+            np.empty(nr), np.empty(nr), np.empty(nr))
+
+
 @njit(cache=True, fastmath=_FM, inline="always")
 def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
               k1, k2, k3, k4, xt):
@@ -100,15 +108,8 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
     x = x0.copy()
     z = z0
     nsteps = r.shape[0] - 1
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    xt = np.empty(n)
     nr = r.shape[1]
-    r0 = np.empty(nr)
-    rm = np.empty(nr)
-    r1 = np.empty(nr)
+    k1, k2, k3, k4, xt, r0, rm, r1 = work_buffers(n, nr)
     rec = 0
     for k in range(nsteps + 1):
         k1n = min(k + 1, nsteps)
@@ -138,39 +139,25 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
 
 
 @njit(cache=True, fastmath=_FM)
-def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, n_per_cycle,
-                    n_settle, n_meas, out):
-    """One sine dwell: r = amp sin(2 pi f t) on every external input channel with a nonzero
-    weight. Accumulates out[o] = (2/N sum y sin, 2/N sum y cos, 1/N sum y) over the
-    ``n_meas`` measurement steps (whole cycles). Returns -1 or the failing step."""
-    n = A.shape[0]
+def sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z, nsteps, meas, out,
+               k1, k2, k3, k4, xt, r0, rm, r1):
+    """``nsteps`` steps of r = amp sin(2 pi k / n_per_cycle) (step ``dt`` [s], from phase 0) on
+    every external input channel, in place on ``x``; returns (z, status, max |z|) with status -1
+    or the failing step. With ``meas`` accumulates the correlation sums of y = Cy x into
+    ``out`` (unnormalised: sum y sin, sum y cos, sum y)."""
+    n = x.shape[0]
     nr = Br.shape[1]
-    x = np.zeros(n)
-    z = 0.0
-    dt = 1.0 / (freq * n_per_cycle)
-    wdt = 2.0 * math.pi / n_per_cycle
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    xt = np.empty(n)
-    r0 = np.empty(nr)
-    rm = np.empty(nr)
-    r1 = np.empty(nr)
     ny = Cy.shape[0]
-    for o in range(ny):
-        out[o, 0] = 0.0
-        out[o, 1] = 0.0
-        out[o, 2] = 0.0
-    total = n_settle + n_meas
-    for k in range(total):
+    wdt = 2.0 * math.pi / n_per_cycle
+    zmax = abs(z)
+    for k in range(nsteps):
         ph = wdt * (k % n_per_cycle)
         s0 = math.sin(ph)
         for j in range(nr):
             r0[j] = amp * s0
             rm[j] = amp * math.sin(ph + 0.5 * wdt)
             r1[j] = amp * math.sin(ph + wdt)
-        if k >= n_settle:
+        if meas:
             c0 = math.cos(ph)
             for o in range(ny):
                 s = 0.0
@@ -181,9 +168,34 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, f
                 out[o, 2] += s
         z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
                             k1, k2, k3, k4, xt)
+        zmax = max(zmax, abs(z))
         if not _finite(x, z):
-            return k + 1
-    for o in range(ny):
+            return z, k + 1, zmax
+    return z, -1, zmax
+
+
+@njit(cache=True, fastmath=_FM)
+def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, n_per_cycle,
+                    n_settle, n_meas, out):
+    """One sine dwell from rest: r = amp sin(2 pi f t) on every external input channel with a
+    nonzero weight, ``n_settle`` steps (whole cycles) of settling, then out[o] = (2/N sum y sin,
+    2/N sum y cos, 1/N sum y) over the ``n_meas`` measurement steps (whole cycles). Returns -1 or
+    the failing step."""
+    n = A.shape[0]
+    nr = Br.shape[1]
+    x = np.zeros(n)
+    dt = 1.0 / (freq * n_per_cycle)
+    k1, k2, k3, k4, xt, r0, rm, r1 = work_buffers(n, nr)
+    out[:, :] = 0.0
+    z, st, _ = sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, 0.0,
+                          n_settle, False, out, k1, k2, k3, k4, xt, r0, rm, r1)
+    if st >= 0:
+        return st
+    _, st, _ = sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z,
+                          n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
+    if st >= 0:
+        return st + n_settle
+    for o in range(Cy.shape[0]):
         out[o, 0] *= 2.0 / n_meas
         out[o, 1] *= 2.0 / n_meas
         out[o, 2] *= 1.0 / n_meas

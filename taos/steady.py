@@ -54,38 +54,28 @@ INFO = ("residual", "periods", "extrapolations", "converged")
 
 
 @njit(cache=True, fastmath=_FM)
-def _run(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z, nsteps, meas, out,
-         k1, k2, k3, k4, xt, r0, rm, r1):
-    """Integrate ``nsteps`` steps of r = amp sin(2 pi k / n_per_cycle) from phase 0, in place
-    on ``x``; returns (z, status, max |z|). With ``meas`` accumulates the correlation sums into
-    ``out`` (unnormalised: sum y sin, sum y cos, sum y)."""
+def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, src, dst, s, nz, set_zscale,
+            x, corr, k1, k2, k3, k4, xt, r0, rm, r1):
+    """One period of the map: dst = P(src), src/dst = (x, z); ``corr`` receives the period's
+    correlation sums (:func:`taos._integrator.sine_steps`). With ``set_zscale`` the friction
+    state's scale s[n] becomes the largest |z| of the period first. Returns (status, scaled
+    residual max_i |dst_i - src_i| / s_i)."""
     n = x.shape[0]
-    nr = Br.shape[1]
-    ny = Cy.shape[0]
-    wdt = 2.0 * math.pi / n_per_cycle
-    zmax = abs(z)
-    for k in range(nsteps):
-        ph = wdt * (k % n_per_cycle)
-        s0 = math.sin(ph)
-        for j in range(nr):
-            r0[j] = amp * s0
-            rm[j] = amp * math.sin(ph + 0.5 * wdt)
-            r1[j] = amp * math.sin(ph + wdt)
-        if meas:
-            c0 = math.cos(ph)
-            for o in range(ny):
-                s = 0.0
-                for i in range(n):
-                    s += Cy[o, i] * x[i]
-                out[o, 0] += s * s0
-                out[o, 1] += s * c0
-                out[o, 2] += s
-        z, _, _ = _ig._rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
-                                k1, k2, k3, k4, xt)
-        zmax = max(zmax, abs(z))
-        if not _ig._finite(x, z):
-            return z, k + 1, zmax
-    return z, -1, zmax
+    for j in range(n):
+        x[j] = src[j]
+    corr[:, :] = 0.0
+    z, st, zmax = _ig.sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x,
+                                 src[n] if nz else 0.0, n_per_cycle, True, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+    if set_zscale and nz:
+        s[n] = max(zmax, 1e-300)
+    d = 0.0
+    for j in range(n):
+        dst[j] = x[j]
+        d = max(d, abs(x[j] - src[j]) / s[j])
+    if nz:
+        dst[n] = z
+        d = max(d, abs(z - src[n]) / s[n])
+    return st, d
 
 
 @njit(cache=True, fastmath=_FM)
@@ -94,67 +84,38 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
     """Periodic steady state of one dwell (module docstring). ``y0`` (n + 1): the start
     (x0, z0); ``scale`` (n + 1): s_i (its last entry is replaced by the friction state's scale
     after the first period); ``nz`` 1 if the law has a state; ``k_rre`` + 1 periods per
-    extrapolation cycle; ``n_budget`` periods of fallback integration. Writes the correlations
-    to ``out`` (as :func:`taos._integrator._sine_dwell_one`) and ``info`` (:data:`INFO`).
-    Returns -1 or the failing step."""
+    extrapolation cycle; ``n_budget`` periods in all before the fallback stops. Writes the
+    correlations to ``out`` (as :func:`taos._integrator._sine_dwell_one`) and ``info``
+    (:data:`INFO`). Returns -1 or the failing step."""
     n = A.shape[0]
     m = n + nz
     nr = Br.shape[1]
     dt = 1.0 / (freq * n_per_cycle)
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    xt = np.empty(n)
-    r0 = np.empty(nr)
-    rm = np.empty(nr)
-    r1 = np.empty(nr)
+    k1, k2, k3, k4, xt, r0, rm, r1 = _ig.work_buffers(n, nr)
     x = np.empty(n)
-    ny = Cy.shape[0]
-    corr = np.zeros((ny, 3))  # correlation sums of the period just integrated
-    have = False              # corr holds the period from ystar (then no re-run is needed)
+    corr = np.zeros((Cy.shape[0], 3))   # correlation sums of the period just integrated
     s = scale.copy()
     kk = k_rre + 2
-    Y = np.empty((kk, m))     # iterates of one extrapolation cycle (unscaled)
-    for i in range(m):
-        Y[0, i] = y0[i]
-    ystar = Y[0].copy()       # the start the response is measured from
+    Y = np.zeros((kk, n + 1))  # iterates of one extrapolation cycle (unscaled; entry n unused if nz = 0)
+    Y[0, :] = y0
+    ystar = Y[0].copy()       # the start the response is measured from (corr holds its period)
     res = np.inf
     periods = 0
     cycles = 0
     converged = False
-    first = True
-    nxt = np.empty(m)
+    nxt = np.zeros(n + 1)
     while not converged:
         used = kk
         for i in range(1, kk):
-            for j in range(n):
-                x[j] = Y[i - 1, j]
-            z0 = Y[i - 1, n] if nz else 0.0
-            corr[:] = 0.0
-            z, st, zmax = _run(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z0,
-                               n_per_cycle, True, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+            st, d = _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, Y[i - 1],
+                            Y[i], s, nz, periods == 0, x, corr, k1, k2, k3, k4, xt, r0, rm, r1)
             periods += 1
             if st >= 0:
                 return st + (periods - 1) * n_per_cycle
-            if first and nz:
-                s[n] = max(zmax, 1e-300)
-            first = False
-            d = 0.0
-            for j in range(n):
-                Y[i, j] = x[j]
-                d = max(d, abs(x[j] - Y[i - 1, j]) / s[j])
-            if nz:
-                Y[i, n] = z
-                d = max(d, abs(z - Y[i - 1, n]) / s[n])
-            if i == 1:
-                res = d
-                ystar[:] = Y[0]
             if d <= tol:
                 res = d
                 ystar[:] = Y[i - 1]
                 converged = True
-                have = True
                 used = i + 1
                 break
         if converged or cycles >= max_cycles:
@@ -187,49 +148,34 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
         if not ok:
             Y[0] = Y[kk - 1]
             break
-        Y[0] = nxt
+        Y[0, :m] = nxt[:m]
     if not converged:
-        # fallback: integrate on from the last point for the settling budget
+        # fallback: integrate on from the last point until the settled dwell's budget is spent
         cur = Y[0].copy()
-        for _ in range(max(n_budget - periods, 1)):   # the settled dwell's budget, all told
-            for j in range(n):
-                x[j] = cur[j]
-            z0 = cur[n] if nz else 0.0
-            corr[:] = 0.0
-            z, st, _ = _run(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z0,
-                            n_per_cycle, True, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+        for _ in range(max(n_budget - periods, 1)):
+            st, d = _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, cur,
+                            nxt, s, nz, periods == 0, x, corr, k1, k2, k3, k4, xt, r0, rm, r1)
             periods += 1
             if st >= 0:
                 return st + (periods - 1) * n_per_cycle
-            d = 0.0
-            for j in range(n):
-                d = max(d, abs(x[j] - cur[j]) / s[j])
-            if nz:
-                d = max(d, abs(z - cur[n]) / s[n])
             ystar[:] = cur
-            have = True
             res = d
-            for j in range(n):
-                cur[j] = x[j]
-            if nz:
-                cur[n] = z
+            cur[:] = nxt
             if d <= tol:
                 converged = True
                 break
     # measure from the periodic start: one measured period is the one already integrated from it
     # (the same steps from the same state); more periods are integrated again from it
-    if have and n_meas == n_per_cycle:
+    if n_meas == n_per_cycle:
         out[:, :] = corr
     else:
         out[:, :] = 0.0
-        for j in range(n):
-            x[j] = ystar[j]
-        z0 = ystar[n] if nz else 0.0
-        _, st, _ = _run(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z0,
-                        n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
+        x[:] = ystar[:n]
+        _, st, _ = _ig.sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x,
+                                  ystar[n] if nz else 0.0, n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
         if st >= 0:
             return st + periods * n_per_cycle
-    for o in range(ny):
+    for o in range(Cy.shape[0]):
         out[o, 0] *= 2.0 / n_meas
         out[o, 1] *= 2.0 / n_meas
         out[o, 2] *= 1.0 / n_meas

@@ -55,6 +55,7 @@ def _Q(*args):
 _NUMBER_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s+([A-Za-z][^\s].*?|[A-Za-z]|1\s*/\s*[A-Za-z].*?)\s*$")
 
 
+@functools.cache
 def _cache_file() -> Path | None:
     """The (unit, kind) table's file: keyed by the installed pint's location, size and time."""
     import importlib.util
