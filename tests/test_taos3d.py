@@ -176,7 +176,7 @@ def test_energy_is_conserved_without_friction_and_damping(hot):
     dt = 2e-4
     n = int(10.0 / dt)
     out = np.empty((n // 1000 + 1, len(dy.REC)))
-    status = dy.integrate(P, pk.fid, pk.fp, pk.avp, x, np.zeros(6), np.zeros((n + 1, 2)), dt, 1000, out)
+    status = dy.integrate(P, pk.fid, pk.fp, pk.avp, x, np.zeros(dy.N_BEARING), np.zeros((n + 1, 2)), dt, 1000, out)
     assert status == -1
     assert np.ptp(out[:, 0]) > 0.001  # it did swing (about 0.1 deg at 7 Hz)
     assert abs(energy(x) / E0 - 1) < 1e-3

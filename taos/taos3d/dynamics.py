@@ -52,6 +52,8 @@ from .. import actuator_limits as _lim
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 N_BODY = 13  # p (3), quaternion (4), v (6)
+#: bearing state: phi (2) [rad], z (2) [rad], T (2) [N m], and phi, z one step back (BDF2)
+N_BEARING = 10
 #: recorded columns of :func:`integrate`
 REC = ("theta_pitch", "theta_yaw", "xp_pitch", "xp_yaw", "fl_pitch", "fl_yaw", "tf_pitch", "tf_yaw",
        "z_pitch", "z_yaw", "phi_pitch", "phi_yaw", "u_pitch", "u_yaw",
@@ -99,6 +101,28 @@ def _cross3(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _rotation(qx, qy, qz, qw):
+    """Rotation matrix R (body -> world) of the unit quaternion (xyzw), row-major 9-tuple."""
+    return (1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw),
+            2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw),
+            2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy))
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _world_torque(r0, r1, r2, th, g0, g1, g2):
+    """World torque Jl(r)^-T g [N m] of the generalized torque g conjugate to the rotation
+    vector r [rad] (angle th [rad]): g + r x g / 2 + c r x (r x g),
+    c = 1/th^2 - (1 + cos th) / (2 th sin th)."""
+    if th < 1e-4:
+        c = 1.0 / 12.0 + th * th / 720.0
+    else:
+        c = 1.0 / (th * th) - (1.0 + math.cos(th)) / (2.0 * th * math.sin(th))
+    rg0, rg1, rg2 = _cross3(r0, r1, r2, g0, g1, g2)
+    rrg0, rrg1, rrg2 = _cross3(r0, r1, r2, rg0, rg1, rg2)
+    return g0 + 0.5 * rg0 + c * rrg0, g1 + 0.5 * rg1 + c * rrg1, g2 + 0.5 * rg2 + c * rrg2
+
+
 #: the actuator rate/pressure limits (taos.actuator_limits), the same source compiled inline here
 _valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.apply_valve_pressure.py_func)
 
@@ -118,16 +142,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     na = Aa.shape[0]
     p0, p1, p2 = x[0], x[1], x[2]
     qx, qy, qz, qw = x[3], x[4], x[5], x[6]
-    # rotation matrix R (body -> world) of the quaternion
-    R00 = 1 - 2 * (qy * qy + qz * qz)
-    R01 = 2 * (qx * qy - qz * qw)
-    R02 = 2 * (qx * qz + qy * qw)
-    R10 = 2 * (qx * qy + qz * qw)
-    R11 = 1 - 2 * (qx * qx + qz * qz)
-    R12 = 2 * (qy * qz - qx * qw)
-    R20 = 2 * (qx * qz - qy * qw)
-    R21 = 2 * (qy * qz + qx * qw)
-    R22 = 1 - 2 * (qx * qx + qy * qy)
+    R00, R01, R02, R10, R11, R12, R20, R21, R22 = _rotation(qx, qy, qz, qw)
     r0, r1, r2, th = _logq4(qx, qy, qz, qw)
     # bearing slip and chain wrench
     phi0 = (G[0, 0] * p0 + G[0, 1] * p1 + G[0, 2] * p2 + G[0, 3] * r0 + G[0, 4] * r1 + G[0, 5] * r2
@@ -155,15 +170,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
         g0 += axes[0, 0] * tsp + axes[1, 0] * tsy
         g1 += axes[0, 1] * tsp + axes[1, 1] * tsy
         g2 += axes[0, 2] * tsp + axes[1, 2] * tsy
-    if th < 1e-4:
-        c = 1.0 / 12.0 + th * th / 720.0
-    else:
-        c = 1.0 / (th * th) - (1.0 + math.cos(th)) / (2.0 * th * math.sin(th))
-    rg0, rg1, rg2 = _cross3(r0, r1, r2, g0, g1, g2)
-    rrg0, rrg1, rrg2 = _cross3(r0, r1, r2, rg0, rg1, rg2)
-    Tw0 = g0 + 0.5 * rg0 + c * rrg0
-    Tw1 = g1 + 0.5 * rg1 + c * rrg1
-    Tw2 = g2 + 0.5 * rg2 + c * rrg2
+    Tw0, Tw1, Tw2 = _world_torque(r0, r1, r2, th, g0, g1, g2)
     Fw0, Fw1, Fw2 = -W0, -W1, -W2
     vx, vy, vz = x[7], x[8], x[9]
     # actuators
@@ -237,6 +244,33 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     aux[9] = phi1
     aux[10] = tp
     aux[11] = ty
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _torque_kick(x, d0, d1, h, P):
+    """x[7:13] += h a, a [m/s^2, rad/s^2] the engine's body-frame acceleration that a change
+    (d0, d1) [N m] of the bearing torque adds at the state x: the chain wrench changes by
+    dW = Ks S Kc dT (phi = G e - Kc T in :func:`rhs`), acting on the engine as
+    (-dW[:3], Jl^-T (-dW[3:])) in the world, Y^-1 of that in the body frame. ``h`` [s]."""
+    Yinv, BT = P[1], P[14]
+    dF0 = -(BT[0, 0] * d0 + BT[0, 1] * d1)
+    dF1 = -(BT[1, 0] * d0 + BT[1, 1] * d1)
+    dF2 = -(BT[2, 0] * d0 + BT[2, 1] * d1)
+    g0 = -(BT[3, 0] * d0 + BT[3, 1] * d1)
+    g1 = -(BT[4, 0] * d0 + BT[4, 1] * d1)
+    g2 = -(BT[5, 0] * d0 + BT[5, 1] * d1)
+    qx, qy, qz, qw = x[3], x[4], x[5], x[6]
+    R00, R01, R02, R10, R11, R12, R20, R21, R22 = _rotation(qx, qy, qz, qw)
+    r0, r1, r2, th = _logq4(qx, qy, qz, qw)
+    Tw0, Tw1, Tw2 = _world_torque(r0, r1, r2, th, g0, g1, g2)
+    f0 = R00 * dF0 + R10 * dF1 + R20 * dF2
+    f1 = R01 * dF0 + R11 * dF1 + R21 * dF2
+    f2 = R02 * dF0 + R12 * dF1 + R22 * dF2
+    f3 = R00 * Tw0 + R10 * Tw1 + R20 * Tw2
+    f4 = R01 * Tw0 + R11 * Tw1 + R21 * Tw2
+    f5 = R02 * Tw0 + R12 * Tw1 + R22 * Tw2
+    for i in range(6):
+        x[7 + i] += h * _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
@@ -320,11 +354,23 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     for i in range(3, 7):
         x[i] /= qn
     ps0, ps1 = pose_psi(x, P)
-    w0, w1, z0, z1, t0, t1 = fid(fp, P[4], ps0 - bs[0], ps1 - bs[1], bs[2], bs[3], dt)
-    bs[0] += w0 * dt
-    bs[1] += w1 * dt
+    # BDF2 on the bearing (phi, z): y_{n+1} = (4 y_n - y_{n-1}) / 3 + h y'_{n+1}, h = 2 dt / 3,
+    # the backward-Euler step's form with y_n -> (4 y_n - y_{n-1}) / 3 and dt -> h
+    h = dt * (2.0 / 3.0)
+    ph0 = (4.0 * bs[0] - bs[6]) * (1.0 / 3.0)
+    ph1 = (4.0 * bs[1] - bs[7]) * (1.0 / 3.0)
+    zh0 = (4.0 * bs[2] - bs[8]) * (1.0 / 3.0)
+    zh1 = (4.0 * bs[3] - bs[9]) * (1.0 / 3.0)
+    w0, w1, z0, z1, t0, t1 = fid(fp, P[4], ps0 - ph0, ps1 - ph1, zh0, zh1, h)
+    bs[6] = bs[0]
+    bs[7] = bs[1]
+    bs[8] = bs[2]
+    bs[9] = bs[3]
+    bs[0] = ph0 + w0 * h
+    bs[1] = ph1 + w1 * h
     bs[2] = z0
     bs[3] = z1
+    _torque_kick(x, t0 - T0, t1 - T1, 0.5 * dt, P)  # trapezoidal T over the step (second order)
     bs[4] = t0
     bs[5] = t1
     s = t0 + t1 + z0 + z1  # a NaN or an infinity anywhere makes the sum non-finite
@@ -407,7 +453,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
     ``nmeas`` steps after ``nset``: out[o] = (2/N sum y sin, 2/N sum y cos, 1/N sum y)."""
     n = x0.shape[0]
     x = x0.copy()
-    bs = np.zeros(6)
+    bs = np.zeros(N_BEARING)
     k1 = np.empty(n)
     k2 = np.empty(n)
     k3 = np.empty(n)

@@ -73,7 +73,7 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     P = (f64(Y), f64(np.linalg.inv(Y)), f64(Ks), f64(G), f64(Kc), f64(S), f64(geo.structure_attach_m),
          f64(geo.engine_attach_m), f64(act.A), f64(act.B[:, act.input_index("x_c_m")]),
          f64(act.B[:, act.input_index("f_load_N")]), f64(act.C[act.output_index("x_p_m")]),
-         f64(np.vstack([PITCH_AXIS, YAW_AXIS])), f64(sc))
+         f64(np.vstack([PITCH_AXIS, YAW_AXIS])), f64(sc), f64(Ks @ S @ Kc))
     law = tm.base.friction
     fp = law.scaled(tm.friction_scale).pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
@@ -115,7 +115,7 @@ def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int =
     cmd = np.ascontiguousarray(cmd, dtype=np.float64)
     nrec = (cmd.shape[0] - 1) // record_every + 1
     out = np.empty((nrec, len(_dy.REC)))
-    status = _dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(6), cmd, dt_s,
+    status = _dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(_dy.N_BEARING), cmd, dt_s,
                            record_every, out)
     if status >= 0:
         raise SimulationUnstable(status * dt_s, f"TAOS, {tm.base.friction.name} friction, dt = {dt_s} s")
