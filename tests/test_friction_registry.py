@@ -88,8 +88,8 @@ def _toy_coeffs(s, p, dt, kappa):  # T = a(|w|) w (memoryless)
     return p[K.SLOT_SIGMA2] + p[K.SLOT_TC] / math.sqrt(s * s + e * e), 0.0
 
 
-def toy_bearing(p, Kc, d0, d1, z0, z1, dt):
-    return coeff_bearing_step(_toy_coeffs, _toy_coeffs, False, 1.0, p, Kc, d0, d1, z0, z1, dt)
+def toy_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
+    return coeff_bearing_step(_toy_coeffs, _toy_coeffs, False, 1.0, p, Kc, d0, d1, z0, z1, dt, s0)
 
 
 def toy_fit_df(law, X, w):
@@ -199,7 +199,9 @@ def test_toy_law_runs_in_the_3d_model(toy):
     tmc = tm.replace(base=tm.base.replace(friction=law))
     run = simulate_taos(tmc, prof, record_every=1, duration_s=0.3)
     dt = run.t_s[1] - run.t_s[0]
-    w = np.diff(run.extra["bearing_slip_rad"], axis=1) / dt
+    ph = run.extra["bearing_slip_rad"]
+    ph = np.hstack([ph[:, :1], ph])  # at rest before the start: phi_{-1} = phi_0
+    w = (3 * ph[:, 2:] - 4 * ph[:, 1:-1] + ph[:, :-2]) / (2 * dt)  # the BDF2 slip rate of each step
     T = run.friction_torque_Nm[:, 1:]
     scaled = law.scaled(tmc.friction_scale)
     s = np.hypot(w[0], w[1])

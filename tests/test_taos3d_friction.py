@@ -92,6 +92,50 @@ def test_torque_levels_scale_with_normal_load(base, name):
     np.testing.assert_allclose(tq, 0.25 * np.array(t), rtol=1e-12)
 
 
+def _assert_series_balance(e, p, law, Kc, d, z, dt, w, T, zn, dmag, tc):
+    """w dt + Kc T = d, and for a law with state the backward-Euler bristle update with T the
+    law's torque there (its zdot3 and torque3 kernels)."""
+    np.testing.assert_allclose(w * dt + Kc @ T, d, rtol=1e-7, atol=1e-9 * dmag + 1e-18)
+    if law.has_state:
+        dz = np.array(e.zdot3(w[0], w[1], zn[0], zn[1], p))
+        np.testing.assert_allclose(zn, z + dt * dz, rtol=1e-7, atol=1e-9 * np.abs(z).max() + 1e-15)
+        tq = e.torque3(w[0], w[1], zn[0], zn[1], dz[0], dz[1], 0, 0, p)
+        np.testing.assert_allclose(T, tq, rtol=1e-6, atol=1e-6 * tc)
+
+
+def test_bearing_step_keeps_the_branch_it_continues_from(base):
+    """Modified LuGre (Stribeck: the torque falls with the slip speed) makes the backward-Euler
+    bearing equation w dt + Kc T(w) = d multi-valued where Kc |dT/ds| > dt: a slow (sticking)
+    and a fast (sliding) root. Each step continues from the previous slip speed, so a slow
+    sweep of the trial increment d up and back down shows stick-slip hysteresis: up, the
+    bearing stays on the slow branch past the point where the fast one appears; down, on the
+    fast branch past where the slow one reappears. Every result satisfies the series balance."""
+    law = base.with_friction("modified-lugre").friction
+    e, p = law.entry, law.pack()
+    Kc = np.array([[5.3e-8, 3e-10], [3e-10, 5.0e-8]])  # the hot-fire model's chain compliance
+    dt = 2e-4
+    tc = law.coulomb_torque_Nm
+    u = np.array([0.6, 0.8])
+    dmags = np.geomspace(1e-5, 1e-3, 300)
+    z = np.zeros(2)
+    sweeps = []
+    for order in (dmags, dmags[::-1]):
+        s0, slips = 0.0, {}
+        for dmag in order:
+            d = u * dmag
+            w0, w1, z0, z1, t0, t1 = e.bearing_step(p, Kc, d[0], d[1], z[0], z[1], dt, s0)
+            _assert_series_balance(e, p, law, Kc, d, z, dt, np.array([w0, w1]), np.array([t0, t1]),
+                                   np.array([z0, z1]), dmag, tc)
+            s0 = slips[dmag] = np.hypot(w0, w1)
+        sweeps.append(np.array([slips[m] for m in dmags]))
+    up, down = sweeps
+    assert np.all(up <= down * (1 + 1e-9))
+    apart = up < 0.2 * down  # slow on the way up, fast on the way down
+    print("hysteresis over d =", dmags[apart].min(), "-", dmags[apart].max(), "rad,", apart.sum(), "of", dmags.size)
+    assert apart.sum() >= 0.3 * dmags.size
+    assert np.all(np.diff(np.flatnonzero(apart)) == 1)  # one band
+
+
 @pytest.mark.parametrize("name", LAWS)
 def test_bearing_step_solves_the_series_balance(base, name):
     """w dt + Kc T = d, with T the law's torque at the backward-Euler state."""
@@ -106,19 +150,15 @@ def test_bearing_step_solves_the_series_balance(base, name):
         dmag = 10 ** rng.uniform(-9, -4)
         d = rng.normal(size=2) * dmag
         z = rng.uniform(-1, 1, 2) * tc / 1.3e7
-        w0, w1, z0, z1, t0, t1 = e.bearing_step(p, Kc, d[0], d[1], z[0], z[1], dt)
+        s0 = 0.0 if rng.uniform() < 0.3 else 10 ** rng.uniform(-8, 1)  # the continuation start [rad/s]
+        w0, w1, z0, z1, t0, t1 = e.bearing_step(p, Kc, d[0], d[1], z[0], z[1], dt, s0)
         w, T, zn = np.array([w0, w1]), np.array([t0, t1]), np.array([z0, z1])
-        np.testing.assert_allclose(w * dt + Kc @ T, d, rtol=1e-7, atol=1e-9 * dmag + 1e-18)
-        if law.has_state:
-            dz = np.array(e.zdot3(w0, w1, z0, z1, p))
-            np.testing.assert_allclose(zn, z + dt * dz, rtol=1e-7, atol=1e-9 * np.abs(z).max() + 1e-15)
-            tq = e.torque3(w0, w1, z0, z1, dz[0], dz[1], 0, 0, p)
-            np.testing.assert_allclose(T, tq, rtol=1e-6, atol=1e-6 * tc)
-        elif name == "coulomb-switching":  # stick: |T| within breakaway; slide: |T| = T_c along w
+        _assert_series_balance(e, p, law, Kc, d, z, dt, w, T, zn, dmag, tc)
+        if name == "coulomb-switching":  # stick: |T| within breakaway; slide: |T| = T_c along w
             if np.linalg.norm(w) == 0:
                 assert np.linalg.norm(T) <= max(law.static_torque_Nm, tc) * (1 + 1e-12)
             else:
                 assert np.linalg.norm(T) == pytest.approx(tc, rel=1e-9)
                 assert abs(T[0] * w[1] - T[1] * w[0]) < 1e-7 * tc * np.linalg.norm(w)
-        else:  # memoryless: the torque at the slip rate
+        elif not law.has_state:  # memoryless: the torque at the slip rate
             np.testing.assert_allclose(T, e.torque3(w0, w1, 0, 0, 0, 0, 0, 0, p), rtol=1e-8, atol=1e-300)

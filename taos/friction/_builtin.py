@@ -61,7 +61,7 @@ def none_torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p):
 
 
 @_kernel(BEARING_SIG)
-def none_bearing(p, Kc, d0, d1, z0, z1, dt):
+def none_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
     return d0 / dt, d1 / dt, 0.0, 0.0, 0.0, 0.0
 
 
@@ -77,8 +77,8 @@ def switching_torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p):
 
 
 @_kernel(BEARING_SIG)
-def switching_bearing(p, Kc, d0, d1, z0, z1, dt):
-    return V.switching_bearing_step(p, Kc, d0, d1, z0, z1, dt)
+def switching_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
+    return V.switching_bearing_step(p, Kc, d0, d1, z0, z1, dt, s0)
 
 
 # -- Coulomb, smooth ---------------------------------------------------------------------------------
@@ -93,8 +93,8 @@ def smooth_torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p):
 
 
 @_kernel(BEARING_SIG)
-def smooth_bearing(p, Kc, d0, d1, z0, z1, dt):
-    return V.coeff_bearing_step(V.smooth_coeffs, V.lugre_rho, False, 1.0, p, Kc, d0, d1, z0, z1, dt)
+def smooth_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
+    return V.coeff_bearing_step(V.smooth_coeffs, V.lugre_rho, False, 1.0, p, Kc, d0, d1, z0, z1, dt, s0)
 
 
 # -- Dahl -------------------------------------------------------------------------------------------
@@ -115,9 +115,9 @@ def dahl_torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p):
 
 
 @_kernel(BEARING_SIG)
-def dahl_bearing(p, Kc, d0, d1, z0, z1, dt):
+def dahl_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
     kappa = V.dahl_kappa(d0, d1, z0, z1, p)
-    return V.coeff_bearing_step(V.dahl_coeffs, V.dahl_rho, True, kappa, p, Kc, d0, d1, z0, z1, dt)
+    return V.coeff_bearing_step(V.dahl_coeffs, V.dahl_rho, True, kappa, p, Kc, d0, d1, z0, z1, dt, s0)
 
 
 # -- LuGre and modified LuGre (one kernel set: the vibration factor is 1 at V_d = 0) --------------
@@ -138,8 +138,8 @@ def lugre_torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p):
 
 
 @_kernel(BEARING_SIG)
-def lugre_bearing(p, Kc, d0, d1, z0, z1, dt):
-    return V.coeff_bearing_step(V.lugre_coeffs, V.lugre_rho, True, 1.0, p, Kc, d0, d1, z0, z1, dt)
+def lugre_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
+    return V.coeff_bearing_step(V.lugre_coeffs, V.lugre_rho, True, 1.0, p, Kc, d0, d1, z0, z1, dt, s0)
 
 
 # -- fit describing functions (rate form, at engine angle amplitude X and frequency w) ----------

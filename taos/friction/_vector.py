@@ -178,40 +178,66 @@ def switching_residual(coeffs, s, p, dt, kappa, Kc, d0, d1, z0, z1):
 
 
 @njit(inline="always")
-def solve_slip(resid, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1):
-    """Slip rate (w0, w1) [rad/s] solving the scalar consistency resid(s) = 0 by bracketed
-    Illinois regula falsi on [0, s_max] (resid(0) >= 0 > resid(s_max))."""
-    s_lo = 0.0
-    h_lo, w0, w1 = resid(coeffs, 0.0, p, dt, kappa, Kc, d0, d1, z0, z1)
-    if h_lo > 0.0:
-        s_hi = 2.0 * math.sqrt(d0 * d0 + d1 * d1) / dt + h_lo + 1e-300
-        h_hi = 0.0
-        for _ in range(400):
+def solve_slip(resid, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1, s0):
+    """Slip rate (w0, w1) [rad/s] solving the scalar consistency resid(s) = 0, continued from
+    the previous step's slip speed ``s0`` [rad/s]: the residual's sign at s0 says which way the
+    slip speed moves (up while |w(s)| > s); a bracket grows from s0 that way, first to the
+    fixed-point image |w(s0)|, then by doubling steps, until the sign changes (resid(0) >= 0, so downwards it ends at s = 0 at the
+    latest), then bracketed Illinois regula falsi on it. Where the backward-Euler equation has
+    several roots (Stribeck friction falling with the slip speed faster than dt / Kc) this
+    keeps the branch the bearing is on while that branch exists (stick-slip hysteresis: the
+    limit of a vanishing bearing inertia relaxing the slip speed from s0)."""
+    s_a = max(s0, 0.0)
+    h_a, w0, w1 = resid(coeffs, s_a, p, dt, kappa, Kc, d0, d1, z0, z1)
+    if h_a == 0.0:
+        return w0, w1
+    if h_a > 0.0:  # the root lies above s0
+        s_lo, h_lo = s_a, h_a
+        step = h_a + 1e-300  # the first trial is the fixed-point image |w(s0)|
+        s_hi, h_hi = s_lo, h_lo
+        for _ in range(2000):
+            s_hi = s_lo + step
             h_hi, w0, w1 = resid(coeffs, s_hi, p, dt, kappa, Kc, d0, d1, z0, z1)
-            if h_hi < 0.0:
+            if h_hi <= 0.0:
                 break
-            s_hi *= 2.0
-        side = 0
-        for _ in range(200):
-            s = (s_lo * h_hi - s_hi * h_lo) / (h_hi - h_lo)
-            h, w0, w1 = resid(coeffs, s, p, dt, kappa, Kc, d0, d1, z0, z1)
-            if h > 0.0:
-                s_lo, h_lo = s, h
-                if side == 1:
-                    h_hi *= 0.5
-                side = 1
-            else:
-                s_hi, h_hi = s, h
-                if side == -1:
-                    h_lo *= 0.5
-                side = -1
-            if s_hi - s_lo <= 1e-14 * s_hi or h == 0.0:
+            s_lo, h_lo = s_hi, h_hi
+            step *= 2.0
+        if h_hi == 0.0:
+            return w0, w1
+    else:  # below s0, at s = 0 at the latest
+        s_hi, h_hi = s_a, h_a
+        step = -h_a
+        s_lo, h_lo = s_hi, h_hi
+        for _ in range(2000):
+            s_lo = max(s_hi - step, 0.0)
+            h_lo, w0, w1 = resid(coeffs, s_lo, p, dt, kappa, Kc, d0, d1, z0, z1)
+            if h_lo >= 0.0:
                 break
+            s_hi, h_hi = s_lo, h_lo
+            step *= 2.0
+        if h_lo == 0.0:
+            return w0, w1
+    side = 0
+    for _ in range(200):
+        s = (s_lo * h_hi - s_hi * h_lo) / (h_hi - h_lo)
+        h, w0, w1 = resid(coeffs, s, p, dt, kappa, Kc, d0, d1, z0, z1)
+        if h > 0.0:
+            s_lo, h_lo = s, h
+            if side == 1:
+                h_hi *= 0.5
+            side = 1
+        else:
+            s_hi, h_hi = s, h
+            if side == -1:
+                h_lo *= 0.5
+            side = -1
+        if s_hi - s_lo <= 1e-14 * s_hi or h == 0.0:
+            break
     return w0, w1
 
 
 @njit(inline="always")
-def coeff_bearing_step(coeffs, rho, stateful, kappa, p, Kc, d0, d1, z0, z1, dt):
+def coeff_bearing_step(coeffs, rho, stateful, kappa, p, Kc, d0, d1, z0, z1, dt, s0):
     """One backward-Euler step of the bearing: massless halves in series with friction.
 
     Unknown slip rate w over the step; the slip increment w dt plus the chain's elastic
@@ -232,7 +258,7 @@ def coeff_bearing_step(coeffs, rho, stateful, kappa, p, Kc, d0, d1, z0, z1, dt):
     Returns (w0, w1, z0, z1, T0, T1): slip rate [rad/s], new bristle state [rad], friction
     torque carried by the bearing [N m].
     """
-    w0, w1 = solve_slip(coeff_residual, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1)
+    w0, w1 = solve_slip(coeff_residual, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1, s0)
     s = math.sqrt(w0 * w0 + w1 * w1)
     a, b = coeffs(s, p, dt, kappa)
     t0 = a * w0 + b * z0
@@ -249,7 +275,7 @@ def _no_coeffs(s, p, dt, kappa):
 
 
 @njit(cache=True)
-def switching_bearing_step(p, Kc, d0, d1, z0, z1, dt):
+def switching_bearing_step(p, Kc, d0, d1, z0, z1, dt, s0):
     """Coulomb switching, the elastic-plastic return map: stick (w = 0, T = Kc^-1 d) while
     |T| <= max(T_s, T_c), else slide with |T| = T_c along the slip (arguments and returns as
     :func:`coeff_bearing_step`)."""
@@ -258,6 +284,6 @@ def switching_bearing_step(p, Kc, d0, d1, z0, z1, dt):
     t1 = (Kc[0, 0] * d1 - Kc[1, 0] * d0) / det
     if math.sqrt(t0 * t0 + t1 * t1) <= max(p[SLOT_TS], p[SLOT_TC]):
         return 0.0, 0.0, 0.0, 0.0, t0, t1
-    w0, w1 = solve_slip(switching_residual, _no_coeffs, p, dt, 1.0, Kc, d0, d1, z0, z1)
+    w0, w1 = solve_slip(switching_residual, _no_coeffs, p, dt, 1.0, Kc, d0, d1, z0, z1, s0)
     s = math.sqrt(w0 * w0 + w1 * w1)
     return w0, w1, 0.0, 0.0, p[SLOT_TC] * w0 / s, p[SLOT_TC] * w1 / s

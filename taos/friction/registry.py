@@ -47,7 +47,7 @@ if TYPE_CHECKING:
 #: rates: (dz/dt [rad/s], T_f [N m]) = rates(v, z, t_app, p);
 #: zdot3: (dz0, dz1) [rad/s] = zdot3(w0, w1, z0, z1, p);
 #: torque3: (T0, T1) [N m] = torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p);
-#: bearing_step: (w0, w1, z0, z1, T0, T1) = bearing_step(p, Kc, d0, d1, z0, z1, dt)
+#: bearing_step: (w0, w1, z0, z1, T0, T1) = bearing_step(p, Kc, d0, d1, z0, z1, dt, s0)
 KERNELS = {"rates": "RATES_SIG", "zdot3": "ZDOT3_SIG", "torque3": "TORQUE3_SIG", "bearing_step": "BEARING_SIG"}
 
 
@@ -66,7 +66,7 @@ def signatures() -> dict:
     return {"RATES_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, p),
             "ZDOT3_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, f8, p),
             "TORQUE3_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, f8, f8, f8, f8, f8, p),
-            "BEARING_SIG": nt.UniTuple(f8, 6)(p, nt.float64[:, ::1], f8, f8, f8, f8, f8)}
+            "BEARING_SIG": nt.UniTuple(f8, 6)(p, nt.float64[:, ::1], f8, f8, f8, f8, f8, f8)}
 
 
 def __getattr__(name: str):

@@ -52,8 +52,9 @@ from .. import actuator_limits as _lim
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 N_BODY = 13  # p (3), quaternion (4), v (6)
-#: bearing state: phi (2) [rad], z (2) [rad], T (2) [N m], and phi, z one step back (BDF2)
-N_BEARING = 10
+#: bearing state: phi (2) [rad], z (2) [rad], T (2) [N m], phi and z one step back (BDF2), and
+#: the slip speed [rad/s] the next bearing solve continues from
+N_BEARING = 11
 #: recorded columns of :func:`integrate`
 REC = ("theta_pitch", "theta_yaw", "xp_pitch", "xp_yaw", "fl_pitch", "fl_yaw", "tf_pitch", "tf_yaw",
        "z_pitch", "z_yaw", "phi_pitch", "phi_yaw", "u_pitch", "u_yaw",
@@ -361,7 +362,8 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     ph1 = (4.0 * bs[1] - bs[7]) * (1.0 / 3.0)
     zh0 = (4.0 * bs[2] - bs[8]) * (1.0 / 3.0)
     zh1 = (4.0 * bs[3] - bs[9]) * (1.0 / 3.0)
-    w0, w1, z0, z1, t0, t1 = fid(fp, P[4], ps0 - ph0, ps1 - ph1, zh0, zh1, h)
+    w0, w1, z0, z1, t0, t1 = fid(fp, P[4], ps0 - ph0, ps1 - ph1, zh0, zh1, h, bs[10])
+    bs[10] = math.sqrt(w0 * w0 + w1 * w1)  # the slip speed the next solve continues from
     bs[6] = bs[0]
     bs[7] = bs[1]
     bs[8] = bs[2]
