@@ -7,12 +7,18 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
 
 1. Speed: 60 s two-axis Green Run profile (models/profiles/greenrun_two_axis.toml repeated to
    60 s, as benchmarks/bench_taos.py), hot-fire FEM gimbal, modified-LuGre bearing, at the
-   model's default step (taos.taos3d.simulate.DEFAULT_DT_S, 2e-4 s) and at 4e-4 s; records
-   every 2 ms. Best and median of ``--repeat`` runs (the machine is shared: both are printed).
+   model's default step (taos.taos3d.simulate.DEFAULT_DT_S, 4e-4 s) and at 2e-4 s (the former
+   default); records every 2 ms. Best and median of ``--repeat`` runs (the machine is
+   shared: both are printed).
 2. Accuracy of the step: 4 s of the same run (modified LuGre, and Coulomb smooth, whose error
    is not masked by stick-slip timing) against a 2.5e-5 s reference, at the default step and
-   at 4e-4 s, beside the former kernel's error (held bearing torque, 2e-4 s; its records are
-   stored in tests/data/taos3d_kernel_2e-4_held.npz) against the same reference.
+   at 2e-4 s, beside the former kernel's error (held bearing torque, backward-Euler bearing,
+   2e-4 s; its records are stored in tests/data/taos3d_kernel_2e-4_held.npz) against the
+   same reference. Then sine dwells (``taos_freqresp_family``, pitch, 0.5-20 Hz, 0.05 and
+   0.4 deg) at the default step and 2e-4 s against 6.25e-6 s, and the 1.25e-5 s run against
+   6.25e-6 s (how far the reference itself has converged); with TAOS_BEFORE=<checkout of the
+   former kernel> the former kernel's dwells at 2e-4 and 1.25e-5 s are run from that source
+   tree on this venv and compared with the same reference (``--no-dwells`` skips this part).
 3. Peer: MuJoCo (mujoco.rollout, native loop, one thread) with the same rigid engine (mass,
    c.g. and inertia of the Pinocchio model, pivot at the gimbal point O, gravity off as in
    TAOS where it is inside K_n) on two hinges (pitch about +y, yaw about -x, the TAOS axes)
@@ -26,7 +32,9 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import os
 import statistics
 import subprocess
 import time
@@ -48,7 +56,7 @@ FRICTION = "modified-lugre"
 T_RUN = 60.0
 REC_S = 2e-3  # record interval [s]
 OLD_DT = 2e-4  # the former kernel's step (its stored records)
-ALT_DT = 4e-4  # twice the default: speed and accuracy for comparison
+ALT_DT = 2e-4  # the former default, half the step: speed and accuracy for comparison
 REF_DT = 2.5e-5
 T_ACC = 4.0
 OLD_REF = Path(__file__).resolve().parent.parent / "tests" / "data" / "taos3d_kernel_2e-4_held.npz"
@@ -94,12 +102,63 @@ def accuracy(prof):
             _, cmd = commands(prof, T_ACC, dt)
             return run_samples(tm, cmd, dt, int(round(0.01 / dt)))  # every 10 ms, as the stored records
         ref = run(REF_DT)
-        rows = [(f"dt {dt:g} s (this kernel)", run(dt)) for dt in sorted({DEFAULT_DT_S, ALT_DT}, reverse=True)]
+        rows = [(f"dt {dt:g} s (this kernel)", run(dt)) for dt in (DEFAULT_DT_S, ALT_DT)]
         if OLD_REF.exists():  # records every 10 ms: theta (2), x_p (2), F_L (2), T_f (2)
-            rows.append((f"dt {OLD_DT:g} s (former kernel, T held)", np.load(OLD_REF)[law]))
+            rows.append((f"dt {OLD_DT:g} s (former kernel, T held, BE)", np.load(OLD_REF)[law]))
         for name, a in rows:
             e = errors(a[:, :8], ref[:, :8])
             print(f"    {law:15s} {name:36s} {e[0]:.2e}  {e[1]:.2e}  {e[2]:7.1f}  {e[3]:7.1f}  {e[4]:.2e}")
+
+
+DWELL_F = np.geomspace(0.5, 20.0, 8)  # [Hz]
+DWELL_A = (0.05, 0.4)  # [deg]
+DWELL_LAWS = (FRICTION, "coulomb-smooth")
+
+DWELL_CODE = """
+import json, sys, numpy as np
+from taos.taos3d import load_taos_model
+from taos.taos3d.simulate import taos_freqresp_family
+out = {}
+for law in %r:
+    tm = load_taos_model(%r, friction=law)
+    for dt in %r:
+        fam = taos_freqresp_family(tm, np.array(%r), np.radians(%r), dt_max_s=dt)
+        out[f"{law} {dt:g}"] = [[[v.real, v.imag] for v in r.engine] + [[v.real, v.imag] for v in r.piston] for r in fam]
+json.dump(out, sys.stdout)
+"""
+
+
+def dwells(dts, cwd=None, pythonpath=None):
+    """Engine and piston responses of DWELL_LAWS x DWELL_A x DWELL_F at each step, by the
+    source tree ``pythonpath`` (default: this one) in a subprocess: {"law dt": (amp, 2 F) complex}."""
+    code = DWELL_CODE % (DWELL_LAWS, MODEL, tuple(dts), DWELL_F.tolist(), DWELL_A)
+    env = dict(os.environ, PYTHONPATH=pythonpath) if pythonpath else None
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=cwd, env=env)
+    return {k: np.array(v)[..., 0] + 1j * np.array(v)[..., 1] for k, v in json.loads(res.stdout).items()}
+
+
+def dwell_accuracy():
+    n = len(DWELL_F)
+    print(f"[dwells] pitch sine dwells {DWELL_F[0]:g}-{DWELL_F[-1]:g} Hz ({n} points), max over the frequencies of "
+          f"|d gain| dB / |d phase| deg against this kernel at 6.25e-6 s; engine | piston")
+    new = dwells((DEFAULT_DT_S, ALT_DT, 1.25e-5, 6.25e-6))
+    rows = [(f"this kernel, dt {dt:g} s", new, dt) for dt in (DEFAULT_DT_S, ALT_DT, 1.25e-5)]
+    before = os.environ.get("TAOS_BEFORE")
+    if before:
+        old = dwells((OLD_DT, 1.25e-5), cwd=before, pythonpath=before)
+        rows += [(f"former kernel, dt {dt:g} s", old, dt) for dt in (OLD_DT, 1.25e-5)]
+    for law in DWELL_LAWS:
+        ref = new[f"{law} {6.25e-6:g}"]
+        for name, d, dt in rows:
+            r = d[f"{law} {dt:g}"] / ref
+            db, ph = np.abs(20 * np.log10(np.abs(r))), np.abs(np.degrees(np.angle(r)))
+            cells = "   ".join(f"{a:g} deg: {db[k, :n].max():.3f} dB {ph[k, :n].max():.2f} deg | "
+                               f"{db[k, n:].max():.3f} dB {ph[k, n:].max():.2f} deg" for k, a in enumerate(DWELL_A))
+            print(f"    {law:15s} {name:30s} {cells}")
+    law = FRICTION
+    print(f"[dwells] {law}, {DWELL_A[0]:g} deg, engine gain [dB] at " + " ".join(f"{f:.3g}" for f in DWELL_F) + " Hz:")
+    for name, d, dt in [("this kernel, dt 6.25e-06 s", new, 6.25e-6)] + rows:
+        print(f"    {name:30s} " + " ".join(f"{v:7.3f}" for v in 20 * np.log10(np.abs(d[f'{law} {dt:g}'][0, :n]))))
 
 
 def mujoco_xml(tm, dt):
@@ -171,6 +230,7 @@ def mujoco_peer(tm, prof, repeat, taos_rec):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--no-dwells", action="store_true", help="skip the sine-dwell accuracy part")
     args = ap.parse_args()
     up = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     print(f"machine load (uptime): {up}")
@@ -182,6 +242,8 @@ def main():
     taos_speed(tm, prof, ALT_DT, args.repeat)
     mujoco_peer(tm, prof, args.repeat, rec)
     accuracy(prof)
+    if not args.no_dwells:
+        dwell_accuracy()
     print(f"machine load (uptime): {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
 
 

@@ -163,7 +163,7 @@ def _write_h5(path: Path, th, linear: dict, dwell: dict, run: dict) -> None:
 # -- the report -------------------------------------------------------------------------------
 
 def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, friction: str | None = None,
-                    engine: str = "simplex", progress: bool = True, dt_s: float = 2e-4,
+                    engine: str = "simplex", progress: bool = True, dt_s: float | None = None,
                     view_angle_scale: float = 5.0, view_fps: float = 100.0, allow_unstable: bool = False,
                     spec_path=DEFAULT_SPEC, data_path=None) -> Path:
     """Build the Green Run report folder ``out_dir`` (see the module docstring); returns its path.
@@ -183,8 +183,8 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
         FEM two-half gimbal, spherical-bearing friction; :mod:`taos.taos3d`).
     progress : bool
         tqdm progress bar on standard error.
-    dt_s : float
-        Integration step [s].
+    dt_s : float, optional
+        Integration step [s]; default the engine's own (:func:`taos.cli.basic.engine_default_dt_s`).
     view_angle_scale : float
         Engine-angle exaggeration of the embedded 3-D view [-].
     view_fps : float
@@ -226,6 +226,9 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     if not isinstance(profile, TwoAxis):
         raise InputError(str(ppath), "(profile)", "a two-axis profile with [pitch] and [yaw] tables",
                          got=type(profile).__name__)
+    if dt_s is None:
+        from taos.cli.basic import engine_default_dt_s
+        dt_s = engine_default_dt_s(engine)
     run_checks.check_run(model, profile, dt_s)
     run_checks.check_linear_stability(model, allow=allow_unstable)
     from taos.cli.report_extras import data_responses, spec_results
