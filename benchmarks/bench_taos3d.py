@@ -19,6 +19,9 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
    6.25e-6 s (how far the reference itself has converged); with TAOS_BEFORE=<checkout of the
    former kernel> the former kernel's dwells at 2e-4 and 1.25e-5 s are run from that source
    tree on this venv and compared with the same reference (``--no-dwells`` skips this part).
+   Energy balance of a free swing with bearing friction (the test
+   tests/test_taos3d.py::test_energy_balance_with_bearing_friction, at four steps; the former
+   kernel's too with TAOS_BEFORE).
 3. Peer: MuJoCo (mujoco.rollout, native loop, one thread) with the same rigid engine (mass,
    c.g. and inertia of the Pinocchio model, pivot at the gimbal point O, gravity off as in
    TAOS where it is inside K_n) on two hinges (pitch about +y, yaw about -x, the TAOS axes)
@@ -161,6 +164,52 @@ def dwell_accuracy():
         print(f"    {name:30s} " + " ".join(f"{v:7.3f}" for v in 20 * np.log10(np.abs(d[f'{law} {dt:g}'][0, :n]))))
 
 
+ENERGY_CODE = """
+import json, sys, numpy as np
+sys.path.insert(0, %r)
+from test_taos3d import _free_engine
+from taos.model import load_model
+from taos.taos3d import dynamics as dy
+from taos.taos3d.simulate import rest_state
+hot = load_model(%r)
+out = {}
+for law in %r:
+    pk, energy = _free_engine(hot, law)
+    for dt in %r:
+        x = rest_state(pk)
+        x[7:13] = [0, 0, 0, 0.03, -0.04, 0.002]
+        E0 = energy(x, np.zeros(2))
+        bs = np.zeros(getattr(dy, "N_BEARING", 6))  # 6 in the former kernel
+        n = int(round(1.0 / dt))
+        rec = np.empty((n + 1, len(dy.REC)))
+        assert dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, x, bs, np.zeros((n + 1, 2)), dt, 1, rec) == -1
+        work = np.sum(0.5 * (rec[1:, 6:8] + rec[:-1, 6:8]) * np.diff(rec[:, 10:12], axis=0))
+        out[f"{law} {dt:g}"] = (energy(x, bs[0:2]) + work - E0) / E0
+json.dump(out, sys.stdout)
+"""
+ENERGY_LAWS = ("coulomb-smooth", "coulomb-switching", "dahl", FRICTION)
+
+
+def energy_balance():
+    """Free swing, 1 s (tests/test_taos3d.py::test_energy_balance_with_bearing_friction): energy
+    left + work on the bearing - energy given, relative to the energy given, at four steps;
+    the former kernel's too with TAOS_BEFORE."""
+    tests = str(Path(__file__).resolve().parent.parent / "tests")
+    dts = (8e-4, 4e-4, 2e-4, 1e-4)
+    runs = [("this kernel", None)]
+    if os.environ.get("TAOS_BEFORE"):
+        runs.append(("former kernel", os.environ["TAOS_BEFORE"]))
+    print("[energy] free swing 1 s, friction on: (energy left + work on the bearing - energy given) / energy given "
+          "at dt " + ", ".join(f"{dt:g}" for dt in dts) + " s")
+    for name, tree in runs:
+        env = dict(os.environ, PYTHONPATH=tree) if tree else None
+        res = subprocess.run([sys.executable, "-c", ENERGY_CODE % (tests, MODEL, ENERGY_LAWS, dts)],
+                             capture_output=True, text=True, check=True, cwd=tree, env=env)
+        r = json.loads(res.stdout)
+        for law in ENERGY_LAWS:
+            print(f"    {name:14s} {law:18s} " + "  ".join(f"{r[f'{law} {dt:g}']:+.2e}" for dt in dts))
+
+
 def mujoco_xml(tm, dt):
     eng, act = tm.base.engine, tm.base.actuator
     cg = tm.geometry.engine_cg_m
@@ -242,6 +291,7 @@ def main():
     taos_speed(tm, prof, ALT_DT, args.repeat)
     mujoco_peer(tm, prof, args.repeat, rec)
     accuracy(prof)
+    energy_balance()
     if not args.no_dwells:
         dwell_accuracy()
     print(f"machine load (uptime): {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
