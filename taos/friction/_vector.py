@@ -182,8 +182,8 @@ def solve_slip(resid, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1, s0):
     """Slip rate (w0, w1) [rad/s] solving the scalar consistency resid(s) = 0, continued from
     the previous step's slip speed ``s0`` [rad/s]: the residual's sign at s0 says which way the
     slip speed moves (up while |w(s)| > s); a bracket grows from s0 that way, first to the
-    fixed-point image |w(s0)|, then by doubling steps, until the sign changes (resid(0) >= 0, so downwards it ends at s = 0 at the
-    latest), then bracketed Illinois regula falsi on it. Where the backward-Euler equation has
+    fixed-point image |w(s0)|, then by doubling steps, until the sign changes (resid(0) >= 0,
+    so downwards it ends at s = 0 at the latest), then bracketed Illinois regula falsi on it. Where the backward-Euler equation has
     several roots (Stribeck friction falling with the slip speed faster than dt / Kc) this
     keeps the branch the bearing is on while that branch exists (stick-slip hysteresis: the
     limit of a vanishing bearing inertia relaxing the slip speed from s0)."""
@@ -254,7 +254,9 @@ def coeff_bearing_step(coeffs, rho, stateful, kappa, p, Kc, d0, d1, z0, z1, dt, 
     factor ``kappa`` is frozen at the step start (exact for alpha = 1).
 
     Parameters: ``p`` packed (scaled) friction vector; ``Kc`` (2, 2) chain pitch/yaw
-    compliance [rad/(N m)]; ``d`` [rad]; ``z`` [rad]; ``dt`` [s].
+    compliance [rad/(N m)]; ``d`` [rad]; ``z`` [rad]; ``dt`` [s]; ``s0`` the previous step's
+    slip speed [rad/s], where the solve starts (:func:`solve_slip`: with several roots it
+    keeps the branch the bearing is on).
     Returns (w0, w1, z0, z1, T0, T1): slip rate [rad/s], new bristle state [rad], friction
     torque carried by the bearing [N m].
     """

@@ -436,7 +436,8 @@ def _record(x, bs, c, u0, u1, P, avp, aux, dxs, out):
 def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     """Integrate over command samples ``r`` (n_steps + 1, 2) [rad] every ``dt`` [s],
     recording :data:`REC` every ``rec_every`` steps into ``out``. Returns -1 or the first
-    step whose state became non-finite. ``x0``/``bs0`` are updated to the final state."""
+    step whose state became non-finite. ``x0``/``bs0`` (the bearing state, :data:`N_BEARING`;
+    zeros at rest) are updated to the final state."""
     n = x0.shape[0]
     x = x0
     bs = bs0

@@ -72,6 +72,7 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
                    tm.base.engine.rotational_stiffness_Nm_per_rad, L0[0], L0[1]])
     cL = tm.base.structure.load_damping_Ns_per_m(tm.base.actuator.moment_arm_m, tm.base.engine.inertia("pitch"))
     sc = np.concatenate([sc, [cL, act.states.index("v_p_m_s")], actuator_limits(tm)])
+    # P[14] = Ks S Kc: the chain wrench per unit bearing torque (dynamics._torque_kick)
     P = (f64(Y), f64(np.linalg.inv(Y)), f64(Ks), f64(G), f64(Kc), f64(S), f64(geo.structure_attach_m),
          f64(geo.engine_attach_m), f64(act.A), f64(act.B[:, act.input_index("x_c_m")]),
          f64(act.B[:, act.input_index("f_load_N")]), f64(act.C[act.output_index("x_p_m")]),
