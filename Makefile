@@ -19,8 +19,14 @@ $(STAMP): pyproject.toml setup.py
 	  $(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# numba's on-disk cache keys each kernel on its own file only: a kernel that inlines code from
+# another file (the friction laws' bearing steps, the 3-D step) keeps its old machine code when
+# only that other file changes. So after any source change `make test` drops the whole kernel
+# cache and warms it again (about a minute); a fresh clone has no cache to drop.
+KERNEL_SOURCES := $(shell find taos -name '*.py' -not -path '*/__pycache__/*')
 WARM := $(VENV)/.warm
-$(WARM): $(STAMP)
+$(WARM): $(STAMP) $(KERNEL_SOURCES)
+	find taos -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
 	$(BIN)/python -m taos.cli.warmup
 	touch $(WARM)
 
