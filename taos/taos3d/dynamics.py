@@ -43,7 +43,10 @@ Against a 6.25e-6 s reference on the 60 s two-axis Green Run (first 4 s) the smo
 error at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler
 bearing) at 2e-4 s, and modified LuGre's is the same (set by one stick-slip event's
 timing); small-amplitude modified-LuGre sine dwells now converge with the step
-(tests/test_taos3d_step.py, benchmarks/bench_taos3d.py). The stiff bearing time constant
+(tests/test_taos3d_step.py, benchmarks/bench_taos3d.py). The implicit bearing equation is
+multi-valued only where Kc |dT/ds| > 2 dt / 3, so a Stribeck law's stick-slip hysteresis is
+resolved only at fine steps (modified LuGre at 0.4 deg near the resonance: up to 0.6 dB
+between 4e-4 s and 1.25e-5 s, as with the former kernel; benchmarks/RESULTS.md). The stiff bearing time constant
 never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
 the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
 omega dt < 2.8 for RK4); accuracy sets the default 4e-4 s. A quantised command is piecewise
