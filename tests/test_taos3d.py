@@ -137,8 +137,9 @@ def test_planar_limit_matches_simplex(hot):
 
 
 def _free_engine(hot, law, halves=()):
-    """The hot-fire 3-D model (gimbal halves ``halves``, default the FEM ones) with servo, seal, leakage and structural damping off (no flow from
-    the valve) and bearing friction ``law``; returns (packed model, energy(x, phi)): the
+    """The hot-fire 3-D model (gimbal halves ``halves``, default the FEM ones) with servo,
+    seal, leakage and structural damping off (no flow from the valve) and bearing friction
+    ``law``; returns (packed model, energy(x, phi)): the
     mechanical energy [J] at state x with bearing slip phi: engine kinetic, chain
     (d = e - S phi, W = K_s d), feedline/gravity spring K_n, actuator lines, piston kinetic
     and oil compression. Friction's bristle energy is not in it: the work T . dphi done on
