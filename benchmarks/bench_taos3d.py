@@ -131,13 +131,19 @@ json.dump(out, sys.stdout)
 """
 
 
-def dwells(dts, cwd=None, pythonpath=None):
+def run_in_tree(code, tree=None):
+    """Run ``code`` in a child interpreter on this venv with the source tree ``tree`` (default:
+    this one) first on the path and as the working folder; returns its JSON on stdout."""
+    env = dict(os.environ, PYTHONPATH=tree) if tree else None
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=tree, env=env)
+    return json.loads(res.stdout)
+
+
+def dwells(dts, tree=None):
     """Engine and piston responses of DWELL_LAWS x DWELL_A x DWELL_F at each step, by the
-    source tree ``pythonpath`` (default: this one) in a subprocess: {"law dt": (amp, 2 F) complex}."""
-    code = DWELL_CODE % (DWELL_LAWS, MODEL, tuple(dts), DWELL_F.tolist(), DWELL_A)
-    env = dict(os.environ, PYTHONPATH=pythonpath) if pythonpath else None
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=cwd, env=env)
-    return {k: np.array(v)[..., 0] + 1j * np.array(v)[..., 1] for k, v in json.loads(res.stdout).items()}
+    source tree ``tree`` (default: this one): {"law dt": (amp, 2 F) complex}."""
+    out = run_in_tree(DWELL_CODE % (DWELL_LAWS, MODEL, tuple(dts), DWELL_F.tolist(), DWELL_A), tree)
+    return {k: np.array(v)[..., 0] + 1j * np.array(v)[..., 1] for k, v in out.items()}
 
 
 def dwell_accuracy():
@@ -148,7 +154,7 @@ def dwell_accuracy():
     rows = [(f"this kernel, dt {dt:g} s", new, dt) for dt in (DEFAULT_DT_S, ALT_DT, 1.25e-5)]
     before = os.environ.get("TAOS_BEFORE")
     if before:
-        old = dwells((OLD_DT, 1.25e-5), cwd=before, pythonpath=before)
+        old = dwells((OLD_DT, 1.25e-5), before)
         rows += [(f"former kernel, dt {dt:g} s", old, dt) for dt in (OLD_DT, 1.25e-5)]
     for law in DWELL_LAWS:
         ref = new[f"{law} {6.25e-6:g}"]
@@ -202,10 +208,7 @@ def energy_balance():
     print("[energy] free swing 1 s, friction on: (energy left + work on the bearing - energy given) / energy given "
           "at dt " + ", ".join(f"{dt:g}" for dt in dts) + " s")
     for name, tree in runs:
-        env = dict(os.environ, PYTHONPATH=tree) if tree else None
-        res = subprocess.run([sys.executable, "-c", ENERGY_CODE % (tests, MODEL, ENERGY_LAWS, dts)],
-                             capture_output=True, text=True, check=True, cwd=tree, env=env)
-        r = json.loads(res.stdout)
+        r = run_in_tree(ENERGY_CODE % (tests, MODEL, ENERGY_LAWS, dts), tree)
         for law in ENERGY_LAWS:
             print(f"    {name:14s} {law:18s} " + "  ".join(f"{r[f'{law} {dt:g}']:+.2e}" for dt in dts))
 

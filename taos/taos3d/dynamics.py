@@ -131,6 +131,20 @@ def _rotation(qx, qy, qz, qw):
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _rv(R, a0, a1, a2):
+    """R a for R the row-major 9-tuple of :func:`_rotation` (body -> world)."""
+    return (R[0] * a0 + R[1] * a1 + R[2] * a2, R[3] * a0 + R[4] * a1 + R[5] * a2,
+            R[6] * a0 + R[7] * a1 + R[8] * a2)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _rtv(R, a0, a1, a2):
+    """R^T a for R the row-major 9-tuple of :func:`_rotation` (world -> body)."""
+    return (R[0] * a0 + R[3] * a1 + R[6] * a2, R[1] * a0 + R[4] * a1 + R[7] * a2,
+            R[2] * a0 + R[5] * a1 + R[8] * a2)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _world_torque(r0, r1, r2, th, g0, g1, g2):
     """World torque Jl(r)^-T g [N m] of the generalized torque g conjugate to the rotation
     vector r [rad] (angle th [rad]): g + r x g / 2 + c r x (r x g),
@@ -166,7 +180,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     na = Aa.shape[0]
     p0, p1, p2 = x[0], x[1], x[2]
     qx, qy, qz, qw = x[3], x[4], x[5], x[6]
-    R00, R01, R02, R10, R11, R12, R20, R21, R22 = _rotation(qx, qy, qz, qw)
+    R = _rotation(qx, qy, qz, qw)
     r0, r1, r2, th = _logq4(qx, qy, qz, qw)
     # bearing slip and chain wrench
     phi0 = (G[0, 0] * p0 + G[0, 1] * p1 + G[0, 2] * p2 + G[0, 3] * r0 + G[0, 4] * r1 + G[0, 5] * r2
@@ -184,9 +198,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     g2 = -W5 - Kn * (axes[0, 2] * tp + axes[1, 2] * ty)
     wx, wy, wz = x[10], x[11], x[12]
     if lim.shape[0] > 0 and lim[4] > 0.0:  # hard stops at the gimbal range (taos.actuator_limits)
-        wo0 = R00 * wx + R01 * wy + R02 * wz
-        wo1 = R10 * wx + R11 * wy + R12 * wz
-        wo2 = R20 * wx + R21 * wy + R22 * wz
+        wo0, wo1, wo2 = _rv(R, wx, wy, wz)
         wp = axes[0, 0] * wo0 + axes[0, 1] * wo1 + axes[0, 2] * wo2
         wyw = axes[1, 0] * wo0 + axes[1, 1] * wo1 + axes[1, 2] * wo2
         tsp = _lim.stop_torque(tp, wp, lim[4], lim[5], lim[6])
@@ -200,9 +212,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     # actuators
     for a in range(2):
         e0, e1, e2 = Eatt[a, 0], Eatt[a, 1], Eatt[a, 2]
-        l0 = R00 * e0 + R01 * e1 + R02 * e2  # lever R E_a
-        l1 = R10 * e0 + R11 * e1 + R12 * e2
-        l2 = R20 * e0 + R21 * e1 + R22 * e2
+        l0, l1, l2 = _rv(R, e0, e1, e2)  # lever R E_a
         E0 = p0 + l0 - Satt[a, 0]
         E1 = p1 + l1 - Satt[a, 1]
         E2 = p2 + l2 - Satt[a, 2]
@@ -217,8 +227,8 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
             b0 += vx
             b1 += vy
             b2 += vz
-            Ld = (E0 * (R00 * b0 + R01 * b1 + R02 * b2) + E1 * (R10 * b0 + R11 * b1 + R12 * b2)
-                  + E2 * (R20 * b0 + R21 * b1 + R22 * b2))
+            Rb0, Rb1, Rb2 = _rv(R, b0, b1, b2)
+            Ld = E0 * Rb0 + E1 * Rb1 + E2 * Rb2
             F += cL * (x[off + ivp] - Ld / L)
         fl0 = F * E0 / L
         fl1 = F * E1 / L
@@ -243,17 +253,17 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     c10, c11, c12 = _cross3(wx, wy, wz, Yv0, Yv1, Yv2)
     c20, c21, c22 = _cross3(wx, wy, wz, Yv3, Yv4, Yv5)
     c30, c31, c32 = _cross3(vx, vy, vz, Yv0, Yv1, Yv2)
-    f0 = R00 * Fw0 + R10 * Fw1 + R20 * Fw2 - c10
-    f1 = R01 * Fw0 + R11 * Fw1 + R21 * Fw2 - c11
-    f2 = R02 * Fw0 + R12 * Fw1 + R22 * Fw2 - c12
-    f3 = R00 * Tw0 + R10 * Tw1 + R20 * Tw2 - (c20 + c30)
-    f4 = R01 * Tw0 + R11 * Tw1 + R21 * Tw2 - (c21 + c31)
-    f5 = R02 * Tw0 + R12 * Tw1 + R22 * Tw2 - (c22 + c32)
+    f0, f1, f2 = _rtv(R, Fw0, Fw1, Fw2)
+    f3, f4, f5 = _rtv(R, Tw0, Tw1, Tw2)
+    f0 -= c10
+    f1 -= c11
+    f2 -= c12
+    f3 -= c20 + c30
+    f4 -= c21 + c31
+    f5 -= c22 + c32
     for i in range(6):
         dx[7 + i] = _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
-    dx[0] = R00 * vx + R01 * vy + R02 * vz
-    dx[1] = R10 * vx + R11 * vy + R12 * vz
-    dx[2] = R20 * vx + R21 * vy + R22 * vz
+    dx[0], dx[1], dx[2] = _rv(R, vx, vy, vz)
     dx[3] = 0.5 * (qw * wx + qy * wz - qz * wy)
     dx[4] = 0.5 * (qw * wy + qz * wx - qx * wz)
     dx[5] = 0.5 * (qw * wz + qx * wy - qy * wx)
@@ -284,15 +294,11 @@ def _torque_kick(x, d0, d1, h, P):
     g1 = -(BT[4, 0] * d0 + BT[4, 1] * d1)
     g2 = -(BT[5, 0] * d0 + BT[5, 1] * d1)
     qx, qy, qz, qw = x[3], x[4], x[5], x[6]
-    R00, R01, R02, R10, R11, R12, R20, R21, R22 = _rotation(qx, qy, qz, qw)
+    R = _rotation(qx, qy, qz, qw)
     r0, r1, r2, th = _logq4(qx, qy, qz, qw)
     Tw0, Tw1, Tw2 = _world_torque(r0, r1, r2, th, g0, g1, g2)
-    f0 = R00 * dF0 + R10 * dF1 + R20 * dF2
-    f1 = R01 * dF0 + R11 * dF1 + R21 * dF2
-    f2 = R02 * dF0 + R12 * dF1 + R22 * dF2
-    f3 = R00 * Tw0 + R10 * Tw1 + R20 * Tw2
-    f4 = R01 * Tw0 + R11 * Tw1 + R21 * Tw2
-    f5 = R02 * Tw0 + R12 * Tw1 + R22 * Tw2
+    f0, f1, f2 = _rtv(R, dF0, dF1, dF2)
+    f3, f4, f5 = _rtv(R, Tw0, Tw1, Tw2)
     for i in range(6):
         x[7 + i] += h * _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
 
