@@ -16,9 +16,9 @@ import numpy as np
 import scipy.integrate
 
 from taos.flight.describing import describing_function_map
-from taos.freqresp import settle_time_s
+from taos.planar.freqresp import settle_time_s
 from taos.model import load_model
-from taos.simplex import simplex_plant
+from taos.planar.simplex import simplex_plant
 
 DEG = math.pi / 180
 AMPS = np.logspace(np.log10(0.02), 0, 8) * DEG

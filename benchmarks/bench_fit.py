@@ -5,7 +5,7 @@ scipy.optimize.least_squares with finite-difference Jacobians on the same proble
 
 Data: the hot-fire model with a LuGre law reduced to its Dahl core plus viscous damping
 (T_s = T_c, sigma_1 = 0: the surrogate's friction element is then exact under a sinusoidal
-rate; the loop's harmonics are what the defect correction adds), time-domain sine dwells (taos.freqresp.sine_dwell_grid) at the Green
+rate; the loop's harmonics are what the defect correction adds), time-domain sine dwells (taos.planar.freqresp.sine_dwell_grid) at the Green
 Run amplitudes (0.4 deg to 7 Hz, 0.8 deg above), 20 log-spaced frequencies 0.3-14 Hz, 0.5 %
 complex noise. Same start (K_L 150,000 lbf/in, T_c 100,000 in-lbf, sigma_0 and sigma_2 x 2),
 same bounds, same residual function (the CasADi surrogate evaluated numerically for scipy,
@@ -31,7 +31,7 @@ sys.path.insert(0, str(ROOT))
 from taos.identify.estimate import MeasuredResponse  # noqa: E402
 from taos.identify.fit import FitProblem, _pack, _stack_points, fit_frequency_response  # noqa: E402
 from taos.identify.surrogate import solve_implicit  # noqa: E402
-from taos.freqresp import sine_dwell_grid  # noqa: E402
+from taos.planar.freqresp import sine_dwell_grid  # noqa: E402
 from taos.model import load_model  # noqa: E402
 from taos.units import to_si  # noqa: E402
 

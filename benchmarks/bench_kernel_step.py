@@ -11,8 +11,8 @@ saved to OUT.npz so two checkouts' results can be compared number for number.
 import math, sys, time
 import numpy as np
 from taos.model import load_model
-from taos.simplex import simplex_plant
-from taos.simulate import integrate_plant
+from taos.planar.simplex import simplex_plant
+from taos.planar.simulate import integrate_plant
 from taos.taos3d import load_taos_model
 from taos.taos3d.simulate import run_samples, pack
 from taos.profiles import load_profile

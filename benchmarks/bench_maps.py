@@ -73,7 +73,7 @@ def simulated_s(settle_s, amps, freqs, settle_cycles=2, measure_cycles=2):
 def main(quick=False):
     from bench_df_grid import scipy_dwell
 
-    from taos.freqresp import settle_time_s, sine_dwell_grid, sine_dwell_points
+    from taos.planar.freqresp import settle_time_s, sine_dwell_grid, sine_dwell_points
     from taos.linear import gain_db
     from taos.model import load_model
 

@@ -79,7 +79,7 @@ def main() -> int:
     from taos.identify.data import from_time_history
     from taos.model import load_model
     from taos.profiles import load_profile
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     csv = work / "record.csv"
     th = simulate(load_model(model), load_profile(prof), record_every=5)

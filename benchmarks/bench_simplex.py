@@ -18,11 +18,11 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from taos import avionics as av
+from taos.planar import avionics as av
 from taos.model import load_model
 from taos.profiles import MultiRamp, Sequence, SineDwell
-from taos.simplex import simplex_plant
-from taos.simulate import kernel_args, simulate
+from taos.planar.simplex import simplex_plant
+from taos.planar.simulate import kernel_args, simulate
 
 DEG = math.pi / 180
 T = 20.0

@@ -23,7 +23,7 @@ import time
 import numpy as np
 import scipy.integrate
 
-from taos.freqresp import sine_dwell_grid
+from taos.planar.freqresp import sine_dwell_grid
 from taos.linear import gain_db
 from taos.profiles import Sequence, TwoAxis, load_profile
 from taos.taos3d import load_taos_model, two_axis_dwell
@@ -53,7 +53,7 @@ def naive_rhs_factory(tm, cmd_fun):
     n = pk.n_state
     Kphi = np.linalg.inv(P[4])
     aux = np.empty(12)
-    from taos import avionics as av
+    from taos.planar import avionics as av
 
     def f(t, y):
         x = y[:n]

@@ -4,7 +4,7 @@ masv imports taos; taos never imports masv.
 
 Modules: :mod:`masv.structure` (modal model, file contract, validation, static correction),
 :mod:`masv.config` (TOML configuration: engines, actuators, structure, band of interest),
-:mod:`masv.system` (assembly of taos.simplex.simplex_state_space engine-axis blocks, the engines'
+:mod:`masv.system` (assembly of taos.planar.simplex.simplex_state_space engine-axis blocks, the engines'
 mass and c.g. offset, and the modes; one StateSpace of the whole, and a fast block-elimination
 frequency response),
 :mod:`masv.analysis` (8x8 responses, notches, coupling, closed-loop eigenvalues, loop margins,

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from taos.freqresp import FrequencyResponse
+from taos.planar.freqresp import FrequencyResponse
 from taos.linear import gain_db, notch_hz, phase_deg
-from taos.margins import loop_margins as _loop_margins
-from taos.simplex import simplex_state_space
+from taos.stability import loop_margins as _loop_margins
+from taos.planar.simplex import simplex_state_space
 
 from .system import MasvSystem, build_system
 
@@ -212,7 +212,7 @@ def _crossing(x, y0, y1):
 
 def margins_from_loop(name: str, f: np.ndarray, L: np.ndarray) -> LoopMargin:
     """Gain and phase margins of loop transfer L sampled on ascending f: the smallest over every
-    crossing that :func:`taos.margins.loop_margins` finds (interpolated between samples)."""
+    crossing that :func:`taos.stability.loop_margins` finds (interpolated between samples)."""
     if not np.any(L):  # no loop (e.g. the TVSE loop on a rigid structure)
         return LoopMargin(name, math.inf, None, math.inf, None)
     lm = _loop_margins(f, L)

@@ -38,7 +38,7 @@ def plot_gain_grid(fr: MasvFrequencyResponse, kind: str = "engine", floor_db: fl
 
 def plot_actuator_vs_simplex(fr: MasvFrequencyResponse, name: str, simplex):
     """Bode plot of actuator ``name``'s own response in MASV beside the simplex model's
-    (``simplex`` a taos.freqresp.FrequencyResponse on the same or any frequency grid)."""
+    (``simplex`` a taos.planar.freqresp.FrequencyResponse on the same or any frequency grid)."""
     import matplotlib.pyplot as plt
 
     from taos.linear import phase_deg

@@ -3,7 +3,7 @@
 
 Pieces (SI)::
 
-    engine axis k     taos.simplex.simplex_state_space(structure_inputs=True): the one simplex
+    engine axis k     taos.planar.simplex.simplex_state_space(structure_inputs=True): the one simplex
                       block (actuator, load path, engine axis) with the structure's motion as
                       inputs and its reactions on the structure as outputs:
       load path       F_L,k = K_L,k (x_p,k - R_k theta_k - e_k)                          [N]
@@ -39,7 +39,7 @@ theta_k''): the engine is an added mass m_e at the gimbal plus the coupling term
 through the retained modes only (the residual flexibility below is massless).
 
 With no modes the eight engine-axis blocks are independent and each is the planar simplex model
-(taos.simplex), the reduction checked by the tests.
+(taos.planar.simplex), the reduction checked by the tests.
 
 Two views of the one model: :meth:`MasvSystem.state_space` assembles the whole as one
 :class:`taos.linear.StateSpace` (eigenvalues, the naive reference response; the gimbal
@@ -63,7 +63,7 @@ import scipy.linalg
 
 from taos.linear import StateSpace
 from taos.model import TvcModel
-from taos.simplex import simplex_state_space
+from taos.planar.simplex import simplex_state_space
 
 from .config import MasvConfig
 from .structure import ModalStructure
@@ -76,7 +76,7 @@ _OUT = {n: i for i, n in enumerate(BLOCK_OUTPUTS)}
 
 def engine_axis_block(model: TvcModel, axis: str, engine_cg_offset_m: float = 0.0) -> StateSpace:
     """One actuator driving one engine axis, with the structure's motion as inputs: the simplex
-    block :func:`taos.simplex.simplex_state_space` (``structure_inputs=True``), friction input
+    block :func:`taos.planar.simplex.simplex_state_space` (``structure_inputs=True``), friction input
     left at zero.
 
     Inputs: ``command_rad`` theta_c [rad] (x_c = R theta_c), ``elongation_m`` e [m] (structure

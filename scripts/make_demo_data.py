@@ -15,7 +15,7 @@ and a constant engine-angle offset per axis (string pots without an absolute ref
 paper sec. 2), written as CSV with a TOML-comment header (``synthetic = true``, the truth
 values, the seed). Deterministic (seeded).
 
-Engines: ``--engine simplex`` (default) uses :func:`taos.simulate.simulate`. HOOK for the
+Engines: ``--engine simplex`` (default) uses :func:`taos.planar.simulate.simulate`. HOOK for the
 3-D TAOS model (written separately): register its simulate function in ``ENGINES`` below
 (same signature: ``(model, profile, dt_s=..., record_every=...) -> TimeHistory``), then
 ``--engine taos`` makes the same datasets from it.
@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 from taos.identify.data import from_time_history  # noqa: E402
 from taos.model import load_model  # noqa: E402
 from taos.profiles import load_profile  # noqa: E402
-from taos.simulate import simulate  # noqa: E402
+from taos.planar.simulate import simulate  # noqa: E402
 
 DEG = math.pi / 180
 ENGINES = {"simplex": simulate}

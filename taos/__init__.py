@@ -12,14 +12,19 @@ The public API, by task (each name is importable from ``taos``)::
     taos.compare_models(model_a, model_b)
     taos.write_html(run, "run.html")                       # offline 3-D view
 
-Layers, bottom to top (none imports a layer above it):
+Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.py`` checks):
 
-1. ``units``, ``errors``, ``results``, ``shipped``, ``limits`` - units, one-line input errors, output files, documented limits;
-2. ``friction``, ``avionics``, ``actuator``, ``actuator_limits``, ``linear``, ``margins``, ``model`` - component models;
-3. ``simplex``, ``simulate``, ``freqresp``, ``taos3d``, ``fem``, ``run_checks`` - the planar and 3-D models;
-4. ``flight``, ``identify``, ``montecarlo``, ``interop`` - analyses built on them;
+1. ``units``, ``errors``, ``results``, ``shipped``, ``bounds`` - units, one-line input errors,
+   output files, the documented bounds of every input;
+2. ``friction``, ``linear``, ``stability``, ``model`` and the component models
+   ``planar.actuator``, ``planar.avionics``, ``planar.saturation``;
+3. the engines: ``planar`` (the simplex model, its kernels, simulation, frequency response,
+   steady state, run envelope) and ``taos3d`` (3-D), with ``fem``, ``profiles``,
+   ``engine_geometry``;
+4. ``flight``, ``identify``, ``report``, ``montecarlo``, ``export``, ``interop`` - analyses built
+   on them;
 5. ``plotting``, ``viewer`` - drawing only;
-6. ``cli`` - the ``taos`` command and the Green Run report.
+6. ``cli`` - the ``taos`` command: argument parsing over the layers below.
 
 Names are resolved on first use (PEP 562), so ``import taos`` stays cheap and a command imports
 only what it needs.
@@ -35,10 +40,10 @@ __version__ = "0.1.0"
 _API = {
     "load_model": "taos.model", "TvcModel": "taos.model",
     "InputError": "taos.errors", "SimulationUnstable": "taos.errors",
-    "linear_freqresp": "taos.freqresp", "sine_dwell_freqresp": "taos.freqresp",
-    "sine_dwell_grid": "taos.freqresp", "FrequencyResponse": "taos.freqresp",
-    "simplex_state_space": "taos.simplex", "load_resonance_from_notch": "taos.simplex",
-    "simulate": "taos.simulate", "TimeHistory": "taos.simulate",
+    "linear_freqresp": "taos.planar.freqresp", "sine_dwell_freqresp": "taos.planar.freqresp",
+    "sine_dwell_grid": "taos.planar.freqresp", "FrequencyResponse": "taos.planar.freqresp",
+    "simplex_state_space": "taos.planar.simplex", "load_resonance_from_notch": "taos.planar.simplex",
+    "simulate": "taos.planar.simulate", "TimeHistory": "taos.planar.simulate",
     "load_profile": "taos.profiles",
     "FrictionLaw": "taos.friction", "LAWS": "taos.friction",
     "taos_model": "taos.taos3d", "simulate_taos": "taos.taos3d", "taos_freqresp": "taos.taos3d", "taos_freqresp_family": "taos.taos3d",
@@ -50,7 +55,7 @@ _API = {
     "load_ascent": "taos.flight.ascent", "simulate_ascent": "taos.flight.ascent_sim",
     "load_campaign": "taos.montecarlo", "run_campaign": "taos.montecarlo",
     "load_run": "taos.viewer", "write_html": "taos.viewer", "serve": "taos.viewer",
-    "loop_margins": "taos.margins", "LoopMargins": "taos.margins",
+    "loop_margins": "taos.stability", "LoopMargins": "taos.stability",
     "to_control": "taos.interop", "from_control_ss": "taos.interop",
 }
 

@@ -1,8 +1,8 @@
 """Linear models and responses exported for other tools: MATLAB ``.mat`` and CSV.
 
-What is written, per axis (``pitch``, ``yaw``), from :func:`taos.simplex.simplex_state_space`
+What is written, per axis (``pitch``, ``yaw``), from :func:`taos.planar.simplex.simplex_state_space`
 (x' = A x + B u, y = C x + D u; SI states, inputs and outputs named) and
-:func:`taos.freqresp.linear_freqresp` (the project's conventions: piston x_p / (R theta_c),
+:func:`taos.planar.freqresp.linear_freqresp` (the project's conventions: piston x_p / (R theta_c),
 phase continuous from low frequency):
 
 * ``.mat`` (``scipy.io.savemat``): a struct per axis with ``A, B, C, D``, ``states``,
@@ -30,9 +30,9 @@ AXES = ("pitch", "yaw")
 
 def linear_export_data(model: TvcModel, freq_hz) -> dict:
     """{axis: dict of arrays} as written by :func:`export_mat` / :func:`export_csv`."""
-    from .freqresp import linear_freqresp
+    from .planar.freqresp import linear_freqresp
     from .linear import gain_db
-    from .simplex import simplex_state_space
+    from .planar.simplex import simplex_state_space
 
     out = {}
     for ax in AXES:

@@ -1,10 +1,10 @@
 """python-control interoperation: take a TVC model into a control engineer's own loop design.
 
 Linear models (:class:`taos.linear.StateSpace`: the simplex block
-:func:`taos.simplex.simplex_state_space`, the vehicle + FCS block and the open flight loop
+:func:`taos.planar.simplex.simplex_state_space`, the vehicle + FCS block and the open flight loop
 :func:`taos.flight.vehicle.vehicle_fcs_state_space` / :func:`~taos.flight.vehicle.open_loop_state_space`,
 the whole MASV model ``masv.system.MasvSystem.state_space()``) become ``control.StateSpace``
-with their signal names; frequency responses (:class:`taos.freqresp.FrequencyResponse`,
+with their signal names; frequency responses (:class:`taos.planar.freqresp.FrequencyResponse`,
 linear or sine-dwell; :class:`taos.identify.estimate.MeasuredResponse`, estimated from data;
 ``masv.analysis.MasvFrequencyResponse``) become ``control.FrequencyResponseData``. Both come
 back: :func:`from_control_ss` and :func:`freqresp_from_control`.
@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from taos.freqresp import FrequencyResponse
+from taos.planar.freqresp import FrequencyResponse
 from taos.identify.estimate import MeasuredResponse
 from taos.linear import StateSpace
 
@@ -101,7 +101,7 @@ def frd_samples(data) -> tuple[np.ndarray, np.ndarray, tuple[str, ...], tuple[st
 
 
 def freqresp_to_control(fr: FrequencyResponse):
-    """A command -> (piston, engine) :class:`~taos.freqresp.FrequencyResponse` (linear or
+    """A command -> (piston, engine) :class:`~taos.planar.freqresp.FrequencyResponse` (linear or
     sine-dwell at one amplitude) as a 2x1 FRD (:data:`FR_OUTPUTS` x :data:`FR_INPUTS`)."""
     H = np.stack([fr.piston, fr.engine], axis=1)[:, :, None]
     amp = "linear" if fr.amplitude_rad is None else f"{math.degrees(fr.amplitude_rad):.4g}deg"
@@ -111,7 +111,7 @@ def freqresp_to_control(fr: FrequencyResponse):
 def freqresp_from_control(data, amplitude_rad: float | None = None, axis: str = "pitch",
                           friction_model: str = "none", provenance: dict | None = None) -> FrequencyResponse:
     """An FRD with outputs ``piston`` and ``engine`` (as made by :func:`freqresp_to_control`) back as
-    a :class:`~taos.freqresp.FrequencyResponse`; ``amplitude_rad`` None for a linear response."""
+    a :class:`~taos.planar.freqresp.FrequencyResponse`; ``amplitude_rad`` None for a linear response."""
     f, H, ins, outs = frd_samples(data)
     if len(ins) != 1 or set(FR_OUTPUTS) - set(outs):
         raise ValueError(f"freqresp_from_control: need one input and outputs {FR_OUTPUTS}, got {outs} x {ins}")

@@ -191,7 +191,7 @@ def phase_deg_continuous(freq_hz, h, reference_deg=None) -> np.ndarray:
     Without ``reference_deg`` the points are sorted by frequency, unwrapped in that order
     and the lowest-frequency point lies in (-180, 180] (right for measured points that start
     at low frequency). With ``reference_deg`` (the continuous phase of a reference response at
-    the same frequencies, e.g. the linear model's from :func:`taos.freqresp.linear_phase_reference`)
+    the same frequencies, e.g. the linear model's from :func:`taos.planar.freqresp.linear_phase_reference`)
     each point takes the 360-deg branch nearest the reference, so sparse points far from low
     frequency (a single 7 Hz point, a cross-axis response) read as on the continuous curve."""
     f = np.atleast_1d(np.asarray(freq_hz, float))

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-from .avionics import Avionics
+from .planar.avionics import Avionics
 from .errors import InputError
 from .friction import FrictionLaw, friction_from_table
 from .shipped import resolve
@@ -47,7 +47,7 @@ class Engine:
     thrust_N : thrust pressing the gimbal bearing [N] (0 when hanging);
     gimbal_range_rad : hard stops at +-theta_max [rad] (0: none); hard_stop_stiffness_Nm_per_rad :
     contact stiffness k_s [N m/rad]; hard_stop_damping_ratio : zeta_s of the contact on J_n [-]
-    (:mod:`taos.actuator_limits`).
+    (:mod:`taos.planar.saturation`).
     """
 
     mass_kg: float
@@ -83,7 +83,7 @@ class Actuator:
     position loop gain [1/s]; K_dpf [m/(s Pa)] with time constant tau_dpf [s] is the dynamic
     pressure feedback that damps the load resonance without softening the static stiffness
     (a velocity servo with oil compressibility alone gives the load mode negative damping
-    unless K_c > A^2 K_v / K_h). Limits (:mod:`taos.actuator_limits`, nonlinear, time domain only):
+    unless K_c > A^2 K_v / K_h). Limits (:mod:`taos.planar.saturation`, nonlinear, time domain only):
     ``max_rate_m_per_s`` the valve flow saturation as a no-load piston rate [m/s] (0: none);
     ``pressure_limited`` the supply-pressure limit, stall force A P_s.
     """
@@ -408,7 +408,7 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     law = friction_from_table(ftab, src, model=friction)
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}
-    from .limits import check_model_plausible
+    from .bounds import check_model_plausible
 
     check_model_plausible(src, engine, actuator, structure)
     return TvcModel(name=str(doc.get("name", p.stem)), engine=engine, actuator=actuator,

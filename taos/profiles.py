@@ -240,7 +240,7 @@ _TOP = {"name", "description"}
 
 
 def _angle(tab, key, src, sec):
-    from .limits import check_command_angle
+    from .bounds import check_command_angle
 
     if key not in tab:
         raise InputError(src, f"{sec}.{key}", "an angle with its unit, like '0.4 deg'", got="nothing (key missing)")
@@ -248,7 +248,7 @@ def _angle(tab, key, src, sec):
 
 
 def _pos(tab, key, kind, src, sec, example):
-    from .limits import check_command_frequency, check_duration
+    from .bounds import check_command_frequency, check_duration
 
     if key not in tab:
         raise InputError(src, f"{sec}.{key}", f"a {kind} with its unit, like {example}", got="nothing (key missing)")
@@ -261,14 +261,14 @@ def _pos(tab, key, kind, src, sec, example):
 
 
 def _time(tab, key, default, src, sec, **chk):
-    from .limits import check_duration
+    from .bounds import check_duration
 
     return check_duration(to_si(tab.get(key, default), "time", source=src, field=f"{sec}.{key}", **chk),
                           src, f"{sec}.{key}")
 
 
 def _int(tab, key, src, sec, default):
-    from .limits import check_cycles
+    from .bounds import check_cycles
 
     v = tab.get(key, default)
     if not isinstance(v, int) or isinstance(v, bool) or v < 1:
@@ -294,7 +294,7 @@ def profile_from_table(tab: dict, src: str, sec: str):
         return Step(_angle(tab, "amplitude", src, sec), _time(tab, "start", "0.5 s", src, sec, nonnegative=True),
                     _time(tab, "hold", "2 s", src, sec, positive=True))
     if kind == "multi_ramp":
-        from .limits import check_command_angle
+        from .bounds import check_command_angle
 
         levels = tab.get("levels")
         if not isinstance(levels, list) or not levels:
@@ -314,7 +314,7 @@ def profile_from_table(tab: dict, src: str, sec: str):
                          _pos(tab, "end_frequency", "frequency", src, sec, "'10 Hz'"),
                          _pos(tab, "duration", "time", src, sec, "'60 s'"), log)
     if kind == "multisine":
-        from .limits import check_command_frequency
+        from .bounds import check_command_frequency
 
         fr = tab.get("frequencies")
         if not isinstance(fr, list) or not fr:
@@ -337,9 +337,9 @@ def load_profile(path: str | Path):
     """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
     ``[pitch]`` and/or ``[yaw]`` tables (two-axis). (A measured record is replayed through
     :func:`profile_from_record`; the CLI reads it.) Every value is checked against the documented limits of
-    :mod:`taos.limits` (gimbal range, frequencies, durations, cycles)."""
+    :mod:`taos.bounds` (gimbal range, frequencies, durations, cycles)."""
     from .errors import check_keys
-    from .limits import check_duration
+    from .bounds import check_duration
     from .model import read_toml
     from .shipped import resolve
 

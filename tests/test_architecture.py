@@ -160,12 +160,13 @@ def test_nothing_below_the_cli_imports_it():
 
 #: the layers of taos/__init__.py's docstring, bottom (1) to top; masv sits on taos
 LAYERS = {
-    "taos.units": 1, "taos.errors": 1, "taos.results": 1, "taos.shipped": 1, "taos.limits": 1,
-    "taos.actuator_limits": 2,
-    "taos.friction": 2, "taos.avionics": 2, "taos._avionics_kernels": 2, "taos.margins": 2, "taos.actuator": 2, "taos.linear": 2, "taos.model": 2,
-    "taos.simplex": 3, "taos.simulate": 3, "taos.freqresp": 3, "taos.taos3d": 3, "taos.fem": 3,
-    "taos._integrator": 3, "taos.steady": 3, "taos.profiles": 3, "taos.engine_geometry": 3, "taos.run_checks": 3,
-    "taos.flight": 4, "taos.identify": 4, "taos.merit": 4, "taos.export": 4, "taos.spec": 4, "taos.montecarlo": 4, "taos.interop": 4,
+    "taos.units": 1, "taos.errors": 1, "taos.results": 1, "taos.shipped": 1, "taos.bounds": 1,
+    "taos.friction": 2, "taos.linear": 2, "taos.stability": 2, "taos.model": 2,
+    "taos.planar.actuator": 2, "taos.planar.avionics": 2, "taos.planar._avionics_kernels": 2,
+    "taos.planar.saturation": 2,
+    "taos.planar": 3, "taos.taos3d": 3, "taos.fem": 3, "taos.profiles": 3, "taos.engine_geometry": 3,
+    "taos.flight": 4, "taos.identify": 4, "taos.report": 4, "taos.export": 4, "taos.montecarlo": 4,
+    "taos.interop": 4,
     "taos.plotting": 5, "taos.viewer": 5,
     "taos.cli": 6, "taos.__main__": 6,
     "masv.structure": 7, "masv.config": 7, "masv.system": 7, "masv.synthetic": 7,

@@ -65,7 +65,7 @@ def test_sidecar_toml_maps_any_column_names_and_units(tmp_path):
 
 def test_taos_simulate_hdf5_is_read_with_absolute_engine_angles(tmp_path, ambient):
     from taos.profiles import SineDwell
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     th = simulate(ambient, SineDwell(0.4 * DEG, 2.0, 2), dt_s=2e-4, record_every=10)
     th.to_hdf5(tmp_path / "run.h5")

@@ -11,7 +11,7 @@ import pytest
 
 from taos.flight.describing import (DescribingFunctionMap, describing_function_map, rigid_engine_response,
                              rigid_limit_model)
-from taos.freqresp import linear_freqresp
+from taos.planar.freqresp import linear_freqresp
 from taos.model import load_model
 
 from .conftest import MODELS

@@ -14,9 +14,9 @@ import pytest
 
 from taos.identify.estimate import MeasuredResponse
 from taos.identify.fit import FitProblem, fit_frequency_response
-from taos.freqresp import linear_freqresp, sine_dwell_grid
+from taos.planar.freqresp import linear_freqresp, sine_dwell_grid
 from taos.model import load_model
-from taos.simplex import load_resonance_from_notch
+from taos.planar.simplex import load_resonance_from_notch
 from taos.units import to_si
 
 from .conftest import MODELS, ROOT, run_cli

@@ -11,7 +11,7 @@ import pytest
 
 from taos.errors import InputError
 from taos.flight.vehicle import fcs_filter_tf, flight_plant, load_flight, loop_freqresp, margins
-from taos.freqresp import linear_freqresp
+from taos.planar.freqresp import linear_freqresp
 from taos.model import load_model
 
 from .conftest import MODELS

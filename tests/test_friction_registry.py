@@ -30,8 +30,8 @@ from taos.identify.fit import fit_frequency_response
 from taos.identify.surrogate import build_surrogate, check_free, solve_implicit, PARAMETERS
 from taos.model import load_model
 from taos.profiles import SineDwell
-from taos.simplex import simplex_state_space
-from taos.simulate import simulate
+from taos.planar.simplex import simplex_state_space
+from taos.planar.simulate import simulate
 from taos.taos3d import load_taos_model, simulate_taos
 
 from .conftest import MODELS
@@ -146,7 +146,7 @@ def test_toy_law_is_found_by_id_everywhere(toy, flight):
 
 
 def test_toy_viscous_law_dwell_equals_linear_model_with_that_damping(toy, flight):
-    """Planar simulation (the DF map's sine dwell and taos.simulate) of the pure viscous toy law
+    """Planar simulation (the DF map's sine dwell and taos.planar.simulate) of the pure viscous toy law
     (T_c = 0) equals the linear model with the damper in the loop."""
     c = damping(flight)
     m = flight.replace(friction=ViscousCoulomb(coulomb_torque_Nm=0.0, viscous_damping_Nms_per_rad=c),
@@ -215,7 +215,7 @@ def test_toy_law_runs_in_the_3d_model(toy):
 def test_toy_law_fit_surrogate_and_fit(toy, flight):
     """Fit surrogate: for the pure viscous toy its describing function is exact, so the
     surrogate equals the linear model with the damper; the fit recovers c from sine-dwell data."""
-    from taos.freqresp import sine_dwell_grid
+    from taos.planar.freqresp import sine_dwell_grid
     from taos.identify.estimate import MeasuredResponse
 
     c = damping(flight)

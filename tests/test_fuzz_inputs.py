@@ -105,7 +105,7 @@ prof_values = st.one_of(
 def test_profile_fuzz(kind, table, tmp_path_factory, capsys):
     """Loaded profiles are within the documented limits and short ones simulate; everything
     else is refused with exit 2 and one line."""
-    from taos.limits import GIMBAL_RANGE_RAD, MAX_DURATION_S
+    from taos.bounds import GIMBAL_RANGE_RAD, MAX_DURATION_S
     from taos.profiles import load_profile
 
     tmp = tmp_path_factory.mktemp("p")

@@ -26,7 +26,7 @@ def sweep_record(tmp_path_factory):
     """A 0.4 deg logarithmic sweep 0.5 -> 14 Hz over 30 s through the hot-fire model, as CSV."""
     from taos.model import load_model
     from taos.profiles import SineSweep
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     th = simulate(load_model(MODELS / "rs25_hotfire.toml"), SineSweep(0.4 * DEG, 0.5, 14.0, 30.0))
     path = tmp_path_factory.mktemp("sweep") / "sweep.csv"

@@ -19,13 +19,13 @@ control = pytest.importorskip("control")
 
 from taos.flight.vehicle import (flight_loop_margins, load_flight, loop_freqresp, margins,  # noqa: E402
                                  open_loop_state_space, vehicle_fcs_state_space)
-from taos.freqresp import linear_freqresp, sine_dwell_freqresp  # noqa: E402
+from taos.planar.freqresp import linear_freqresp, sine_dwell_freqresp  # noqa: E402
 from taos.interop import (freqresp_from_control, frd_samples, from_control_ss, measured_to_control,  # noqa: E402
                           to_control, to_control_ss)
 from taos.linear import StateSpace  # noqa: E402
-from taos.margins import loop_margins  # noqa: E402
+from taos.stability import loop_margins  # noqa: E402
 from taos.model import load_model  # noqa: E402
-from taos.simplex import simplex_state_space  # noqa: E402
+from taos.planar.simplex import simplex_state_space  # noqa: E402
 
 F = np.logspace(-2, 2, 200)
 DEG = math.pi / 180

@@ -9,10 +9,10 @@ import math
 import numpy as np
 import pytest
 
-from taos.avionics import Avionics
+from taos.planar.avionics import Avionics
 from taos.model import load_model
-from taos.simplex import simplex_plant
-from taos.simulate import integrate_plant
+from taos.planar.simplex import simplex_plant
+from taos.planar.simulate import integrate_plant
 
 from .conftest import MODELS
 

@@ -11,7 +11,7 @@ import pytest
 import scipy.signal
 
 from taos.model import load_model
-from taos.simplex import load_resonance_from_notch, simplex_state_space
+from taos.planar.simplex import load_resonance_from_notch, simplex_state_space
 
 from .conftest import MODELS
 
@@ -53,7 +53,7 @@ def test_fit_frees_the_load_damping(ambient):
     truth = ambient.with_friction("none")
     truth = truth.replace(structure=dataclasses.replace(truth.structure, load_damping_ratio=0.03))
     f = np.array([2.0, 4.0, 4.8, 5.0, 5.1, 5.2, 5.3, 5.4, 5.6, 6.0, 8.0])
-    from taos.freqresp import sine_dwell_grid
+    from taos.planar.freqresp import sine_dwell_grid
     p, e = sine_dwell_grid(truth, [0.4 * DEG], f)  # the full model (avionics in the path)
     ones = np.ones(f.size)
     data = [MeasuredResponse("pitch", f, np.full(f.size, 0.4 * DEG), p[0] * truth.actuator.moment_arm_m, e[0],

@@ -16,7 +16,7 @@ from masv.structure import NODE_NAMES, ModalStructure, rigid_structure
 from masv.synthetic import core_stage_specs, synthetic_structure
 from masv.system import build_system
 from taos.model import Structure, load_model
-from taos.simplex import simplex_state_space
+from taos.planar.simplex import simplex_state_space
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -54,7 +54,7 @@ def test_one_engine_on_rigid_structure_reproduces_simplex(hotfire, axis):
     f = np.logspace(-2, 2.5, 200)
     xp, th = s.frf(f)
     h = simplex_state_space(model, axis).freqresp(f, "command_rad", ["x_p_m", "theta_rad"])
-    # one definition of the block (taos.simplex): equal to rounding (measured 1.5e-15)
+    # one definition of the block (taos.planar.simplex): equal to rounding (measured 1.5e-15)
     assert np.max(np.abs(xp[:, 0, 0] / h[:, 0] - 1)) < 1e-13
     assert np.max(np.abs(th[:, 0, 0] / h[:, 1] - 1)) < 1e-13
     # the assembled state space has the simplex's poles

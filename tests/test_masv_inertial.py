@@ -18,7 +18,7 @@ from masv.config import ActuatorSpec, EngineSpec, make_config
 from masv.structure import NODE_NAMES, ModalStructure, rigid_structure
 from masv.system import build_system
 from taos.model import Structure, load_model
-from taos.simplex import simplex_state_space
+from taos.planar.simplex import simplex_state_space
 
 ROOT = Path(__file__).resolve().parents[1]
 L_E = 1.5          # gimbal -> engine c.g. [m] (the shipped files' [geometry] engine_cg)

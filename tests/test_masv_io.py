@@ -128,7 +128,7 @@ def test_plots_save_png(tmp_path):
     from masv.config import load_config
     from masv.plotting import plot_actuator_vs_simplex, plot_coupling_matrix, plot_gain_grid, save
     from masv.system import build_system
-    from taos.freqresp import linear_freqresp
+    from taos.planar.freqresp import linear_freqresp
 
     s = build_system(load_config(RIGID))
     f = np.logspace(-1, 1.5, 30)

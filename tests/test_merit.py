@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from taos.merit import response_merit, step_merit
+from taos.report.merit import response_merit, step_merit
 from taos.model import load_model
 
 from .conftest import MODELS, run_cli

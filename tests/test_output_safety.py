@@ -270,7 +270,7 @@ def test_3d_run_records_the_stiffness_file_hash(tmp_path, capsys):
 def test_viewer_server_ends_when_its_parent_is_killed(tmp_path):
     from taos.model import load_model
     from taos.profiles import load_profile
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     h5 = tmp_path / "run.h5"
     simulate(load_model(AMBIENT), load_profile(STEP)).to_hdf5(h5)

@@ -13,10 +13,10 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402
 
-from taos.freqresp import FrequencyResponse, linear_freqresp  # noqa: E402
+from taos.planar.freqresp import FrequencyResponse, linear_freqresp  # noqa: E402
 from taos.plotting import bode, compare, save, timehist  # noqa: E402
-from taos.simplex import load_resonance_from_notch  # noqa: E402
-from taos.simulate import TimeHistory  # noqa: E402
+from taos.planar.simplex import load_resonance_from_notch  # noqa: E402
+from taos.planar.simulate import TimeHistory  # noqa: E402
 
 F = np.logspace(-1, math.log10(30), 300)
 

@@ -37,7 +37,7 @@ def test_greenrun_cli_writes_index_h5_and_shows_progress(report, hotfire):
     assert len(re.findall(r'<img [^>]*src="data:image/png;base64,', page)) == 4
     assert page.count("<iframe") == 1 and "srcdoc=" in page and "MeshCat.Viewer" in page
     s = json.loads((out / "summary.json").read_text())
-    from taos.simplex import load_resonance_from_notch
+    from taos.planar.simplex import load_resonance_from_notch
     assert s["load_resonance_hz"]["pitch"] == pytest.approx(hotfire.load_resonance_hz("pitch"))
     assert s["notch_frequency_hz"]["pitch"] == pytest.approx(load_resonance_from_notch(hotfire, "pitch"))
     assert s["breakaway_deflection_deg"] == pytest.approx(math.degrees(hotfire.breakaway_deflection_rad()))
@@ -65,7 +65,7 @@ def test_two_axis_run_dwells_agree_with_the_sine_dwell_kernel(report):
 
 
 def test_greenrun_h5_holds_the_run_and_the_responses(report):
-    from taos.simulate import TimeHistory
+    from taos.planar.simulate import TimeHistory
 
     out, _ = report
     th = TimeHistory.from_hdf5(out / "greenrun.h5")
@@ -142,7 +142,7 @@ def test_report_shows_figures_of_merit_and_spec_mask_result(report, hotfire, tmp
     # +11.7 dB at 4.92 Hz, -90 deg at 4.74 Hz by hand before the 0.5 % load-path damping)
     import numpy as np
 
-    from taos.freqresp import linear_freqresp
+    from taos.planar.freqresp import linear_freqresp
     fd = np.linspace(3.0, 8.0, 5001)
     he = linear_freqresp(hotfire, fd, "pitch").engine
     k = int(np.argmax(np.abs(he)))

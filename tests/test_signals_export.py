@@ -17,7 +17,7 @@ DATA = MODELS / "data" / "greenrun_hotfire_synthetic.csv"
 @pytest.fixture(scope="module")
 def run(hotfire):
     from taos.profiles import SineDwell
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
     return simulate(hotfire, SineDwell(math.radians(0.4), 0.5, 3), record_every=5)
 
 
@@ -31,7 +31,7 @@ def test_simulation_records_load_pressure_spool_and_supply(run, hotfire, tmp_pat
     # spool (no-load flow / A) ~ piston rate at low frequency
     v = np.gradient(run.piston_m[0], run.t_s)
     assert np.corrcoef(run.spool_flow_m_s[0], v)[0, 1] > 0.98
-    from taos.simulate import TimeHistory
+    from taos.planar.simulate import TimeHistory
     run.to_hdf5(tmp_path / "r.h5")
     back = TimeHistory.from_hdf5(tmp_path / "r.h5")
     np.testing.assert_array_equal(back.load_pressure_Pa, run.load_pressure_Pa)
@@ -59,7 +59,7 @@ def test_measured_record_replays_through_taos_simulate(tmp_path):
     assert r.returncode == 0, r.stderr
     lines = [x for x in r.stdout.splitlines() if x.startswith("replay pitch")]
     hot = float(lines[0].split("piston ")[1].split(" in")[0])
-    from taos.simulate import TimeHistory
+    from taos.planar.simulate import TimeHistory
     th = TimeHistory.from_hdf5(tmp_path / "hot.h5")
     assert th.axes == ("pitch", "yaw") and th.t_s[-1] > 30
     r = run_cli("simulate", MODELS / "rs25_ambient.toml", "--profile", DATA, "--out", tmp_path / "amb.h5")
@@ -72,7 +72,7 @@ def test_linear_model_exports_to_mat_and_csv(hotfire, tmp_path):
     import scipy.io
     import scipy.signal
 
-    from taos.simplex import simplex_state_space
+    from taos.planar.simplex import simplex_state_space
     r = run_cli("export", MODELS / "rs25_hotfire.toml", "--out", tmp_path / "lin.mat", "--freq-hz", "0.5,2,7,10")
     assert r.returncode == 0, r.stderr
     m = scipy.io.loadmat(tmp_path / "lin.mat", simplify_cells=True)["pitch"]

@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
-from taos.freqresp import linear_freqresp, sine_dwell_grid
+from taos.planar.freqresp import linear_freqresp, sine_dwell_grid
 from taos.linear import gain_db
 from taos.profiles import MultiRamp, Sequence, SineDwell
-from taos.simplex import load_resonance_from_notch, simplex_state_space
-from taos.simulate import simulate
+from taos.planar.simplex import load_resonance_from_notch, simplex_state_space
+from taos.planar.simulate import simulate
 
 from .conftest import MODELS, run_cli
 
@@ -56,7 +56,7 @@ def test_load_resonance_equation_1_and_piston_notch(name):
     assert d["notch_frequency_hz"] == pytest.approx(wl, rel=3e-4)
     import dataclasses
 
-    from taos.simplex import load_resonance_from_notch
+    from taos.planar.simplex import load_resonance_from_notch
     undamped = m.replace(structure=dataclasses.replace(m.structure, load_damping_ratio=0.0))
     assert load_resonance_from_notch(undamped) == pytest.approx(wl, rel=1e-7)
 

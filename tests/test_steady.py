@@ -1,4 +1,4 @@
-"""Periodic steady state by shooting (taos.steady) and whole N(A, w) maps in one call.
+"""Periodic steady state by shooting (taos.planar.steady) and whole N(A, w) maps in one call.
 
 The shooting solution (linear-orbit start, reduced rank extrapolation of the one-period map) is
 checked against an independent route to the same orbit: plain integration from rest for 60 s,
@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from taos.freqresp import linear_freqresp, sine_dwell_family, sine_dwell_points
+from taos.planar.freqresp import linear_freqresp, sine_dwell_family, sine_dwell_points
 from taos.linear import gain_db
 from taos.model import load_model
 

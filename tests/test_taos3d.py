@@ -11,9 +11,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from taos.actuator import actuator_state_space
+from taos.planar.actuator import actuator_state_space
 from taos.errors import InputError
-from taos.freqresp import linear_freqresp, sine_dwell_grid
+from taos.planar.freqresp import linear_freqresp, sine_dwell_grid
 from taos.linear import gain_db, phase_deg
 from taos.model import load_model
 from taos.profiles import SineDwell, TwoAxis

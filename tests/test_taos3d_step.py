@@ -82,10 +82,10 @@ def test_bearing_coupling_converges_at_second_order(law):
 
 @pytest.mark.parametrize("rounding", [False, True])
 def test_command_mean_is_the_mean_of_the_command_path_over_a_ramp(rounding):
-    """dynamics.command_mean (the mean of taos.avionics.apply over a ramp) against brute-force
+    """dynamics.command_mean (the mean of taos.planar.avionics.apply over a ramp) against brute-force
     quadrature of the command path over the ramp (2e5 points), for ramps inside one bin,
     across a few bins, through zero, and reversed."""
-    from taos.avionics import Avionics
+    from taos.planar.avionics import Avionics
     from taos.taos3d.dynamics import command_mean as apply_mean
     av = Avionics(12, np.radians(21.0), rounding, tuple(np.radians([0.0, 0.02, 0.1, 1.0])), (0.95, 0.95, 0.98, 1.0))
     p = av.pack()

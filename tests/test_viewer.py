@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from taos.simulate import TimeHistory
+from taos.planar.simulate import TimeHistory
 from taos.viewer import GimbalGeometry, load_run, offline_html, viewer_frames
 from taos.viewer.kinematics import AXES
 

@@ -36,9 +36,9 @@ def model_from_args(args) -> TvcModel:
 
 
 def merit_dict(model: TvcModel, axes=AXES, steps: bool = True) -> dict:
-    """Figures of merit per axis (:mod:`taos.merit`): frequency figures from the linear
+    """Figures of merit per axis (:mod:`taos.report.merit`): frequency figures from the linear
     response, and (``steps``) step, threshold and hysteresis figures by simulation."""
-    from taos.merit import frequency_merit, step_merit
+    from taos.report.merit import frequency_merit, step_merit
     out = {}
     for ax in axes:
         d = frequency_merit(model, ax).to_dict()
@@ -54,7 +54,7 @@ def info_dict(model: TvcModel, steps: bool = True) -> dict:
 
     import numpy as np
 
-    from taos.simplex import load_resonance_from_notch, simplex_state_space
+    from taos.planar.simplex import load_resonance_from_notch, simplex_state_space
 
     poles = simplex_state_space(model, "pitch").poles()
     p = poles[poles.imag >= 0]
@@ -121,9 +121,10 @@ def cmd_info(args) -> int:
 def cmd_freqresp(args) -> int:
     import numpy as np
 
-    from taos.freqresp import family_to_dict, linear_freqresp, sine_dwell_family
+    from taos.planar.freqresp import family_to_dict, linear_freqresp, sine_dwell_family
 
-    from taos import limits, run_checks
+    from taos import bounds as limits
+    from taos.planar import envelope as run_checks
     from taos.results import check_output_file
 
     freqs = parse_float_list(args.freq_hz, "--freq-hz")
@@ -161,7 +162,7 @@ def cmd_freqresp(args) -> int:
                                  "engine": args.engine}
     d["provenance"]["seeds"] = "none (deterministic)"
     if not args.cross:
-        from taos.merit import frequency_merit
+        from taos.report.merit import frequency_merit
         d["figures_of_merit"] = frequency_merit(model, args.axis).to_dict()
     if args.json:
         write_json(args.json, d)
@@ -185,7 +186,7 @@ def cmd_freqresp(args) -> int:
         else:   # the linear response as a dense curve, not straight lines between the listed points
             fd = np.logspace(math.log10(min(freqs) / 1.5), math.log10(max(freqs) * 1.5), 400)
             dense = linear_freqresp(model, fd, args.axis)
-            from taos.simplex import load_resonance_from_notch   # the one notch finder every command uses
+            from taos.planar.simplex import load_resonance_from_notch   # the one notch finder every command uses
             fig = bode.plot_freqresp([dense] + ([] if fr.amplitude_rad is None else fam),
                                      resonance_hz=model.load_resonance_hz(args.axis),
                                      notch_hz=load_resonance_from_notch(model, args.axis))
@@ -198,19 +199,19 @@ def cmd_freqresp(args) -> int:
 
 def engine_default_dt_s(engine: str) -> float:
     """The integration step [s] an engine model runs at unless told otherwise: 2e-4 s for the
-    planar simplex model (taos.simulate), 4e-4 s for the 3-D model (taos.taos3d.simulate)."""
+    planar simplex model (taos.planar.simulate), 4e-4 s for the 3-D model (taos.taos3d.simulate)."""
     if engine == "taos":
         from taos.taos3d.simulate import DEFAULT_DT_S
     else:
-        from taos.simulate import DEFAULT_DT_S
+        from taos.planar.simulate import DEFAULT_DT_S
     return DEFAULT_DT_S
 
 
 def cmd_simulate(args) -> int:
-    from taos import run_checks
+    from taos.planar import envelope as run_checks
     from taos.cli.records import load_profile
     from taos.results import check_output_file, input_provenance
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     check_output_file(args.out, "--out")
     model = model_from_args(args)

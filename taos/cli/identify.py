@@ -23,7 +23,7 @@ def _estimate(path, args):
         raise InputError(str(path), f"{axes[0]}_command", f"a {axes[0]} axis in the data", got=", ".join(data.axes))
     kw = {"axes": axes}
     if getattr(args, "nperseg", None) is not None:
-        from taos.limits import NPERSEG_MIN
+        from taos.bounds import NPERSEG_MIN
         if not NPERSEG_MIN <= args.nperseg <= data.t_s.size:
             raise InputError("command line", "--nperseg", f"a segment length from {NPERSEG_MIN} to the "
                              f"{data.t_s.size} samples of {path}", got=str(args.nperseg))
@@ -124,7 +124,7 @@ def cmd_fit(args) -> int:
     from taos.identify.fit import fit_frequency_response
     from taos.model import load_model
 
-    from taos.limits import MAX_STARTS
+    from taos.bounds import MAX_STARTS
 
     _outputs(args, "json", "plot", "out_model")
     if not 1 <= args.starts <= MAX_STARTS:

@@ -2,14 +2,14 @@
 
 Runs the two-axis Green Run profile (default ``models/profiles/greenrun_two_axis.toml``: pitch
 and yaw commanded at the same time at different frequencies, 0.4 deg up to 7 Hz and 0.8 deg up
-to 14 Hz, paper sec. 3.2) through the simplex model (:func:`taos.simulate.simulate`), and
+to 14 Hz, paper sec. 3.2) through the simplex model (:func:`taos.planar.simulate.simulate`), and
 computes per axis:
 
-* the exact linear response (:func:`taos.freqresp.linear_freqresp`) on a log grid, its piston
-  notch (:func:`taos.simplex.load_resonance_from_notch`) and the load resonance
+* the exact linear response (:func:`taos.planar.freqresp.linear_freqresp`) on a log grid, its piston
+  notch (:func:`taos.planar.simplex.load_resonance_from_notch`) and the load resonance
   w_L = sqrt((K_L R^2 + K_n) / J_n) (paper eq. 1);
 * sine-dwell responses at the profile's amplitudes and frequencies
-  (:func:`taos.freqresp.sine_dwell_grid`);
+  (:func:`taos.planar.freqresp.sine_dwell_grid`);
 * the response read off the two-axis run itself, as the test was analysed: for each dwell
   segment of the profile a least-squares fit y = a sin(w t') + b cos(w t') + c over its last
   two whole cycles, H = (a + j b) / A (piston as x_p / (R theta_c)).
@@ -78,7 +78,7 @@ def run_dwell_response(t_s, command_amp_rad: float, freq_hz: float, t0_s: float,
 
 def run_responses(th, profile, moment_arm_m: float) -> dict:
     """{axis: FrequencyResponse-like dict arrays} read off the two-axis run's dwell segments."""
-    from taos.freqresp import FrequencyResponse
+    from taos.planar.freqresp import FrequencyResponse
 
     out = {}
     for k, ax in enumerate(th.axes):
@@ -191,7 +191,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
         Keyframe rate of the embedded 3-D view [1/s]; lowered so that the view holds at most
         :data:`MAX_VIEW_FRAMES` keyframes (the page stays under 15 MB for any run length).
     spec_path : str or Path, optional
-        Spec mask (:mod:`taos.spec`) checked against each axis' linear response and marked on
+        Spec mask (:mod:`taos.report.spec`) checked against each axis' linear response and marked on
         the Bode plots; default ``models/specs/tvc_actuator_notional.toml``; None: no check.
     data_path : str or Path, optional
         A measured record (e.g. ``models/data/greenrun_hotfire_synthetic.csv``): its estimated
@@ -207,14 +207,14 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
 
     from taos.cli.basic import info_dict
     from taos.cli.report_extras import decorate_bode, extras_summary
-    from taos.freqresp import FrequencyResponse, linear_freqresp, sine_dwell_grid
+    from taos.planar.freqresp import FrequencyResponse, linear_freqresp, sine_dwell_grid
     from taos.model import load_model
     from taos.plotting import bode, timehist
-    from taos.simplex import load_resonance_from_notch
-    from taos.simulate import simulate
+    from taos.planar.simplex import load_resonance_from_notch
+    from taos.planar.simulate import simulate
     from taos.viewer import offline_html
 
-    from taos import run_checks
+    from taos.planar import envelope as run_checks
     from taos.results import check_output_folder, input_provenance, write_output_folder
 
     out = Path(out_dir)
@@ -333,7 +333,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
 
 
 def _summary(model, info, th, notch, wl, dwell, run, ppath) -> dict:
-    from taos.freqresp import linear_phase_reference
+    from taos.planar.freqresp import linear_phase_reference
     from taos.linear import phase_deg_continuous
     from taos.units import from_si
 

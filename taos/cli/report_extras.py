@@ -1,5 +1,5 @@
-"""Green Run report additions: figures of merit (:mod:`taos.merit`), the spec-mask verdict
-(:mod:`taos.spec`) and a measured record overlaid on the model (:mod:`taos.identify`).
+"""Green Run report additions: figures of merit (:mod:`taos.report.merit`), the spec-mask verdict
+(:mod:`taos.report.spec`) and a measured record overlaid on the model (:mod:`taos.identify`).
 
 Kept beside :mod:`taos.cli.report` so the report module stays small; the numbers come from
 the analysis modules, this module only gathers, tabulates and draws them."""
@@ -22,7 +22,7 @@ def spec_results(model, spec_path) -> dict:
     """{axis: SpecResult} of the model's linear response against the mask (empty if None)."""
     if spec_path is None:
         return {}
-    from taos.spec import check_spec, load_spec
+    from taos.report.spec import check_spec, load_spec
     mask = load_spec(spec_path)
     return {ax: check_spec(model, mask, ax) for ax in AXES}
 

@@ -12,10 +12,10 @@ import time
 
 
 def main() -> None:
-    from taos.freqresp import sine_dwell_grid
+    from taos.planar.freqresp import sine_dwell_grid
     from taos.model import load_model
     from taos.profiles import SineDwell
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     t0 = time.perf_counter()
     model = load_model("rs25_hotfire")

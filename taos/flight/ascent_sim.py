@@ -3,7 +3,7 @@ time-varying vehicle, boosters until separation, PTIs and winds; and the LCO rea
 
 Each axis (pitch, yaw) is the planar flight loop of :func:`taos.flight.vehicle.flight_plant`
 (vehicle + FCS + the simplex TVC with its friction and avionics, integrated by the compiled RK4
-kernel of :mod:`taos._integrator`) augmented with
+kernel of :mod:`taos.planar.dynamics`) augmented with
 
 * the booster TVC, a first-order servo on the FCS command (state ``booster_deflection_rad``),
   adding n_b T_b l_b / I_v delta_b to the attitude acceleration until separation;
@@ -31,8 +31,8 @@ from taos.flight.vehicle import FlightModel, flight_plant
 from taos.linear import StateSpace
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
-from taos.simplex import LurePlant
-from taos.simulate import check_step, integrate_plant
+from taos.planar.simplex import LurePlant
+from taos.planar.simulate import check_step, integrate_plant
 
 AXES = ("pitch", "yaw")
 DEFAULT_DT_S = 5e-4

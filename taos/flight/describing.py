@@ -4,7 +4,7 @@ N(A, w) = theta_1 / theta_c,1, the complex ratio of the fundamentals of the engi
 of the FCS command theta_c = A sin(w t), with the avionics (quantisation, crossover gain) and
 the gimbal friction in the path (seed paper sections 3.1-3.2; Gelb & Vander Velde,
 *Multiple-Input Describing Functions and Nonlinear System Design*, 1968, ch. 2 and 5). It is
-measured by sine dwell on the nonlinear simplex model (:func:`taos.freqresp.sine_dwell_grid`,
+measured by sine dwell on the nonlinear simplex model (:func:`taos.planar.freqresp.sine_dwell_grid`,
 the compiled integrator) over a grid of amplitudes x frequencies and interpolated in
 (log A, log f) bilinearly in gain [dB] and unwrapped phase [deg]; outside the grid the
 nearest edge value is held.
@@ -26,12 +26,12 @@ import h5py
 import numpy as np
 
 from taos.errors import InputError
-from taos.freqresp import sine_dwell_grid
+from taos.planar.freqresp import sine_dwell_grid
 from taos.linear import StateSpace, gain_db
 from taos.model import Structure, TvcModel
 from taos.results import atomic_write, package_version, write_json, write_provenance
-from taos.simplex import simplex_state_space
-from taos.simulate import DEFAULT_DT_S
+from taos.planar.simplex import simplex_state_space
+from taos.planar.simulate import DEFAULT_DT_S
 
 #: gain floor [dB] below which the engine is taken as stuck (phase is then borrowed from the
 #: nearest amplitude at which it moves; the gain itself is kept, floored here)
@@ -152,11 +152,11 @@ def describing_function_map(model: TvcModel, amplitudes_rad, freq_hz, axis: str 
     amplitudes_rad, freq_hz : command amplitudes [rad] and frequencies [Hz] (sorted here)
     axis : 'pitch' or 'yaw'
     settle_cycles, measure_cycles, settle_s, dt_max_s : sine-dwell settings
-        (:func:`taos.freqresp.sine_dwell_grid`; settle at least ``settle_s`` [s], default four
+        (:func:`taos.planar.freqresp.sine_dwell_grid`; settle at least ``settle_s`` [s], default four
         decades of the slowest linear mode).
     method : 'settle' or 'shoot'
-        How each dwell reaches its periodic orbit (:func:`taos.freqresp.sine_dwell_points`;
-        'shoot': the periodic steady state by shooting, :mod:`taos.steady`).
+        How each dwell reaches its periodic orbit (:func:`taos.planar.freqresp.sine_dwell_points`;
+        'shoot': the periodic steady state by shooting, :mod:`taos.planar.steady`).
     """
     amps = np.sort(np.atleast_1d(np.asarray(amplitudes_rad, float)))
     f = np.sort(np.atleast_1d(np.asarray(freq_hz, float)))

@@ -29,14 +29,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.optimize
 
-from taos.avionics import Avionics
+from taos.planar.avionics import Avionics
 from taos.flight._harmonics import harmonic_amplitudes as _fit
 from taos.flight.describing import DescribingFunctionMap, describing_function_map
 from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
 from taos.linear import gain_db
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
-from taos.simulate import DEFAULT_DT_S, integrate_plant
+from taos.planar.simulate import DEFAULT_DT_S, integrate_plant
 
 DEG = math.pi / 180.0
 #: default describing-function grid for the flight loop: command amplitudes [deg], frequencies [Hz]
@@ -389,7 +389,7 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
     file's quantisation and crossover curve, as flown; the default amplitudes then reach half an
     LSB, :func:`model_avionics_amplitudes_rad`). ``steady``: how each dwell of the map reaches
     its periodic orbit ("settle", or "shoot": the periodic steady state by shooting,
-    :func:`taos.freqresp.sine_dwell_points`)."""
+    :func:`taos.planar.freqresp.sine_dwell_points`)."""
     axis = axis or flight.axis
     if avionics == "bounding":
         model = with_bounding_avionics(model)

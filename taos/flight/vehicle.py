@@ -10,7 +10,7 @@ Vehicle Flight Control Systems*, 1970, ch. 1)::
     K_twd = J_n + m_e l_e l_c                       "tail wags dog" inertial coupling
 
 theta vehicle attitude [rad], delta engine deflection [rad] (all n_e engines alike, each the
-simplex TVC of :mod:`taos.simplex`), T thrust per engine [N], l_c c.g. -> gimbal-plane arm [m],
+simplex TVC of :mod:`taos.planar.simplex`), T thrust per engine [N], l_c c.g. -> gimbal-plane arm [m],
 m_e engine mass [kg], l_e gimbal -> engine c.g. offset [m], J_n engine inertia about the gimbal
 [kg m^2], M_a aerodynamic instability [1/s^2] (0 exo-atmospheric). The TWD zeros sit at
 w_twd = sqrt(T l_c / K_twd). The engine equation does not feel the vehicle's own angular
@@ -30,7 +30,7 @@ L0(jw) = -d delta_c / d delta (jw); with the TVC's describing function N(A, w) t
 characteristic equation is 1 + L0 N = 0 (negative feedback convention: the critical point is
 -1, i.e. 0 dB and -180 deg on a Nichols chart). :func:`vehicle_fcs_state_space` is the single
 definition of vehicle + FCS; :func:`loop_freqresp` and the closed loop
-:func:`flight_plant` (a :class:`~taos.simplex.LurePlant` for the compiled integrator) both
+:func:`flight_plant` (a :class:`~taos.planar.simplex.LurePlant` for the compiled integrator) both
 use it.
 """
 
@@ -47,11 +47,11 @@ import scipy.signal
 
 from taos.errors import InputError
 from taos.linear import StateSpace
-from taos.margins import LoopMargins, loop_margins
+from taos.stability import LoopMargins, loop_margins
 from taos.model import TvcModel, read_toml
 from taos.shipped import resolve
-from taos.actuator_limits import embed_limits
-from taos.simplex import LurePlant, simplex_limits, simplex_state_space
+from taos.planar.saturation import embed_limits
+from taos.planar.simplex import LurePlant, simplex_limits, simplex_state_space
 from taos.units import Q_
 
 #: vehicle + FCS block signals
@@ -386,7 +386,7 @@ def open_loop_state_space(flight: FlightModel, axis: str | None = None) -> State
 
 @dataclass(frozen=True)
 class Margins:
-    """Stability margins of an open loop L (negative feedback), from :func:`taos.margins.loop_margins`.
+    """Stability margins of an open loop L (negative feedback), from :func:`taos.stability.loop_margins`.
 
     Gain margins in dB, each positive: ``high_gain_margin_db`` the gain may rise by that much
     (the smallest -20 log|L| over the -180 deg crossings where |L| < 1), ``low_gain_margin_db``
@@ -421,7 +421,7 @@ def _margins(lm: LoopMargins) -> Margins:
 
 def margins(freq_hz, L) -> Margins:
     """Margins of the sampled open loop ``L`` (complex, on an increasing frequency grid [Hz]);
-    every crossing located between samples by :func:`taos.margins.loop_margins`."""
+    every crossing located between samples by :func:`taos.stability.loop_margins`."""
     return _margins(loop_margins(freq_hz, L))
 
 

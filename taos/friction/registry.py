@@ -15,7 +15,7 @@ An entry (:class:`FrictionLawEntry`) holds everything about a law:
   function the fit surrogate uses (CasADi or float arithmetic), and ``fit_parameters``, the
   friction parameters a fit may free.
 
-The compiled integrators (:mod:`taos._integrator`, :mod:`taos.taos3d.dynamics`) take the
+The compiled integrators (:mod:`taos.planar.dynamics`, :mod:`taos.taos3d.dynamics`) take the
 kernels as first-class function arguments (numba ``FunctionType``): one compiled (and
 cached) integrator serves every law, including a law registered at run time. Kernel
 arguments (SI): relative rate ``v``/``w`` [rad/s], bristle state ``z`` [rad], its

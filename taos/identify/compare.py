@@ -5,7 +5,7 @@ sec. 2.2, figs. 2 and 11).
 the friction torque in in*lbf as well) with the ratio B / A, and the derived figures that
 tell the conditions apart: the load resonance w_L = sqrt((K_L R^2 + K_n) / J_n) / 2 pi
 (paper eq. 1) per axis, the notch of the linear command -> piston response
-(:func:`taos.simplex.load_resonance_from_notch`), and the friction breakaway deflection
+(:func:`taos.planar.simplex.load_resonance_from_notch`), and the friction breakaway deflection
 T_c / (K_L R^2). With test data (time-history files) each condition's responses are
 estimated (:func:`taos.identify.estimate.estimate`) and the plots overlay them on the model curves:
 the exact linear response and the time-domain sine dwell of the full model at the data's
@@ -110,7 +110,7 @@ def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
                    labels: tuple[str, str] | None = None) -> Comparison:
     """The comparison table of two models (module docstring); ``data_a``/``data_b`` are
     lists of :class:`~taos.identify.estimate.MeasuredResponse` shown on the plots."""
-    from taos.simplex import load_resonance_from_notch
+    from taos.planar.simplex import load_resonance_from_notch
 
     labels = labels or (model_a.name, model_b.name)
     rows: list[Row] = []
@@ -144,7 +144,7 @@ def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
 
 def model_curves(model: TvcModel, axis: str, amplitudes_rad, f_lo: float = 0.3, f_hi: float = 20.0, n: int = 24):
     """(dense linear FrequencyResponse, [sine-dwell FrequencyResponse per amplitude]) for plots."""
-    from taos.freqresp import linear_freqresp, sine_dwell_freqresp
+    from taos.planar.freqresp import linear_freqresp, sine_dwell_freqresp
 
     f = np.geomspace(f_lo, f_hi, 300)
     lin = linear_freqresp(model, f, axis)
@@ -158,7 +158,7 @@ def model_curves(model: TvcModel, axis: str, amplitudes_rad, f_lo: float = 0.3, 
 class ConditionCurves:
     """What the comparison plots draw for one condition and axis: the model's exact linear
     response and its sine dwells at the data's command amplitudes (FrequencyResponse objects),
-    the piston notch [Hz] (:func:`taos.simplex.load_resonance_from_notch`), the measured
+    the piston notch [Hz] (:func:`taos.planar.simplex.load_resonance_from_notch`), the measured
     responses on this axis, and the moment arm R [m] and load stiffness K_L [N/m]."""
 
     label: str

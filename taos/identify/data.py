@@ -9,7 +9,7 @@ Signals (canonical names, unit kind)::
     time [time], pitch_command, yaw_command [angle], pitch_piston, yaw_piston [length],
     pitch_engine, yaw_engine [angle]; optional hydraulic signals: pitch_load_pressure,
     yaw_load_pressure [pressure] (P_L), pitch_spool, yaw_spool [velocity] (servovalve
-    opening as its no-load piston rate K_q x_v / A, as :class:`taos.simulate.TimeHistory`
+    opening as its no-load piston rate K_q x_v / A, as :class:`taos.planar.simulate.TimeHistory`
     records it), supply_pressure [pressure]
 
 CSV layout: optional leading ``#`` lines holding TOML metadata (``# condition = "hot fire"``,
@@ -23,7 +23,7 @@ with a sidecar TOML beside the file (``run.csv`` + ``run.toml``)::
     t = {signal = "time", unit = "s"}
     cmd_p = {signal = "pitch_command", unit = "deg"}
 
-HDF5: a ``taos simulate`` :class:`~taos.simulate.TimeHistory` file (``/t_s``, ``/<axis>/...``,
+HDF5: a ``taos simulate`` :class:`~taos.planar.simulate.TimeHistory` file (``/t_s``, ``/<axis>/...``,
 engine angles absolute), or root datasets named by signal with a ``unit`` attribute and the
 metadata as root attributes.
 
@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from taos.errors import InputError
-from taos.limits import MAX_DATA_SAMPLES, MAX_RESAMPLE_FACTOR
+from taos.bounds import MAX_DATA_SAMPLES, MAX_RESAMPLE_FACTOR
 from taos.results import atomic_write
 from taos.units import Q_
 
@@ -413,7 +413,7 @@ def load_test_data(path, *, resample: bool = True) -> TestData:
 
 def from_time_history(th, *, engine_offset_rad=None, condition: str = "", source: str = "<simulation>",
                       synthetic: bool = True) -> TestData:
-    """A :class:`TestData` view of a :class:`~taos.simulate.TimeHistory` (engine angles
+    """A :class:`TestData` view of a :class:`~taos.planar.simulate.TimeHistory` (engine angles
     absolute unless an ``engine_offset_rad`` per axis is added, which makes them relative)."""
     eng = np.asarray(th.engine_rad, float)
     if engine_offset_rad is not None:

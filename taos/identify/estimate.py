@@ -78,8 +78,8 @@ class MeasuredResponse:
                        sigma_piston=self.sigma_piston[m], sigma_engine=opt(self.sigma_engine))
 
     def to_freqresp(self, moment_arm_m: float):
-        """As a :class:`~taos.freqresp.FrequencyResponse` (piston x_p / (R theta_c)) for plots."""
-        from taos.freqresp import FrequencyResponse
+        """As a :class:`~taos.planar.freqresp.FrequencyResponse` (piston x_p / (R theta_c)) for plots."""
+        from taos.planar.freqresp import FrequencyResponse
         amps = self.amplitude_rad[np.isfinite(self.amplitude_rad)]
         amp = float(np.median(amps)) if amps.size else None
         eng = self.engine if self.engine is not None else np.full(self.freq_hz.shape, np.nan + 0j)
@@ -104,7 +104,7 @@ class MeasuredResponse:
         whose moment arm then also defines the piston)."""
         rp = re = None
         if model is not None and len(self):
-            from taos.freqresp import linear_phase_reference
+            from taos.planar.freqresp import linear_phase_reference
             rp, re = linear_phase_reference(model, self.freq_hz, self.axis)
             moment_arm_m = model.actuator.moment_arm_m
 

@@ -20,7 +20,7 @@ Method (:func:`fit_frequency_response`):
    (the start values, then log-uniform draws within a factor of 2), best objective kept.
 4. Defect correction (when the model has friction): the describing function neglects
    harmonics, so the surrogate is corrected against the time-domain sine dwell of the full
-   nonlinear model (:func:`taos.freqresp.sine_dwell_grid`) at the current estimate:
+   nonlinear model (:func:`taos.planar.freqresp.sine_dwell_grid`) at the current estimate:
    c_k = H_sim / H_surrogate, data H_d / c_k refitted, until the parameters change by less
    than ``correction_tol`` (a fixed point where the *simulated* responses match the data to
    first order; noise-free data from the model class are recovered exactly).
@@ -160,7 +160,7 @@ def fitted_linear_curves(result: FitResult, n: int = 300) -> dict:
     """axis -> exact linear FrequencyResponse of the fitted model on a log grid of ``n``
     points spanning the data's frequencies (x 1/1.5 .. x 1.5) [Hz]: the grey lines that
     :func:`taos.plotting.fit.plot_fit` draws behind the data."""
-    from taos.freqresp import linear_freqresp
+    from taos.planar.freqresp import linear_freqresp
 
     fmin = min(float(np.min(d.freq_hz)) for d in result.data)
     fmax = max(float(np.max(d.freq_hz)) for d in result.data)
@@ -290,9 +290,9 @@ def _apply(model: TvcModel, names, values) -> TvcModel:
 
 def simulate_points(model: TvcModel, axes, freq_hz, amp_rad) -> tuple[np.ndarray, np.ndarray]:
     """Sine-dwell responses of the full nonlinear model at the points (hx [m/rad], he): every
-    point of an axis in one parallel call (:func:`taos.freqresp.sine_dwell_points`, the path
+    point of an axis in one parallel call (:func:`taos.planar.freqresp.sine_dwell_points`, the path
     of ``taos freqresp`` and of the LCO describing-function map)."""
-    from taos.freqresp import sine_dwell_points
+    from taos.planar.freqresp import sine_dwell_points
     hx = np.empty(freq_hz.size, complex)
     he = np.empty(freq_hz.size, complex)
     R = model.actuator.moment_arm_m
@@ -388,7 +388,7 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
         fitted_p.append(gx[pos:pos + n])
         fitted_e.append(ge[pos:pos + n] if dset.engine is not None else None)
         pos += n
-    from taos.simplex import load_resonance_from_notch
+    from taos.planar.simplex import load_resonance_from_notch
     ax_set = sorted(set(map(str, axes)))
     return FitResult(model=mfit, initial=m0, names=free, values=values, start_values=prob.p_ref.copy(),
                      std_errors=se_s * prob.p_ref, correlation=corr, cost=cost, n_residuals=nres, sigma2=sigma2,

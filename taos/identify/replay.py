@@ -2,7 +2,7 @@
 angle are from the test's, sample by sample.
 
 The record's commands drive the model (:func:`taos.profiles.profile_from_record`,
-:func:`taos.simulate.simulate`); the simulated signals are interpolated onto the record's
+:func:`taos.planar.simulate.simulate`); the simulated signals are interpolated onto the record's
 time stamps and compared: RMS of (model - test) for the piston [m] and for the engine angle
 [rad] (its mean difference removed when the record's engine angles are relative, the
 string pots' unknown offset), each also relative to the RMS of the test signal."""
@@ -33,7 +33,7 @@ class AxisReplay:
 
 
 def compare_replay(data, th) -> tuple[AxisReplay, ...]:
-    """Model run ``th`` (a :class:`taos.simulate.TimeHistory` of the replayed record) against
+    """Model run ``th`` (a :class:`taos.planar.simulate.TimeHistory` of the replayed record) against
     the record ``data`` (:class:`taos.identify.data.TestData`)."""
     t = np.asarray(data.t_s, float) - float(data.t_s[0])
     out = []

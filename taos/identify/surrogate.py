@@ -5,12 +5,12 @@ levels, servo gains, engine properties and the avionics gain. Each maps to one f
 model dataclasses (SI) and one key of the model file (written back with its unit).
 
 Surrogate of the amplitude-dependent sine-dwell response (one point: axis, frequency w,
-command amplitude A). The linear simplex block (:func:`taos.simplex.simplex_state_space`,
+command amplitude A). The linear simplex block (:func:`taos.planar.simplex.simplex_state_space`,
 built with CasADi SX parameters, the one definition of the dynamics) gives, exactly and
 differentiably (:func:`taos.linear.freqresp_symbolic`), the four responses from command c and
 friction torque T to piston x_p and engine rate omega: G_xc, G_xT, G_wc, G_wT. The command
 path is the describing function of the avionics (quantiser and crossover gain, a static map:
-its fundamental computed numerically from :class:`taos.avionics.Avionics` itself), times the
+its fundamental computed numerically from :class:`taos.planar.avionics.Avionics` itself), times the
 free ``avionics_gain`` k: C = k N_av(A) A. The friction element is replaced by the describing
 function its registry entry gives the fit (``fit_describing_function``, from engine rate to
 torque, T = N Omega; :mod:`taos.friction.registry`). Two loop solutions:
@@ -200,7 +200,7 @@ def build_surrogate(model: TvcModel, params, axes, freq_hz, amp_rad) -> Surrogat
     import casadi as ca
 
     from taos.linear import balancing_scale
-    from taos.simplex import simplex_state_space
+    from taos.planar.simplex import simplex_state_space
 
     params = tuple(params)
     fam = friction_family(model)

@@ -117,7 +117,7 @@ def mark_notch(ax, fr, notch_hz: float, scale: float, color="k", label_prefix: s
 def plot_freqresp(responses, resonance_hz: float | None = None, length_unit: str = "in", *,
                   moment_arm_m: float | None = None, notch_hz: float | None | bool = None,
                   title: str | None = None, data=None, data_label: str = "data"):
-    """Bode families of ``responses`` (list of :class:`~taos.freqresp.FrequencyResponse`).
+    """Bode families of ``responses`` (list of :class:`~taos.planar.freqresp.FrequencyResponse`).
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """Spec-mask marks on a 2 x 2 Bode figure (:func:`taos.plotting.bode.new_bode_figure` layout:
 piston gain, engine gain / piston phase, engine phase). Plotting only draws: the pass/fail
-comes from :func:`taos.spec.check_spec`."""
+comes from :func:`taos.report.spec.check_spec`."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Time-history plots of a recorded run (:class:`~taos.simulate.TimeHistory`).
+"""Time-history plots of a recorded run (:class:`~taos.planar.simulate.TimeHistory`).
 
 Four panels sharing the time axis [s]: command (FCS command, solid; after avionics
 quantisation and crossover gain, dashed) in ``angle_unit``; piston position x_p in

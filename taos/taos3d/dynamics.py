@@ -16,7 +16,7 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
                  springs are exactly conservative); each actuator i pulls along its line u_i
                  = (E_i - S_i)/L_i with F_L,i = K_L (x_p,i - (L_i - L0_i)) + c_L (v_p,i - L_i') at E_i
                  (c_L the load path's structural damping, taos.model.Structure)
-    actuators    the one linear actuator model (taos.actuator), x_c,i = R avionics(theta_c,i),
+    actuators    the one linear actuator model (taos.planar.actuator), x_c,i = R avionics(theta_c,i),
                  load input F_L,i
     bearing      (phi, z, T) advanced once per step by the friction law's implicit bearing solve
                  (its registry entry's ``bearing_step``, passed to the kernels as the
@@ -67,8 +67,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from .. import _avionics_kernels as _av
-from .. import actuator_limits as _lim
+from ..planar import _avionics_kernels as _av
+from ..planar import saturation as _lim
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 N_BODY = 13  # p (3), quaternion (4), v (6)
@@ -161,7 +161,7 @@ def _world_torque(r0, r1, r2, th, g0, g1, g2):
     return g0 + 0.5 * rg0 + c * rrg0, g1 + 0.5 * rg1 + c * rrg1, g2 + 0.5 * rg2 + c * rrg2
 
 
-#: the actuator rate/pressure limits (taos.actuator_limits), the same source compiled inline here
+#: the actuator rate/pressure limits (taos.planar.saturation), the same source compiled inline here
 _valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.apply_valve_pressure.py_func)
 
 
@@ -176,7 +176,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
         P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11], P[12], P[13])
     KL, Rarm, Kn = sc[0], sc[1], sc[2]
     cL, ivp = sc[5], int(sc[6])  # load-path damping [N s/m] and the actuator's v_p state index
-    lim = sc[7:]  # actuator/gimbal limits packed over one actuator's state (taos.actuator_limits)
+    lim = sc[7:]  # actuator/gimbal limits packed over one actuator's state (taos.planar.saturation)
     na = Aa.shape[0]
     p0, p1, p2 = x[0], x[1], x[2]
     qx, qy, qz, qw = x[3], x[4], x[5], x[6]
@@ -197,7 +197,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     g1 = -W4 - Kn * (axes[0, 1] * tp + axes[1, 1] * ty)
     g2 = -W5 - Kn * (axes[0, 2] * tp + axes[1, 2] * ty)
     wx, wy, wz = x[10], x[11], x[12]
-    if lim.shape[0] > 0 and lim[4] > 0.0:  # hard stops at the gimbal range (taos.actuator_limits)
+    if lim.shape[0] > 0 and lim[4] > 0.0:  # hard stops at the gimbal range (taos.planar.saturation)
         wo0, wo1, wo2 = _rv(R, wx, wy, wz)
         wp = axes[0, 0] * wo0 + axes[0, 1] * wo1 + axes[0, 2] * wo2
         wyw = axes[1, 0] * wo0 + axes[1, 1] * wo1 + axes[1, 2] * wo2
@@ -315,7 +315,7 @@ def pose_psi(x, P):
 
 @njit(cache=True, error_model="numpy")
 def command_mean(c0, c1, p):
-    """Mean of the avionics command path (:func:`taos.avionics.apply`, packed parameters ``p``)
+    """Mean of the avionics command path (:func:`taos.planar.avionics.apply`, packed parameters ``p``)
     over a command ramping linearly from ``c0`` to ``c1`` [rad] (one integration step) [rad].
     With quantisation the command path is piecewise constant in the command (bins of one LSB,
     edges at k LSB for truncation, (k + 1/2) LSB for rounding; the crossover gain is a

@@ -1,7 +1,7 @@
 """TAOS simulation, linearisation and frequency responses.
 
 * :func:`simulate_taos` runs a command profile (one or two axes) -> :class:`TaosTimeHistory`
-  (the arrays of :class:`taos.simulate.TimeHistory` for pitch and yaw, plus ``extra``: bearing
+  (the arrays of :class:`taos.planar.simulate.TimeHistory` for pitch and yaw, plus ``extra``: bearing
   slip, chain wrench, gimbal-half deflections, engine-point translation); HDF5 adds a
   ``/taos`` group.
 * :func:`taos_freqresp` gives command -> piston / engine responses per axis (and cross-axis):
@@ -18,12 +18,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..actuator import actuator_state_space
+from ..planar.actuator import actuator_state_space
 from ..errors import SimulationUnstable
-from ..freqresp import FrequencyResponse, deal_by_cost, settle_time_s
+from ..planar.freqresp import FrequencyResponse, deal_by_cost, settle_time_s
 from ..linear import StateSpace
 from ..profiles import is_two_axis
-from ..simulate import SolverSettings, TimeHistory, provenance
+from ..planar.simulate import SolverSettings, TimeHistory, provenance
 from . import dynamics as _dy
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
 
@@ -45,10 +45,10 @@ class Packed:
 
 
 def actuator_limits(tm: TaosModel) -> np.ndarray:
-    """The actuator and gimbal limits (:mod:`taos.actuator_limits`) packed over one actuator's state:
+    """The actuator and gimbal limits (:mod:`taos.planar.saturation`) packed over one actuator's state:
     valve flow saturation and supply-pressure limit per actuator, hard stops per axis (the
     stop damping from the pitch inertia; the 3-D engine is axisymmetric about its axis)."""
-    from ..actuator_limits import limit_rows_for_actuator, pack_limits
+    from ..planar.saturation import limit_rows_for_actuator, pack_limits
     act, eng = tm.base.actuator, tm.base.engine
     rows, kv = limit_rows_for_actuator(act)
     return pack_limits(act.max_rate_m_per_s, kv * act.moment_arm_m,
@@ -92,7 +92,7 @@ def rest_state(pk: Packed) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class TaosTimeHistory(TimeHistory):
-    """:class:`~taos.simulate.TimeHistory` (axes pitch and yaw) plus ``extra`` arrays:
+    """:class:`~taos.planar.simulate.TimeHistory` (axes pitch and yaw) plus ``extra`` arrays:
     ``bearing_slip_rad`` (2, n), ``chain_wrench`` (6, n) [N, N m] at O, ``upper_deflection``
     and ``lower_deflection`` (6, n) = K^-1 W [m, rad], ``engine_point_m`` (3, n)."""
 

@@ -27,7 +27,7 @@ __all__ = ["BaseVisualizer", "GimbalGeometry", "MeshcatVisualizer", "OfflineWind
 
 def load_run(path):
     """Read a ``taos simulate`` HDF5 run; InputError (one line) if it is not one."""
-    from ..simulate import TimeHistory
+    from ..planar.simulate import TimeHistory
 
     p = Path(path)
     if not p.is_file():

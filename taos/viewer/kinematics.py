@@ -1,11 +1,11 @@
-"""Display kinematics: a recorded :class:`~taos.simulate.TimeHistory` -> per-frame poses and colours.
+"""Display kinematics: a recorded :class:`~taos.planar.simulate.TimeHistory` -> per-frame poses and colours.
 
 Engine: rotation Ry(s theta_pitch) Rx(-s theta_yaw) about the gimbal pivot (s = ``angle_scale``,
 1 = true motion), so each clevis moves by R s theta along its actuator line
 (:mod:`taos.viewer.geometry`).
 
 Load path: the simplex model lumps every compliance outside the actuator position loop into
-K_L with F_L = K_L (x_p - R theta) (:mod:`taos.simplex`); its deflection is
+K_L with F_L = K_L (x_p - R theta) (:mod:`taos.planar.simplex`); its deflection is
 delta = x_p - R theta [m]. It is drawn at the structure-side attach point, which is pushed
 back along the actuator line by k delta (k = ``deflection_scale``); the actuator spans that
 point and the engine clevis, so the drawn rod stroke is |C - S'| - L0 ~ s R theta + k delta,

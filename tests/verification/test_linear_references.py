@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from taos.freqresp import linear_freqresp, sine_dwell_grid
+from taos.planar.freqresp import linear_freqresp, sine_dwell_grid
 from taos.linear import gain_db
 from taos.model import load_model
-from taos.simplex import simplex_plant, simplex_state_space
-from taos.simulate import integrate_plant
+from taos.planar.simplex import simplex_plant, simplex_state_space
+from taos.planar.simulate import integrate_plant
 
 DEG = math.pi / 180
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from taos.model import load_model
-from taos.simplex import simplex_state_space
+from taos.planar.simplex import simplex_state_space
 
 from ..test_masv import one_engine
 
@@ -35,11 +35,11 @@ def test_masv_one_engine_rigid_structure_equals_simplex(axis, verify):
 def test_dwell_estimator_recovers_the_exact_linear_response(verify):
     """Friction off, ideal avionics: a simulated dwell record, estimated as the test data were
     (taos.identify), gives the exact linear response."""
-    from taos.freqresp import linear_freqresp
+    from taos.planar.freqresp import linear_freqresp
     from taos.identify.data import from_time_history
     from taos.identify.estimate import estimate
     from taos.profiles import Sequence, SineDwell
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     a = load_model("rs25_ambient")
     m = a.with_friction("none").replace(avionics=a.avionics.ideal())
@@ -55,7 +55,7 @@ def test_dwell_estimator_recovers_the_exact_linear_response(verify):
 def test_csv_round_trip(tmp_path, verify):
     from taos.identify.data import from_time_history, load_test_data
     from taos.profiles import SineDwell
-    from taos.simulate import simulate
+    from taos.planar.simulate import simulate
 
     th = simulate(load_model("rs25_ambient"), SineDwell(0.4 * DEG, 2.0, 4))
     d = from_time_history(th)
@@ -81,7 +81,7 @@ def test_log_sweep_instantaneous_frequency(verify):
 
 def test_rounding_quantiser_error_is_at_most_half_an_lsb(verify):
     """A rounding quantiser errs by at most LSB/2, truncation by less than one LSB (Widrow)."""
-    from taos.avionics import apply_array
+    from taos.planar.avionics import apply_array
 
     av = load_model("rs25_ambient").avionics.ideal()
     av = dataclasses.replace(av, quantization_bits=12, command_range_rad=21 * DEG, rounding=True)

@@ -19,7 +19,11 @@ from docutils.statemachine import StringList
 from sphinx.util import logging
 from sphinx.util.docutils import SphinxDirective
 
-from . import guide, layouts, reference
+from . import guide
+
+from . import layouts
+
+from . import reference
 from .docstrings import process_docstring
 
 logger = logging.getLogger(__name__)

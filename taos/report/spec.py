@@ -10,7 +10,7 @@ A mask file (TOML, shipped ones in ``models/specs/``)::
     phase_deg = [-45.0, 5.0]     # optional [min, max], phase continuous from low frequency
 
 :func:`check_spec` evaluates the exact linear response of a model at each point
-(:func:`taos.freqresp.linear_freqresp`, the project's conventions) and returns a
+(:func:`taos.planar.freqresp.linear_freqresp`, the project's conventions) and returns a
 :class:`SpecResult` with one row per point and the overall verdict.
 """
 
@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .units import to_si
+from ..errors import InputError
+from ..units import to_si
 
 RESPONSES = ("engine", "piston")
 
@@ -55,7 +55,7 @@ def _pair(v, src, field):
 
 def load_spec(path) -> SpecMask:
     """Read and validate a spec-mask file (module docstring)."""
-    from .shipped import resolve
+    from ..shipped import resolve
     p = Path(resolve(path, "spec"))
     src = str(path)
     try:
@@ -137,8 +137,8 @@ class SpecResult:
 
 def check_spec(model, mask: SpecMask, axis: str = "pitch") -> SpecResult:
     """The linear response of ``model``'s ``axis`` against ``mask``."""
-    from .freqresp import linear_freqresp
-    from .linear import gain_db
+    from ..planar.freqresp import linear_freqresp
+    from ..linear import gain_db
 
     f = np.array([p.freq_hz for p in mask.points])
     fr = linear_freqresp(model, f, axis)

@@ -13,7 +13,7 @@ Command path (seed paper section 2.3)::
   the default has a valley of 0.95 (-0.45 dB... -1.1 dB with the paper's bounding) in the
   low-amplitude region tending to 1.0 at large commands.
 
-Both maps are numba kernels over a packed parameter vector (:mod:`taos._avionics_kernels`,
+Both maps are numba kernels over a packed parameter vector (:mod:`taos.planar._avionics_kernels`,
 the single definition) so the time-domain integrator applies them in the loop (closed
 flight loop) or to a whole command array (open loop).
 """
@@ -77,7 +77,7 @@ class Avionics:
 
 
 def __getattr__(name: str):
-    """``apply`` and ``apply_array``: the compiled kernels (:mod:`taos._avionics_kernels`),
+    """``apply`` and ``apply_array``: the compiled kernels (:mod:`taos.planar._avionics_kernels`),
     imported on first use so that loading a model does not import numba."""
     if name in ("apply", "apply_array"):
         from . import _avionics_kernels

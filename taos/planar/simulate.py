@@ -1,6 +1,6 @@
-"""Time-domain simulation of the simplex TVC model (and any :class:`~taos.simplex.LurePlant`).
+"""Time-domain simulation of the simplex TVC model (and any :class:`~taos.planar.simplex.LurePlant`).
 
-Fixed-step classical RK4 in the compiled kernel of :mod:`taos._integrator`. The default step
+Fixed-step classical RK4 in the compiled kernel of :mod:`taos.planar.dynamics`. The default step
 (2e-4 s) resolves the fastest dynamics of the shipped models (oil column ~ 250 Hz,
 servovalve 100 Hz) with a wide RK4 stability margin; halving it changes a 20 s LuGre run by
 less than 1e-4 deg (``tests/test_simplex.py::test_step_refinement_lugre_20s``).
@@ -18,10 +18,10 @@ import numpy as np
 if TYPE_CHECKING:
     import h5py
 
-from .errors import SimulationUnstable
-from .model import TvcModel
-from .profiles import is_two_axis
-from .results import atomic_write, base_provenance, write_provenance
+from ..errors import SimulationUnstable
+from ..model import TvcModel
+from ..profiles import is_two_axis
+from ..results import atomic_write, base_provenance, write_provenance
 from .simplex import LurePlant, simplex_plant
 
 DEFAULT_DT_S = 2e-4
@@ -66,7 +66,7 @@ def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: floa
     y = np.empty((nrec, plant.ss.C.shape[0]))
     aux = np.empty((nrec, 3))
     x0 = np.zeros(n) if x0 is None else np.asarray(x0, float)
-    from . import _integrator as _ig
+    from . import dynamics as _ig
 
     status = _ig.integrate_samples(*kernel_args(plant, model), np.ascontiguousarray(plant.ss.C),
                                    model.friction.entry.rates, model.friction.pack(), model.avionics.pack(),
@@ -159,7 +159,7 @@ def _with_spool_output(plant: LurePlant) -> LurePlant:
     """The plant with the servovalve state ``q_m_s`` as an extra output (recorded only)."""
     import dataclasses
 
-    from .linear import StateSpace
+    from ..linear import StateSpace
     ss = plant.ss
     row = np.zeros((1, ss.A.shape[0]))
     row[0, ss.state_index("q_m_s")] = 1.0

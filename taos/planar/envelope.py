@@ -2,7 +2,7 @@
 sizes, linear stability before a run, and the physical envelope after it.
 
 The documented limits themselves (gimbal range, frequencies, durations, sizes) and the scalar
-checks are in :mod:`taos.limits`; this module sits one layer up, beside the simplex model and
+checks are in :mod:`taos.bounds`; this module sits one layer up, beside the simplex model and
 the profiles it inspects.
 """
 
@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from .errors import EnvelopeExceeded, InputError, UnstableModel
-from .limits import (GIMBAL_RANGE_RAD, HARD_STOP_RAD, LOAD_FORCE_FACTOR, MAX_JOB_BYTES, MAX_STEPS,
+from ..errors import EnvelopeExceeded, InputError, UnstableModel
+from ..bounds import (GIMBAL_RANGE_RAD, HARD_STOP_RAD, LOAD_FORCE_FACTOR, MAX_JOB_BYTES, MAX_STEPS,
                      MIN_STEPS_PER_CYCLE, RK4_STEP_LIMIT, check_duration)
 
 
@@ -53,7 +53,7 @@ def check_step(dt_s: float, model=None, *, max_freq_hz: float | None = None, dur
 
 def _profile_parts(profile):
     """Single-axis leaves of a profile (for frequency and amplitude checks)."""
-    from .profiles import Circular, Sequence, TwoAxis
+    from ..profiles import Circular, Sequence, TwoAxis
 
     if isinstance(profile, TwoAxis):
         return _profile_parts(profile.pitch) + _profile_parts(profile.yaw)
@@ -81,7 +81,7 @@ def check_dwell(model, freqs_hz, dt_s: float = 2e-4, axis: str = "pitch", source
                 field: str = "--freq-hz", min_steps_per_cycle: int = 64, n_amplitudes: int = 1) -> None:
     """The integration steps a sine-dwell grid of ``n_amplitudes`` x ``freqs_hz`` will take at
     most (settling over the slowest linear mode, then two measured cycles;
-    :func:`taos.freqresp.sine_dwell_points`; shooting's fallback has the same budget) within
+    :func:`taos.planar.freqresp.sine_dwell_points`; shooting's fallback has the same budget) within
     MAX_DWELL_STEPS."""
     from .freqresp import settle_time_s
 

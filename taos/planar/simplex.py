@@ -1,7 +1,7 @@
 """Planar "simplex" TVC model: one actuator, one engine axis, compliant load path, gimbal
 friction and command avionics (seed paper sections 2 and 3).
 
-Equations (SI), built from the actuator state space of :mod:`taos.actuator`::
+Equations (SI), built from the actuator state space of :mod:`taos.planar.actuator`::
 
     x_c = R theta_c'                       theta_c' = avionics(theta_c)   [rad]
     F_L = K_L (x_p - R theta)              load path (structure, engine, gimbal, case)
@@ -11,7 +11,7 @@ Equations (SI), built from the actuator state space of :mod:`taos.actuator`::
 
 The load resonance w_L = sqrt((K_L R^2 + K_n)/J_n) (paper eq. 1) is the notch of the
 command -> piston response. Two views of one model: :func:`simplex_plant` gives the linear
-block (exact frequency response, poles), and :mod:`taos.simulate` integrates the same block
+block (exact frequency response, poles), and :mod:`taos.planar.simulate` integrates the same block
 with the friction and avionics nonlinearities closed around it.
 
 On an elastic structure (MASV, paper sec. 1 and 3.3) the same block takes the structure's
@@ -42,8 +42,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .actuator import actuator_state_space
-from .linear import StateSpace, finish, is_symbolic, notch_hz, zeros
-from .model import TvcModel
+from ..linear import StateSpace, finish, is_symbolic, notch_hz, zeros
+from ..model import TvcModel
 
 #: Outputs of the simplex linear block, in order.
 SIMPLEX_OUTPUTS = ("x_p_m", "theta_rad", "omega_rad_s", "applied_torque_Nm", "load_force_N", "p_load_Pa")
@@ -62,7 +62,7 @@ class LurePlant:
     inputs); the friction element sees the relative rate ``rate_c . x`` [rad/s] and the applied
     torque ``applied_c . x`` [N m]. ``inertia_kgm2`` is the inertia the friction acts on
     (for step-size checks). ``limits`` packs the actuator/gimbal limits over the state
-    (:mod:`taos.actuator_limits`; empty: none).
+    (:mod:`taos.planar.saturation`; empty: none).
     """
 
     ss: StateSpace
@@ -191,9 +191,9 @@ def simplex_plant(model: TvcModel, axis: str = "pitch") -> LurePlant:
 
 
 def simplex_limits(model: TvcModel, axis: str = "pitch") -> np.ndarray:
-    """The model's actuator and gimbal limits packed over the simplex state (:mod:`taos.actuator_limits`):
+    """The model's actuator and gimbal limits packed over the simplex state (:mod:`taos.planar.saturation`):
     valve flow saturation, supply-pressure limit, hard stops at the gimbal range."""
-    from .actuator_limits import limit_rows_for_actuator, pack_limits
+    from .saturation import limit_rows_for_actuator, pack_limits
     act, eng = model.actuator, model.engine
     rows, kv = limit_rows_for_actuator(act)
     ss = simplex_state_space(model, axis)

@@ -2,10 +2,10 @@
 
 A sine dwell wants the periodic orbit y*(t) = y*(t + T) of the plant driven by
 r(t) = A sin(w t), T = 2 pi / w [s], with y = (x, z) the linear states (SI, as
-:class:`taos.simplex.LurePlant`) and the friction law's state z [rad]. Settling finds it by
+:class:`taos.planar.simplex.LurePlant`) and the friction law's state z [rad]. Settling finds it by
 integrating from rest through the slowest transient (seconds of the lightly damped load mode).
 Shooting solves the fixed-point problem of the one-period map P (``n_per_cycle`` steps of
-the same compiled RK4 step as every other run, :func:`taos._integrator._rk4_step`)::
+the same compiled RK4 step as every other run, :func:`taos.planar.dynamics._rk4_step`)::
 
     G(y0) = P(y0) - y0 = 0
 
@@ -45,7 +45,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from . import _integrator as _ig
+from . import dynamics as _ig
 
 _FM = _ig._FM
 
@@ -57,7 +57,7 @@ INFO = ("residual", "periods", "extrapolations", "converged")
 def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, src, dst, s, nz, set_zscale,
             x, corr, k1, k2, k3, k4, xt, r0, rm, r1):
     """One period of the map: dst = P(src), src/dst = (x, z); ``corr`` receives the period's
-    correlation sums (:func:`taos._integrator.sine_steps`). With ``set_zscale`` the friction
+    correlation sums (:func:`taos.planar.dynamics.sine_steps`). With ``set_zscale`` the friction
     state's scale s[n] becomes the largest |z| of the period first. Returns (status, scaled
     residual max_i |dst_i - src_i| / s_i)."""
     n = x.shape[0]
@@ -85,7 +85,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
     (x0, z0); ``scale`` (n + 1): s_i (its last entry is replaced by the friction state's scale
     after the first period); ``nz`` 1 if the law has a state; ``k_rre`` + 1 periods per
     extrapolation cycle; ``n_budget`` periods in all before the fallback stops. Writes the
-    correlations to ``out`` (as :func:`taos._integrator._sine_dwell_one`) and ``info``
+    correlations to ``out`` (as :func:`taos.planar.dynamics._sine_dwell_one`) and ``info``
     (:data:`INFO`). Returns -1 or the failing step."""
     n = A.shape[0]
     m = n + nz

@@ -1,9 +1,9 @@
 """The avionics command-path kernels (quantiser, then crossover-distortion gain), compiled by
-numba: the single definition the integrators and :class:`taos.avionics.Avionics` use.
+numba: the single definition the integrators and :class:`taos.planar.avionics.Avionics` use.
 
 ``apply(c, p)``: command ``c`` [rad] -> c_out [rad]; ``p`` the packed parameters of
-:meth:`taos.avionics.Avionics.pack` (bits, LSB [rad], rounding 0/1, table length n, table
-magnitudes [rad] (n), gains [-] (n)). Equations: :mod:`taos.avionics`.
+:meth:`taos.planar.avionics.Avionics.pack` (bits, LSB [rad], rounding 0/1, table length n, table
+magnitudes [rad] (n), gains [-] (n)). Equations: :mod:`taos.planar.avionics`.
 """
 
 from __future__ import annotations

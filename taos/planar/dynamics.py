@@ -1,20 +1,20 @@
 """Compiled fixed-step integrator for Lur'e plants (linear block + friction + avionics).
 
-State equations (see :class:`taos.simplex.LurePlant`)::
+State equations (see :class:`taos.planar.simplex.LurePlant`)::
 
     c   = cc . x + dc . r(t)                 pre-avionics command [rad]
     u   = avionics(c)                        post-avionics command [rad]
     w   = cw . x,  T_a = ca . x              friction relative rate [rad/s], applied torque [N m]
     (z', T_f) = friction.rates(w, z, T_a)    the law's kernel (registry entry)
     x'  = A x + Br r(t) + bc u + bf T_f  (+ the actuator/gimbal limit corrections of
-                                          :mod:`taos.actuator_limits`, packed in ``lim``)
+                                          :mod:`taos.planar.saturation`, packed in ``lim``)
 
 Classical fourth-order Runge-Kutta with a fixed step; the external input is evaluated at the
 stage times (linear interpolation of samples, or exactly for sines). The friction kernels
 come from the law's registry entry (:mod:`taos.friction.registry`): ``fid`` is its
 ``rates(w, z, T_a, p) -> (z', T_f)``, a compiled C callback passed as a first-class
 function, so one compiled integrator serves every law, including laws registered at run
-time. The avionics kernel is the single definition in :mod:`taos.avionics`. A non-finite
+time. The avionics kernel is the single definition in :mod:`taos.planar.avionics`. A non-finite
 state stops the run and reports the step.
 """
 
@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit, prange
 
 from . import _avionics_kernels as _av
-from . import actuator_limits as _lim
+from . import saturation as _lim
 
 # reassociation and FMA contraction only: no-NaN/no-Inf flags would remove the stability checks
 _FM = {"reassoc", "contract", "arcp", "nsz"}
@@ -54,7 +54,7 @@ def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, dx):
         for j in range(nr):
             s += Br[i, j] * r[j]
         dx[i] = s
-    _lim.apply(lim, x, u, dx)  # actuator/gimbal limits (taos.actuator_limits); no-op when none
+    _lim.apply(lim, x, u, dx)  # actuator/gimbal limits (taos.planar.saturation); no-op when none
     return dz, tf, u
 
 

@@ -1,7 +1,7 @@
 """Actuator and gimbal limits: valve flow saturation, supply-pressure (stall) limit, hard stops.
 
 Three hard nonlinearities every real TVC servo has, added to the linear actuator model of
-:mod:`taos.actuator` as corrections to its state derivative (so that, away from the limits,
+:mod:`taos.planar.actuator` as corrections to its state derivative (so that, away from the limits,
 the model is exactly the linear one the fits and the frequency responses use):
 
 * **Valve flow saturation (rate limit).** The spool stroke bounds the servovalve's no-load
@@ -153,7 +153,7 @@ def apply(lim, x, u, dx):
 
 
 def limit_rows_for_actuator(act) -> tuple[dict[str, np.ndarray], float]:
-    """State rows of the limits over the actuator's own state (:func:`taos.actuator.actuator_state_space`
+    """State rows of the limits over the actuator's own state (:func:`taos.planar.actuator.actuator_state_space`
     order) and the command weight K_v [1/s] of u_v per metre of x_c."""
     from .actuator import actuator_state_space
     ss = actuator_state_space(act)

@@ -19,7 +19,7 @@ and ``settle_time_s`` (default from the slowest linear pole), and correlates the
 with sin and cos over ``measure_cycles`` whole cycles (steps per cycle an integer, so the
 rectangle rule is exact for the fundamental of a periodic signal). With ``method="shoot"``
 the dwell is measured instead from the periodic steady state found by shooting
-(:mod:`taos.steady`), which starts on the exact linear orbit and skips the settling
+(:mod:`taos.planar.steady`), which starts on the exact linear orbit and skips the settling
 transient. A list of amplitudes is one parallel call (:func:`sine_dwell_family`, the
 N(A, w) map).
 """
@@ -31,9 +31,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import SimulationUnstable
-from .linear import gain_db, phase_deg_continuous
-from .model import TvcModel
+from ..errors import SimulationUnstable
+from ..linear import gain_db, phase_deg_continuous
+from ..model import TvcModel
 from .simplex import simplex_plant, simplex_state_space
 from .simulate import DEFAULT_DT_S, check_step, kernel_args
 
@@ -182,7 +182,7 @@ class DwellPoints:
     """Sine-dwell responses at paired (amplitude, frequency) points: complex ``piston``
     (x_p / (R theta_c)) and ``engine`` (theta / theta_c); with ``method="shoot"`` also the
     final scaled residual of the one-period map [-], the periods integrated and whether
-    shooting converged (:mod:`taos.steady`); for settled dwells these are None."""
+    shooting converged (:mod:`taos.planar.steady`); for settled dwells these are None."""
 
     piston: np.ndarray
     engine: np.ndarray
@@ -203,7 +203,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     ``method="settle"``: from rest through at least ``settle_cycles`` cycles and ``settle_s``
     [s] (default: four decades of the slowest linear mode), then ``measure_cycles`` measured
     cycles (default 2). ``method="shoot"``: the periodic steady state by shooting
-    (:mod:`taos.steady`, to the scaled residual ``tol``, ``k_rre`` + 1 periods per
+    (:mod:`taos.planar.steady`, to the scaled residual ``tol``, ``k_rre`` + 1 periods per
     extrapolation, at most ``max_cycles`` extrapolations, then integration for the settling
     budget), measured over ``measure_cycles`` cycles (default 1: the orbit is periodic). Steps: at most ``dt_max_s`` [s] and at least
     ``min_steps_per_cycle`` per cycle, an integer number per cycle."""
@@ -229,7 +229,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     status = np.full(A.size, -1, np.int64)
     extra = {}
     if method == "settle":
-        from . import _integrator as _ig
+        from . import dynamics as _ig
 
         _ig.sine_dwell_batch(*args, Cy, *kern, A, F, npc, nbud * npc, nmeas, out, status)
     else:

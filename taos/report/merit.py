@@ -1,7 +1,7 @@
 """Figures of merit of a TVC axis, as an actuator specification states them.
 
 Frequency domain (:func:`frequency_merit`, from the exact linear response on a dense log
-grid, :func:`taos.freqresp.linear_freqresp`; phase continuous from low frequency):
+grid, :func:`taos.planar.freqresp.linear_freqresp`; phase continuous from low frequency):
 
 * ``bandwidth_3db_hz``: the lowest frequency at which the gain falls 3 dB below its
   low-frequency value (linear interpolation of dB in log f between grid points);
@@ -10,13 +10,13 @@ grid, :func:`taos.freqresp.linear_freqresp`; phase continuous from low frequency
   value and where it occurs (refined by a parabola in log f through the three grid points
   around the maximum);
 * ``load_resonance_hz`` w_L = sqrt((K_L R^2 + K_n) / J_n) and ``notch_hz``, the minimum of
-  the command -> piston gain (:func:`taos.simplex.load_resonance_from_notch`, the one notch
+  the command -> piston gain (:func:`taos.planar.simplex.load_resonance_from_notch`, the one notch
   finder every command uses).
 
 Reported for command -> engine (theta / theta_c) and command -> piston (x_p / (R theta_c)).
 
 Time domain (:func:`step_merit`, by simulating the full nonlinear simplex model,
-:func:`taos.simulate.simulate`, with its friction and avionics):
+:func:`taos.planar.simulate.simulate`, with its friction and avionics):
 
 * ``rise_time_s``: 10 % to 90 % of the final engine angle after a step of
   ``step_amplitude_rad``; ``overshoot_pct``: (peak - final) / final;
@@ -40,7 +40,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .model import TvcModel
+from ..model import TvcModel
 
 
 def _none(x):
@@ -115,8 +115,8 @@ def response_merit(name: str, freq_hz, h, phase_deg) -> ResponseMerit:
 def frequency_merit(model: TvcModel, axis: str = "pitch", f_min_hz: float = 0.01, f_max_hz: float = 50.0,
                     n: int = 1500) -> FrequencyMerit:
     """Frequency figures of merit of ``axis`` from the exact linear response (module docstring)."""
-    from .freqresp import linear_freqresp
-    from .simplex import load_resonance_from_notch
+    from ..planar.freqresp import linear_freqresp
+    from ..planar.simplex import load_resonance_from_notch
 
     f = np.logspace(math.log10(f_min_hz), math.log10(f_max_hz), n)
     fr = linear_freqresp(model, f, axis)
@@ -144,8 +144,8 @@ class StepMerit:
 
 
 def _engine_step(model, axis, amp_rad, t_step=0.2, hold=1.5, dt_s=2e-4):
-    from .profiles import Step
-    from .simulate import simulate
+    from ..profiles import Step
+    from ..planar.simulate import simulate
     th = simulate(_axis_model(model, axis), Step(amp_rad, t_step, hold), dt_s=dt_s, record_every=1, duration_s=t_step + hold)
     return th.t_s, th.engine_rad[0]
 
@@ -163,8 +163,8 @@ def step_merit(model: TvcModel, axis: str = "pitch", *, step_amplitude_rad: floa
                hysteresis_amplitude_rad: float = math.radians(0.2), ramp_rate_rad_s: float = math.radians(0.05),
                threshold_tol_rad: float = math.radians(0.002), dt_s: float = 2e-4) -> StepMerit:
     """Step, threshold and hysteresis figures of ``axis`` by simulation (module docstring)."""
-    from .profiles import MultiRamp
-    from .simulate import simulate
+    from ..profiles import MultiRamp
+    from ..planar.simulate import simulate
 
     t, th = _engine_step(model, axis, step_amplitude_rad, dt_s=dt_s)
     t0 = 0.2

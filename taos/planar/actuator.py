@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import math
 
-from .linear import StateSpace, finish, is_symbolic, zeros
-from .model import Actuator
+from ..linear import StateSpace, finish, is_symbolic, zeros
+from ..model import Actuator
 
 
 def actuator_state_space(act: Actuator) -> StateSpace:
