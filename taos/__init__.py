@@ -14,7 +14,7 @@ The public API, by task (each name is importable from ``taos``)::
 
 Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.py`` checks):
 
-1. ``units``, ``errors``, ``results``, ``shipped``, ``bounds`` - units, one-line input errors,
+1. ``units``, ``errors``, ``results``, ``shipped``, ``bounds``, ``harmonics`` - units, one-line input errors,
    output files, the documented bounds of every input;
 2. ``friction``, ``linear``, ``stability``, ``model`` and the component models
    ``planar.actuator``, ``planar.avionics``, ``planar.saturation``;

@@ -35,6 +35,7 @@ import h5py
 import numpy as np
 
 from taos.errors import InputError
+from taos.harmonics import fit_sines
 from taos.linear import gain_db, notch_hz
 from taos.profiles import Sequence, SineDwell, TwoAxis
 from taos.cli.records import load_profile
@@ -67,13 +68,9 @@ def run_dwell_response(t_s, command_amp_rad: float, freq_hz: float, t0_s: float,
                        fit_cycles: int = 2) -> complex:
     """Fundamental of ``y`` relative to A sin(w (t - t0)) over the segment's last whole cycles."""
     m = min(fit_cycles, max(1, cycles - 1))
-    w = 2 * math.pi * freq_hz
     lo, hi = t0_s + (cycles - m) / freq_hz, t0_s + cycles / freq_hz
     sel = (t_s >= lo) & (t_s < hi)
-    tt = t_s[sel] - t0_s
-    X = np.column_stack([np.sin(w * tt), np.cos(w * tt), np.ones_like(tt)])
-    (a, b, _), *_ = np.linalg.lstsq(X, y[sel], rcond=None)
-    return complex(a, b) / command_amp_rad
+    return complex(fit_sines(t_s[sel] - t0_s, y[sel], freq_hz).phasor[0, 0]) / command_amp_rad
 
 
 def run_responses(th, profile, moment_arm_m: float) -> dict:

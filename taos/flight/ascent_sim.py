@@ -28,6 +28,7 @@ import numpy as np
 from taos.flight.ascent import Ascent, aero_instability, control_acceleration, pti_command, wind_speed
 from taos.flight.lco import FlightHistory, measure_oscillation
 from taos.flight.vehicle import FlightModel, flight_plant
+from taos.harmonics import fit_sines
 from taos.linear import StateSpace
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
@@ -273,13 +274,6 @@ def analysis_windows(h: AscentHistory, axis: str, settle_s: float = 15.0, min_qu
     return out
 
 
-def _harmonic(t, y, f):
-    w = 2 * math.pi * f
-    M = np.column_stack([np.sin(w * t), np.cos(w * t), t - t.mean(), np.ones_like(t)])
-    c = np.linalg.lstsq(M, y, rcond=None)[0]
-    return math.hypot(c[0], c[1])
-
-
 def analyse_ascent(h: AscentHistory, linear: AscentHistory | None = None, axes=None,
                    threshold_rad: float = 0.004 * math.pi / 180) -> list[WindowResult]:
     """Measure each post-separation window of ``h`` (:func:`analysis_windows`). Quiescent
@@ -311,6 +305,6 @@ def analyse_ascent(h: AscentHistory, linear: AscentHistory | None = None, axes=N
             if linear is not None and f:
                 sel = (h.t_s >= 0.5 * (a + b)) & (h.t_s <= b)
                 d = h.signal("command_rad", ax)[sel] - linear.signal("command_rad", ax)[sel]
-                band = _harmonic(h.t_s[sel], d, f)
+                band = float(fit_sines(h.t_s[sel], d, f, trend=True).amplitude()[0, 0])
             res.append(WindowResult(ax, kind, a, b, False, float("nan"), float("nan"), f or float("nan"), band))
     return sorted(res, key=lambda r: (r.axis, r.start_s))

@@ -30,7 +30,7 @@ import numpy as np
 import scipy.optimize
 
 from taos.planar.avionics import Avionics
-from taos.flight._harmonics import harmonic_amplitudes as _fit
+from taos.harmonics import harmonic_amplitudes as _fit
 from taos.flight.describing import DescribingFunctionMap, describing_function_map
 from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
 from taos.linear import gain_db

@@ -134,7 +134,7 @@ def lco_verdict(report) -> LcoVerdict:
                                   2 * math.pi * c.freq_hz * att))
     td, h = report.time_domain, report.history
     if td is not None and td.lco and h is not None:
-        from taos.flight._harmonics import harmonic_amplitudes as _fit
+        from taos.harmonics import harmonic_amplitudes as _fit
         m = h.t_s >= h.t_s[-1] - td.window_s
         att, _ = _fit(h.t_s[m], h.attitude_rad[m], td.freq_hz)
         motion.append(CycleMotion("time domain", td.freq_hz, td.amplitude_rad, td.engine_amplitude_rad, att,

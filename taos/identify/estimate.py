@@ -34,6 +34,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from taos.harmonics import fit_sines
+
 from taos.identify.data import TestData
 from taos.errors import InputError
 from taos.linear import gain_db
@@ -282,23 +284,6 @@ def classify_record(data: TestData) -> list[Excitation]:
     return [classify_excitation(data.t_s, data.command_rad[i], ax) for i, ax in enumerate(data.axes)]
 
 
-def _lsq_harmonics(t, ys, freqs):
-    """Least squares of each row of ys on [sin, cos] at each of ``freqs`` plus c0 + c1 t.
-
-    Returns (coefficients (n_rows, 2 len(freqs) + 2), residual RMS per row)."""
-    tm = t - t.mean()
-    cols = []
-    for f in freqs:
-        w = 2 * np.pi * f
-        cols += [np.sin(w * t), np.cos(w * t)]
-    cols += [np.ones_like(t), tm]
-    X = np.column_stack(cols)
-    coef, *_ = np.linalg.lstsq(X, np.asarray(ys).T, rcond=None)
-    res = np.asarray(ys).T - X @ coef
-    dof = max(1, t.size - X.shape[1])
-    return coef.T, np.sqrt(np.sum(res ** 2, axis=0) / dof)
-
-
 def estimate_dwells(data: TestData, axes=None, *, segments: dict | None = None, settle_fraction: float = 0.5,
                     min_cycles: int = 2) -> list[MeasuredResponse]:
     """Sine-dwell responses of each axis (see the module docstring).
@@ -344,8 +329,8 @@ def estimate_dwells(data: TestData, axes=None, *, segments: dict | None = None, 
             ys = [data.command_rad[i][m], data.piston_m[i][m]]
             if data.engine_rad is not None:
                 ys.append(data.engine_rad[i][m])
-            coef, rms = _lsq_harmonics(t[m], ys, freqs)
-            Y = coef[:, 0] + 1j * coef[:, 1]
+            sf = fit_sines(t[m], ys, freqs, trend=True)
+            Y, rms = sf.phasor[:, 0], sf.residual_rms
             U = Y[0]
             n = int(m.sum())
             var = np.var(np.asarray(ys), axis=1)
