@@ -41,6 +41,7 @@ from typing import Callable
 
 import numpy as np
 
+from taos.descfcn import static_describing_function
 from taos.errors import InputError
 from taos.model import TvcModel
 from taos.linear import freqresp_symbolic
@@ -152,14 +153,11 @@ def check_free(model: TvcModel, names) -> list[FitParam]:
 
 def avionics_df(model: TvcModel, amplitude_rad: float, n: int = 4096) -> complex:
     """Describing function of the command avionics at ``amplitude_rad`` (fundamental of
-    avionics(A sin psi) over A sin psi, from the avionics kernel itself)."""
+    avionics(A sin psi) over A sin psi, from the avionics kernel itself,
+    :func:`taos.descfcn.static_describing_function`); 1 for no amplitude."""
     if amplitude_rad <= 0 or not math.isfinite(amplitude_rad):
         return 1.0 + 0j
-    psi = (np.arange(n) + 0.5) * 2 * np.pi / n
-    y = model.avionics(amplitude_rad * np.sin(psi))
-    a = 2 * np.mean(y * np.sin(psi))
-    b = 2 * np.mean(y * np.cos(psi))
-    return complex(a, b) / amplitude_rad
+    return static_describing_function(model.avionics, amplitude_rad, n)
 
 
 # -- complex arithmetic on (re, im) pairs of SX ------------------------------------------------
