@@ -21,7 +21,7 @@ torque, T = N Omega; :mod:`taos.friction.registry`). Two loop solutions:
   V = a Re G_wT + sqrt(|G_wc C|^2 - a^2 (Im G_wT)^2), and V = 0 (engine held, the load path
   takes the whole piston motion) when that is not positive: smoothed for the NLP.
 * any other describing function N(X, w) of the engine angle amplitude X (Dahl with exponent
-  1: the exact hysteresis loop, :func:`taos.friction.dahl_angle_df`; LuGre/modified LuGre
+  1: the exact hysteresis loop, :func:`taos.descfcn.dahl_angle_df`; LuGre/modified LuGre
   through their Dahl core plus sigma_2): the amplitude X solves the implicit loop equation
   ln(w X) + ln|1 - G_wT N| - ln|G_wc C| = 0, which the NLP carries as constraints with
   u = ln(X / X_lin) as variables.
