@@ -28,7 +28,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from taos.identify.estimate import MeasuredResponse  # noqa: E402
+from taos.identify.estimation import MeasuredResponse  # noqa: E402
 from taos.identify.fit import FitProblem, _pack, _stack_points, fit_frequency_response  # noqa: E402
 from taos.identify.surrogate import solve_implicit  # noqa: E402
 from taos.planar.freqresp import sine_dwell_grid  # noqa: E402

@@ -12,7 +12,7 @@ the TVSE loop break, modes in the band of interest), :mod:`masv.plotting`, :mod:
 mirror-symmetric test structure), :mod:`masv.cli` (``masv modes|freqresp|coupling|tvse``).
 """
 
-from .analysis import (TvseLoop, closed_loop_eigenvalues, coupling, frequency_response, loop_margins,
+from .analysis import (TvseLoop, actuator_loop_margins, closed_loop_eigenvalues, coupling, frequency_response,
                        modes_in_band, modes_near_bandwidth, notch_frequencies, structure_effect, tvse_loops)
 from .config import ActuatorSpec, EngineSpec, MasvConfig, load_config, make_config
 from .structure import ModalStructure, load_modes, rigid_structure, validate_modes
@@ -20,5 +20,5 @@ from .system import MasvSystem, build_system, engine_axis_block
 
 __all__ = ["ActuatorSpec", "EngineSpec", "MasvConfig", "MasvSystem", "ModalStructure", "build_system",
            "closed_loop_eigenvalues", "coupling", "engine_axis_block", "frequency_response", "load_config",
-           "load_modes", "loop_margins", "make_config", "modes_near_bandwidth", "notch_frequencies",
+           "load_modes", "actuator_loop_margins", "make_config", "modes_near_bandwidth", "notch_frequencies",
            "rigid_structure", "structure_effect", "validate_modes", "TvseLoop", "tvse_loops", "modes_in_band"]

@@ -222,7 +222,7 @@ def margins_from_loop(name: str, f: np.ndarray, L: np.ndarray) -> LoopMargin:
     return LoopMargin(name, float(gm), None if k is None else float(lm.phase_crossover_hz[k]), float(pm), fpm)
 
 
-def loop_margins(system: MasvSystem, f_lo_hz: float = 0.01, f_hi_hz: float = 1000.0,
+def actuator_loop_margins(system: MasvSystem, f_lo_hz: float = 0.01, f_hi_hz: float = 1000.0,
                  n: int = 3000) -> tuple[LoopMargin, ...]:
     """Margins of every actuator's position loop with the other loops closed (:class:`LoopMargin`)."""
     f = np.logspace(math.log10(f_lo_hz), math.log10(f_hi_hz), n)
@@ -363,7 +363,7 @@ def structure_effect(system: MasvSystem) -> dict:
     from .structure import rigid_structure
     st = system.config.structure
     rigid = build_system(system.config, rigid_structure(st.node_names, st.node_xyz_m))
-    with_s, without = loop_margins(system), loop_margins(rigid)
+    with_s, without = actuator_loop_margins(system), actuator_loop_margins(rigid)
     rows = []
     for a, b in zip(with_s, without):
         rows.append({"actuator": a.actuator, "with_structure": a.to_dict(), "rigid": b.to_dict(),

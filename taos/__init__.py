@@ -14,8 +14,8 @@ The public API, by task (each name is importable from ``taos``)::
 
 Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.py`` checks):
 
-1. ``units``, ``errors``, ``results``, ``shipped``, ``bounds``, ``harmonics`` - units, one-line input errors,
-   output files, the documented bounds of every input;
+1. ``units``, ``errors``, ``results``, ``shipped``, ``bounds``, ``harmonics``, ``descfcn`` - units, one-line
+   input errors, output files, the documented bounds of every input, sine fits, describing functions;
 2. ``friction``, ``linear``, ``stability``, ``model`` and the component models
    ``planar.actuator``, ``planar.avionics``, ``planar.saturation``;
 3. the engines: ``planar`` (the simplex model, its kernels, simulation, frequency response,
@@ -50,7 +50,7 @@ _API = {
     "describing_function_map": "taos.flight.describing", "DescribingFunctionMap": "taos.flight.describing",
     "load_flight": "taos.flight.vehicle", "margins": "taos.flight.vehicle",
     "analyse_lco": "taos.flight.lco", "predict_lco": "taos.flight.lco",
-    "load_test_data": "taos.identify.data", "estimate": "taos.identify.estimate",
+    "load_test_data": "taos.identify.data", "estimate": "taos.identify.estimation",
     "fit_frequency_response": "taos.identify.fit", "compare_models": "taos.identify.compare",
     "load_ascent": "taos.flight.ascent", "simulate_ascent": "taos.flight.ascent_sim",
     "load_campaign": "taos.montecarlo", "run_campaign": "taos.montecarlo",

@@ -5,7 +5,7 @@ Linear models (:class:`taos.linear.StateSpace`: the simplex block
 :func:`taos.flight.vehicle.vehicle_fcs_state_space` / :func:`~taos.flight.vehicle.open_loop_state_space`,
 the whole MASV model ``masv.system.MasvSystem.state_space()``) become ``control.StateSpace``
 with their signal names; frequency responses (:class:`taos.planar.freqresp.FrequencyResponse`,
-linear or sine-dwell; :class:`taos.identify.estimate.MeasuredResponse`, estimated from data;
+linear or sine-dwell; :class:`taos.identify.estimation.MeasuredResponse`, estimated from data;
 ``masv.analysis.MasvFrequencyResponse``) become ``control.FrequencyResponseData``. Both come
 back: :func:`from_control_ss` and :func:`freqresp_from_control`.
 
@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from taos.planar.freqresp import FrequencyResponse
-from taos.identify.estimate import MeasuredResponse
+from taos.identify.estimation import MeasuredResponse
 from taos.linear import StateSpace
 
 _DOT = "__"
@@ -121,7 +121,7 @@ def freqresp_from_control(data, amplitude_rad: float | None = None, axis: str = 
 
 
 def measured_to_control(mr: MeasuredResponse):
-    """An estimated :class:`~taos.identify.estimate.MeasuredResponse` as an FRD: outputs
+    """An estimated :class:`~taos.identify.estimation.MeasuredResponse` as an FRD: outputs
     ``piston_m_per_rad`` [m/rad] and (with engine data) ``engine`` [-], input ``command_rad``.
     Frequencies must be distinct: pick one amplitude with ``mr.select(...)`` first."""
     cols = [mr.piston_m_per_rad] + ([mr.engine] if mr.engine is not None else [])

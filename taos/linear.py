@@ -123,11 +123,13 @@ def gain_db(h, floor: float = 1e-300) -> np.ndarray:
     return 20.0 * np.log10(np.maximum(np.abs(h), floor))
 
 
-def phase_deg(h, unwrap: bool = True) -> np.ndarray:
-    """Phase of h [deg], unwrapped along the first axis by default."""
+def phase_deg(h, unwrap: bool = True, axis: int = 0) -> np.ndarray:
+    """Phase of h [deg], unwrapped along ``axis`` (the first by default) in the order given.
+    The one plain-unwrap phase helper; :func:`phase_deg_continuous` is the one for responses
+    sampled at (possibly unsorted, possibly sparse) frequencies."""
     ph = np.angle(h)
     if unwrap:
-        ph = np.unwrap(ph, axis=0)
+        ph = np.unwrap(ph, axis=axis)
     return np.degrees(ph)
 
 
@@ -185,7 +187,7 @@ def sampled_notch_hz(freq_hz, h) -> float:
     return float(10 ** np.clip(-b / (2 * a), x[0], x[2])) if a > 0 else float(f[k])
 
 
-def phase_deg_continuous(freq_hz, h, reference_deg=None) -> np.ndarray:
+def phase_deg_continuous(freq_hz, h, reference_deg=None, reference_freq_hz=None) -> np.ndarray:
     """Phase of h [deg] continuous from low frequency: the project's one phase convention.
 
     Without ``reference_deg`` the points are sorted by frequency, unwrapped in that order
@@ -193,10 +195,17 @@ def phase_deg_continuous(freq_hz, h, reference_deg=None) -> np.ndarray:
     at low frequency). With ``reference_deg`` (the continuous phase of a reference response at
     the same frequencies, e.g. the linear model's from :func:`taos.planar.freqresp.linear_phase_reference`)
     each point takes the 360-deg branch nearest the reference, so sparse points far from low
-    frequency (a single 7 Hz point, a cross-axis response) read as on the continuous curve."""
+    frequency (a single 7 Hz point, a cross-axis response) read as on the continuous curve.
+    With ``reference_freq_hz`` too, ``reference_deg`` is a dense reference curve sampled there
+    (increasing [Hz]), interpolated linearly in log10 f to ``freq_hz`` first; a reference of
+    fewer than two points is ignored."""
     f = np.atleast_1d(np.asarray(freq_hz, float))
     hh = np.atleast_1d(np.asarray(h, complex))
     ph = np.angle(hh)
+    if reference_freq_hz is not None and reference_deg is not None:
+        rf = np.atleast_1d(np.asarray(reference_freq_hz, float))
+        reference_deg = (np.interp(np.log10(f), np.log10(rf), np.asarray(reference_deg, float))
+                         if rf.size > 1 else None)
     if reference_deg is not None:
         ref = np.radians(np.atleast_1d(np.asarray(reference_deg, float)))
         return np.degrees(ph + 2 * np.pi * np.round((ref - ph) / (2 * np.pi)))

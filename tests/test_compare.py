@@ -11,7 +11,7 @@ import pytest
 
 from taos.identify.compare import compare_models, comparison_curves
 from taos.plotting.fit import plot_compare_overlay, plot_compare_side_by_side
-from taos.identify.estimate import MeasuredResponse
+from taos.identify.estimation import MeasuredResponse
 
 from .conftest import MODELS, run_cli
 

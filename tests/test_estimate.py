@@ -9,7 +9,7 @@ import numpy as np
 import scipy.signal as ss
 
 from taos.identify.data import TestData
-from taos.identify.estimate import detect_dwells, estimate_dwells, estimate_h1
+from taos.identify.estimation import detect_dwells, estimate_dwells, estimate_h1
 
 from .conftest import MODELS
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from taos.identify.estimate import MeasuredResponse
+from taos.identify.estimation import MeasuredResponse
 from taos.identify.fit import FitProblem, fit_frequency_response
 from taos.planar.freqresp import linear_freqresp, sine_dwell_grid
 from taos.model import load_model
@@ -180,7 +180,7 @@ def test_demo_datasets_reproduce_the_paper_direction_hot_fire_stiffer(tmp_path):
     assert r.returncode == 0, r.stderr
     d_amb = json.loads(r.stdout)
     from taos.identify.data import load_test_data
-    from taos.identify.estimate import estimate
+    from taos.identify.estimation import estimate
     model = load_model(MODELS / "rs25_hotfire.toml")
     res_hot = fit_frequency_response(model, estimate(load_test_data(hot)), ["load_stiffness", "coulomb_torque"],
                                      start={"load_stiffness": 160000 * LBF_IN, "coulomb_torque": 100000 * INLBF})

@@ -216,7 +216,7 @@ def test_toy_law_fit_surrogate_and_fit(toy, flight):
     """Fit surrogate: for the pure viscous toy its describing function is exact, so the
     surrogate equals the linear model with the damper; the fit recovers c from sine-dwell data."""
     from taos.planar.freqresp import sine_dwell_grid
-    from taos.identify.estimate import MeasuredResponse
+    from taos.identify.estimation import MeasuredResponse
 
     c = damping(flight)
     m = flight.replace(friction=ViscousCoulomb(coulomb_torque_Nm=0.0, viscous_damping_Nms_per_rad=c),

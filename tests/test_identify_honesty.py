@@ -13,7 +13,7 @@ import pytest
 
 from taos.errors import InputError
 from taos.identify.data import TestData, from_time_history
-from taos.identify.estimate import choose_method, classify_excitation, detect_dwells, estimate
+from taos.identify.estimation import choose_method, classify_excitation, detect_dwells, estimate
 
 from .conftest import MODELS, ROOT, run_cli
 

@@ -118,7 +118,7 @@ def test_linear_freqresp_frd_matches_state_space_conversion():
 
 def test_measured_response_round_trip():
     from taos.identify.data import load_test_data
-    from taos.identify.estimate import estimate
+    from taos.identify.estimation import estimate
     rs = estimate(load_test_data("models/data/greenrun_hotfire_synthetic.csv"))
     mr = rs[0]
     _, idx = np.unique(mr.freq_hz, return_index=True)

@@ -48,7 +48,7 @@ def test_notch_zero_damping_matches_hand_calculation(ambient):
 def test_fit_frees_the_load_damping(ambient):
     """``taos fit --free load_damping_ratio``: from sine-dwell data around the notch made with
     zeta_L = 0.03, a start at 0.01 recovers it within 5 %."""
-    from taos.identify.estimate import MeasuredResponse
+    from taos.identify.estimation import MeasuredResponse
     from taos.identify.fit import fit_frequency_response
     truth = ambient.with_friction("none")
     truth = truth.replace(structure=dataclasses.replace(truth.structure, load_damping_ratio=0.03))

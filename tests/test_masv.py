@@ -144,7 +144,7 @@ def test_gain_margin_predicts_the_loop_gain_that_destabilises(hotfire):
     """L = T/(1-T) is proportional to the loop gain K_v, so raising K_v by the gain margin puts a
     closed-loop pole on the imaginary axis at the phase-crossover frequency."""
     s = one_engine(hotfire)
-    (lm,) = an.loop_margins(s)
+    (lm,) = an.actuator_loop_margins(s)
     assert math.isfinite(lm.gain_margin_db) and lm.gain_margin_db > 0 and lm.phase_margin_deg > 0
     act = dataclasses.replace(hotfire.actuator, loop_gain_per_s=hotfire.actuator.loop_gain_per_s
                               * 10 ** (lm.gain_margin_db / 20))

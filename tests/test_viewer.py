@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from taos.planar.simulate import TimeHistory
-from taos.viewer import GimbalGeometry, load_run, offline_html, viewer_frames
+from taos.viewer import EngineDrawing, load_run, offline_html, viewer_frames
 from taos.viewer.kinematics import AXES
 
 from .conftest import MODELS
@@ -98,7 +98,7 @@ def test_drawn_rod_stroke_is_the_recorded_piston_position_at_true_scale():
     assert err.max() < 0.5 * 0.8 * math.radians(4) ** 2 + 1e-4
     # the structure attach moves by k |delta| along the actuator line
     fr100 = viewer_frames(run, deflection_scale=100.0, fps=1e9)
-    g = GimbalGeometry(moment_arm_m=0.8)
+    g = EngineDrawing(moment_arm_m=0.8)
     for i, ax in enumerate(AXES):
         moved = np.linalg.norm(fr100.structure_attach_m[i] - g.structure_attach_m(ax), axis=1)
         assert np.allclose(moved, 100 * np.abs(fr100.deflection_m[i]), rtol=1e-9, atol=1e-12)
@@ -122,7 +122,7 @@ def test_engine_meshes_have_the_rs25_public_dimensions():
     exit diameter 2.4 m, engine 4.3 m from the gimbal bearing top (+0.145 m) to the exit."""
     from taos.viewer.geometry import engine_meshes
 
-    g = GimbalGeometry()
+    g = EngineDrawing()
     for use_files in (True, False):
         m = engine_meshes(g, use_files)
         lo, hi = m["nozzle"].bounds

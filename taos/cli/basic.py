@@ -209,13 +209,13 @@ def engine_default_dt_s(engine: str) -> float:
 
 def cmd_simulate(args) -> int:
     from taos.planar import envelope as run_checks
-    from taos.cli.records import load_profile
+    from taos.cli.records import load_command_source
     from taos.results import check_output_file, input_provenance
     from taos.planar.simulate import simulate
 
     check_output_file(args.out, "--out")
     model = model_from_args(args)
-    profile = load_profile(args.profile)
+    profile = load_command_source(args.profile)
     dt = engine_default_dt_s(args.engine) if args.dt is None else args.dt
     run_checks.check_run(model, profile, dt)
     run_checks.check_linear_stability(model, allow=args.allow_unstable)

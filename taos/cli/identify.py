@@ -15,7 +15,7 @@ AXES = ("pitch", "yaw")
 
 def _estimate(path, args):
     from taos.identify.data import load_test_data
-    from taos.identify.estimate import estimate
+    from taos.identify.estimation import estimate
 
     data = load_test_data(path)
     axes = None if args.axis in (None, "both") else (args.axis,)

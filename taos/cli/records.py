@@ -7,7 +7,7 @@ from pathlib import Path
 RECORD_SUFFIXES = (".csv", ".txt", ".h5", ".hdf5")
 
 
-def load_profile(path):
+def load_command_source(path):
     """:func:`taos.profiles.load_profile`, or for a measured record (``.csv``/``.h5``,
     :func:`taos.identify.data.load_test_data`) the profile replaying its commands
     (:func:`taos.profiles.profile_from_record`)."""

@@ -38,7 +38,7 @@ from taos.errors import InputError
 from taos.harmonics import fit_sines
 from taos.linear import gain_db, notch_hz
 from taos.profiles import Sequence, SineDwell, TwoAxis
-from taos.cli.records import load_profile
+from taos.cli.records import load_command_source
 from taos.shipped import models_dir
 
 DEFAULT_PROFILE = models_dir() / "profiles" / "greenrun_two_axis.toml"
@@ -219,7 +219,7 @@ def greenrun_report(model_path, out_dir="out/greenrun", *, profile_path=None, fr
     check_output_folder(out, OUTPUTS)
     model = load_model(model_path, friction=friction)
     ppath = DEFAULT_PROFILE if profile_path is None else Path(profile_path)
-    profile = load_profile(ppath)
+    profile = load_command_source(ppath)
     if not isinstance(profile, TwoAxis):
         raise InputError(str(ppath), "(profile)", "a two-axis profile with [pitch] and [yaw] tables",
                          got=type(profile).__name__)

@@ -29,9 +29,9 @@ def spec_results(model, spec_path) -> dict:
 
 def data_responses(data_path, model) -> dict:
     """{axis: MeasuredResponse} estimated from a measured record (estimator chosen and
-    explained by :func:`taos.identify.estimate.estimate`)."""
+    explained by :func:`taos.identify.estimation.estimate`)."""
     from taos.identify.data import load_test_data
-    from taos.identify.estimate import estimate
+    from taos.identify.estimation import estimate
     data = load_test_data(data_path)
     return {r.axis: r for r in estimate(data)}
 

@@ -33,7 +33,7 @@ from taos.linear import StateSpace
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
 from taos.planar.simplex import LurePlant
-from taos.planar.simulate import check_step, integrate_plant
+from taos.planar.simulate import check_friction_step, integrate_plant
 
 AXES = ("pitch", "yaw")
 DEFAULT_DT_S = 5e-4
@@ -185,7 +185,7 @@ def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes=AXES, start_s: floa
             si = plant.ss.state_index
             b = flight.vehicle.twd_coefficient(ax)
             if x is None:
-                check_step(model, plant.inertia_kgm2, dt_s)
+                check_friction_step(model, plant.inertia_kgm2, dt_s)
                 x = np.zeros(plant.ss.A.shape[0])
                 x[si("xi_rad")] = attitude0_rad
                 z = 0.0

@@ -27,7 +27,7 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.planar.freqresp import sine_dwell_grid
-from taos.linear import StateSpace, gain_db
+from taos.linear import StateSpace, gain_db, phase_deg
 from taos.model import Structure, TvcModel
 from taos.results import atomic_write, package_version, write_json, write_provenance
 from taos.planar.simplex import simplex_state_space
@@ -43,7 +43,7 @@ def _unwrap_map(h: np.ndarray) -> np.ndarray:
     each amplitude row shifted by whole turns to lie within 180 deg of its neighbour at the
     lowest frequency (stuck rows borrow the nearest moving row's phase)."""
     g = gain_db(h)
-    ph = np.degrees(np.unwrap(np.angle(h), axis=1))
+    ph = phase_deg(h, axis=1)
     moving = (g > STUCK_DB).all(axis=1)
     if moving.any():
         idx = np.flatnonzero(moving)

@@ -33,7 +33,7 @@ from taos.planar.avionics import Avionics
 from taos.harmonics import harmonic_amplitudes as _fit
 from taos.flight.describing import DescribingFunctionMap, describing_function_map
 from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
-from taos.linear import gain_db
+from taos.linear import gain_db, phase_deg
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
 from taos.planar.simulate import DEFAULT_DT_S, integrate_plant
@@ -132,7 +132,7 @@ def predict_lco(flight: FlightModel, df: DescribingFunctionMap, axis: str | None
     f = np.exp(lf)
     L0 = loop_freqresp(flight, f, axis)
     l0db = gain_db(L0)
-    l0ph = np.degrees(np.unwrap(np.angle(L0)))
+    l0ph = phase_deg(L0)
 
     def nichols(lA, lF):
         """(gain dB, phase error to -180 mod 360) of L0 N at scalar log A, log f."""

@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from taos.linear import phase_deg
+
 MARGIN_MEANING = ("smallest distance [dB] from 0 dB of the gain of L0 N(A, .) at its -180 deg (mod 360) "
                   "crossings, over all command amplitudes A of the describing-function map: how far the loop gain "
                   "would have to move for a limit cycle to appear")
@@ -109,7 +111,7 @@ def nearest_margin(pred, n_amp: int = 60, n_freq: int = 600) -> NearestMargin | 
     for a in amps:
         L = L0 * df(a, f)
         g = 20 * np.log10(np.abs(L))
-        e = (np.degrees(np.unwrap(np.angle(L))) + 180.0 + 180.0) % 360.0 - 180.0
+        e = (phase_deg(L) + 180.0 + 180.0) % 360.0 - 180.0
         k = np.flatnonzero((np.sign(e[:-1]) != np.sign(e[1:])) & (np.abs(e[:-1]) < 90) & (np.abs(e[1:]) < 90))
         for j in k:
             t = e[j] / (e[j] - e[j + 1])

@@ -25,13 +25,12 @@ from ._laws import (
     LuGre,
     ModifiedLuGre,
     NoFriction,
-    coulomb_describing_function,
-    dahl_angle_df,
     friction_from_table,
     friction_keys,
     param,
 )
 from ._laws import BUILTIN_PARAMS
+from ..descfcn import coulomb_describing_function, dahl_angle_df
 from .registry import LAWS, FrictionLawEntry, declare_builtins, get, ids, param_classes, params_of, register, unregister
 
 

@@ -8,7 +8,7 @@ All fields are SI and made by :func:`param`, which records the ``[friction]`` mo
 parameter scales with the bearing normal load. A class is one part of its law's registry
 entry (:mod:`.registry`), which also holds the compiled kernels.
 
-Interface (python-control ``descfcn`` style): ``law(v, z, t_app)`` gives the torque,
+Interface (a :class:`taos.descfcn.Nonlinearity`): ``law(v, z, t_app)`` gives the torque,
 ``law.derivative(v, z)`` the state derivative, ``law.steady_state(v)`` the analytic
 steady-sliding curve, ``law.describing_function(V, w)`` the analytic describing function
 where one exists (else ``None``), ``law.numeric_describing_function(V, f)`` the numeric one
@@ -35,6 +35,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..descfcn import Nonlinearity, coulomb_describing_function, dahl_angle_df, simulated_describing_function
+from ..descfcn import coulomb_relay_level  # noqa: F401  (._builtin imports it from here)
 from ..errors import InputError
 from ..units import to_si
 from . import _slots as K
@@ -60,7 +62,7 @@ def friction_keys() -> frozenset[str]:
 
 
 @dataclass(frozen=True)
-class FrictionLaw(abc.ABC):
+class FrictionLaw(Nonlinearity):
     """Base class: a gimbal friction law's parameters (fields made with :func:`param`, SI)
     and its analytic properties. Subclasses set ``name`` (the registry id) and
     ``has_state``; the compiled kernels live in the law's registry entry (:attr:`entry`)."""
@@ -132,18 +134,10 @@ class FrictionLaw(abc.ABC):
     def numeric_describing_function(self, rate_amplitude: float, freq_hz: float,
                                     cycles: int = 6, steps_per_cycle: int = 4000) -> complex:
         """Describing function by simulation: v = V sin(w t), fundamental of the torque over
-        the last whole cycle, divided by V. [N m s/rad]"""
-        n = cycles * steps_per_cycle + 1
-        dt = 1.0 / (freq_hz * steps_per_cycle)
-        t = np.arange(n) * dt
-        w = 2 * math.pi * freq_hz
-        tq, _ = self.response(rate_amplitude * np.sin(w * t), dt)
-        last = slice(n - 1 - steps_per_cycle, n - 1)
-        s = np.sin(w * t[last])
-        c = np.cos(w * t[last])
-        a = 2.0 * np.mean(tq[last] * s)
-        b = 2.0 * np.mean(tq[last] * c)
-        return complex(a, b) / rate_amplitude
+        the last whole cycle, divided by V (:func:`taos.descfcn.simulated_describing_function`).
+        [N m s/rad]"""
+        return simulated_describing_function(lambda v, dt: self.response(v, dt)[0], rate_amplitude, freq_hz,
+                                             cycles, steps_per_cycle)
 
     # -- construction -----------------------------------------------------------------------
     @classmethod
@@ -167,48 +161,6 @@ class FrictionLaw(abc.ABC):
 
     def validate(self, source: str, section: str = "friction") -> None:
         """Range checks beyond the unit parse; raise :class:`InputError`."""
-
-
-def coulomb_describing_function(coulomb_torque_Nm: float, rate_amplitude: float) -> complex:
-    """4 T_c / (pi V): fundamental of T_c sign(V sin wt) over V [N m s/rad] (relay describing
-    function, Gelb & Vander Velde, Multiple-Input Describing Functions, 1968)."""
-    return complex(coulomb_relay_level(coulomb_torque_Nm) / rate_amplitude, 0.0)
-
-
-def coulomb_relay_level(coulomb_torque_Nm):
-    """4 T_c / pi [N m]: the relay describing function times the rate amplitude (float or SX)."""
-    return 4.0 * coulomb_torque_Nm / math.pi
-
-
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(64)
-
-
-def dahl_angle_df(tc, sigma0, X):
-    """Dahl (exponent 1) describing function from relative angle to torque [N m/rad] at angle
-    amplitude ``X`` [rad], as (re, im); float or CasADi SX arguments.
-
-    The periodic hysteresis loop under theta = X sin(psi) is exact: on the upward branch
-    T_up = T_c - (T_c + T_top) exp(-beta (1 + sin psi)), beta = sigma_0 X / T_c,
-    T_top = T_c tanh(beta) (the downward branch is its odd mirror), so the fundamental is
-    N_x = (2/pi) int_{-pi/2}^{pi/2} T_up (sin psi + j cos psi) dpsi / X, integrated by
-    64-point Gauss-Legendre quadrature (Dahl 1968; rate form N = N_x / (j w))."""
-    if isinstance(tc, (int, float, np.floating)) and isinstance(sigma0, (int, float, np.floating)) \
-            and isinstance(X, (int, float, np.floating)):
-        exp, tanh = math.exp, math.tanh
-    else:
-        import casadi as ca
-        exp, tanh = ca.exp, ca.tanh
-    psi = 0.5 * math.pi * _GL_X
-    w = 0.5 * math.pi * _GL_W
-    beta = sigma0 * X / tc
-    ttop = tc * tanh(beta)
-    a = 0
-    b = 0
-    for p, wi in zip(psi, w):
-        tu = tc - (tc + ttop) * exp(-beta * (1 + math.sin(p)))
-        a = a + wi * tu * math.sin(p)
-        b = b + wi * tu * math.cos(p)
-    return (2 / math.pi) * a / X, (2 / math.pi) * b / X
 
 
 @dataclass(frozen=True)

@@ -36,12 +36,9 @@ from __future__ import annotations
 import functools
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Callable
+from typing import Callable
 
 from ..errors import InputError
-
-if TYPE_CHECKING:
-    from ._laws import FrictionLaw
 
 #: the kernel fields of an entry and their signature names (:func:`signatures`):
 #: rates: (dz/dt [rad/s], T_f [N m]) = rates(v, z, t_app, p);
@@ -218,6 +215,7 @@ def params_of(law_id: str, source: str = "friction registry", field: str = "fric
                          got=repr(law_id)) from None
 
 
-def entry_of(law: "FrictionLaw") -> FrictionLawEntry:
-    """The entry of a law instance (by its class's ``name``)."""
+def entry_of(law) -> FrictionLawEntry:
+    """The entry of a law instance (a :class:`~taos.friction._laws.FrictionLaw`, by its class's
+    ``name``; the registry imports no law class: the laws import it)."""
     return get(type(law).name)

@@ -7,7 +7,7 @@ tell the conditions apart: the load resonance w_L = sqrt((K_L R^2 + K_n) / J_n) 
 (paper eq. 1) per axis, the notch of the linear command -> piston response
 (:func:`taos.planar.simplex.load_resonance_from_notch`), and the friction breakaway deflection
 T_c / (K_L R^2). With test data (time-history files) each condition's responses are
-estimated (:func:`taos.identify.estimate.estimate`) and the plots overlay them on the model curves:
+estimated (:func:`taos.identify.estimation.estimate`) and the plots overlay them on the model curves:
 the exact linear response and the time-domain sine dwell of the full model at the data's
 command amplitudes.
 """
@@ -109,7 +109,7 @@ def _numeric_fields(obj) -> dict:
 def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
                    labels: tuple[str, str] | None = None) -> Comparison:
     """The comparison table of two models (module docstring); ``data_a``/``data_b`` are
-    lists of :class:`~taos.identify.estimate.MeasuredResponse` shown on the plots."""
+    lists of :class:`~taos.identify.estimation.MeasuredResponse` shown on the plots."""
     from taos.planar.simplex import load_resonance_from_notch
 
     labels = labels or (model_a.name, model_b.name)

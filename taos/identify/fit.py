@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from taos.errors import InputError
-from taos.identify.estimate import MeasuredResponse
+from taos.identify.estimation import MeasuredResponse
 from taos.identify.surrogate import PARAMETERS, build_surrogate, check_free, solve_implicit
 from taos.model import TvcModel, load_model
 from taos.results import atomic_write
@@ -316,7 +316,7 @@ def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = 
     model : TvcModel
         The model whose other values are held (its friction law decides the surrogate).
     data : list of MeasuredResponse
-        From :mod:`taos.identify.estimate` (or synthetic).
+        From :mod:`taos.identify.estimation` (or synthetic).
     free : list of str
         Names from :data:`taos.identify.surrogate.PARAMETERS`.
     start : dict name -> SI value, optional

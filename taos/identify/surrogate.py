@@ -21,7 +21,7 @@ torque, T = N Omega; :mod:`taos.friction.registry`). Two loop solutions:
   V = a Re G_wT + sqrt(|G_wc C|^2 - a^2 (Im G_wT)^2), and V = 0 (engine held, the load path
   takes the whole piston motion) when that is not positive: smoothed for the NLP.
 * any other describing function N(X, w) of the engine angle amplitude X (Dahl with exponent
-  1: the exact hysteresis loop, :func:`taos.friction.dahl_angle_df`; LuGre/modified LuGre
+  1: the exact hysteresis loop, :func:`taos.descfcn.dahl_angle_df`; LuGre/modified LuGre
   through their Dahl core plus sigma_2): the amplitude X solves the implicit loop equation
   ln(w X) + ln|1 - G_wT N| - ln|G_wc C| = 0, which the NLP carries as constraints with
   u = ln(X / X_lin) as variables.
@@ -41,6 +41,7 @@ from typing import Callable
 
 import numpy as np
 
+from taos.descfcn import static_describing_function
 from taos.errors import InputError
 from taos.model import TvcModel
 from taos.linear import freqresp_symbolic
@@ -152,14 +153,11 @@ def check_free(model: TvcModel, names) -> list[FitParam]:
 
 def avionics_df(model: TvcModel, amplitude_rad: float, n: int = 4096) -> complex:
     """Describing function of the command avionics at ``amplitude_rad`` (fundamental of
-    avionics(A sin psi) over A sin psi, from the avionics kernel itself)."""
+    avionics(A sin psi) over A sin psi, from the avionics kernel itself,
+    :func:`taos.descfcn.static_describing_function`); 1 for no amplitude."""
     if amplitude_rad <= 0 or not math.isfinite(amplitude_rad):
         return 1.0 + 0j
-    psi = (np.arange(n) + 0.5) * 2 * np.pi / n
-    y = model.avionics(amplitude_rad * np.sin(psi))
-    a = 2 * np.mean(y * np.sin(psi))
-    b = 2 * np.mean(y * np.cos(psi))
-    return complex(a, b) / amplitude_rad
+    return static_describing_function(model.avionics, amplitude_rad, n)
 
 
 # -- complex arithmetic on (re, im) pairs of SX ------------------------------------------------

@@ -24,12 +24,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from taos.descfcn import Nonlinearity
+
 # packed layout: [bits, lsb_rad, rounding(0/1), n_table, amp_0..amp_{n-1}, gain_0..gain_{n-1}]
 
 
 @dataclass(frozen=True)
-class Avionics:
-    """Command avionics parameters (SI).
+class Avionics(Nonlinearity):
+    """Command avionics parameters (SI); a static nonlinearity (:class:`taos.descfcn.Nonlinearity`,
+    no analytic describing function: :func:`taos.descfcn.static_describing_function`).
 
     Parameters
     ----------

@@ -24,8 +24,8 @@ def fastest_mode_rad_s(model, axes=("pitch", "yaw")) -> float:
     return max(float(np.max(np.abs(simplex_state_space(model, ax).poles()))) for ax in axes)
 
 
-def check_step(dt_s: float, model=None, *, max_freq_hz: float | None = None, duration_s: float | None = None,
-               n_axes: int = 1, source: str = "command line", field: str = "--dt") -> None:
+def check_run_step(dt_s: float, model=None, *, max_freq_hz: float | None = None, duration_s: float | None = None,
+                   n_axes: int = 1, source: str = "command line", field: str = "--dt") -> None:
     """The integration step against the fastest linear mode, the command frequencies and the
     job size (steps and memory, estimated before any array is made)."""
     if not (math.isfinite(dt_s) and dt_s > 0):
@@ -98,7 +98,7 @@ def check_dwell(model, freqs_hz, dt_s: float = 2e-4, axis: str = "pitch", source
 def check_run(model, profile, dt_s: float, *, source: str = "command line", field: str = "--dt") -> None:
     """Everything about a time run that can be refused before it starts (see the table)."""
     check_duration(profile.duration_s, getattr(profile, "source", "profile"), "(duration)")
-    check_step(dt_s, model, max_freq_hz=profile_max_frequency_hz(profile) or None,
+    check_run_step(dt_s, model, max_freq_hz=profile_max_frequency_hz(profile) or None,
                duration_s=profile.duration_s + 1.0, n_axes=2, source=source, field=field)
 
 

@@ -35,7 +35,7 @@ from ..errors import SimulationUnstable
 from ..linear import gain_db, phase_deg_continuous
 from ..model import TvcModel
 from .simplex import simplex_plant, simplex_state_space
-from .simulate import DEFAULT_DT_S, check_step, kernel_args
+from .simulate import DEFAULT_DT_S, check_friction_step, kernel_args
 
 
 #: engine fundamental below this fraction of the command (-80 dB) = engine held by friction
@@ -214,7 +214,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     A = np.atleast_1d(np.asarray(amplitudes_rad, float))
     F = np.atleast_1d(np.asarray(freq_hz, float))
     plant = simplex_plant(model, axis)
-    check_step(model, plant.inertia_kgm2, dt_max_s)
+    check_friction_step(model, plant.inertia_kgm2, dt_max_s)
     ts = settle_time_s(model, axis) if settle_s is None else settle_s
     npc = np.maximum(np.ceil(1.0 / (F * dt_max_s)), min_steps_per_cycle).astype(np.int64)
     nbud = np.maximum(settle_cycles, np.ceil(ts * F)).astype(np.int64)

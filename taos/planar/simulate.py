@@ -36,7 +36,7 @@ class SolverSettings:
     record_every: int = 10
 
 
-def check_step(model: TvcModel, inertia_kgm2: float, dt_s: float) -> None:
+def check_friction_step(model: TvcModel, inertia_kgm2: float, dt_s: float) -> None:
     """Refuse steps that the friction law cannot be integrated with (the law's own explicit-step
     rule, :meth:`taos.friction.FrictionLaw.check_step`)."""
     model.friction.check_step(inertia_kgm2, dt_s, model.source)
@@ -60,7 +60,7 @@ def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: floa
 
     Returns (y (n_rec, n_out), aux (n_rec, 3) = friction torque, friction state, avionics
     output). Raises :class:`SimulationUnstable` on a non-finite state."""
-    check_step(model, plant.inertia_kgm2, dt_s)
+    check_friction_step(model, plant.inertia_kgm2, dt_s)
     n = plant.ss.A.shape[0]
     nrec = (r.shape[0] - 1) // record_every + 1
     y = np.empty((nrec, plant.ss.C.shape[0]))

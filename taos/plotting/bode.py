@@ -22,7 +22,7 @@ import numpy as np
 
 from ._common import LENGTH_UNITS, finish_bode_axes  # (importing _common also sets the Agg backend)
 from ..errors import InputError
-from ..linear import gain_db, sampled_notch_hz
+from ..linear import gain_db, phase_deg, phase_deg_continuous, sampled_notch_hz
 
 import matplotlib.pyplot as plt  # noqa: E402
 
@@ -39,17 +39,6 @@ def piston_scale(length_unit: str, moment_arm_m: float | None) -> tuple[float, s
     if moment_arm_m is None:
         return 1.0, "x_p / (R θ_c)"
     return moment_arm_m * math.pi / 180.0 / unit_m, f"x_p / θ_c [{length_unit}/deg]"
-
-
-def phase_deg(h, freq_hz=None, ref=None) -> np.ndarray:
-    """Unwrapped phase [deg]; with ``ref`` = (freq_hz, phase_deg) of a dense reference curve,
-    each point is shifted by the multiple of 360 deg that brings it nearest the reference
-    (sparse sine-dwell points cannot be unwrapped on their own)."""
-    ph = np.degrees(np.unwrap(np.angle(h)))
-    if ref is not None and freq_hz is not None and np.size(ref[0]) > 1:
-        r = np.interp(np.log10(freq_hz), np.log10(ref[0]), ref[1])
-        ph = ph - 360.0 * np.round((ph - r) / 360.0)
-    return ph
 
 
 def response_label(fr) -> str:
@@ -80,20 +69,22 @@ def new_bode_figure(title: str | None = None, piston_label: str = "x_p / (R θ_c
 def draw_response(ax, fr, scale: float, *, color, label: str, gid: str = "response", marker=None,
                   linestyle="-", ref=None):
     """Draw one response on a 2 x 2 Bode axes array; ``ref`` = reference response for phase
-    alignment (see :func:`phase_deg`)."""
+    alignment: each phase point on the 360-deg branch nearest the reference's unwrapped phase
+    (:func:`taos.linear.phase_deg_continuous`; sparse sine-dwell points cannot be unwrapped on
+    their own)."""
     f = np.asarray(fr.freq_hz, float)
     if marker is None:
         marker = None if fr.amplitude_rad is None and f.size > 12 else "o"
     kw = dict(color=color, marker=marker, markersize=4, linestyle=linestyle, gid=gid)
     ax[0, 0].plot(f, gain_db(np.asarray(fr.piston) * scale), label=label, **kw)
-    rp = re = None
+    rf = rp = re = None
     if ref is not None and ref is not fr:
         rf = np.asarray(ref.freq_hz, float)
-        rp, re = (rf, phase_deg(ref.piston)), (rf, phase_deg(ref.engine))
-    ax[1, 0].plot(f, phase_deg(fr.piston, f, rp), **kw)
+        rp, re = phase_deg(ref.piston), phase_deg(ref.engine)
+    ax[1, 0].plot(f, phase_deg_continuous(f, fr.piston, rp, rf), **kw)
     held = fr.engine_held() if hasattr(fr, "engine_held") else np.zeros(f.size, bool)
     ax[0, 1].plot(f, np.where(held, np.nan, gain_db(fr.engine)), label=label, **kw)
-    ax[1, 1].plot(f, np.where(held, np.nan, phase_deg(fr.engine, f, re)), **kw)
+    ax[1, 1].plot(f, np.where(held, np.nan, phase_deg_continuous(f, fr.engine, re, rf)), **kw)
     if held.any():  # no motion is not a number: say so on the plot
         ax[0, 1].text(0.02, 0.04, f"engine held (no motion) at {', '.join(f'{x:g}' for x in f[held])} Hz, "
                       f"{label}", transform=ax[0, 1].transAxes, fontsize=8, color=kw["color"], gid="engine-held")

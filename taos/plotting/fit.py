@@ -18,8 +18,8 @@ import math
 import numpy as np
 
 from ._common import finish_bode_axes  # (importing _common also sets the Agg backend)
-from .bode import phase_deg
 from ..linear import gain_db as _db
+from ..linear import phase_deg, phase_deg_continuous
 from ..units import from_si
 
 import matplotlib.pyplot as plt  # noqa: E402
@@ -30,7 +30,7 @@ IN_PER_DEG = from_si(1.0, "m/rad", "in/deg")   # (m/rad) -> (in/deg)
 
 def _ph(h, ref_f, ref_ph, f):
     """Phase [deg] of sparse points, each on the 360-deg branch nearest the dense reference."""
-    return phase_deg(h, f, (ref_f, ref_ph))
+    return phase_deg_continuous(f, h, ref_ph, ref_f)
 
 
 def plot_fit(result, linear: dict, title: str | None = None):
@@ -44,8 +44,8 @@ def plot_fit(result, linear: dict, title: str | None = None):
     for k, ax_name in enumerate(sorted(linear)):
         lin = linear[ax_name]
         fl = lin.freq_hz
-        lp = np.degrees(np.unwrap(np.angle(lin.piston)))
-        le = np.degrees(np.unwrap(np.angle(lin.engine)))
+        lp = phase_deg(lin.piston)
+        le = phase_deg(lin.engine)
         ls = "-" if k == 0 else "--"
         ax[0, 0].plot(fl, _db(lin.piston * R * IN_PER_DEG), color="0.6", ls=ls, gid="linear",
                       label=f"fitted model, linear ({ax_name})")
@@ -106,7 +106,7 @@ def plot_compare_side_by_side(curves):
         axis = cc.axis
         R = cc.moment_arm_m
         lin, dwell = cc.linear, cc.dwell
-        lp = np.degrees(np.unwrap(np.angle(lin.piston)))
+        lp = phase_deg(lin.piston)
         ax[0, k].plot(lin.freq_hz, _db(lin.piston * R * IN_PER_DEG), "k-", gid="linear", label="model, linear")
         ax[1, k].plot(lin.freq_hz, lp, "k-", gid="linear")
         for j, fr in enumerate(dwell):
@@ -140,8 +140,8 @@ def plot_compare_overlay(curves):
         axis = cc.axis
         R = cc.moment_arm_m
         lin, dwell = cc.linear, cc.dwell
-        lp = np.degrees(np.unwrap(np.angle(lin.piston)))
-        le = np.degrees(np.unwrap(np.angle(lin.engine)))
+        lp = phase_deg(lin.piston)
+        le = phase_deg(lin.engine)
         lab = cc.label
         ax[0, 0].plot(lin.freq_hz, _db(lin.piston * R * IN_PER_DEG), "-", color=c, gid="linear", label=f"{lab}: linear")
         ax[1, 0].plot(lin.freq_hz, lp, "-", color=c, gid="linear")

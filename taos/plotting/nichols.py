@@ -8,7 +8,7 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..linear import gain_db
+from ..linear import gain_db, phase_deg
 from ..units import from_si
 
 
@@ -23,7 +23,7 @@ def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
     amps = df.amplitude_rad[::2] if amplitudes_rad is None else np.asarray(amplitudes_rad, float)
 
     def draw(h, **kw):
-        ph = np.degrees(np.unwrap(np.angle(h)))
+        ph = phase_deg(h)
         ph -= 360.0 * np.round((ph[len(ph) // 2] + 180.0) / 360.0)  # the branch around -180
         ax.plot(ph, gain_db(h, 1e-6), **kw)
 
@@ -35,7 +35,7 @@ def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
     def mark(h_of, color, text: bool):
         hm = h_of(np.asarray(marks))
         hf = h_of(f)
-        ph_f = np.degrees(np.unwrap(np.angle(hf)))
+        ph_f = phase_deg(hf)
         ph_f -= 360.0 * np.round((ph_f[len(ph_f) // 2] + 180.0) / 360.0)
         ph_m = np.interp(np.log10(marks), np.log10(f), ph_f)
         g_m = 20 * np.log10(np.maximum(np.abs(hm), 1e-6))

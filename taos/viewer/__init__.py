@@ -17,11 +17,11 @@ from pathlib import Path
 from ..errors import InputError
 from ..results import atomic_write
 from .base import BaseVisualizer
-from .geometry import GimbalGeometry, geometry_for_run
+from .geometry import EngineDrawing, geometry_for_run
 from .kinematics import ViewerFrames, viewer_frames
 from .meshcat_backend import MeshcatVisualizer, OfflineWindow, legend_html, live_visualizer
 
-__all__ = ["BaseVisualizer", "GimbalGeometry", "MeshcatVisualizer", "OfflineWindow", "ViewerFrames",
+__all__ = ["BaseVisualizer", "EngineDrawing", "MeshcatVisualizer", "OfflineWindow", "ViewerFrames",
            "load_run", "offline_html", "serve", "viewer_frames", "write_html"]
 
 
@@ -61,7 +61,7 @@ def _title(th) -> str:
 
 
 def offline_html(th, *, angle_scale: float = 1.0, deflection_scale: float | None = None, fps: float = 100.0,
-                 paused_at_s: float | None = None, geometry: GimbalGeometry | None = None,
+                 paused_at_s: float | None = None, geometry: EngineDrawing | None = None,
                  gimbal_scale: float | None = None) -> str:
     """Self-contained HTML (meshcat viewer + scene + animation) of run ``th``.
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import abc
 
-from .geometry import GimbalGeometry
+from .geometry import EngineDrawing
 from .kinematics import ViewerFrames
 
 #: scene node names shared by all backends
@@ -35,8 +35,8 @@ def pin_node(axis: str) -> str:
 class BaseVisualizer(abc.ABC):
     """Backend-independent part: the display geometry."""
 
-    def __init__(self, geometry: GimbalGeometry | None = None):
-        self.geometry = geometry or GimbalGeometry()
+    def __init__(self, geometry: EngineDrawing | None = None):
+        self.geometry = geometry or EngineDrawing()
 
     @abc.abstractmethod
     def load_scene(self) -> None:

@@ -31,8 +31,10 @@ MESH_SUFFIXES = (".stl", ".obj", ".ply", ".glb")
 
 
 @dataclass(frozen=True)
-class GimbalGeometry:
-    """Display dimensions [m]; defaults are the RS-25 public figures (module docstring)."""
+class EngineDrawing:
+    """Display dimensions [m] of the drawn engine, gimbal and actuators; defaults are the RS-25
+    public figures (module docstring). Display only: the bearing's structural geometry is
+    :class:`taos.fem.gimbal.GimbalGeometry`."""
 
     moment_arm_m: float = 0.8
     engine_length_m: float = 4.3
@@ -70,7 +72,7 @@ class GimbalGeometry:
         return self.structure_attach_height_m + self.engine_attach_depth_m
 
 
-def _nozzle(g: GimbalGeometry) -> trimesh.Trimesh:
+def _nozzle(g: EngineDrawing) -> trimesh.Trimesh:
     """Bell nozzle and combustion chamber, revolved about z (open surface, drawn two-sided)."""
     top = g.gimbal_height_m / 2  # the engine length runs from the bearing top, as in models/meshes
     z_throat = top - g.powerhead_length_m
@@ -85,7 +87,7 @@ def _nozzle(g: GimbalGeometry) -> trimesh.Trimesh:
     return trimesh.creation.revolve(prof, sections=48)
 
 
-def _powerhead(g: GimbalGeometry) -> trimesh.Trimesh:
+def _powerhead(g: EngineDrawing) -> trimesh.Trimesh:
     """Powerhead envelope: main body, two high-pressure turbopumps, injector dome."""
     L = g.powerhead_length_m
     parts = [
@@ -118,7 +120,7 @@ def _load_mesh(name: str) -> trimesh.Trimesh | None:
     return None
 
 
-def engine_meshes(g: GimbalGeometry, use_files: bool = True) -> dict[str, trimesh.Trimesh]:
+def engine_meshes(g: EngineDrawing, use_files: bool = True) -> dict[str, trimesh.Trimesh]:
     """{'powerhead': mesh, 'nozzle': mesh} in the engine frame (gimbal pivot at the origin):
     the shipped meshes when present, else the procedural shapes of this module."""
     out = {}
@@ -128,7 +130,7 @@ def engine_meshes(g: GimbalGeometry, use_files: bool = True) -> dict[str, trimes
     return out
 
 
-def clevis_bracket(g: GimbalGeometry, axis: str) -> trimesh.Trimesh:
+def clevis_bracket(g: EngineDrawing, axis: str) -> trimesh.Trimesh:
     """Engine-side bracket from the powerhead out to the actuator clevis."""
     c = g.engine_attach_m(axis)
     inner = c.copy()
@@ -136,7 +138,7 @@ def clevis_bracket(g: GimbalGeometry, axis: str) -> trimesh.Trimesh:
     return trimesh.creation.cylinder(0.05, segment=(inner, c), sections=12)
 
 
-def gimbal_half(g: GimbalGeometry, upper: bool) -> trimesh.Trimesh:
+def gimbal_half(g: EngineDrawing, upper: bool) -> trimesh.Trimesh:
     """One half of the ball-and-socket gimbal block (upper to the structure, lower to the engine)."""
     h = g.gimbal_height_m / 2
     z = h / 2 if upper else -h / 2
@@ -144,18 +146,18 @@ def gimbal_half(g: GimbalGeometry, upper: bool) -> trimesh.Trimesh:
                                      transform=trimesh.transformations.translation_matrix((0, 0, z)))
 
 
-def axis_pin(g: GimbalGeometry, axis: str) -> trimesh.Trimesh:
+def axis_pin(g: EngineDrawing, axis: str) -> trimesh.Trimesh:
     """Friction-state indicator through the bearing, along the rotation axis of ``axis``."""
     rot = trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0) if axis == "pitch" else (0, 1, 0))
     return trimesh.creation.cylinder(0.045, g.gimbal_diameter_m * 1.7, sections=16, transform=rot)
 
 
-def actuator_body(g: GimbalGeometry) -> trimesh.Trimesh:
+def actuator_body(g: EngineDrawing) -> trimesh.Trimesh:
     """Actuator cylinder along local +z from 0 to the body length (placed at the structure attach)."""
     return trimesh.creation.cylinder(g.body_diameter_m / 2, segment=((0, 0, 0), (0, 0, g.body_length_m)), sections=24)
 
 
-def actuator_rod(g: GimbalGeometry) -> trimesh.Trimesh:
+def actuator_rod(g: EngineDrawing) -> trimesh.Trimesh:
     """Piston rod along local -z from 0 back into the cylinder (placed at the engine clevis)."""
     return trimesh.creation.cylinder(g.rod_diameter_m / 2, segment=((0, 0, -g.rod_length_m), (0, 0, 0)), sections=16)
 
@@ -164,7 +166,7 @@ def attach_point(radius: float = 0.07) -> trimesh.Trimesh:
     return trimesh.creation.icosphere(subdivisions=2, radius=radius)
 
 
-def thrust_structure(g: GimbalGeometry) -> trimesh.Trimesh:
+def thrust_structure(g: EngineDrawing) -> trimesh.Trimesh:
     """Thrust-structure beams carrying the gimbal and the two actuator attach points."""
     zt = g.structure_attach_height_m + 0.12
     R = g.moment_arm_m
@@ -176,18 +178,18 @@ def thrust_structure(g: GimbalGeometry) -> trimesh.Trimesh:
     return trimesh.util.concatenate(beams)
 
 
-def geometry_from_model(model) -> GimbalGeometry:
+def geometry_from_model(model) -> EngineDrawing:
     """Display geometry whose actuator attach points are the model file's ``[geometry]`` (the
     3-D TAOS model's, :func:`taos.taos3d.model.parse_geometry`): moment arm, structure attach
     height and engine attach depth from the pitch actuator's points, not repeated here."""
     from taos.taos3d.model import parse_geometry
     geo = parse_geometry(model)
     S, E = geo.structure_attach_m[0], geo.engine_attach_m[0]
-    return GimbalGeometry(moment_arm_m=float(np.hypot(E[0], E[1])), structure_attach_height_m=float(S[2]),
+    return EngineDrawing(moment_arm_m=float(np.hypot(E[0], E[1])), structure_attach_height_m=float(S[2]),
                           engine_attach_depth_m=float(-E[2]))
 
 
-def geometry_for_run(th) -> GimbalGeometry:
+def geometry_for_run(th) -> EngineDrawing:
     """Display geometry of a recorded run: the ``[geometry]`` of the model file named in its
     provenance when that file is readable and has one, else the defaults with the run's moment arm."""
     src = (getattr(th, "provenance", None) or {}).get("model_file")
@@ -200,4 +202,4 @@ def geometry_for_run(th) -> GimbalGeometry:
                 return geometry_from_model(m)
         except InputError:  # a moved or edited model file: fall back to the defaults
             pass
-    return GimbalGeometry(moment_arm_m=float(th.moment_arm_m))
+    return EngineDrawing(moment_arm_m=float(th.moment_arm_m))

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .geometry import GimbalGeometry, geometry_for_run
+from .geometry import EngineDrawing, geometry_for_run
 
 AXES = ("pitch", "yaw")
 
@@ -124,7 +124,7 @@ def auto_deflection_scale(peak_deflection_m: float) -> float:
 AUTO_GIMBAL_M = 0.03
 
 
-def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: float = 1.0,
+def viewer_frames(th, geometry: EngineDrawing | None = None, *, angle_scale: float = 1.0,
                   deflection_scale: float | None = None, fps: float = 100.0,
                   stick_rate_rad_s: float = 1.75e-3, gimbal_scale: float | None = None) -> ViewerFrames:
     """Poses and colours for the 3-D view of run ``th`` (see the module docstring).
@@ -134,7 +134,7 @@ def viewer_frames(th, geometry: GimbalGeometry | None = None, *, angle_scale: fl
     th : TimeHistory
         Recorded run (axes pitch and/or yaw; t_s [s], engine_rad, piston_m, friction_torque_Nm,
         load_force_N).
-    geometry : GimbalGeometry
+    geometry : EngineDrawing
         Display geometry; default RS-25 with the run's moment arm.
     angle_scale : float
         Engine-angle exaggeration s [-] (1 = true angles).

@@ -177,7 +177,7 @@ def legend_html(frames: ViewerFrames | None) -> str:
 class MeshcatVisualizer(BaseVisualizer):
     """meshcat backend; ``window`` is a meshcat ``ViewerWindow`` (live) or :class:`OfflineWindow`."""
 
-    def __init__(self, geometry: geo.GimbalGeometry | None = None, window=None, use_mesh_files: bool = True):
+    def __init__(self, geometry: geo.EngineDrawing | None = None, window=None, use_mesh_files: bool = True):
         super().__init__(geometry)
         self.window = window if window is not None else OfflineWindow()
         self.vis = meshcat.Visualizer(window=self.window)
@@ -306,7 +306,7 @@ def start_loopback_server(timeout_s: float = 20.0):
     return proc, zmq_url, web_url
 
 
-def live_visualizer(geometry: geo.GimbalGeometry | None = None):
+def live_visualizer(geometry: geo.EngineDrawing | None = None):
     """(MeshcatVisualizer on a fresh loopback server, server process)."""
     import contextlib
     import io

@@ -37,7 +37,7 @@ def test_dwell_estimator_recovers_the_exact_linear_response(verify):
     (taos.identify), gives the exact linear response."""
     from taos.planar.freqresp import linear_freqresp
     from taos.identify.data import from_time_history
-    from taos.identify.estimate import estimate
+    from taos.identify.estimation import estimate
     from taos.profiles import Sequence, SineDwell
     from taos.planar.simulate import simulate
 
