@@ -16,7 +16,7 @@ import sys
 
 import numpy as np
 
-from taos.cli.basic import parse_float_list
+from taos.units import parse_float_list
 from taos.errors import InputError
 from taos.results import package_version, write_json
 
