@@ -61,7 +61,7 @@ OUTPUTS = ("index.html", "summary.json", "greenrun.h5")
 AXES = ("pitch", "yaw")
 #: a measured record given as the profile replays its commands (:func:`taos.profiles.profile_from_record`)
 RECORD_SUFFIXES = (".csv", ".txt", ".h5", ".hdf5")
-#: the linear response's grid [Hz]
+# the linear response's grid [Hz], 0.1-30 Hz
 LINEAR_GRID_HZ = np.logspace(-1, math.log10(30.0), 240)
 
 
@@ -127,7 +127,7 @@ class GreenRunResult:
     dt_s: float
     #: the two-axis run (``taos.planar.simulate.TimeHistory``; 3-D: ``TaosTimeHistory``), with its provenance
     time_history: TimeHistory
-    #: exact linear response on :data:`LINEAR_GRID_HZ`
+    #: exact linear response on a log grid 0.1-30 Hz (240 points)
     linear: Mapping[str, FrequencyResponse]
     #: sine-dwell responses, one per profile amplitude, at the profile's frequencies
     dwell: Mapping[str, tuple[FrequencyResponse, ...]]
@@ -281,6 +281,10 @@ def greenrun(model, profile=None, *, engine: str = "simplex", friction: str | No
     """The Green Run analysis of ``model`` (see the module docstring); with ``out``, also the
     report folder (:meth:`GreenRunResult.write`).
 
+    Raises :class:`~taos.errors.InputError` on bad input (before any work starts; nothing
+    written), and :class:`~taos.errors.SimulationUnstable` when the model is unstable or the run
+    leaves its physical envelope.
+
     Parameters
     ----------
     model : TvcModel, str or Path
@@ -312,10 +316,6 @@ def greenrun(model, profile=None, *, engine: str = "simplex", friction: str | No
         tqdm progress bar on standard error.
     view_angle_scale, view_fps : float
         The embedded 3-D view's angle exaggeration [-] and keyframe rate [1/s] (with ``out``).
-
-    Raises :class:`~taos.errors.InputError` on bad input (nothing written), and
-    :class:`~taos.errors.SimulationUnstable` when the model is unstable or the run leaves its
-    physical envelope.
     """
     from tqdm import tqdm
 
