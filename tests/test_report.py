@@ -285,10 +285,13 @@ def test_greenrun_library_call_gives_the_cli_summary_and_never_draws(tmp_path):
     assert lib["drew"] == []
     s = lib["summary"]
     assert cli.pop("created_utc") and s.pop("created_utc")
+    # (the working tree's revision is provenance of the moment, not of the inputs)
+    assert cli["provenance"].pop("git_revision") is not None and s["provenance"].pop("git_revision") is not None
     assert s == cli                                   # every key and number, in the same order
     assert list(s) == list(cli)
     written = json.loads((tmp_path / "lib" / "summary.json").read_text())
     written.pop("created_utc")
+    written["provenance"].pop("git_revision")
     assert written == cli
     assert sorted(p.name for p in (tmp_path / "lib").iterdir() if not p.name.startswith(".")) == [
         "greenrun.h5", "index.html", "summary.json"]
