@@ -16,7 +16,7 @@ import sys
 
 import numpy as np
 
-from taos.cli.basic import parse_float_list
+from taos.units import parse_float_list
 from taos.errors import InputError
 from taos.results import package_version, write_json
 
@@ -163,7 +163,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from taos.cli import run
+    from taos.errors import run_cli as run
     return run(build_parser(), argv)
 
 

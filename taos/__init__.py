@@ -11,6 +11,9 @@ The public API, by task (each name is importable from ``taos``)::
     taos.fit_frequency_response(model, responses, ["load_stiffness"])
     taos.compare_models(model_a, model_b)
     taos.write_html(run, "run.html")                       # offline 3-D view
+    res = taos.greenrun(model, out="out/greenrun")         # the Green Run report (GreenRunResult)
+    res.summary()["figures_of_merit"]                      # its numbers (summary.json)
+    taos.model_summary(model, steps=False)                 # what `taos info --json` prints
 
 Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.py`` checks):
 
@@ -21,9 +24,10 @@ Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.
 3. the engines: ``planar`` (the simplex model, its kernels, simulation, frequency response,
    steady state, run envelope) and ``taos3d`` (3-D), with ``fem``, ``profiles``,
    ``engine_geometry``;
-4. ``flight``, ``identify``, ``report``, ``montecarlo``, ``export``, ``interop`` - analyses built
-   on them;
-5. ``plotting``, ``viewer`` - drawing only;
+4. ``flight``, ``identify``, ``report`` (figures of merit, spec masks, summaries), ``montecarlo``,
+   ``export``, ``interop`` - analyses built on them;
+5. ``plotting``, ``viewer`` - drawing only; ``report.analysis`` and ``report.html`` - the Green Run
+   report, whose folder holds its drawn page;
 6. ``cli`` - the ``taos`` command: argument parsing over the layers below.
 
 Names are resolved on first use (PEP 562), so ``import taos`` stays cheap and a command imports
@@ -57,6 +61,8 @@ _API = {
     "load_run": "taos.viewer", "write_html": "taos.viewer", "serve": "taos.viewer",
     "loop_margins": "taos.stability", "LoopMargins": "taos.stability",
     "to_control": "taos.interop", "from_control_ss": "taos.interop",
+    "greenrun": "taos.report.analysis", "GreenRunResult": "taos.report.analysis",
+    "model_summary": "taos.report.summary",
 }
 
 __all__ = sorted(_API) + ["__version__"]

@@ -107,3 +107,68 @@ def check_keys(table: Mapping, allowed: Iterable[str], source: str, section: str
         if guess is not None:
             raise InputError(source, field, f"a known key (did you mean {guess!r}?)", got="an unknown key")
         raise InputError(source, field, "one of " + ", ".join(allowed), got="an unknown key")
+
+
+# -- the exit-status contract of the command lines (taos and masv) --------------------------
+
+def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None) -> int:
+    """Parse and dispatch; every failure ends with one line on standard error (no traceback
+    unless ``--debug``): bad input -> exit 2, an unstable run or one that left its envelope ->
+    exit 3, Ctrl-C -> exit 130, SIGTERM -> exit 143, anything unexpected -> exit 1."""
+    import contextlib
+    import io
+    import os
+    import signal
+    import sys
+    import threading
+    import traceback
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv or bool(os.environ.get("TAOS_DEBUG"))
+    argv = [a for a in argv if a != "--debug"]
+    buf = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(buf):
+            args = parser.parse_args(argv)
+    except SystemExit as e:  # argparse: usage + error; keep the one error line
+        lines = [ln for ln in buf.getvalue().splitlines() if ln.strip()]
+        if lines:
+            print(lines[-1], file=sys.stderr)
+        return int(e.code or 0) if not isinstance(e.code, str) else 2
+    old = None
+    if threading.current_thread() is threading.main_thread():
+        def _term(signum, frame):
+            raise Interrupted(signum)
+        old = signal.signal(signal.SIGTERM, _term)
+    try:
+        return int(args.func(args) or 0)
+    except InputError as e:
+        if debug:
+            traceback.print_exc()
+        print(f"{parser.prog}: {e}", file=sys.stderr)
+        return 2
+    except SimulationUnstable as e:
+        if debug:
+            traceback.print_exc()
+        print(f"{parser.prog}: {e}", file=sys.stderr)
+        return 3
+    except KeyboardInterrupt:
+        print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
+        return 130
+    except Interrupted as e:
+        print(f"{parser.prog}: terminated (signal {e.signum}); no partial output written", file=sys.stderr)
+        return 128 + e.signum
+    except MemoryError:
+        print(f"{parser.prog}: out of memory: the job is larger than this machine can hold "
+              "(shorten the run or coarsen the step)", file=sys.stderr)
+        return 2
+    except Exception as e:  # a bug: still one line unless --debug
+        if debug:
+            traceback.print_exc()
+        msg = " ".join(str(e).split())[:300]
+        print(f"{parser.prog}: internal error: {type(e).__name__}: {msg} (rerun with --debug for the traceback)",
+              file=sys.stderr)
+        return 1
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)

@@ -3,7 +3,8 @@
 One pint registry for the whole package. Model files, CLI options and reports carry
 strings such as ``"115000 lbf/in"`` or ``"144000 in*lbf"``; :func:`to_si` turns them into
 plain SI floats after checking their dimension, and :func:`from_si` formats SI floats
-back into engineering units for reports.
+back into engineering units for reports. :func:`parse_float_list` reads an option's
+comma-separated list of numbers (``--freq-hz 0.5,1,2``) for both command lines.
 
 Start-up: pint takes about a quarter of a second to import and set up, longer than a whole
 ``taos info``. So the registry (``ureg``, ``Q_``) is built on first use, with its parsed
@@ -216,3 +217,15 @@ def from_si(value: float, si_unit: str, unit: str) -> float:
     """Convert an SI float to ``unit`` (e.g. ``from_si(k, 'N/m', 'lbf/in')``)."""
     return float(_Q(value, si_unit).to(unit).magnitude)
 
+
+def parse_float_list(text: str, option: str, source: str = "command line") -> list[float]:
+    """'0.1,0.5,1' -> [0.1, 0.5, 1.0] (a command-line option's list of numbers); refuses empty,
+    non-numeric, non-positive or non-finite items (:class:`~taos.errors.InputError` naming ``option``)."""
+    try:
+        vals = [float(s) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise InputError(source, option, "a comma-separated list of numbers like 0.1,0.5,1",
+                         got=repr(text)) from None
+    if not vals or not all(math.isfinite(v) and v > 0 for v in vals):
+        raise InputError(source, option, "positive finite numbers", got=repr(text))
+    return vals

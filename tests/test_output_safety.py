@@ -320,7 +320,7 @@ def test_debug_shows_the_traceback_and_an_internal_error_is_still_one_line(tmp_p
 
     def boom(args):
         raise RuntimeError("bug\nwith two lines")
-    monkeypatch.setattr(basic, "info_dict", lambda m: boom(None))
+    monkeypatch.setattr(basic, "model_summary", lambda m, steps=False: boom(None))
     assert main(["info", str(AMBIENT)]) == 1
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "internal error" in err and "Traceback" not in err

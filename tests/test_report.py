@@ -89,7 +89,8 @@ def test_report_opens_offline_with_the_3d_view_drawn(report, tmp_path):
 
 
 def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypatch):
-    import taos.cli.report as rep
+    import taos.report.analysis as rep
+    import taos.report.html as page
     from taos.errors import InputError
 
     out = tmp_path / "gr"
@@ -99,7 +100,7 @@ def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypa
     bad = tmp_path / "bad.toml"
     bad.write_text(HOTFIRE.read_text().replace('load_stiffness = "205000 lbf/in"', 'load_stiffness = "-1 lbf/in"'))
     with pytest.raises(InputError):
-        rep.greenrun_report(bad, out, progress=False)
+        rep.greenrun(bad, out=out)
     assert (out / "index.html").read_text() == "previous" and len(list(out.iterdir())) == 2
 
     def boom(*a, **k):
@@ -109,10 +110,10 @@ def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypa
 
     import taos.viewer
     monkeypatch.setattr(rep, "_write_h5", boom)  # fails while the new folder is being written
-    monkeypatch.setattr(rep, "_png", lambda fig: (plt.close(fig), "data:,")[1])  # (speed only)
+    monkeypatch.setattr(page, "_png", lambda fig: (plt.close(fig), "data:,")[1])  # (speed only)
     monkeypatch.setattr(taos.viewer, "offline_html", lambda *a, **k: "<html></html>")
     with pytest.raises(InputError):  # an output place that cannot be written: exit 2
-        rep.greenrun_report(HOTFIRE, out, progress=False)
+        rep.greenrun(HOTFIRE, out=out)
     assert (out / "index.html").read_text() == "previous"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml", "gr"]  # no temp folder left
     r = run_cli("greenrun", bad, "--out", tmp_path / "new", cwd=ROOT)
@@ -123,10 +124,12 @@ def test_greenrun_with_the_3d_engine(tmp_path):
     """taos greenrun --engine taos: the report is built from the 3-D model and says so."""
     import json as _json
 
-    from taos.cli.report import greenrun_report
+    from taos.report import greenrun
 
-    out = greenrun_report(MODELS / "rs25_hotfire.toml", tmp_path / "gr", engine="taos", progress=False)
+    out = tmp_path / "gr"
+    res = greenrun(MODELS / "rs25_hotfire.toml", engine="taos", out=out)
     s = _json.loads((out / "summary.json").read_text())
+    assert res.engine == "taos" and res.summary()["engine_model"] == "taos"
     assert s["engine_model"] == "taos"
     assert "taos engine model" in (out / "index.html").read_text()
 
@@ -224,3 +227,92 @@ def test_every_command_reports_the_same_piston_gain_and_phase(report, tmp_path):
             assert est[resp]["gain_db"][k] == pytest.approx(sdw[resp]["gain_db"][k], abs=0.01)
             assert est[resp]["phase_deg"][k] == pytest.approx(sdw[resp]["phase_deg"][k], abs=0.1)
     assert est["engine"]["phase_deg"][1] < -180
+
+
+SHORT_PROFILE = """name = "short two-axis"
+[pitch]
+type = "sequence"
+[[pitch.segments]]
+type = "sine_dwell"
+amplitude = "0.4 deg"
+frequency = "2 Hz"
+cycles = 6
+[[pitch.segments]]
+type = "sine_dwell"
+amplitude = "0.8 deg"
+frequency = "1 Hz"
+cycles = 10
+[yaw]
+type = "sine_dwell"
+amplitude = "0.4 deg"
+frequency = "3 Hz"
+cycles = 8
+"""
+
+LIBRARY_PROBE = """
+import json, math, sys
+import taos
+res = taos.greenrun(taos.load_model("rs25_hotfire"), sys.argv[1])
+drew = [m for m in ("matplotlib", "taos.plotting", "taos.viewer", "taos.report.html") if m in sys.modules]
+s = res.summary()
+fields = {"notch_hz": dict(res.notch_hz), "load_resonance_hz": dict(res.load_resonance_hz),
+          "dwell_pitch_gain_db": [20 * math.log10(abs(h)) for fr in res.dwell["pitch"] for h in fr.engine],
+          "run_yaw_gain_db": [20 * math.log10(abs(h)) for fr in res.run["yaw"] for h in fr.engine],
+          "spec_pass": res.spec_pass, "merit": res.figures_of_merit,
+          "samples": int(res.time_history.t_s.size), "type": type(res).__name__}
+res.write(sys.argv[2])
+print(json.dumps({"summary": s, "drew": drew, "fields": fields}))
+"""
+
+
+def test_greenrun_library_call_gives_the_cli_summary_and_never_draws(tmp_path):
+    """taos.greenrun(...) as a library call: the same numbers as ``taos greenrun``'s summary.json
+    for the same inputs (every key, only the timestamp differs), the result's fields agree with
+    the summary, its ``write`` gives the same summary.json, and the analysis draws nothing
+    (matplotlib, taos.plotting and the viewer are imported only when the page is made)."""
+    import subprocess
+    import sys
+
+    prof = tmp_path / "short.toml"
+    prof.write_text(SHORT_PROFILE)
+    r = run_cli("greenrun", "rs25_hotfire", "--profile", prof, "--out", tmp_path / "cli", "--quiet")
+    assert r.returncode == 0, r.stderr
+    cli = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    p = subprocess.run([sys.executable, "-c", LIBRARY_PROBE, str(prof), str(tmp_path / "lib")], capture_output=True,
+                       text=True, cwd=ROOT, timeout=600)
+    assert p.returncode == 0, p.stderr
+    lib = json.loads(p.stdout.strip().splitlines()[-1])
+    assert lib["drew"] == []
+    s = lib["summary"]
+    assert cli.pop("created_utc") and s.pop("created_utc")
+    # (the working tree's revision is provenance of the moment, not of the inputs)
+    assert cli["provenance"].pop("git_revision") is not None and s["provenance"].pop("git_revision") is not None
+    assert s == cli                                   # every key and number, in the same order
+    assert list(s) == list(cli)
+    written = json.loads((tmp_path / "lib" / "summary.json").read_text())
+    written.pop("created_utc")
+    written["provenance"].pop("git_revision")
+    assert written == cli
+    assert sorted(p.name for p in (tmp_path / "lib").iterdir() if not p.name.startswith(".")) == [
+        "greenrun.h5", "index.html", "summary.json"]
+    f = lib["fields"]
+    assert f["type"] == "GreenRunResult" and f["samples"] == cli["run"]["samples"]
+    assert f["notch_hz"] == cli["notch_frequency_hz"] and f["load_resonance_hz"] == cli["load_resonance_hz"]
+    assert f["dwell_pitch_gain_db"] == pytest.approx([x["engine_gain_db"] for x in cli["sine_dwell"]["pitch"]],
+                                                     rel=1e-12)
+    assert f["run_yaw_gain_db"] == pytest.approx([x["engine_gain_db"] for x in cli["run_dwell"]["yaw"]], rel=1e-12)
+    assert f["spec_pass"] is cli["spec_pass"] and f["merit"] == cli["figures_of_merit"]
+    # the profile's amplitudes and frequencies: pitch 0.4 deg at 2 Hz, 0.8 deg at 1 Hz; yaw 0.4 deg at 3 Hz
+    assert [(round(x["amplitude_deg"], 6), x["freq_hz"]) for x in cli["run_dwell"]["pitch"]] == [(0.4, 2.0), (0.8, 1.0)]
+    assert len(cli["sine_dwell"]["pitch"]) == 4 and len(cli["run_dwell"]["yaw"]) == 1
+
+
+def test_analysis_module_imports_no_drawing():
+    import subprocess
+    import sys
+
+    code = ("import sys, taos.report.analysis, taos.report.summary; "
+            "print([m for m in ('matplotlib', 'taos.plotting', 'taos.viewer', 'taos.report.html') if m in sys.modules])")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == "[]"

@@ -1,4 +1,5 @@
-"""``taos info``, ``taos freqresp`` and ``taos simulate``."""
+"""``taos info``, ``taos freqresp`` and ``taos simulate``: argument parsing over the library
+(``taos info``: :func:`taos.report.summary.model_summary`)."""
 
 from __future__ import annotations
 
@@ -8,25 +9,15 @@ import sys
 from typing import TYPE_CHECKING
 
 from taos.errors import InputError
+from taos.planar.envelope import ENGINES
+from taos.report.summary import model_summary
 from taos.results import write_json
+from taos.units import parse_float_list
 
 if TYPE_CHECKING:  # the model layer is imported when a command runs, not for --help
     from taos.model import TvcModel
 
 AXES = ("pitch", "yaw")
-ENGINES = ("simplex", "taos")
-
-
-def parse_float_list(text: str, option: str) -> list[float]:
-    """'0.1,0.5,1' -> [0.1, 0.5, 1.0]; refuses empty, non-numeric, non-positive or non-finite items."""
-    try:
-        vals = [float(s) for s in text.split(",") if s.strip()]
-    except ValueError:
-        raise InputError("command line", option, "a comma-separated list of numbers like 0.1,0.5,1",
-                         got=repr(text)) from None
-    if not vals or not all(math.isfinite(v) and v > 0 for v in vals):
-        raise InputError("command line", option, "positive finite numbers", got=repr(text))
-    return vals
 
 
 def model_from_args(args) -> TvcModel:
@@ -35,62 +26,9 @@ def model_from_args(args) -> TvcModel:
     return load_model(args.model, friction=getattr(args, "friction", None))
 
 
-def merit_dict(model: TvcModel, axes=AXES, steps: bool = True) -> dict:
-    """Figures of merit per axis (:mod:`taos.report.merit`): frequency figures from the linear
-    response, and (``steps``) step, threshold and hysteresis figures by simulation."""
-    from taos.report.merit import frequency_merit, step_merit
-    out = {}
-    for ax in axes:
-        d = frequency_merit(model, ax).to_dict()
-        if steps:
-            d["step"] = step_merit(model, ax).to_dict()
-        out[ax] = d
-    return out
-
-
-def info_dict(model: TvcModel, steps: bool = True) -> dict:
-    """Parameters in SI and derived figures (the ``taos info`` JSON), with the figures of merit."""
-    from dataclasses import asdict
-
-    import numpy as np
-
-    from taos.planar.simplex import load_resonance_from_notch, simplex_state_space
-
-    poles = simplex_state_space(model, "pitch").poles()
-    p = poles[poles.imag >= 0]
-    p = p[np.argsort(np.abs(p))]
-    friction = {"model": model.friction.name, **asdict(model.friction)}
-    av = model.avionics
-    return {
-        "model_file": model.source,
-        "model_sha256": model.sha256,
-        "name": model.name,
-        "load_resonance_hz": model.load_resonance_hz("pitch"),
-        "load_resonance_yaw_hz": model.load_resonance_hz("yaw"),
-        "notch_frequency_hz": load_resonance_from_notch(model, "pitch"),
-        "breakaway_deflection_deg": math.degrees(model.breakaway_deflection_rad()),
-        "oil_column_stiffness_N_per_m": model.actuator.oil_column_stiffness_N_per_m,
-        "load_stiffness_rotational_Nm_per_rad": model.structure.load_stiffness_N_per_m * model.actuator.moment_arm_m ** 2,
-        "stall_force_N": model.actuator.stall_force_N,
-        "avionics_lsb_deg": math.degrees(av.lsb_rad),
-        "figures_of_merit": merit_dict(model, steps=steps),
-        "linear_modes": [{"freq_hz": float(abs(x) / (2 * math.pi)),
-                          "damping_ratio": float(-x.real / abs(x)) if abs(x) > 0 else 1.0} for x in p],
-        "parameters": {
-            "engine": asdict(model.engine),
-            "actuator": asdict(model.actuator),
-            "structure": asdict(model.structure),
-            "friction": friction,
-            "avionics": {"quantization_bits": av.quantization_bits, "command_range_rad": av.command_range_rad,
-                         "rounding": "round" if av.rounding else "truncate",
-                         "crossover_command_rad": list(av.gain_table_rad), "crossover_gain": list(av.gain_table)},
-        },
-    }
-
-
 def cmd_info(args) -> int:
     model = model_from_args(args)
-    d = info_dict(model, steps=args.steps)
+    d = model_summary(model, steps=args.steps)
     if args.json:
         from taos.results import output_provenance
         d["provenance"] = output_provenance([model])
@@ -197,26 +135,16 @@ def cmd_freqresp(args) -> int:
     return 0
 
 
-def engine_default_dt_s(engine: str) -> float:
-    """The integration step [s] an engine model runs at unless told otherwise: 2e-4 s for the
-    planar simplex model (taos.planar.simulate), 4e-4 s for the 3-D model (taos.taos3d.simulate)."""
-    if engine == "taos":
-        from taos.taos3d.simulate import DEFAULT_DT_S
-    else:
-        from taos.planar.simulate import DEFAULT_DT_S
-    return DEFAULT_DT_S
-
-
 def cmd_simulate(args) -> int:
     from taos.planar import envelope as run_checks
-    from taos.cli.records import load_command_source
+    from taos.identify.replay import load_command_source
     from taos.results import check_output_file, input_provenance
     from taos.planar.simulate import simulate
 
     check_output_file(args.out, "--out")
     model = model_from_args(args)
     profile = load_command_source(args.profile)
-    dt = engine_default_dt_s(args.engine) if args.dt is None else args.dt
+    dt = run_checks.default_dt_s(args.engine) if args.dt is None else args.dt
     run_checks.check_run(model, profile, dt)
     run_checks.check_linear_stability(model, allow=args.allow_unstable)
     if args.engine == "taos":

@@ -1,4 +1,5 @@
-"""``taos view`` (3-D gimbal animation, live or offline HTML) and ``taos greenrun`` (the report)."""
+"""``taos view`` (3-D gimbal animation, live or offline HTML) and ``taos greenrun`` (the report:
+:func:`taos.report.greenrun`)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import math
 import sys
 
 from taos.errors import InputError
+from taos.planar.envelope import ENGINES
 
 
 def _positive(value: float, option: str) -> float:
@@ -42,13 +44,14 @@ def cmd_view(args) -> int:
 
 
 def cmd_greenrun(args) -> int:
-    from taos.cli.report import greenrun_report
+    from pathlib import Path
 
-    from taos.cli.report import DEFAULT_SPEC
+    from taos.report.analysis import DEFAULT_SPEC, greenrun
+
     spec = None if args.spec == "none" else (args.spec or DEFAULT_SPEC)
-    out = greenrun_report(args.model, args.out, profile_path=args.profile, friction=args.friction,
-                          engine=args.engine, progress=not args.quiet, allow_unstable=args.allow_unstable,
-                          spec_path=spec, data_path=args.data)
+    greenrun(args.model, args.profile, engine=args.engine, friction=args.friction, out=args.out,
+             spec=spec, data=args.data, allow_unstable=args.allow_unstable, progress=not args.quiet)
+    out = Path(args.out)
     print(f"wrote {out / 'index.html'} and {out / 'greenrun.h5'}")
     return 0
 
@@ -77,7 +80,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--spec", help="spec mask (TOML) marked pass/fail on the plots and in summary.json "
                    "(default models/specs/tvc_actuator_notional.toml; 'none' for no check)")
     p.add_argument("--data", help="measured record overlaid on the model (e.g. models/data/greenrun_hotfire_synthetic.csv)")
-    p.add_argument("--engine", choices=("simplex", "taos"), default="simplex",
+    p.add_argument("--engine", choices=ENGINES, default="simplex",
                    help="simplex (planar) or taos (3-D engine, FEM gimbal halves)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--allow-unstable", action="store_true",

@@ -14,6 +14,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: file suffixes read as measured records (:func:`taos.identify.data.load_test_data`)
+RECORD_SUFFIXES = (".csv", ".txt", ".h5", ".hdf5")
+
+
+def load_command_source(path):
+    """A command profile from ``path``: :func:`taos.profiles.load_profile` for a profile file (or
+    shipped name), or for a measured record (``.csv``/``.txt``/``.h5``/``.hdf5``,
+    :func:`taos.identify.data.load_test_data`) the profile replaying its commands
+    (:func:`taos.profiles.profile_from_record`)."""
+    from pathlib import Path
+
+    from taos import profiles
+
+    if Path(str(path)).suffix.lower() in RECORD_SUFFIXES:
+        from taos.identify.data import load_test_data
+        return profiles.profile_from_record(load_test_data(path))
+    return profiles.load_profile(path)
+
 
 @dataclass(frozen=True)
 class AxisReplay:

@@ -1,5 +1,6 @@
-"""Run checks that need the model's dynamics: the step against the fastest mode, dwell and run
-sizes, linear stability before a run, and the physical envelope after it.
+"""Run checks that need the model's dynamics: the engines' default steps
+(:func:`default_dt_s`), the step against the fastest mode, dwell and run sizes, linear stability
+before a run, and the physical envelope after it.
 
 The documented limits themselves (gimbal range, frequencies, durations, sizes) and the scalar
 checks are in :mod:`taos.bounds`; this module sits one layer up, beside the simplex model and
@@ -15,6 +16,25 @@ import numpy as np
 from ..errors import EnvelopeExceeded, InputError, UnstableModel
 from ..bounds import (GIMBAL_RANGE_RAD, HARD_STOP_RAD, LOAD_FORCE_FACTOR, MAX_JOB_BYTES, MAX_STEPS,
                      MIN_STEPS_PER_CYCLE, RK4_STEP_LIMIT, check_duration)
+
+
+#: the engine models a run can use: the planar simplex model (:mod:`taos.planar`) and the 3-D
+#: TAOS model (:mod:`taos.taos3d`)
+ENGINES = ("simplex", "taos")
+
+
+def default_dt_s(engine: str = "simplex", *, source: str = "command line", field: str = "--engine") -> float:
+    """The integration step [s] engine model ``engine`` runs at unless told otherwise:
+    :data:`taos.planar.simulate.DEFAULT_DT_S` (2e-4 s) for ``"simplex"``,
+    :data:`taos.taos3d.simulate.DEFAULT_DT_S` (4e-4 s) for ``"taos"`` (imported only then: the 3-D
+    model loads its compiled kernels). Another name is bad input (one line naming ``field``)."""
+    if engine == "taos":
+        from ..taos3d.simulate import DEFAULT_DT_S
+    elif engine == "simplex":
+        from .simulate import DEFAULT_DT_S
+    else:
+        raise InputError(source, field, " or ".join(ENGINES), got=repr(engine))
+    return DEFAULT_DT_S
 
 
 def fastest_mode_rad_s(model, axes=("pitch", "yaw")) -> float:

@@ -1,2 +1,39 @@
-"""Analyses behind the Green Run report and the ``info`` summaries: spec masks (:mod:`.spec`)
-and figures of merit (:mod:`.merit`)."""
+"""The Green Run report and the ``info`` summaries, as library calls.
+
+* :mod:`.analysis` - :func:`greenrun` (the analysis) -> :class:`GreenRunResult`, with
+  ``.summary()`` (the ``summary.json`` dict) and ``.write(DIR)`` (the report folder);
+* :mod:`.html` - the report page (rendering only; the one module here that draws);
+* :mod:`.summary` - :func:`model_summary` (what ``taos info --json`` prints) and
+  :func:`figures_of_merit`;
+* :mod:`.merit` - the figures of merit; :mod:`.spec` - spec masks.
+
+Layers: the analyses (:mod:`.merit`, :mod:`.spec`, :mod:`.summary`) sit with the other analyses
+(layer 4); :mod:`.analysis` and :mod:`.html` sit with the drawing (layer 5), because writing the
+report draws it. Names are resolved on first use, so ``taos info`` imports none of the report.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+#: public name -> module that defines it
+_API = {
+    "greenrun": "taos.report.analysis", "GreenRunResult": "taos.report.analysis",
+    "model_summary": "taos.report.summary", "figures_of_merit": "taos.report.summary",
+}
+
+__all__ = sorted(_API)
+
+
+def __getattr__(name: str):
+    try:
+        module = _API[name]
+    except KeyError:
+        raise AttributeError(f"module 'taos.report' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return __all__
