@@ -98,7 +98,13 @@ class CouplingResult:
     """Peak gains over the band [dB]: ``engine_peak_db[i, j]`` = max |theta_i / theta_c,j|,
     ``piston_peak_db[i, j]`` = max |x_p,i / (R_i theta_c,j)|, at ``engine_peak_hz``/
     ``piston_peak_hz``. Off-diagonal pairs on different engines are engine-to-engine coupling,
-    on the same engine axis-to-axis coupling."""
+    on the same engine axis-to-axis coupling.
+
+    Engine-to-engine coupling is reported beside the direct response (:meth:`engine_pairs`,
+    :meth:`engine_to_engine`): both are peak gains over the same band, each relative to its own
+    command, so ``below_direct_db`` = (direct peak of the commanded actuator) - (peak of another
+    engine's actuator for that command) says how much smaller the cross response is than the
+    commanded engine's own (positive: smaller)."""
 
     actuators: tuple[str, ...]
     engines: tuple[str, ...]
@@ -125,6 +131,52 @@ class CouplingResult:
         return {"command": self.actuators[j], "response": self.actuators[i], "gain_db": float(v),
                 "freq_hz": float(H[i, j])}
 
+    def _kind(self, kind: str):
+        if kind not in ("engine", "piston"):
+            raise ValueError(f"kind must be 'engine' or 'piston', got {kind!r}")
+        return (self.engine_peak_db, self.engine_peak_hz) if kind == "engine" else (self.piston_peak_db,
+                                                                                    self.piston_peak_hz)
+
+    def engine_pairs(self, kind: str = "engine") -> dict:
+        """Per engine pair [dB]: ``peak_db[i][j]`` the largest peak gain of any actuator on engine i
+        for a command to any actuator on engine j (i != j), on the diagonal the largest direct
+        (own-actuator) peak on engine i; ``peak_hz`` where; ``kind`` 'engine' (theta / theta_c)
+        or 'piston' (x_p / (R theta_c))."""
+        P, H = self._kind(kind)
+        names = list(dict.fromkeys(self.engines))
+        n = len(names)
+        peak, hz = np.full((n, n), -np.inf), np.zeros((n, n))
+        for i in range(len(self.actuators)):
+            for j in range(len(self.actuators)):
+                a, b = names.index(self.engines[i]), names.index(self.engines[j])
+                if (a == b) != (i == j):
+                    continue  # same engine: only the direct responses; other engines: every pair
+                if P[i, j] > peak[a, b]:
+                    peak[a, b], hz[a, b] = P[i, j], H[i, j]
+        return {"kind": kind, "engines": names, "peak_db": peak.tolist(), "peak_hz": hz.tolist()}
+
+    def engine_to_engine(self, kind: str = "engine") -> dict | None:
+        """The strongest engine-to-engine coupling beside the direct response: ``cross_db`` at
+        ``cross_hz`` (command -> response actuators), ``direct_db`` the commanded actuator's own
+        peak, and ``below_direct_db`` the smallest (direct - cross) over every cross pair [dB]
+        (class docstring). None with a single engine."""
+        P, H = self._kind(kind)
+        best, below = None, math.inf
+        n = len(self.actuators)
+        for i in range(n):
+            for j in range(n):
+                if self.engines[i] == self.engines[j]:
+                    continue
+                below = min(below, float(P[j, j] - P[i, j]))
+                if best is None or P[i, j] > P[best[0], best[1]]:
+                    best = (i, j)
+        if best is None:
+            return None
+        i, j = best
+        return {"kind": kind, "command": self.actuators[j], "response": self.actuators[i],
+                "cross_db": float(P[i, j]), "cross_hz": float(H[i, j]), "direct_db": float(P[j, j]),
+                "direct_hz": float(H[j, j]), "below_direct_db": below}
+
     @property
     def strongest_engine_to_engine(self) -> dict | None:
         return self._strongest(False)
@@ -140,7 +192,9 @@ class CouplingResult:
                 "strongest_engine_to_engine": self.strongest_engine_to_engine,
                 "strongest_axis_to_axis": self.strongest_axis_to_axis,
                 "strongest_engine_to_engine_piston": self._strongest(False, "piston"),
-                "strongest_axis_to_axis_piston": self._strongest(True, "piston")}
+                "strongest_axis_to_axis_piston": self._strongest(True, "piston"),
+                "engine_to_engine": {k: self.engine_to_engine(k) for k in ("engine", "piston")},
+                "engine_pairs": {k: self.engine_pairs(k) for k in ("engine", "piston")}}
 
 
 def coupling(system: MasvSystem, n_freq: int = 400) -> CouplingResult:

@@ -2,7 +2,8 @@
 
     masv modes CONFIG [--factor F] [--json PATH]     (modes in the file's [band], or bandwidth x/÷ F)
     masv freqresp CONFIG --freq-hz 0.5,1,2,5 [--json PATH] [--plot GRID.png]
-    masv coupling CONFIG [--json PATH] [--plot MATRIX.png]
+    masv coupling CONFIG [--reference CONFIG] [--json PATH] [--plot MATRIX.png]
+                                                      (with a reference: the same figures for it)
     masv tvse CONFIG [--json PATH] [--plot BODE.png]   TVSE loops (paper sec. 3.3) and their margins
 
 Bad input exits with status 2 and one line naming the file, the field and what was expected.
@@ -84,12 +85,39 @@ def cmd_freqresp(args) -> int:
     return 0
 
 
+def _coupling_summary(s) -> dict:
+    """Stability, worst loop margins and engine-to-engine coupling of one system (the figures
+    ``masv coupling`` compares with a reference configuration)."""
+    c = an.coupling(s)
+    eig = an.closed_loop_eigenvalues(s)
+    m = an.structure_effect(s)
+    return {"config_file": s.config.source, "n_modes": s.config.structure.n_modes, "stable": eig.stable,
+            "max_real_per_s": eig.max_real_per_s, "least_damped": eig.least_damped(2),
+            "worst_phase_margin_deg": m["worst_phase_margin_deg"],
+            "worst_gain_margin_db": None if math.isinf(m["worst_gain_margin_db"]) else m["worst_gain_margin_db"],
+            "engine_to_engine": {k: c.engine_to_engine(k) for k in ("engine", "piston")}}
+
+
+def _e2e_line(v: dict | None) -> str:
+    if not v:
+        return "none (one engine)"
+    if v["cross_db"] <= -300:
+        return f"none (rigid structure); direct {v['direct_db']:+.1f} dB"
+    return (f"{v['cross_db']:+.1f} dB at {v['cross_hz']:.2f} Hz ({v['command']} -> {v['response']}), "
+            f"{v['below_direct_db']:.1f} dB below the direct response (peak {v['direct_db']:+.1f} dB)")
+
+
 def cmd_coupling(args) -> int:
     s = _system(args)
     c = an.coupling(s)
     eig = an.closed_loop_eigenvalues(s)
     d = {"coupling": c.to_dict(), "notches": an.notch_frequencies(s), "closed_loop": eig.to_dict(),
          "margins": an.structure_effect(s), "provenance": _prov(s.config)}
+    ref_path = args.reference if args.reference else s.config.reference
+    if ref_path:
+        ref = build_system(load_config(ref_path))
+        d["reference"] = _coupling_summary(ref)
+        d["this"] = _coupling_summary(s)
     if args.json:
         write_json(args.json, d)
     else:
@@ -104,6 +132,22 @@ def cmd_coupling(args) -> int:
             v = d["coupling"][k]
             if v:
                 print(f"  {k}: {v['command']} -> {v['response']} {v['gain_db']:.1f} dB at {v['freq_hz']:.2f} Hz")
+        lo, hi = c.band_hz
+        for kind, label in (("engine", "theta_i / theta_c,j"), ("piston", "x_p,i / x_c,j")):
+            ep = c.engine_pairs(kind)
+            print(f"engine-to-engine, peak |{label}| over {lo:g}-{hi:g} Hz [dB] "
+                  "(row response engine, column command engine; diagonal: the engine's own direct response)")
+            print("  " + " " * 10 + "".join(f"{e:>10}" for e in ep["engines"]))
+            for e, row in zip(ep["engines"], ep["peak_db"]):
+                print(f"  {e:>10}" + "".join(f"{'-' if v <= -300 else f'{v:+.1f}':>10}" for v in row))
+            print(f"  strongest ({kind}): {_e2e_line(c.engine_to_engine(kind))}")
+        if ref_path:
+            print(f"against the reference {ref_path}:")
+            for tag, v in (("this", d["this"]), ("reference", d["reference"])):
+                gm = v["worst_gain_margin_db"]
+                print(f"  {tag:>9}: {v['n_modes']} modes, {'stable' if v['stable'] else 'UNSTABLE'}, worst PM "
+                      f"{v['worst_phase_margin_deg']:.1f} deg, worst GM {'inf' if gm is None else f'{gm:.1f}'} dB; "
+                      f"engine-to-engine (engine) {_e2e_line(v['engine_to_engine']['engine'])}")
     if args.plot:
         from .plotting import plot_coupling_matrix, save
         save(plot_coupling_matrix(c), args.plot)
@@ -154,6 +198,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("coupling", help="notches, coupling peaks, closed-loop stability, loop margins")
     common(p)
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save the peak-coupling matrix")
+    p.add_argument("--reference", metavar="CONFIG",
+                   help="compare with this configuration (default: the file's own `reference`, if any)")
     p.set_defaults(func=cmd_coupling)
     p = sub.add_parser("tvse", help="TVSE loops: engines' inertial coupling with the structure modes, margins")
     common(p)

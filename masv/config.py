@@ -3,6 +3,8 @@
 Format (every physical value with its unit, parsed by pint; paths relative to the file)::
 
     name = "SLS core stage, four RS-25, hot fire"
+    reference = "core_stage.toml"  # optional: another MASV configuration (the nominal structure)
+                                 # that ``masv coupling`` compares this one with
     [structure]
     modes = "../../fem_data/thrust_structure_modes.npz"   # or "rigid" (no modes)
     damping_ratio = 0.005        # every mode (default, paper sec. 3.3); "file" keeps the file's
@@ -100,7 +102,8 @@ class ActuatorSpec:
 @dataclass(frozen=True, eq=False)
 class MasvConfig:
     """A validated MASV configuration (SI inside): engines, actuators, modal structure and the
-    band of interest [Hz]."""
+    band of interest [Hz]; ``reference`` the path of another configuration to compare with
+    (``masv coupling``), or None."""
 
     name: str
     engines: tuple[EngineSpec, ...]
@@ -110,6 +113,7 @@ class MasvConfig:
     band_high_hz: float
     source: str = "<code>"
     sha256: str = ""
+    reference: str | None = None
 
     def engine(self, name: str) -> EngineSpec:
         return next(e for e in self.engines if e.name == name)
@@ -228,7 +232,7 @@ def load_config(path) -> MasvConfig:
     p = resolve(path, "masv")
     src = str(p)
     raw, doc = read_toml(p, "a readable MASV configuration file")
-    check_keys(doc, {"name", "description", "structure", "band", "engine", "actuator"}, src)
+    check_keys(doc, {"name", "description", "reference", "structure", "band", "engine", "actuator"}, src)
     base = p.parent
     structure = _structure(doc, src, base)
     band = doc.get("band", {})
@@ -279,7 +283,14 @@ def load_config(path) -> MasvConfig:
             ax = np.zeros(3)  # rigid structure: the axis is never used
         actuators.append(ActuatorSpec(_str(t, "name", src, f"{f}.name"), eng, _str(t, "axis", src, f"{f}.axis"),
                                       node, tuple(float(c) for c in n), tuple(float(c) for c in ax)))
+    ref = None
+    if "reference" in doc:
+        rp = (base / _str(doc, "reference", src, "reference")).resolve()
+        if not rp.is_file() or rp == p.resolve():
+            raise InputError(src, "reference", "the path of another MASV configuration file",
+                             got=repr(doc["reference"]))
+        ref = str(rp)
     cfg = MasvConfig(str(doc.get("name", p.stem)), tuple(engines), tuple(actuators), structure, lo, hi, src,
-                     hashlib.sha256(raw).hexdigest())
+                     hashlib.sha256(raw).hexdigest(), ref)
     check_config(cfg)
     return cfg

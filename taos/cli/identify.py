@@ -228,6 +228,9 @@ def cmd_compare(args) -> int:
     out = write_comparison(cmp, args.out, json_path=args.json)
     stream = sys.stderr if args.json == "-" else sys.stdout
     print(cmp.table(), file=stream)
+    from taos.fem.shift import DEFAULT_PATH, fem_shift_share
+    if DEFAULT_PATH.is_file():  # the gimbal FEM's part in an ambient -> hot-fire K_L change, with its range
+        print(fem_shift_share().text(), file=stream)
     print(f"wrote {out}/ (table.txt, comparison.json, piston_side_by_side.png, bode_overlay.png)", file=stream)
     return 0
 

@@ -4,6 +4,7 @@
 * :mod:`taos.fem.elasticity` - scikit-fem linear elasticity, RBE2 couplings, Guyan condensation.
 * :mod:`taos.fem.gimbal` - parametric ball-and-socket gimbal, hanging / thrust load paths.
 * :mod:`taos.fem.load_path` - gimbal compliance along the actuator line, implied K_L.
+* :mod:`taos.fem.shift` - the share of the Green Run K_L shift the gimbal FEM explains, with its range.
 * :mod:`taos.fem.verification` - FE check against beam theory (cantilevered tube).
 * :mod:`taos.fem.frame`, :mod:`taos.fem.thrust_structure` - 3-D frame model and its modes.
 * :mod:`taos.fem.io` - load and validate user matrices, provenance files.
@@ -16,6 +17,7 @@ from .io import (GimbalStiffness, load_gimbal_stiffness, load_stiffness_matrix, 
                  validate_stiffness_matrix)
 from .load_path import (LBF_PER_IN, ActuatorLine, LoadStiffnessShift, actuator_line_compliance,
                         implied_load_stiffness, stuck_gimbal_stiffness)
+from .shift import ShiftShareRange, explained_share, fem_shift_share
 from .thrust_structure import InterfaceModes, ThrustStructureSpec, node_names, thrust_structure_modes
 from .verification import TubeCheck, cantilever_tube_check
 
@@ -26,4 +28,5 @@ __all__ = [
     "validate_stiffness_matrix", "LBF_PER_IN", "ActuatorLine", "LoadStiffnessShift", "actuator_line_compliance",
     "implied_load_stiffness", "stuck_gimbal_stiffness", "InterfaceModes", "ThrustStructureSpec", "node_names",
     "thrust_structure_modes", "TubeCheck", "cantilever_tube_check",
+    "ShiftShareRange", "explained_share", "fem_shift_share",
 ]

@@ -106,6 +106,28 @@ def engine_actuator_line(moment_arm_m: float = 0.8) -> ActuatorLine:
                         engine_inertia_about_gimbal_kgm2=p.inertia_pitch_kgm2)
 
 
+def write_thrust_structure_modes(stem: Path, spec: ThrustStructureSpec, generator: str = GENERATOR,
+                                 notes: dict | None = None):
+    """Compute the frame's modes for ``spec`` and write ``stem``.npz (the MASV file contract) and
+    its provenance ``stem``.toml (``notes``: extra top-level provenance keys); return the modes."""
+    stem = Path(stem)
+    modes = thrust_structure_modes(spec)
+    np.savez(stem.with_suffix(".npz"), freq_hz=modes.freq_hz, damping_ratio=modes.damping_ratio,
+             node_names=np.array(modes.node_names), node_xyz_m=modes.node_xyz_m, phi=modes.phi)
+    write_toml(stem.with_suffix(".toml"), {
+        "": {"generator": generator, "model": "notional engine-section frame (taos.fem.thrust_structure)",
+             "element": "3-D Euler-Bernoulli frame, consistent mass", "boundary": "forward ring clamped",
+             "frame": "vehicle: x along the axis forward positive, y and z lateral; origin on the axis in the cross-beam plane",
+             "units": "freq_hz Hz; node_xyz_m m; phi translations m/sqrt(kg), rotations rad/sqrt(kg)",
+             "normalisation": "phi^T M phi = 1", "damping": "0.5 % viscous on every mode (paper sec. 3.3)",
+             **(notes or {})},
+        "mesh": {"elements": modes.n_elements, "nodes": modes.n_nodes, "free_dofs": modes.n_dofs},
+        "parameters": {**{k: v for k, v in asdict(spec).items()}, "structural_mass_kg": modes.total_mass_kg},
+        "modes": {"count": int(modes.freq_hz.size), "freq_hz": [round(float(f), 4) for f in modes.freq_hz]},
+    }, header=f"Provenance of {stem.name}.npz (generated; do not edit).")
+    return modes
+
+
 def build_fem_data(out: Path, coarse: bool = False, geom: GimbalGeometry = GimbalGeometry(),
                    line: ActuatorLine | None = None, log=print) -> dict:
     """Rebuild fem_data into ``out``; return a summary of the figures (also in README.md)."""
@@ -127,20 +149,7 @@ def build_fem_data(out: Path, coarse: bool = False, geom: GimbalGeometry = Gimba
     for c in CONDITIONS:
         _save_gimbal(out, geom, fine, c, shift)
     t1 = time.perf_counter()
-    ts_spec = ThrustStructureSpec()
-    modes = thrust_structure_modes(ts_spec)
-    np.savez(out / "thrust_structure_modes.npz", freq_hz=modes.freq_hz, damping_ratio=modes.damping_ratio,
-             node_names=np.array(modes.node_names), node_xyz_m=modes.node_xyz_m, phi=modes.phi)
-    write_toml(out / "thrust_structure_modes.toml", {
-        "": {"generator": GENERATOR, "model": "notional engine-section frame (taos.fem.thrust_structure)",
-             "element": "3-D Euler-Bernoulli frame, consistent mass", "boundary": "forward ring clamped",
-             "frame": "vehicle: x along the axis forward positive, y and z lateral; origin on the axis in the cross-beam plane",
-             "units": "freq_hz Hz; node_xyz_m m; phi translations m/sqrt(kg), rotations rad/sqrt(kg)",
-             "normalisation": "phi^T M phi = 1", "damping": "0.5 % viscous on every mode (paper sec. 3.3)"},
-        "mesh": {"elements": modes.n_elements, "nodes": modes.n_nodes, "free_dofs": modes.n_dofs},
-        "parameters": {**{k: v for k, v in asdict(ts_spec).items()}, "structural_mass_kg": modes.total_mass_kg},
-        "modes": {"count": int(modes.freq_hz.size), "freq_hz": [round(float(f), 4) for f in modes.freq_hz]},
-    }, header="Provenance of thrust_structure_modes.npz (generated; do not edit).")
+    modes = write_thrust_structure_modes(out / "thrust_structure_modes", ThrustStructureSpec())
     timing["modes_s"] = time.perf_counter() - t1
     changes = relative_changes(levels)
     summary = {"tube": tube, "levels": levels, "changes": changes, "shift": shift, "modes": modes,

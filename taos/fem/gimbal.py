@@ -70,7 +70,8 @@ class GimbalGeometry:
     ~880 MPa). The lip thickness is the notional dimension that sets the hanging compliance
     (roughly as t^-3); 4 mm was chosen as the thinnest lip with that margin, which makes the
     FEM explain ~45 % of the Green Run load-stiffness shift (K_L x1.35 of the paper's x1.78; the
-    paper calls the gimbal FEM "a partial explanation", sec. 4). A 6 mm lip gave x1.10.
+    paper calls the gimbal FEM "a partial explanation", sec. 4). That share depends strongly on
+    the notional lip and seat: its range over plausible values is :func:`taos.fem.shift.fem_shift_share`.
     """
 
     bore_radius: float = 0.040

@@ -37,6 +37,10 @@ def readme_text(s: dict) -> str:
     a("| `gimbal_thrust.npz` / `.toml` | gimbal halves, hot-fire (thrust-loaded) load path, and provenance |")
     a("| `thrust_structure_modes.npz` / `.toml` | notional engine-section modes at 4 gimbal + 8 actuator points |")
     a("| `mesh_study.toml` | mesh-convergence study, FE verification, implied load stiffness |")
+    a("| `thrust_structure_modes_local.npz` / `.toml` | the same frame softened: local modes in the actuator band "
+      "(`scripts/build_local_modes.py`) |")
+    a("| `fem_shift_range.toml` | FEM-explained share of the K_L shift over plausible lip and seat geometry "
+      "(`scripts/fem_shift_sensitivity.py`) |")
     a("")
     a("## Gimbal matrices: keys, frame, DOF order, units")
     a("")
@@ -129,7 +133,9 @@ def readme_text(s: dict) -> str:
       f"(x{shift.ratio:.3f}) against the paper's 205,000 lbf/in (x1.78).")
     a("Same sign, a smaller shift: as in the paper (sec. 4), the gimbal's load-path change explains only part of")
     a("the notch shift; the rest (amplitude-dependent nonlinearities in the unloaded gimbal, actuator attach points")
-    a("and actuator, per the paper) is not in this linear FEM.")
+    a("and actuator, per the paper) is not in this linear FEM. How large that part is depends on the notional lip and")
+    a("seat: its range over plausible geometry is `fem_shift_range.toml` (`scripts/fem_shift_sensitivity.py`,")
+    a("`taos.fem.shift.fem_shift_share`).")
     a("")
     a("## Mesh convergence")
     a("")
