@@ -159,7 +159,7 @@ LAYERS = {
     "taos.planar.actuator": 2, "taos.planar.avionics": 2, "taos.planar._avionics_kernels": 2,
     "taos.planar.saturation": 2,
     "taos.planar": 3, "taos.taos3d": 3, "taos.fem": 3, "taos.profiles": 3, "taos.engine_geometry": 3,
-    "taos.flight": 4, "taos.identify": 4, "taos.report": 4, "taos.export": 4, "taos.montecarlo": 4,
+    "taos.flight": 4, "taos.identify": 4, "taos.report": 4, "taos.montecarlo": 4,
     "taos.interop": 4,
     "taos.plotting": 5, "taos.viewer": 5, "taos.report.analysis": 5, "taos.report.html": 5,
     "taos.cli": 6, "taos.__main__": 6,

@@ -1,5 +1,5 @@
 """``taos export MODEL --out FILE.mat | DIR`` : linear models and responses for other tools
-(:mod:`taos.export`)."""
+(:mod:`taos.interop.files`)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from taos.errors import InputError
 
 def cmd_export(args) -> int:
     from taos.cli.basic import parse_float_list
-    from taos.export import export_csv, export_mat
+    from taos.interop.files import export_csv, export_mat
     from taos.model import load_model
 
     model = load_model(args.model, friction=getattr(args, "friction", None))

@@ -16,12 +16,7 @@ import base64
 import html
 import io
 import math
-from typing import TYPE_CHECKING
-
 import numpy as np
-
-if TYPE_CHECKING:
-    from taos.report.analysis import GreenRunResult
 
 #: keyframes of the embedded 3-D view (fps lowered for long runs) and samples per plotted trace
 MAX_VIEW_FRAMES = 4000
@@ -75,9 +70,9 @@ def decorate_bode(fig, spec_result, test, axis, linear_fr, moment_arm_m: float) 
         draw_spec(ax, spec_result)
 
 
-def render_html(result: GreenRunResult, summary: dict | None = None, *, view_angle_scale: float = 5.0,
+def render_html(result, summary: dict | None = None, *, view_angle_scale: float = 5.0,
                 view_fps: float = 100.0, progress=None) -> str:
-    """The report page of ``result`` (``summary``: its ``summary()``, computed when not given).
+    """The report page of ``result`` (a :class:`taos.report.analysis.GreenRunResult`; ``summary``: its ``summary()``, computed when not given).
 
     ``view_angle_scale``: engine-angle exaggeration of the 3-D view [-]; ``view_fps``: its
     keyframe rate [1/s], lowered to keep at most :data:`MAX_VIEW_FRAMES` keyframes;

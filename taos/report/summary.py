@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # imported when a summary is made, not when this module is
     from taos.model import TvcModel
-    from taos.report.analysis import GreenRunResult
 
 AXES = ("pitch", "yaw")
 
@@ -129,8 +128,9 @@ def _test_data(test: dict, dwell_grids: dict, model) -> dict:
     return {"source": next(iter(test.values())).source, "axes": rows}
 
 
-def greenrun_summary(result: GreenRunResult) -> dict:
-    """The Green Run report's ``summary.json`` (docs/reference/outputs.md): the model's derived
+def greenrun_summary(result) -> dict:
+    """The Green Run report's ``summary.json`` (docs/reference/outputs.md) of ``result`` (a
+    :class:`taos.report.analysis.GreenRunResult`): the model's derived
     figures, the run's peaks, the sine-dwell and run-dwell responses per axis, the figures of
     merit, and (when checked / given) the spec-mask verdict and the measured record beside the
     model. Numbers only: the same dict whether or not the report folder is written."""

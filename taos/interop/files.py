@@ -22,17 +22,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .model import TvcModel
-from .results import atomic_write
+from ..model import TvcModel
+from ..results import atomic_write
 
 AXES = ("pitch", "yaw")
 
 
 def linear_export_data(model: TvcModel, freq_hz) -> dict:
     """{axis: dict of arrays} as written by :func:`export_mat` / :func:`export_csv`."""
-    from .planar.freqresp import linear_freqresp
-    from .linear import gain_db
-    from .planar.simplex import simplex_state_space
+    from ..planar.freqresp import linear_freqresp
+    from ..linear import gain_db
+    from ..planar.simplex import simplex_state_space
 
     out = {}
     for ax in AXES:
