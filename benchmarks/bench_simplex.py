@@ -45,7 +45,7 @@ def ours(model, dt):
 
 def scipy_baseline(model, t_eval, rtol):
     plant = simplex_plant(model)
-    A, Br, bc, bf, cc, dc, cw, ca = kernel_args(plant, model)
+    A, Br, bc, bf, cc, dc, cw, ca, _lim = kernel_args(plant, model)  # the scipy baseline has no limits
     fp, avp = model.friction.pack(), model.avionics.pack()
     rates, apply = model.friction.entry.rates, av.apply.py_func
     prof = profile()

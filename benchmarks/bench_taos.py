@@ -51,8 +51,8 @@ def naive_rhs_factory(tm, cmd_fun):
     P, fp, avp = pk.P, pk.fp, pk.avp
     law = tm.base.friction.entry  # the vector kernels (Python-callable C callbacks)
     n = pk.n_state
-    Kphi = np.linalg.inv(P[4])
-    aux = np.empty(12)
+    Kphi = np.linalg.inv(P.bearing_compliance)
+    aux = np.empty(dy.N_AUX)
     from taos.planar import avionics as av
 
     def f(t, y):

@@ -157,6 +157,7 @@ LAYERS = {
     "taos.harmonics": 1, "taos.descfcn": 1,
     "taos.friction": 2, "taos.linear": 2, "taos.stability": 2, "taos.model": 2,
     "taos.planar.actuator": 2, "taos.planar.avionics": 2, "taos.planar._avionics_kernels": 2,
+    "taos.planar._avionics_slots": 2,
     "taos.planar.saturation": 2,
     "taos.planar": 3, "taos.taos3d": 3, "taos.fem": 3, "taos.profiles": 3, "taos.engine_geometry": 3,
     "taos.flight": 4, "taos.identify": 4, "taos.report": 4, "taos.montecarlo": 4,

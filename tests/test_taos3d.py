@@ -58,14 +58,14 @@ def test_rigid_body_matches_pinocchio_aba_and_crba(tm):
     q0 = pin.neutral(pmodel)
     M = pin.crba(pmodel, data, q0)
     M = np.triu(M) + np.triu(M, 1).T
-    np.testing.assert_allclose(M, P[0], rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(M, P.spatial_inertia, rtol=1e-12, atol=1e-9)
     assert M[4, 4] == pytest.approx(tm.base.engine.inertia_pitch_kgm2, rel=1e-12)
-    Ks, G = P[2], P[3]
-    S = P[5]
+    Ks, G = P.chain_stiffness, P.slip_gain
+    S = P.bearing_selection
     for _ in range(5):
         x = _random_state(pk, rng)
         dx = np.empty_like(x)
-        aux = np.empty(12)
+        aux = np.empty(dy.N_AUX)
         dy.rhs(x, 0.0, 0.0, 0.0, 0.0, P, dx, aux)
         q = np.concatenate([x[:3], x[3:7]])
         R = pin.Quaternion(x[3:7]).matrix()
@@ -74,7 +74,7 @@ def test_rigid_body_matches_pinocchio_aba_and_crba(tm):
         d = e - S @ (G @ e)
         W = Ks @ d
         g = -W[3:] - tm.base.engine.rotational_stiffness_Nm_per_rad * (
-            P[12][0] * (P[12][0] @ r) + P[12][1] * (P[12][1] @ r))
+            P.bearing_axes[0] * (P.bearing_axes[0] @ r) + P.bearing_axes[1] * (P.bearing_axes[1] @ r))
         fext = pin.StdVec_Force()
         fext.append(pin.Force.Zero())
         fext.append(pin.Force(R.T @ -W[:3], pin.Jlog3(R).T @ g))
@@ -106,15 +106,15 @@ def test_actuator_lengths_follow_pinocchio_kinematics(tm):
     x[:3] = [1e-4, -2e-4, 3e-5]
     x[3:7] = pin.Quaternion(pin.exp3(r)).coeffs()
     dx = np.empty_like(x)
-    aux = np.empty(12)
+    aux = np.empty(dy.N_AUX)
     dy.rhs(x, 0.0, 0.0, 0.0, 0.0, pk.P, dx, aux)
     pin.framesForwardKinematics(pmodel, data, np.concatenate([x[:3], x[3:7]]))
     for i, ax in enumerate(("pitch", "yaw")):
         E = data.oMf[pmodel.getFrameId(f"{ax}_attach")].translation
         L = np.linalg.norm(E - tm.geometry.structure_attach_m[i])
         L0 = np.linalg.norm(tm.geometry.engine_attach_m[i] - tm.geometry.structure_attach_m[i])
-        assert aux[6 + i] == pytest.approx(-tm.line_load_stiffness_N_per_m * (L - L0), rel=1e-9)
-    assert aux[10] == pytest.approx(0.02) and aux[11] == pytest.approx(0.01)
+        assert aux[dy.AUX_FL + i] == pytest.approx(-tm.line_load_stiffness_N_per_m * (L - L0), rel=1e-9)
+    assert aux[dy.AUX_THETA] == pytest.approx(0.02) and aux[dy.AUX_THETA + 1] == pytest.approx(0.01)
 
 
 def test_planar_limit_matches_simplex(hot):
@@ -158,17 +158,17 @@ def _free_engine(hot, law, halves=()):
 
     def energy(x, phi):
         dx = np.empty_like(x)
-        aux = np.empty(12)
+        aux = np.empty(dy.N_AUX)
         dy.rhs(x, 0.0, 0.0, 0.0, 0.0, P, dx, aux)
         v = x[7:13]
         r = pin.log3(pin.Quaternion(x[3:7]).matrix())
         e = np.concatenate([x[:3], r])
-        d = e - P[5] @ phi
-        E = 0.5 * v @ P[0] @ v + 0.5 * d @ P[2] @ d
-        E += 0.5 * P[13][2] * ((P[12][0] @ r) ** 2 + (P[12][1] @ r) ** 2)
+        d = e - P.bearing_selection @ phi
+        E = 0.5 * v @ P.spatial_inertia @ v + 0.5 * d @ P.chain_stiffness @ d
+        E += 0.5 * P.engine_stiffness_Nm_per_rad * ((P.bearing_axes[0] @ r) ** 2 + (P.bearing_axes[1] @ r) ** 2)
         for a in range(2):
             xa = x[13 + a * na:13 + (a + 1) * na]
-            E += 0.5 * aux[6 + a] ** 2 / P[13][0]
+            E += 0.5 * aux[dy.AUX_FL + a] ** 2 / P.line_stiffness_N_per_m
             E += 0.5 * M_p * xa[sts.index("v_p_m_s")] ** 2 + 0.5 * cvol * xa[sts.index("p_load_Pa")] ** 2
         return E
 

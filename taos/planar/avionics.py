@@ -24,9 +24,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+<<<<<<< HEAD
 from taos.descfcn import Nonlinearity
 
 # packed layout: [bits, lsb_rad, rounding(0/1), n_table, amp_0..amp_{n-1}, gain_0..gain_{n-1}]
+=======
+from ._avionics_slots import AV_BITS, AV_LSB, AV_NTAB, AV_ROUND, AV_TABLE
+>>>>>>> kernels
 
 
 @dataclass(frozen=True)
@@ -62,9 +66,16 @@ class Avionics(Nonlinearity):
         return self.command_range_rad / 2.0 ** self.quantization_bits
 
     def pack(self) -> np.ndarray:
+        """The parameters packed for the compiled kernels (slots ``AV_*``, module layout)."""
         n = len(self.gain_table_rad)
-        return np.array([float(self.quantization_bits), self.lsb_rad, 1.0 if self.rounding else 0.0,
-                         float(n), *self.gain_table_rad, *self.gain_table], dtype=float)
+        p = np.zeros(AV_TABLE + 2 * n)
+        p[AV_BITS] = float(self.quantization_bits)
+        p[AV_LSB] = self.lsb_rad
+        p[AV_ROUND] = 1.0 if self.rounding else 0.0
+        p[AV_NTAB] = float(n)
+        p[AV_TABLE:AV_TABLE + n] = self.gain_table_rad
+        p[AV_TABLE + n:AV_TABLE + 2 * n] = self.gain_table
+        return p
 
     def __call__(self, command_rad):
         """Apply the command path to a command value or array [rad]."""

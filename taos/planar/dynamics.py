@@ -16,6 +16,31 @@ come from the law's registry entry (:mod:`taos.friction.registry`): ``fid`` is i
 function, so one compiled integrator serves every law, including laws registered at run
 time. The avionics kernel is the single definition in :mod:`taos.planar.avionics`. A non-finite
 state stops the run and reports the step.
+
+Kernel arguments (the plant's arrays in the order of :func:`taos.planar.simulate.kernel_args`,
+then the outputs, the friction law and the avionics; n states, n_r external inputs, n_y
+outputs; [x], [r] and [y] stand for the SI units of the plant's states, inputs and outputs)::
+
+    name  shape        quantity                                     unit
+    A     (n, n)       state matrix                                 [x/s per x]
+    Br    (n, n_r)     external-input columns                       [x/s per r]
+    bc    (n,)         post-avionics command column                 [x/s per rad]
+    bf    (n,)         friction-torque column                       [x/s per N m]
+    cc    (n,)         pre-avionics command row over x              [rad per x]
+    dc    (n_r,)       pre-avionics command row over r              [rad per r]
+    cw    (n,)         friction relative-rate row                   [rad/s per x]
+    ca    (n,)         applied (non-friction) torque row            [N m per x]
+    lim   (k,)         packed actuator/gimbal limits over the       taos.planar.saturation
+                       state (empty: no limits)                     (LIM_*, ROW_*)
+    Cy    (n_y, n)     recorded outputs                             [y per x]
+    fid   function     the law's rates(v, z, t_app, p)              registry RATES_SIG
+                       -> (dz/dt [rad/s], T_f [N m])
+    fp    (NPARAM,)    the law's packed parameters                  taos.friction._slots (SLOT_*)
+    avp   (4 + 2 m,)   packed avionics (m: gain-table length)       taos.planar._avionics_slots (AV_*)
+
+The friction state z is in [rad] (the bristle deflection), the step dt in [s]. Records of
+:func:`integrate_samples`: ``y_out`` = Cy x, ``aux_out`` columns ``AUX_*`` (T_f [N m], z [rad],
+u [rad]).
 """
 
 from __future__ import annotations
@@ -30,10 +55,18 @@ from . import saturation as _lim
 
 # reassociation and FMA contraction only: no-NaN/no-Inf flags would remove the stability checks
 _FM = {"reassoc", "contract", "arcp", "nsz"}
+#: columns of :func:`integrate_samples`' ``aux_out``: friction torque T_f [N m], friction state
+#: z [rad], post-avionics command u [rad]
+AUX_TF, AUX_Z, AUX_U = 0, 1, 2
+N_AUX = 3
 
 
 @njit(cache=True, fastmath=_FM, inline="always")
 def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, dx):
+    """The state equations (module docstring) at the state ``x`` (n,) [x], friction state ``z``
+    [rad] and external input ``r`` (n_r,) [r]: writes dx/dt into ``dx`` (n,) [x/s] and returns
+    (dz/dt [rad/s], T_f [N m], u [rad]). Plant arrays, ``fid``, ``fp``, ``avp``: module
+    docstring."""
     n = x.shape[0]
     nr = r.shape[0]
     c = 0.0
@@ -60,7 +93,7 @@ def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, dx):
 
 @njit(cache=True, fastmath=_FM, inline="always")
 def _finite(x, z):
-    """True if the friction state and every linear state are finite."""
+    """True if the friction state ``z`` [rad] and every linear state ``x`` (n,) are finite."""
     ok = math.isfinite(z)
     for i in range(x.shape[0]):
         ok = ok and math.isfinite(x[i])
@@ -70,7 +103,7 @@ def _finite(x, z):
 @njit(cache=True, inline="always")
 def work_buffers(n, nr):
     """Scratch of one RK4 integration: the stages k1..k4 and the trial state (n,), the input
-    at the step start, middle and end (nr,)."""
+    at the step start, middle and end (nr,); ``n`` states, ``nr`` external inputs."""
     return (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
             np.empty(nr), np.empty(nr), np.empty(nr))
 
@@ -78,7 +111,13 @@ def work_buffers(n, nr):
 @njit(cache=True, fastmath=_FM, inline="always")
 def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
               k1, k2, k3, k4, xt):
-    """Advance (x, z) by one step in place; return (z_new, T_f, u) at the step start."""
+    """Advance (x, z) by one classical RK4 step in place; return (z_new [rad], T_f [N m], u [rad])
+    at the step start.
+
+    ``x`` (n,) [x] (in place), ``z`` [rad]; ``r0``, ``rm``, ``r1`` (n_r,) [r] the external input
+    at the step's start, middle and end; ``dt`` [s]; plant arrays, ``fid``, ``fp``, ``avp``:
+    module docstring; ``k1``..``k4``, ``xt`` (n,) scratch (k1 receives the derivative at the
+    step start)."""
     n = x.shape[0]
     dz1, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k1)
     for i in range(n):
@@ -99,9 +138,32 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
 @njit(cache=True, fastmath=_FM)
 def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, z0, r, dt,
                       rec_every, y_out, aux_out):
-    """Integrate over the input samples ``r`` (n_steps + 1, n_r) taken every ``dt``.
+    """Integrate over the input samples ``r`` taken every ``dt``.
 
-    Records every ``rec_every`` steps: ``y_out[k] = Cy x`` and ``aux_out[k] = (T_f, z, u)``.
+    Parameters
+    ----------
+    A, Br, bc, bf, cc, dc, cw, ca, lim
+        The plant (module docstring: shapes and units).
+    Cy : (n_y, n) float64
+        Recorded outputs [y per x].
+    fid, fp, avp
+        The friction law's ``rates`` kernel and packed parameters, the packed avionics
+        (module docstring).
+    x0 : (n,) float64
+        Initial state [x] (not modified).
+    z0 : float
+        Initial friction state [rad].
+    r : (n_steps + 1, n_r) float64
+        External input samples [r], linearly interpolated between samples.
+    dt : float
+        Step [s].
+    rec_every : int
+        Record every that many steps.
+    y_out : (n_steps // rec_every + 1, n_y) float64
+        Receives Cy x.
+    aux_out : (n_steps // rec_every + 1, N_AUX) float64
+        Receives (T_f [N m], z [rad], u [rad]) (columns ``AUX_*``).
+
     Returns -1 on success or the index of the step whose state became non-finite.
     """
     n = x0.shape[0]
@@ -125,9 +187,9 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
                 for i in range(n):
                     s += Cy[o, i] * x[i]
                 y_out[rec, o] = s
-            aux_out[rec, 0] = tf
-            aux_out[rec, 1] = z
-            aux_out[rec, 2] = u
+            aux_out[rec, AUX_TF] = tf
+            aux_out[rec, AUX_Z] = z
+            aux_out[rec, AUX_U] = u
             rec += 1
         if k == nsteps:
             break
@@ -142,9 +204,33 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
 def sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z, nsteps, meas, out,
                k1, k2, k3, k4, xt, r0, rm, r1):
     """``nsteps`` steps of r = amp sin(2 pi k / n_per_cycle) (step ``dt`` [s], from phase 0) on
-    every external input channel, in place on ``x``; returns (z, status, max |z|) with status -1
-    or the failing step. With ``meas`` accumulates the correlation sums of y = Cy x into
-    ``out`` (unnormalised: sum y sin, sum y cos, sum y)."""
+    every external input channel, in place on ``x``; returns (z [rad], status, max |z| [rad])
+    with status -1 or the failing step. With ``meas`` accumulates the correlation sums of
+    y = Cy x into ``out`` (unnormalised: sum y sin, sum y cos, sum y).
+
+    Parameters
+    ----------
+    A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp
+        As :func:`integrate_samples` (module docstring).
+    amp : float
+        Input amplitude [r].
+    n_per_cycle : int
+        Steps per cycle.
+    dt : float
+        Step [s].
+    x : (n,) float64
+        State [x], advanced in place.
+    z : float
+        Friction state [rad].
+    nsteps : int
+        Steps to take.
+    meas : bool
+        Accumulate the correlation sums.
+    out : (n_y, 3) float64
+        Correlation sums [y], accumulated in place.
+    k1, k2, k3, k4, xt : (n,) float64; r0, rm, r1 : (n_r,) float64
+        Scratch (:func:`work_buffers`).
+    """
     n = x.shape[0]
     nr = Br.shape[1]
     ny = Cy.shape[0]
@@ -180,7 +266,11 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, f
     """One sine dwell from rest: r = amp sin(2 pi f t) on every external input channel with a
     nonzero weight, ``n_settle`` steps (whole cycles) of settling, then out[o] = (2/N sum y sin,
     2/N sum y cos, 1/N sum y) over the ``n_meas`` measurement steps (whole cycles). Returns -1 or
-    the failing step."""
+    the failing step.
+
+    Plant arrays, ``Cy``, ``fid``, ``fp``, ``avp``: as :func:`integrate_samples`; ``amp`` [r];
+    ``freq`` [Hz]; ``n_per_cycle``, ``n_settle``, ``n_meas`` int (steps; dt = 1 / (freq
+    n_per_cycle) [s]); ``out`` (n_y, 3) float64 [y]."""
     n = A.shape[0]
     nr = Br.shape[1]
     x = np.zeros(n)
@@ -205,7 +295,11 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, f
 @njit(cache=True, parallel=True, fastmath=_FM)
 def sine_dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps, freqs, n_per_cycle,
                      n_settle, n_meas, out, status):
-    """Independent sine dwells in parallel (one per entry of ``amps``/``freqs``)."""
+    """Independent sine dwells in parallel: :func:`_sine_dwell_one` for every entry b of
+    ``amps`` (n_b,) [r] and ``freqs`` (n_b,) [Hz], with ``n_per_cycle``, ``n_settle``,
+    ``n_meas`` (n_b,) int, into ``out[b]`` (n_b, n_y, 3) and ``status[b]`` (n_b,) int (-1 or
+    the failing step); plant arrays, ``Cy``, ``fid``, ``fp``, ``avp`` as
+    :func:`integrate_samples`."""
     for b in prange(amps.shape[0]):
         status[b] = _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps[b], freqs[b],
                                     n_per_cycle[b], n_settle[b], n_meas[b], out[b])

@@ -246,7 +246,8 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
         info = np.zeros((A.size, len(steady.INFO)))
         steady.shoot_batch(*args, Cy, *kern, A, F, npc, nbud, nmeas, y0, scale, nz, tol, k_rre, max_cycles,
                            out, info, status)
-        extra = {"residual": info[:, 0], "periods": info[:, 1].astype(np.int64), "converged": info[:, 3] > 0.5}
+        extra = {"residual": info[:, steady.INFO_RESIDUAL], "periods": info[:, steady.INFO_PERIODS].astype(np.int64),
+                 "converged": info[:, steady.INFO_CONVERGED] > 0.5}
     bad = np.flatnonzero(status >= 0)
     if bad.size:
         b = bad[np.argmin(perm[bad])]

@@ -59,14 +59,16 @@ def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: floa
     linear state ``x0`` and the friction state ``z0`` (default rest).
 
     Returns (y (n_rec, n_out), aux (n_rec, 3) = friction torque, friction state, avionics
-    output). Raises :class:`SimulationUnstable` on a non-finite state."""
+    output; columns :data:`taos.planar.dynamics.AUX_TF`, ``AUX_Z``, ``AUX_U``). Raises
+    :class:`SimulationUnstable` on a non-finite state."""
+    from . import dynamics as _ig
+
     check_friction_step(model, plant.inertia_kgm2, dt_s)
     n = plant.ss.A.shape[0]
     nrec = (r.shape[0] - 1) // record_every + 1
     y = np.empty((nrec, plant.ss.C.shape[0]))
-    aux = np.empty((nrec, 3))
+    aux = np.empty((nrec, _ig.N_AUX))
     x0 = np.zeros(n) if x0 is None else np.asarray(x0, float)
-    from . import dynamics as _ig
 
     status = _ig.integrate_samples(*kernel_args(plant, model), np.ascontiguousarray(plant.ss.C),
                                    model.friction.entry.rates, model.friction.pack(), model.avionics.pack(),
@@ -202,6 +204,8 @@ def simulate(model: TvcModel, profile, *, dt_s: float = DEFAULT_DT_S, record_eve
     if progress:
         from tqdm import tqdm
         it = tqdm(axes, desc="simplex", unit="axis")
+    from .dynamics import AUX_TF, AUX_U, AUX_Z
+
     for i, ax in enumerate(it):
         plant = _with_spool_output(simplex_plant(model, ax))
         y, aux = integrate_plant(plant, model, cmd[i][:, None], dt_s, record_every)
@@ -210,11 +214,11 @@ def simulate(model: TvcModel, profile, *, dt_s: float = DEFAULT_DT_S, record_eve
         out["spool_flow_m_s"].append(y[:, o("q_m_s")])
         out["supply_pressure_Pa"].append(np.full(y.shape[0], model.actuator.supply_pressure_Pa))
         out["command_rad"].append(cmd[i][::record_every])
-        out["command_avionics_rad"].append(aux[:, 2])
+        out["command_avionics_rad"].append(aux[:, AUX_U])
         out["piston_m"].append(y[:, o("x_p_m")])
         out["engine_rad"].append(y[:, o("theta_rad")])
-        out["friction_torque_Nm"].append(aux[:, 0])
-        out["friction_state_rad"].append(aux[:, 1])
+        out["friction_torque_Nm"].append(aux[:, AUX_TF])
+        out["friction_state_rad"].append(aux[:, AUX_Z])
         out["load_force_N"].append(y[:, o("load_force_N")])
     solver = SolverSettings(dt_s=dt_s, record_every=record_every)
     prov = provenance(model, solver, engine="simplex", profile=getattr(profile, "name", type(profile).__name__))

@@ -51,15 +51,23 @@ _FM = _ig._FM
 
 #: columns of the ``info`` array of :func:`shoot_batch`
 INFO = ("residual", "periods", "extrapolations", "converged")
+#: their indices: final scaled residual [-], periods integrated, extrapolation cycles, 1.0 if
+#: converged else 0.0
+INFO_RESIDUAL, INFO_PERIODS, INFO_EXTRAPOLATIONS, INFO_CONVERGED = range(len(INFO))
 
 
 @njit(cache=True, fastmath=_FM)
 def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, src, dst, s, nz, set_zscale,
             x, corr, k1, k2, k3, k4, xt, r0, rm, r1):
-    """One period of the map: dst = P(src), src/dst = (x, z); ``corr`` receives the period's
-    correlation sums (:func:`taos.planar.dynamics.sine_steps`). With ``set_zscale`` the friction
-    state's scale s[n] becomes the largest |z| of the period first. Returns (status, scaled
-    residual max_i |dst_i - src_i| / s_i)."""
+    """One period of the map: dst = P(src), src/dst = (x, z) (n + 1,) [x, rad]; ``corr``
+    (n_y, 3) receives the period's correlation sums (:func:`taos.planar.dynamics.sine_steps`).
+    With ``set_zscale`` the friction state's scale s[n] becomes the largest |z| of the period
+    first. Returns (status, scaled residual max_i |dst_i - src_i| / s_i [-]).
+
+    Plant arrays, ``Cy``, ``fid``, ``fp``, ``avp``: as :func:`taos.planar.dynamics.integrate_samples`
+    (shapes and units in :mod:`taos.planar.dynamics`); ``amp`` [r]; ``n_per_cycle`` steps
+    per period of ``dt`` [s]; ``s`` (n + 1,) the scales [x, rad]; ``nz`` 1 if the law has a
+    state; ``x`` (n,) and the rest scratch (:func:`taos.planar.dynamics.work_buffers`)."""
     n = x.shape[0]
     for j in range(n):
         x[j] = src[j]
@@ -86,7 +94,12 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
     after the first period); ``nz`` 1 if the law has a state; ``k_rre`` + 1 periods per
     extrapolation cycle; ``n_budget`` periods in all before the fallback stops. Writes the
     correlations to ``out`` (as :func:`taos.planar.dynamics._sine_dwell_one`) and ``info``
-    (:data:`INFO`). Returns -1 or the failing step."""
+    (:data:`INFO`, indices ``INFO_*``). Returns -1 or the failing step.
+
+    Plant arrays, ``Cy``, ``fid``, ``fp``, ``avp``: as :func:`taos.planar.dynamics.integrate_samples`
+    (shapes and units in :mod:`taos.planar.dynamics`); ``amp`` [r]; ``freq`` [Hz];
+    ``n_per_cycle`` steps per period; ``n_meas`` measured steps; ``tol`` the scaled residual
+    [-]; ``max_cycles`` extrapolation cycles at most."""
     n = A.shape[0]
     m = n + nz
     nr = Br.shape[1]
@@ -179,17 +192,20 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
         out[o, 0] *= 2.0 / n_meas
         out[o, 1] *= 2.0 / n_meas
         out[o, 2] *= 1.0 / n_meas
-    info[0] = res
-    info[1] = periods
-    info[2] = cycles
-    info[3] = 1.0 if converged else 0.0
+    info[INFO_RESIDUAL] = res
+    info[INFO_PERIODS] = periods
+    info[INFO_EXTRAPOLATIONS] = cycles
+    info[INFO_CONVERGED] = 1.0 if converged else 0.0
     return -1
 
 
 @njit(cache=True, parallel=True, fastmath=_FM)
 def shoot_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps, freqs, n_per_cycle, n_budget, n_meas,
                 y0, scale, nz, tol, k_rre, max_cycles, out, info, status):
-    """Independent shooting dwells in parallel (one per entry of ``amps``/``freqs``)."""
+    """Independent shooting dwells in parallel: :func:`_shoot_one` for every entry b of ``amps``
+    (n_b,) [r] and ``freqs`` (n_b,) [Hz] with its ``n_per_cycle``, ``n_budget``, ``n_meas``
+    (n_b,), start ``y0`` and scales ``scale`` (n_b, n + 1), into ``out[b]`` (n_b, n_y, 3),
+    ``info[b]`` (n_b, len(INFO)) and ``status[b]`` (n_b,) int; the rest as :func:`_shoot_one`."""
     for b in prange(amps.shape[0]):
         status[b] = _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps[b], freqs[b],
                                n_per_cycle[b], n_budget[b], n_meas[b], y0[b], scale[b], nz, tol, k_rre,

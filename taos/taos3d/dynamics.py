@@ -35,7 +35,7 @@ Time stepping (second order in the bearing coupling):
   2 dt / 3 (so every law's own ``bearing_step`` serves; L-stable, as the stiff
   chain-rotation / bristle-damping time constant Kc (sigma_1 + sigma_2) ~ 1e-4 s needs);
   the history starts at rest (y_{-1} = y_0);
-* the bearing solve continues from the previous step's slip speed (``bs[10]``), so where a
+* the bearing solve continues from the previous step's slip speed (``bs[BS_SLIP]``), so where a
   Stribeck law makes the implicit step multi-valued it keeps the bearing's branch
   (stick-slip hysteresis; :func:`taos.friction._vector.solve_slip`).
 
@@ -58,6 +58,22 @@ scheme is plain RK4.
 The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays), and the
 step's kernels allocate nothing and are compiled without reference counting (``_nrt=False``);
 the recorded step reuses its derivative as the first RK4 stage.
+
+Packed data (every index below is a module constant of :mod:`taos.taos3d._layout`, re-exported
+here, used by the packer :func:`taos.taos3d.simulate.pack` and the kernels alike;
+``tests/test_kernel_packs.py`` checks the tables tile their arrays):
+
+* ``P``: the model, a :class:`~taos.taos3d._layout.TaosParams` named tuple (fields, shapes and
+  units in its docstring);
+* ``x`` (:data:`N_BODY` + 2 n_a): engine position ``X_P`` (3) [m], orientation quaternion
+  ``X_Q`` (4, xyzw) [-], body twist: linear ``X_V`` (3) [m/s] and angular ``X_W`` (3)
+  [rad/s]; then the pitch and the yaw actuator's states (n_a each,
+  :func:`taos.planar.actuator.actuator_state_space` order, SI);
+* ``bs`` (:data:`N_BEARING`): the bearing state, ``BS_*``;
+* ``aux`` (:data:`N_AUX`): what :func:`rhs` reports besides the derivative, ``AUX_*``;
+* ``fp``: the friction law's packed parameters (:mod:`taos.friction._slots`), ``avp`` the
+  avionics' (``AV_*``, :mod:`taos.planar._avionics_slots`);
+* records (:data:`REC`, columns ``REC_*``).
 """
 
 from __future__ import annotations
@@ -69,16 +85,14 @@ from numba import njit, prange
 
 from ..planar import _avionics_kernels as _av
 from ..planar import saturation as _lim
+from ..planar._avionics_slots import AV_LSB, AV_ROUND
+# the packed model and the index tables, shared with the packer (re-exported: the kernels' layout)
+from ._layout import (  # noqa: F401
+    AUX_FL, AUX_PHI, AUX_THETA, AUX_W, BS_PHI, BS_PHI_PREV, BS_SLIP, BS_T, BS_Z, BS_Z_PREV, N_AUX, N_BEARING,
+    N_BODY, REC, REC_FL, REC_P, REC_PHI, REC_TF, REC_THETA, REC_U, REC_W, REC_XP, REC_Z, U_END, U_MID,
+    U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams)
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
-N_BODY = 13  # p (3), quaternion (4), v (6)
-#: bearing state: phi (2) [rad], z (2) [rad], T (2) [N m], phi and z one step back (BDF2), and
-#: the slip speed [rad/s] the next bearing solve continues from
-N_BEARING = 11
-#: recorded columns of :func:`integrate`
-REC = ("theta_pitch", "theta_yaw", "xp_pitch", "xp_yaw", "fl_pitch", "fl_yaw", "tf_pitch", "tf_yaw",
-       "z_pitch", "z_yaw", "phi_pitch", "phi_yaw", "u_pitch", "u_yaw",
-       "w_fx", "w_fy", "w_fz", "w_mx", "w_my", "w_mz", "px", "py", "pz")
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
@@ -167,19 +181,34 @@ _valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def rhs(x, T0, T1, u0, u1, P, dx, aux):
-    """State derivative dx of the TAOS engine + actuators with bearing torque (T0, T1) [N m]
-    and post-avionics commands (u0, u1) [rad]. ``aux`` receives: 0-5 chain wrench W at O in
-    the gimbal frame [N, N m], 6-7 F_L [N], 8-9 phi [rad], 10-11 engine angles [rad].
+    """State derivative of the TAOS engine + actuators (module docstring).
+
+    Parameters
+    ----------
+    x : (N_BODY + 2 n_a,) float64
+        State (``X_*``, then the pitch and yaw actuators) [SI].
+    T0, T1 : float
+        Bearing friction torque, pitch and yaw [N m].
+    u0, u1 : float
+        Post-avionics commands, pitch and yaw [rad].
+    P : TaosParams
+        The packed model.
+    dx : (N_BODY + 2 n_a,) float64
+        Receives dx/dt [SI per second].
+    aux : (N_AUX,) float64
+        Receives the chain wrench, load forces, bearing slip and engine angles (``AUX_*``).
 
     Written with scalar locals and tuples only (no heap arrays: it runs four times a step)."""
-    Y, Yinv, Ks, G, Kc, S, Satt, Eatt, Aa, bxc, bf, cxp, axes, sc = (
-        P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11], P[12], P[13])
-    KL, Rarm, Kn = sc[0], sc[1], sc[2]
-    cL, ivp = sc[5], int(sc[6])  # load-path damping [N s/m] and the actuator's v_p state index
-    lim = sc[7:]  # actuator/gimbal limits packed over one actuator's state (taos.planar.saturation)
+    Y, Yinv, Ks, G, Kc, S = (P.spatial_inertia, P.spatial_inertia_inv, P.chain_stiffness, P.slip_gain,
+                             P.bearing_compliance, P.bearing_selection)
+    Satt, Eatt, axes = P.structure_attach_m, P.engine_attach_m, P.bearing_axes
+    Aa, bxc, bf, cxp = P.act_A, P.act_b_xc, P.act_b_fl, P.act_c_xp
+    KL, Rarm, Kn = P.line_stiffness_N_per_m, P.moment_arm_m, P.engine_stiffness_Nm_per_rad
+    cL, ivp, L0 = P.line_damping_Ns_per_m, P.act_vp_index, P.line_length0_m
+    lim = P.limits  # actuator/gimbal limits packed over one actuator's state (taos.planar.saturation)
     na = Aa.shape[0]
-    p0, p1, p2 = x[0], x[1], x[2]
-    qx, qy, qz, qw = x[3], x[4], x[5], x[6]
+    p0, p1, p2 = x[X_P], x[X_P + 1], x[X_P + 2]
+    qx, qy, qz, qw = x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3]
     R = _rotation(qx, qy, qz, qw)
     r0, r1, r2, th = _logq4(qx, qy, qz, qw)
     # bearing slip and chain wrench
@@ -196,19 +225,20 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     g0 = -W3 - Kn * (axes[0, 0] * tp + axes[1, 0] * ty)
     g1 = -W4 - Kn * (axes[0, 1] * tp + axes[1, 1] * ty)
     g2 = -W5 - Kn * (axes[0, 2] * tp + axes[1, 2] * ty)
-    wx, wy, wz = x[10], x[11], x[12]
-    if lim.shape[0] > 0 and lim[4] > 0.0:  # hard stops at the gimbal range (taos.planar.saturation)
+    wx, wy, wz = x[X_W], x[X_W + 1], x[X_W + 2]
+    if lim.shape[0] > 0 and lim[_lim.LIM_THMAX] > 0.0:  # hard stops at the gimbal range (taos.planar.saturation)
+        th_max, k_s, c_s = lim[_lim.LIM_THMAX], lim[_lim.LIM_KS], lim[_lim.LIM_CS]
         wo0, wo1, wo2 = _rv(R, wx, wy, wz)
         wp = axes[0, 0] * wo0 + axes[0, 1] * wo1 + axes[0, 2] * wo2
         wyw = axes[1, 0] * wo0 + axes[1, 1] * wo1 + axes[1, 2] * wo2
-        tsp = _lim.stop_torque(tp, wp, lim[4], lim[5], lim[6])
-        tsy = _lim.stop_torque(ty, wyw, lim[4], lim[5], lim[6])
+        tsp = _lim.stop_torque(tp, wp, th_max, k_s, c_s)
+        tsy = _lim.stop_torque(ty, wyw, th_max, k_s, c_s)
         g0 += axes[0, 0] * tsp + axes[1, 0] * tsy
         g1 += axes[0, 1] * tsp + axes[1, 1] * tsy
         g2 += axes[0, 2] * tsp + axes[1, 2] * tsy
     Tw0, Tw1, Tw2 = _world_torque(r0, r1, r2, th, g0, g1, g2)
     Fw0, Fw1, Fw2 = -W0, -W1, -W2
-    vx, vy, vz = x[7], x[8], x[9]
+    vx, vy, vz = x[X_V], x[X_V + 1], x[X_V + 2]
     # actuators
     for a in range(2):
         e0, e1, e2 = Eatt[a, 0], Eatt[a, 1], Eatt[a, 2]
@@ -221,7 +251,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
         xp = 0.0
         for k in range(na):
             xp += cxp[k] * x[off + k]
-        F = KL * (xp - (L - sc[3 + a]))
+        F = KL * (xp - (L - L0[a]))
         if cL > 0.0:  # structural damping across the line: c_L (v_p - L')
             b0, b1, b2 = _cross3(wx, wy, wz, e0, e1, e2)
             b0 += vx
@@ -247,7 +277,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
                 s += Aa[k, j] * x[off + j]
             dx[off + k] = s
         _valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
-        aux[6 + a] = F
+        aux[AUX_FL + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
     Yv0, Yv1, Yv2, Yv3, Yv4, Yv5 = _mv6(Y, vx, vy, vz, wx, wy, wz)
     c10, c11, c12 = _cross3(wx, wy, wz, Yv0, Yv1, Yv2)
@@ -262,22 +292,22 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     f4 -= c21 + c31
     f5 -= c22 + c32
     for i in range(6):
-        dx[7 + i] = _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
-    dx[0], dx[1], dx[2] = _rv(R, vx, vy, vz)
-    dx[3] = 0.5 * (qw * wx + qy * wz - qz * wy)
-    dx[4] = 0.5 * (qw * wy + qz * wx - qx * wz)
-    dx[5] = 0.5 * (qw * wz + qx * wy - qy * wx)
-    dx[6] = -0.5 * (qx * wx + qy * wy + qz * wz)
-    aux[0] = W0
-    aux[1] = W1
-    aux[2] = W2
-    aux[3] = W3
-    aux[4] = W4
-    aux[5] = W5
-    aux[8] = phi0
-    aux[9] = phi1
-    aux[10] = tp
-    aux[11] = ty
+        dx[X_V + i] = _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
+    dx[X_P], dx[X_P + 1], dx[X_P + 2] = _rv(R, vx, vy, vz)
+    dx[X_Q] = 0.5 * (qw * wx + qy * wz - qz * wy)
+    dx[X_Q + 1] = 0.5 * (qw * wy + qz * wx - qx * wz)
+    dx[X_Q + 2] = 0.5 * (qw * wz + qx * wy - qy * wx)
+    dx[X_Q + 3] = -0.5 * (qx * wx + qy * wy + qz * wz)
+    aux[AUX_W] = W0
+    aux[AUX_W + 1] = W1
+    aux[AUX_W + 2] = W2
+    aux[AUX_W + 3] = W3
+    aux[AUX_W + 4] = W4
+    aux[AUX_W + 5] = W5
+    aux[AUX_PHI] = phi0
+    aux[AUX_PHI + 1] = phi1
+    aux[AUX_THETA] = tp
+    aux[AUX_THETA + 1] = ty
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
@@ -285,31 +315,34 @@ def _torque_kick(x, d0, d1, h, P):
     """x[7:13] += h a, a [m/s^2, rad/s^2] the engine's body-frame acceleration that a change
     (d0, d1) [N m] of the bearing torque adds at the state x: the chain wrench changes by
     dW = Ks S Kc dT (phi = G e - Kc T in :func:`rhs`), acting on the engine as
-    (-dW[:3], Jl^-T (-dW[3:])) in the world, Y^-1 of that in the body frame. ``h`` [s]."""
-    Yinv, BT = P[1], P[14]
+    (-dW[:3], Jl^-T (-dW[3:])) in the world, Y^-1 of that in the body frame. ``h`` [s];
+    ``P`` the packed model (:class:`TaosParams`)."""
+    Yinv, BT = P.spatial_inertia_inv, P.torque_wrench
     dF0 = -(BT[0, 0] * d0 + BT[0, 1] * d1)
     dF1 = -(BT[1, 0] * d0 + BT[1, 1] * d1)
     dF2 = -(BT[2, 0] * d0 + BT[2, 1] * d1)
     g0 = -(BT[3, 0] * d0 + BT[3, 1] * d1)
     g1 = -(BT[4, 0] * d0 + BT[4, 1] * d1)
     g2 = -(BT[5, 0] * d0 + BT[5, 1] * d1)
-    qx, qy, qz, qw = x[3], x[4], x[5], x[6]
+    qx, qy, qz, qw = x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3]
     R = _rotation(qx, qy, qz, qw)
     r0, r1, r2, th = _logq4(qx, qy, qz, qw)
     Tw0, Tw1, Tw2 = _world_torque(r0, r1, r2, th, g0, g1, g2)
     f0, f1, f2 = _rtv(R, dF0, dF1, dF2)
     f3, f4, f5 = _rtv(R, Tw0, Tw1, Tw2)
     for i in range(6):
-        x[7 + i] += h * _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
+        x[X_V + i] += h * _row6(Yinv, i, f0, f1, f2, f3, f4, f5)
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def pose_psi(x, P):
-    """psi = G e: the bearing angles that carry no torque at the current pose [rad]."""
-    G = P[3]
-    r0, r1, r2, _ = _logq4(x[3], x[4], x[5], x[6])
-    p0 = G[0, 0] * x[0] + G[0, 1] * x[1] + G[0, 2] * x[2] + G[0, 3] * r0 + G[0, 4] * r1 + G[0, 5] * r2
-    p1 = G[1, 0] * x[0] + G[1, 1] * x[1] + G[1, 2] * x[2] + G[1, 3] * r0 + G[1, 4] * r1 + G[1, 5] * r2
+    """psi = G e: the bearing angles (pitch, yaw) that carry no torque at the pose of the state
+    ``x`` (``X_*``) [rad]; ``P`` the packed model (:class:`TaosParams`)."""
+    G = P.slip_gain
+    r0, r1, r2, _ = _logq4(x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3])
+    e0, e1, e2 = x[X_P], x[X_P + 1], x[X_P + 2]
+    p0 = G[0, 0] * e0 + G[0, 1] * e1 + G[0, 2] * e2 + G[0, 3] * r0 + G[0, 4] * r1 + G[0, 5] * r2
+    p1 = G[1, 0] * e0 + G[1, 1] * e1 + G[1, 2] * e2 + G[1, 3] * r0 + G[1, 4] * r1 + G[1, 5] * r2
     return p0, p1
 
 
@@ -321,13 +354,13 @@ def command_mean(c0, c1, p):
     edges at k LSB for truncation, (k + 1/2) LSB for rounding; the crossover gain is a
     function of the quantised value), so the mean is the bin values weighted by the fraction
     of the ramp in each bin: an integrator that uses it for a step places the output's jumps
-    in time to first order instead of at its stage points."""
+    in time to first order instead of at its stage points. ``p``: slots ``AV_*``."""
     lo = min(c0, c1)
     hi = max(c0, c1)
-    lsb = p[1]
+    lsb = p[AV_LSB]
     if lsb <= 0.0 or hi - lo <= 0.0:
         return _av.apply(0.5 * (lo + hi), p)
-    off = 0.5 if p[2] > 0.5 else 0.0
+    off = 0.5 if p[AV_ROUND] > 0.5 else 0.0
     k = math.floor(lo / lsb - off) + 1.0
     b = (k + off) * lsb  # first bin edge above lo
     a = lo
@@ -347,8 +380,9 @@ def stage_inputs(c0, cm, c1, avp):
     step with pre-avionics commands c0/cm/c1 (2,) at its start, middle and end. A quantised
     command path is piecewise constant in time: every stage then takes its mean over the step
     (:func:`command_mean`), which places its jumps in time to first order
-    (sampled at the stages, a jump would move to a stage point: an O(dt) error)."""
-    if avp[1] > 0.0:
+    (sampled at the stages, a jump would move to a stage point: an O(dt) error). ``avp`` the
+    packed avionics (``AV_*``). Returns (u0, u1) at the start, the middle and the end."""
+    if avp[AV_LSB] > 0.0:
         a0 = command_mean(c0[0], c1[0], avp)
         a1 = command_mean(c0[1], c1[1], avp)
         return a0, a1, a0, a1, a0, a1
@@ -358,16 +392,41 @@ def stage_inputs(c0, cm, c1, avp):
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
-    """One step (module docstring): RK4 on (q, v, actuators) with the bearing torque T = bs[4:6]
-    held, the BDF2 bearing update, the trapezoidal torque kick. ``bs`` (:data:`N_BEARING`:
-    phi (2), z (2), T (2), phi and z one step back, the slip speed) is updated in place;
-    ``u`` the stage commands (:func:`stage_inputs`); ``k1_ready``: k1 already holds the
-    derivative at the step start (from the record, with the same inputs)."""
+    """One step (module docstring): RK4 on (q, v, actuators) with the bearing torque T held at
+    its step-start value, the BDF2 bearing update, the trapezoidal torque kick.
+
+    Parameters
+    ----------
+    x : (N_BODY + 2 n_a,) float64
+        State (``X_*``, then the actuators) [SI], advanced in place.
+    bs : (N_BEARING,) float64
+        Bearing state (``BS_*``), advanced in place.
+    u : 6-tuple of float
+        Post-avionics stage commands [rad] (:func:`stage_inputs`): pitch and yaw at the step's
+        start (``U_START``), middle (``U_MID``) and end (``U_END``).
+    dt : float
+        Step [s].
+    P : TaosParams
+        The packed model.
+    fid : first-class function
+        The friction law's ``bearing_step`` (:data:`taos.friction.registry.BEARING_SIG`).
+    fp : (NPARAM,) float64
+        The law's packed (normal-load scaled) parameters (:mod:`taos.friction._slots`).
+    avp : float64 array
+        Packed avionics (``AV_*``; unused here, the stage commands already passed through it).
+    k1, k2, k3, k4, xt : (N_BODY + 2 n_a,) float64
+        Scratch: the RK4 stages and the trial state.
+    aux : (N_AUX,) float64
+        Scratch for :func:`rhs`.
+    k1_ready : bool
+        k1 already holds the derivative at the step start (from the record, same inputs).
+
+    Returns True while the state stays finite."""
     n = x.shape[0]
-    T0, T1 = bs[4], bs[5]
+    T0, T1 = bs[BS_T], bs[BS_T + 1]
     if not k1_ready:
-        rhs(x, T0, T1, u[0], u[1], P, k1, aux)
-    um0, um1 = u[2], u[3]
+        rhs(x, T0, T1, u[U_START], u[U_START + 1], P, k1, aux)
+    um0, um1 = u[U_MID], u[U_MID + 1]
     h = 0.5 * dt
     for i in range(n):
         xt[i] = x[i] + h * k1[i]
@@ -377,34 +436,34 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     rhs(xt, T0, T1, um0, um1, P, k3, aux)
     for i in range(n):
         xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0, T1, u[4], u[5], P, k4, aux)
+    rhs(xt, T0, T1, u[U_END], u[U_END + 1], P, k4, aux)
     h6 = dt / 6.0
     for i in range(n):
         x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-    qn = math.sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5] + x[6] * x[6])
-    for i in range(3, 7):
+    qn = math.sqrt(x[X_Q] * x[X_Q] + x[X_Q + 1] * x[X_Q + 1] + x[X_Q + 2] * x[X_Q + 2] + x[X_Q + 3] * x[X_Q + 3])
+    for i in range(X_Q, X_Q + 4):
         x[i] /= qn
     ps0, ps1 = pose_psi(x, P)
     # BDF2 on the bearing (phi, z): y_{n+1} = (4 y_n - y_{n-1}) / 3 + h y'_{n+1}, h = 2 dt / 3,
     # the backward-Euler step's form with y_n -> (4 y_n - y_{n-1}) / 3 and dt -> h
     h = dt * (2.0 / 3.0)
-    ph0 = (4.0 * bs[0] - bs[6]) * (1.0 / 3.0)
-    ph1 = (4.0 * bs[1] - bs[7]) * (1.0 / 3.0)
-    zh0 = (4.0 * bs[2] - bs[8]) * (1.0 / 3.0)
-    zh1 = (4.0 * bs[3] - bs[9]) * (1.0 / 3.0)
-    w0, w1, z0, z1, t0, t1 = fid(fp, P[4], ps0 - ph0, ps1 - ph1, zh0, zh1, h, bs[10])
-    bs[10] = math.sqrt(w0 * w0 + w1 * w1)  # the slip speed the next solve continues from
-    bs[6] = bs[0]
-    bs[7] = bs[1]
-    bs[8] = bs[2]
-    bs[9] = bs[3]
-    bs[0] = ph0 + w0 * h
-    bs[1] = ph1 + w1 * h
-    bs[2] = z0
-    bs[3] = z1
+    ph0 = (4.0 * bs[BS_PHI] - bs[BS_PHI_PREV]) * (1.0 / 3.0)
+    ph1 = (4.0 * bs[BS_PHI + 1] - bs[BS_PHI_PREV + 1]) * (1.0 / 3.0)
+    zh0 = (4.0 * bs[BS_Z] - bs[BS_Z_PREV]) * (1.0 / 3.0)
+    zh1 = (4.0 * bs[BS_Z + 1] - bs[BS_Z_PREV + 1]) * (1.0 / 3.0)
+    w0, w1, z0, z1, t0, t1 = fid(fp, P.bearing_compliance, ps0 - ph0, ps1 - ph1, zh0, zh1, h, bs[BS_SLIP])
+    bs[BS_SLIP] = math.sqrt(w0 * w0 + w1 * w1)  # the slip speed the next solve continues from
+    bs[BS_PHI_PREV] = bs[BS_PHI]
+    bs[BS_PHI_PREV + 1] = bs[BS_PHI + 1]
+    bs[BS_Z_PREV] = bs[BS_Z]
+    bs[BS_Z_PREV + 1] = bs[BS_Z + 1]
+    bs[BS_PHI] = ph0 + w0 * h
+    bs[BS_PHI + 1] = ph1 + w1 * h
+    bs[BS_Z] = z0
+    bs[BS_Z + 1] = z1
     _torque_kick(x, t0 - T0, t1 - T1, 0.5 * dt, P)  # trapezoidal T over the step (second order)
-    bs[4] = t0
-    bs[5] = t1
+    bs[BS_T] = t0
+    bs[BS_T + 1] = t1
     s = t0 + t1 + z0 + z1  # a NaN or an infinity anywhere makes the sum non-finite
     for i in range(n):
         s += x[i]
@@ -413,40 +472,58 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def _record(x, bs, c, u0, u1, P, avp, aux, dxs, out):
-    """Record :data:`REC` at the state x with the commands c (2,) [rad] (post-avionics u0, u1 as
-    the first RK4 stage takes them); dxs receives the derivative there."""
-    rhs(x, bs[4], bs[5], u0, u1, P, dxs, aux)
-    na = P[8].shape[0]
-    cxp = P[11]
-    out[0] = aux[10]
-    out[1] = aux[11]
+    """Record :data:`REC` (columns ``REC_*``) into ``out`` at the state ``x`` with bearing
+    state ``bs``, pre-avionics commands ``c`` (2,) [rad] and post-avionics ``u0``, ``u1``
+    [rad] as the first RK4 stage takes them; ``P`` the packed model, ``avp`` the packed
+    avionics; ``dxs`` receives the derivative there, ``aux`` :func:`rhs`'s reports."""
+    rhs(x, bs[BS_T], bs[BS_T + 1], u0, u1, P, dxs, aux)
+    cxp = P.act_c_xp
+    na = cxp.shape[0]
     for a in range(2):
+        out[REC_THETA + a] = aux[AUX_THETA + a]
         s = 0.0
         for k in range(na):
             s += cxp[k] * x[N_BODY + a * na + k]
-        out[2 + a] = s
-    out[4] = aux[6]
-    out[5] = aux[7]
-    out[6] = bs[4]
-    out[7] = bs[5]
-    out[8] = bs[2]
-    out[9] = bs[3]
-    out[10] = bs[0]
-    out[11] = bs[1]
-    out[12] = _av.apply(c[0], avp)
-    out[13] = _av.apply(c[1], avp)
+        out[REC_XP + a] = s
+        out[REC_FL + a] = aux[AUX_FL + a]
+        out[REC_TF + a] = bs[BS_T + a]
+        out[REC_Z + a] = bs[BS_Z + a]
+        out[REC_PHI + a] = bs[BS_PHI + a]
+        out[REC_U + a] = _av.apply(c[a], avp)
     for i in range(6):
-        out[14 + i] = aux[i]
+        out[REC_W + i] = aux[AUX_W + i]
     for i in range(3):
-        out[20 + i] = x[i]
+        out[REC_P + i] = x[X_P + i]
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy")
 def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
-    """Integrate over command samples ``r`` (n_steps + 1, 2) [rad] every ``dt`` [s],
-    recording :data:`REC` every ``rec_every`` steps into ``out``. Returns -1 or the first
-    step whose state became non-finite. ``x0``/``bs0`` (the bearing state, :data:`N_BEARING`;
-    zeros at rest) are updated to the final state."""
+    """Integrate over command samples, recording :data:`REC` every ``rec_every`` steps.
+
+    Parameters
+    ----------
+    P : TaosParams
+        The packed model (:func:`taos.taos3d.simulate.pack`).
+    fid : first-class function
+        The friction law's ``bearing_step`` (:data:`taos.friction.registry.BEARING_SIG`).
+    fp : (NPARAM,) float64
+        The law's packed (normal-load scaled) parameters (:mod:`taos.friction._slots`).
+    avp : float64 array
+        Packed avionics (``AV_*``, :meth:`taos.planar.avionics.Avionics.pack`).
+    x0 : (N_BODY + 2 n_a,) float64
+        Initial state (``X_*``) [SI]; updated to the final state.
+    bs0 : (N_BEARING,) float64
+        Initial bearing state (``BS_*``; zeros at rest); updated to the final state.
+    r : (n_steps + 1, 2) float64
+        Pre-avionics commands, pitch and yaw, every ``dt`` [rad].
+    dt : float
+        Step [s].
+    rec_every : int
+        Record every that many steps.
+    out : (n_steps // rec_every + 1, len(REC)) float64
+        Receives the records (columns ``REC_*``).
+
+    Returns -1, or the first step whose state became non-finite."""
     n = x0.shape[0]
     x = x0
     bs = bs0
@@ -455,7 +532,7 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     k3 = np.empty(n)
     k4 = np.empty(n)
     xt = np.empty(n)
-    aux = np.empty(12)
+    aux = np.empty(N_AUX)
     c0 = np.empty(2)
     cm = np.empty(2)
     c1 = np.empty(2)
@@ -470,7 +547,8 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
         u = stage_inputs(c0, cm, c1, avp)
         ready = k % rec_every == 0
         if ready:
-            _record(x, bs, c0, u[0], u[1], P, avp, aux, k1, out[rec])  # k1 = the derivative at the step start
+            # k1 = the derivative at the step start
+            _record(x, bs, c0, u[U_START], u[U_START + 1], P, avp, aux, k1, out[rec])
             rec += 1
         if k == nsteps:
             break
@@ -482,8 +560,30 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
 @njit(cache=True, fastmath=_FM, error_model="numpy")
 def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
     """Two sines (pitch amp[0] sin(2 pi freq[0] t), yaw amp[1] sin(2 pi freq[1] t)) from rest;
-    Fourier coefficients at ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw) over
-    ``nmeas`` steps after ``nset``: out[o] = (2/N sum y sin, 2/N sum y cos, 1/N sum y)."""
+    Fourier coefficients at ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw)
+    (:data:`_DWELL_COLS`) over ``nmeas`` steps after ``nset``: out[o] = (2/N sum y sin,
+    2/N sum y cos, 1/N sum y) [m or rad].
+
+    Parameters
+    ----------
+    P, fid, fp, avp
+        As :func:`integrate`.
+    x0 : (N_BODY + 2 n_a,) float64
+        The rest state (``X_*``); not modified.
+    amp : (2,) float64
+        Command amplitudes, pitch and yaw [rad].
+    freq : (2,) float64
+        Command frequencies, pitch and yaw [Hz].
+    fmeas : float
+        Frequency the outputs are correlated at [Hz].
+    dt : float
+        Step [s].
+    nset, nmeas : int
+        Settling and measured steps.
+    out : (4, 3) float64
+        Receives the Fourier coefficients.
+
+    Returns -1, or the first step whose state became non-finite."""
     n = x0.shape[0]
     x = x0.copy()
     bs = np.zeros(N_BEARING)
@@ -492,7 +592,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
     k3 = np.empty(n)
     k4 = np.empty(n)
     xt = np.empty(n)
-    aux = np.empty(12)
+    aux = np.empty(N_AUX)
     rec = np.empty(len(REC))
     c0 = np.empty(2)
     cm = np.empty(2)
@@ -509,11 +609,11 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
             c1[j] = amp[j] * math.sin(w * freq[j] * (t + dt))
         u = stage_inputs(c0, cm, c1, avp)
         if k >= nset:
-            _record(x, bs, c0, u[0], u[1], P, avp, aux, k1, rec)
+            _record(x, bs, c0, u[U_START], u[U_START + 1], P, avp, aux, k1, rec)
             s = math.sin(w * fmeas * t)
             c = math.cos(w * fmeas * t)
             for o in range(4):
-                y = rec[(2, 3, 0, 1)[o]]
+                y = rec[_DWELL_COLS[o]]
                 out[o, 0] += y * s
                 out[o, 1] += y * c
                 out[o, 2] += y
@@ -528,7 +628,10 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
 
 @njit(cache=True, parallel=True, fastmath=_FM, error_model="numpy")
 def dwell_batch(P, fid, fp, avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out, status):
-    """Independent two-axis dwells in parallel (rows of ``amps``/``freqs`` (n, 2))."""
+    """Independent two-axis dwells in parallel: :func:`_dwell_one` for every row b of ``amps``
+    (n, 2) [rad] and ``freqs`` (n, 2) [Hz], with ``fmeas`` (n,) [Hz], ``dts`` (n,) [s],
+    ``nset``, ``nmeas`` (n,) int, into ``out[b]`` (n, 4, 3) and ``status[b]`` (n,) int
+    (-1 or the failing step); ``P``, ``fid``, ``fp``, ``avp``, ``x0`` as :func:`_dwell_one`."""
     for b in prange(amps.shape[0]):
         status[b] = _dwell_one(P, fid, fp, avp, x0, amps[b], freqs[b], fmeas[b], dts[b], nset[b],
                                nmeas[b], out[b])

@@ -34,10 +34,13 @@ DEFAULT_DT_S = 4e-4
 
 @dataclass(frozen=True, eq=False)
 class Packed:
-    """Arrays the compiled kernels take (see :func:`pack`)."""
+    """Arrays the compiled kernels take (see :func:`pack`): the model ``P``
+    (:class:`taos.taos3d.dynamics.TaosParams`), the friction law's ``bearing_step`` kernel
+    ``fid`` (its registry entry) and packed parameters ``fp`` (scaled by the normal load), the
+    packed avionics ``avp``, the state length and the actuator's state length."""
 
-    P: tuple
-    fid: object  # the friction law's bearing_step kernel (its registry entry)
+    P: _dy.TaosParams
+    fid: object
     fp: np.ndarray
     avp: np.ndarray
     n_state: int
@@ -67,16 +70,20 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     G = Kc @ S.T @ Ks
     act = actuator_state_space(tm.base.actuator)
     geo = tm.geometry
-    L0 = [float(np.linalg.norm(geo.engine_attach_m[i] - geo.structure_attach_m[i])) for i in range(2)]
-    sc = np.array([tm.line_load_stiffness_N_per_m, tm.base.actuator.moment_arm_m,
-                   tm.base.engine.rotational_stiffness_Nm_per_rad, L0[0], L0[1]])
-    cL = tm.base.structure.load_damping_Ns_per_m(tm.base.actuator.moment_arm_m, tm.base.engine.inertia("pitch"))
-    sc = np.concatenate([sc, [cL, act.states.index("v_p_m_s")], actuator_limits(tm)])
-    # P[14] = Ks S Kc: the chain wrench per unit bearing torque (dynamics._torque_kick)
-    P = (f64(Y), f64(np.linalg.inv(Y)), f64(Ks), f64(G), f64(Kc), f64(S), f64(geo.structure_attach_m),
-         f64(geo.engine_attach_m), f64(act.A), f64(act.B[:, act.input_index("x_c_m")]),
-         f64(act.B[:, act.input_index("f_load_N")]), f64(act.C[act.output_index("x_p_m")]),
-         f64(np.vstack([PITCH_AXIS, YAW_AXIS])), f64(sc), f64(Ks @ S @ Kc))
+    R = tm.base.actuator.moment_arm_m
+    P = _dy.TaosParams(
+        spatial_inertia=f64(Y), spatial_inertia_inv=f64(np.linalg.inv(Y)), chain_stiffness=f64(Ks),
+        slip_gain=f64(G), bearing_compliance=f64(Kc), bearing_selection=f64(S),
+        structure_attach_m=f64(geo.structure_attach_m), engine_attach_m=f64(geo.engine_attach_m),
+        act_A=f64(act.A), act_b_xc=f64(act.B[:, act.input_index("x_c_m")]),
+        act_b_fl=f64(act.B[:, act.input_index("f_load_N")]), act_c_xp=f64(act.C[act.output_index("x_p_m")]),
+        bearing_axes=f64(np.vstack([PITCH_AXIS, YAW_AXIS])),
+        line_stiffness_N_per_m=float(tm.line_load_stiffness_N_per_m), moment_arm_m=float(R),
+        engine_stiffness_Nm_per_rad=float(tm.base.engine.rotational_stiffness_Nm_per_rad),
+        line_length0_m=f64([np.linalg.norm(geo.engine_attach_m[i] - geo.structure_attach_m[i]) for i in range(2)]),
+        line_damping_Ns_per_m=float(tm.base.structure.load_damping_Ns_per_m(R, tm.base.engine.inertia("pitch"))),
+        act_vp_index=act.states.index("v_p_m_s"), limits=f64(actuator_limits(tm)),
+        torque_wrench=f64(Ks @ S @ Kc))
     law = tm.base.friction
     fp = law.scaled(tm.friction_scale).pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
@@ -85,8 +92,9 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
 
 
 def rest_state(pk: Packed) -> np.ndarray:
+    """The state at rest (:mod:`taos.taos3d.dynamics` layout): identity quaternion, all else 0."""
     x = np.zeros(pk.n_state)
-    x[6] = 1.0
+    x[_dy.X_Q + 3] = 1.0  # quaternion w
     return x
 
 
@@ -159,13 +167,13 @@ def simulate_taos(tm: TaosModel, profile, *, dt_s: float = DEFAULT_DT_S, record_
 def _state_from_tangent(pk: Packed, y: np.ndarray) -> np.ndarray:
     """Full state from tangent coordinates y = (dp (3), dr (3), v (6), actuators)."""
     x = np.empty(pk.n_state)
-    x[:3] = y[:3]
+    x[_dy.X_P:_dy.X_P + 3] = y[:3]
     r = y[3:6]
     a = np.linalg.norm(r)
     s = 0.5 if a < 1e-12 else math.sin(a / 2) / a
-    x[3:6] = s * r
-    x[6] = math.cos(a / 2)
-    x[7:] = y[6:]
+    x[_dy.X_Q:_dy.X_Q + 3] = s * r
+    x[_dy.X_Q + 3] = math.cos(a / 2)
+    x[_dy.X_V:] = y[6:]  # the twist (linear, angular) and the actuators
     return x
 
 
@@ -175,7 +183,7 @@ def linear_state_space(tm: TaosModel) -> StateSpace:
     (after the avionics, unity here); outputs x_p and theta per axis."""
     pk = pack(tm, ideal_avionics=True)
     n = pk.n_state - 1
-    aux = np.empty(12)
+    aux = np.empty(_dy.N_AUX)
     dx = np.empty(pk.n_state)
 
     def f(y, u):
@@ -185,7 +193,7 @@ def linear_state_space(tm: TaosModel) -> StateSpace:
         out[:3] = y[6:9]          # dp/dt = v_lin at rest
         out[3:6] = y[9:12]        # dr/dt = omega at rest
         out[6:] = dx[7:]
-        return out, np.array([aux[10], aux[11]])
+        return out, np.array([aux[_dy.AUX_THETA], aux[_dy.AUX_THETA + 1]])
 
     y0 = np.zeros(n)
     u0 = np.zeros(2)
@@ -210,7 +218,7 @@ def linear_state_space(tm: TaosModel) -> StateSpace:
         up[j] += 1e-6
         um[j] -= 1e-6
         B[:, j] = (f(y0, up)[0] - f(y0, um)[0]) / 2e-6
-    cxp = pk.P[11]
+    cxp = pk.P.act_c_xp
     C[0, 12:12 + na] = cxp
     C[1, 12 + na:12 + 2 * na] = cxp
     states = tuple(f"{k}" for k in ("px", "py", "pz", "rx", "ry", "rz", "vx", "vy", "vz", "wx", "wy", "wz")) + \
