@@ -24,13 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-<<<<<<< HEAD
 from taos.descfcn import Nonlinearity
 
-# packed layout: [bits, lsb_rad, rounding(0/1), n_table, amp_0..amp_{n-1}, gain_0..gain_{n-1}]
-=======
 from ._avionics_slots import AV_BITS, AV_LSB, AV_NTAB, AV_ROUND, AV_TABLE
->>>>>>> kernels
 
 
 @dataclass(frozen=True)
