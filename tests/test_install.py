@@ -43,6 +43,7 @@ def installed(tmp_path_factory):
     assert "taos/shipped/models/profiles/greenrun_two_axis.toml" in names
     assert any(n.startswith("taos/shipped/fem_data/") and n.endswith(".npz") for n in names)
     assert not any(n.startswith("tests/") for n in names)
+    assert "taos/py.typed" in names and "masv/py.typed" in names  # PEP 561: typed packages
     site = tmp / "site"
     r = _run([sys.executable, "-m", "pip", "install", "--no-deps", "--no-compile", "-q", "--target", site,
               wheels[0]], cwd=tmp)
