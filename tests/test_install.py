@@ -7,8 +7,8 @@ directory with only that folder on ``PYTHONPATH``: ``taos info rs25_hotfire`` (a
 named without a path) and ``python -m taos greenrun rs25_hotfire --out DIR`` (the report).
 
 Building the wheel fetches setuptools and wheel into pip's isolated build environment (network);
-the fresh install compiles its numba kernels on first use (about a minute of CPU), so the
-greenrun test is marked slow.
+the fresh install compiles its numba kernels on first use (about a minute of CPU). The whole
+module is marked slow (``make check`` skips it; ``make test`` runs it).
 """
 
 from __future__ import annotations
@@ -21,6 +21,9 @@ import zipfile
 from pathlib import Path
 
 import pytest
+
+#: slow (make check skips these, make test runs them): wheel build (network) and install
+pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[1]
 
