@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -37,7 +38,12 @@ def _run(args, cwd, env=None, timeout=1800):
 def installed(tmp_path_factory):
     """(site folder holding the installed wheel, environment that sees only it, a work folder)."""
     tmp = tmp_path_factory.mktemp("install")
-    r = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", tmp / "dist", ROOT], cwd=tmp)
+    # build from a copy: pip builds in the source folder (build/, *.egg-info), which must not be
+    # shared with another test session (make test runs two pytest processes) or left in the tree
+    src = tmp / "src"
+    shutil.copytree(ROOT, src, ignore=shutil.ignore_patterns(".git", ".venv", "build", "*.egg-info", "__pycache__",
+                                                              "out", "docs", "tests", ".hypothesis", ".pytest_cache"))
+    r = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", tmp / "dist", src], cwd=tmp)
     assert r.returncode == 0, r.stderr[-2000:]
     wheels = sorted((tmp / "dist").glob("taos_tvc-*.whl"))
     assert len(wheels) == 1
