@@ -21,11 +21,22 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
 from .errors import InputError
 from .units import to_si
+
+
+class Profile(Protocol):
+    """What every profile is (the classes below): its duration [s] and the command
+    theta_c(t) [rad] at times ``t`` [s], shape (n,) (one axis) or (2, n) (pitch, yaw)."""
+
+    @property
+    def duration_s(self) -> float: ...
+
+    def __call__(self, t: np.ndarray) -> np.ndarray: ...
 
 
 @dataclass(frozen=True)
@@ -333,7 +344,7 @@ def profile_from_table(tab: dict, src: str, sec: str):
                      got=repr(kind))
 
 
-def load_profile(path: str | Path):
+def load_profile(path: str | Path) -> Profile:
     """Load a profile file: a top-level ``type`` (single axis, or ``circular``), or
     ``[pitch]`` and/or ``[yaw]`` tables (two-axis). (A measured record is replayed through
     :func:`profile_from_record`; the CLI reads it.) Every value is checked against the documented limits of

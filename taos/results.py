@@ -37,26 +37,58 @@ _TMP_RE = re.compile(r"^\..+\.(\d+)\.taos\.tmp$")  # only this program's own tem
 
 
 def package_version() -> str:
+    """taos's own version: the installed distribution's (``taos-tvc``) metadata, else
+    ``taos.__version__`` (a source tree on the path, not installed)."""
     try:
         return metadata.version("taos-tvc")
     except metadata.PackageNotFoundError:
-        return "0+unknown"
+        from . import __version__
+        return __version__
+
+
+def _git(folder: Path, *args: str) -> str | None:
+    """stdout of ``git -C folder args`` (stripped), or None when git fails or is missing."""
+    try:
+        r = subprocess.run(["git", "-C", str(folder), *args], capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return r.stdout.strip() if r.returncode == 0 else None
+
+
+def own_checkout(package_dir: Path) -> Path | None:
+    """The root of taos's own git checkout when ``package_dir`` is its ``taos/`` folder, else None.
+
+    taos's own checkout: ``package_dir`` is ``<root>/taos``, ``<root>/pyproject.toml`` names the
+    project ``taos-tvc`` and ``<root>`` is the top level of a git work tree. Installed (or
+    copied) inside another project's git repository, the package is not in its own checkout, and
+    that project's commit is not taos's revision."""
+    import tomllib
+    root = package_dir.resolve().parent
+    if package_dir.resolve().name != "taos":
+        return None
+    try:
+        name = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))["project"]["name"]
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, KeyError, TypeError):
+        return None
+    if name != "taos-tvc":
+        return None
+    top = _git(root, "rev-parse", "--show-toplevel")
+    return root if top and Path(top).resolve() == root else None
 
 
 @cache
-def git_revision() -> str:
-    """``git describe --always --dirty`` of the source checkout the package runs from, or ''."""
-    here = Path(__file__).resolve().parent
-    try:
-        r = subprocess.run(["git", "-C", str(here), "describe", "--always", "--dirty", "--abbrev=40"],
-                           capture_output=True, text=True, timeout=10)
-    except (OSError, subprocess.SubprocessError):
+def git_revision(package_dir: Path | None = None) -> str:
+    """``git describe --always --dirty`` of taos's own source checkout when the package runs
+    from one (:func:`own_checkout`), else '' (an installed package: its version is
+    :func:`package_version`). ``package_dir`` defaults to this package's folder."""
+    root = own_checkout(Path(__file__).resolve().parent if package_dir is None else Path(package_dir))
+    if root is None:
         return ""
-    return r.stdout.strip() if r.returncode == 0 else ""
+    return _git(root, "describe", "--always", "--dirty", "--abbrev=40") or ""
 
 
 def base_provenance() -> dict:
-    """Package version and git revision (when the package runs from a git checkout)."""
+    """Package version and git revision (when the package runs from its own git checkout)."""
     return {"package_version": package_version(), "git_revision": git_revision()}
 
 

@@ -141,7 +141,7 @@ def _exact(ss: StateSpace) -> LoopMargins:
                        pm, "state-space (python-control)")
 
 
-def loop_margins(loop, L=None) -> LoopMargins:
+def loop_margins(loop: StateSpace | np.typing.ArrayLike, L: np.typing.ArrayLike | None = None) -> LoopMargins:
     """Every gain and phase crossing of a SISO loop (negative feedback).
 
     ``loop_margins(ss)``: ``ss`` a numeric single-input single-output

@@ -169,6 +169,7 @@ def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
     assert back.actuator == truth.actuator and back.engine == truth.engine
 
 
+@pytest.mark.slow
 def test_demo_datasets_reproduce_the_paper_direction_hot_fire_stiffer(tmp_path):
     """Fits of the synthetic demo datasets (two-axis Green Run profile, noise, engine-angle
     offsets) from a neutral start: hot-fire K_L above ambient and the notch shifted up, each

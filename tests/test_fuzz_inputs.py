@@ -191,6 +191,7 @@ def test_freqresp_option_fuzz(freq, amp, axis, capsys):
         one_line_exit_2(rc, out.err)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(dt=option_text, nperseg=st.one_of(st.integers(-10, 10 ** 9).map(str), st.text(max_size=5)))
 def test_step_and_segment_option_fuzz(dt, nperseg, tmp_path_factory, capsys):

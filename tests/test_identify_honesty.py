@@ -116,6 +116,7 @@ def test_fit_with_the_right_model_is_not_inadequate_and_reports_bounds(tmp_path)
     assert "model adequacy:" in p.stdout and "bounds" in p.stdout
 
 
+@pytest.mark.slow
 def test_parameter_held_at_a_set_bound_is_flagged(tmp_path):
     out = tmp_path / "fit.json"
     p = run_cli("fit", HOTFIRE_DATA, "--model", MODELS / "rs25_hotfire.toml", "--free", "load_stiffness",

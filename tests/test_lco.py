@@ -17,6 +17,9 @@ from taos.model import Structure, load_model
 
 from .conftest import MODELS, run_cli
 
+#: slow (make check skips these, make test runs them): cycles confirmed in the time domain
+pytestmark = pytest.mark.slow
+
 DEG = math.pi / 180
 LBF_IN = 4.4482216152605 / 0.0254
 FLIGHT = MODELS / "flight" / "core_stage.toml"

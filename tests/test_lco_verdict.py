@@ -14,6 +14,7 @@ FLIGHT = MODELS / "flight" / "core_stage.toml"
 GRID = ("--amplitudes-deg", "0.02,0.05,0.1,0.2,0.5", "--freq-hz", "0.05,0.08,0.12,0.2,0.3")
 
 
+@pytest.mark.slow
 def test_coulomb_soft_structure_verdict_in_plain_words_with_vehicle_motion(tmp_path):
     r = run_cli("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "coulomb-switching", *GRID,
                 "--duration", "60", "--json", tmp_path / "lco.json", "--plot", tmp_path / "n.svg")
@@ -36,6 +37,7 @@ def test_coulomb_soft_structure_verdict_in_plain_words_with_vehicle_motion(tmp_p
     assert "limit cycle expected" in r.stdout and "low GM" in r.stdout   # text beside the JSON file
 
 
+@pytest.mark.slow
 def test_no_cycle_states_which_margin_and_where():
     r = run_cli("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "dahl", "--load-stiffness",
                 "205000 lbf/in", *GRID, "--no-time-domain", "--json", "-")

@@ -153,3 +153,147 @@ def test_3d_command_beyond_the_hard_stop_holds_the_engine_in_range(taos_ambient)
     kchain = float(np.linalg.eigvalsh(taos_ambient.chain_stiffness[3:, 3:]).min())
     assert held.min() >= e.gimbal_range_rad - torque / kchain
     assert held.max() <= e.gimbal_range_rad + 1.05 * torque / e.hard_stop_stiffness_Nm_per_rad + torque / kchain
+
+
+# -- both directions: the negative stop, the negative rate and pressure limits ---------------
+# Every check above drives the positive direction. The limits are odd in the state (the valve
+# clips u_v to +-v_max, the stops sit at +-theta_max, the stall pressure is +-P_s), so each
+# analytic reference holds mirrored; a sign or factor wrong on one side only breaks them there.
+def _contact_penetration_rad(w_hit, zeta, J, k_s):
+    """Largest penetration [rad] of a free inertia J hitting a Kelvin-Voigt contact (stiffness
+    k_s, damping ratio zeta < 1) at rate w_hit: the damped oscillator from rest position with
+    initial rate w_hit, x = (w_hit / w_d) exp(-zeta w_n t) sin(w_d t), peaks where
+    tan(w_d t) = w_d / (zeta w_n): x_max = (w_hit / w_n) exp(-zeta / sqrt(1 - zeta^2) atan(sqrt(1 - zeta^2) / zeta))."""
+    wn = math.sqrt(k_s / J)
+    s = math.sqrt(1.0 - zeta * zeta)
+    return w_hit / wn * math.exp(-zeta / s * math.atan2(s, zeta))
+
+
+def _run(m, r):
+    plant = simplex_plant(m)
+    y, _ = integrate_plant(plant, m, r.reshape(-1, 1), DT, 1)
+    o = plant.ss.output_index
+    return y[:, o("x_p_m")], y[:, o("theta_rad")], y[:, o("load_force_N")], y[:, o("p_load_Pa")]
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["positive", "negative"])
+def test_step_slews_at_the_no_load_valve_rate_in_both_directions(ambient_ideal, sign):
+    """The valve's flow saturation Q_max gives the piston the no-load rate v_max = Q_max / A
+    whichever way it moves: a +-5 deg step crosses 20-80 % of its stroke at +-v_max, and the
+    piston never moves faster than v_max (plus the oil column's decompression) either way."""
+    m = ambient_ideal
+    vmax = m.actuator.max_rate_m_per_s
+    R = m.actuator.moment_arm_m
+    t, xp, th, _, _ = _step(m, sign * 5 * DEG)
+    x5 = R * 5 * DEG
+    i0, i1 = np.argmax(sign * xp > 0.2 * x5), np.argmax(sign * xp > 0.8 * x5)
+    assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(sign * vmax, rel=0.03)
+    vp = np.gradient(xp, DT)
+    assert np.abs(vp).max() <= vmax * 1.10
+    assert np.abs(np.gradient(th, DT)).max() < 2 * vmax / R
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["positive", "negative"])
+def test_impact_on_either_stop_penetrates_no_deeper_than_the_damped_contact(ambient_ideal, sign):
+    """A +-12 deg command: the engine reaches the stop at +-theta_max at some rate w_hit and
+    penetrates no deeper than the damped contact's analytic peak (a damping that pushed the
+    engine in, not out, would let it through) plus the static deflection R F_L / k_s under the
+    actuator force; it then holds at the stop, on the commanded side."""
+    m = ambient_ideal
+    e = m.engine
+    R = m.actuator.moment_arm_m
+    J, ks = e.inertia("pitch"), e.hard_stop_stiffness_Nm_per_rad
+    t, xp, th, fl, _ = _step(m, sign * 12 * DEG, t_end=2.0)
+    i = int(np.argmax(sign * th > e.gimbal_range_rad))
+    assert i > 0
+    w_hit = abs(np.gradient(th, DT)[i])
+    static = np.abs(R * fl[t > 1.5]).max() / ks
+    assert static < 0.05 * DEG  # a stiff contact: the engine holds at the stop
+    deepest = (sign * th).max() - e.gimbal_range_rad
+    assert deepest <= _contact_penetration_rad(w_hit, e.hard_stop_damping_ratio, J, ks) + static
+    held = sign * th[t > 1.5]
+    assert held.min() >= e.gimbal_range_rad
+    assert held.max() <= e.gimbal_range_rad + 1.05 * static
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["positive", "negative"])
+def test_slow_ramp_into_either_stop_holds_the_engine_at_the_gimbal_range(ambient_ideal, sign):
+    """A 6 deg/s ramp to +-12 deg: the engine follows the ramp (lagging it by ~0.5 deg: the
+    position loop's rate / K_v plus the feedline spring's and the pressure feedback's steady
+    error) without touching the stop, reaches +-theta_max within 0.3 s after the ramp passes it
+    and stays there, within the contact's static deflection, while the command goes beyond."""
+    m = ambient_ideal
+    e = m.engine
+    R = m.actuator.moment_arm_m
+    rate = 6 * DEG
+    t = np.arange(int(2.6 / DT) + 1) * DT
+    r = sign * np.minimum(rate * t, 12 * DEG)
+    xp, th, fl, _ = _run(m, r)
+    static = np.abs(R * fl).max() / e.hard_stop_stiffness_Nm_per_rad
+    t_stop = e.gimbal_range_rad / rate
+    before = t < t_stop
+    assert np.abs(th[before] - r[before]).max() < 1.0 * DEG  # following the ramp
+    assert (sign * th[before]).max() < e.gimbal_range_rad
+    after = sign * th[t > t_stop + 0.3]
+    assert after.min() >= e.gimbal_range_rad
+    assert after.max() <= e.gimbal_range_rad + 1.05 * static
+    assert (sign * th).max() <= e.gimbal_range_rad + 1.05 * static + _contact_penetration_rad(
+        2 * rate, e.hard_stop_damping_ratio, e.inertia("pitch"), e.hard_stop_stiffness_Nm_per_rad)
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["positive", "negative"])
+def test_supply_pressure_limits_the_load_pressure_to_plus_minus_p_s(ambient_ideal, sign):
+    """Pushing against either stop with the supply-pressure limit on holds the load pressure at
+    +-P_s (the stall force +-A P_s), on the side of the command."""
+    act = dataclasses.replace(ambient_ideal.actuator, pressure_limited=True)
+    m = ambient_ideal.replace(actuator=act)
+    t, xp, th, fl, p = _step(m, sign * 14 * DEG, t_end=2.0)
+    assert np.abs(p).max() <= act.supply_pressure_Pa * 1.3
+    assert p[t > 1.5].mean() == pytest.approx(sign * act.supply_pressure_Pa, rel=0.05)
+    assert fl[t > 1.5].mean() == pytest.approx(sign * act.stall_force_N, rel=0.05)
+
+
+def test_all_limits_together_are_odd_in_the_command(ambient_ideal):
+    """With all three limits on (no friction, unity avionics) the model is odd: the response to
+    -r is minus the response to r, to rounding. One side's stop, rate or pressure law wrong
+    breaks it."""
+    act = dataclasses.replace(ambient_ideal.actuator, pressure_limited=True)
+    m = ambient_ideal.replace(actuator=act)
+    t = np.arange(int(1.5 / DT) + 1) * DT
+    r = np.where(t >= 0.05, 14 * DEG, 0.0) * np.where(t < 0.9, 1.0, -0.5)  # into the stop and back
+    up = _run(m, r)
+    down = _run(m, -r)
+    for a, b in zip(up, down):
+        assert np.abs(a + b).max() <= 1e-9 * np.abs(a).max()
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0], ids=["positive", "negative"])
+def test_3d_limits_in_both_directions(taos_ambient, sign):
+    """TAOS (the same limit laws, compiled into the 3-D step): a +-5 deg pitch step slews at
+    +-v_max, and a +-12 deg command holds the engine at the stop on its side. The torque on the
+    stop is bounded independently of the run: once the piston reaches x_c = R theta_c the load
+    path pushes with at most K_L R^2 (theta_c - theta_max) (the stop and the gimbal chain take
+    part of that deflection), doubled for the impact's ringing (measured 1.26 x). The engine
+    penetrates no deeper than the damped contact's analytic peak at the measured impact rate
+    plus that torque's deflection of the stop and of the gimbal chain."""
+    base = taos_ambient.base
+    e, R = base.engine, base.actuator.moment_arm_m
+    vmax = base.actuator.max_rate_m_per_s
+    t, xp, th, _ = _step3d(taos_ambient, sign * 5 * DEG)
+    x5 = R * 5 * DEG
+    i0, i1 = np.argmax(sign * xp > 0.2 * x5), np.argmax(sign * xp > 0.8 * x5)
+    assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(sign * vmax, rel=0.03)
+    assert np.abs(np.gradient(th, DT)).max() < 2 * vmax / R
+    t, xp, th, fl = _step3d(taos_ambient, sign * 12 * DEG, t_end=2.0)
+    torque = 2.0 * base.structure.load_stiffness_N_per_m * R * R * (12 * DEG - e.gimbal_range_rad)
+    assert np.abs(R * fl).max() <= torque
+    kchain = float(np.linalg.eigvalsh(taos_ambient.chain_stiffness[3:, 3:]).min())
+    ks = e.hard_stop_stiffness_Nm_per_rad
+    held = sign * th[t > 1.5]
+    assert held.min() >= e.gimbal_range_rad - torque / kchain
+    assert held.max() <= e.gimbal_range_rad + torque / ks + torque / kchain
+    i = int(np.argmax(sign * th > e.gimbal_range_rad))
+    w_hit = abs(np.gradient(th, DT)[i])
+    deepest = (sign * th).max() - e.gimbal_range_rad
+    assert deepest <= _contact_penetration_rad(w_hit, e.hard_stop_damping_ratio, e.inertia("pitch"), ks) \
+        + torque / ks + torque / kchain

@@ -123,6 +123,7 @@ def test_cli_modes_and_coupling_with_modal_file(tmp_path, capsys):
     assert d["closed_loop"]["stable"] is True and len(d["margins"]["loops"]) == 8
 
 
+@pytest.mark.slow
 def test_plots_save_png(tmp_path):
     from masv import analysis as an
     from masv.config import load_config

@@ -47,6 +47,7 @@ def test_coulomb_hysteresis_and_threshold_follow_the_friction_band():
     assert none.hysteresis_deg < 0.1 * band          # no friction, (almost) no hysteresis
 
 
+@pytest.mark.slow
 def test_engine_held_below_breakaway_is_reported_as_held_not_minus_330_db(tmp_path):
     r = run_cli("freqresp", MODELS / "rs25_hotfire.toml", "--friction", "coulomb-switching", "--amplitude-deg",
                 "0.02", "--freq-hz", "0.5,2", "--json", "-", "--plot", tmp_path / "held.svg")

@@ -50,6 +50,7 @@ def default_run(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_default_executor_writes_every_run_and_the_statistics(default_run):
     s = _stats(default_run)
     assert s["runs"] == RUNS and s["runs_ok"] + s["runs_failed"] == RUNS
@@ -62,6 +63,7 @@ def test_default_executor_writes_every_run_and_the_statistics(default_run):
     assert prov["campaign_sha256"] and prov["model_sha256"] and prov["ascent_sha256"] and prov["seed"] == 7
 
 
+@pytest.mark.slow
 def test_one_worker_gives_identical_statistics(default_run, tmp_path):
     out = tmp_path / "w1"
     assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--workers", "1", "--out", str(out),
@@ -109,6 +111,7 @@ def cluster():
             p.kill()
 
 
+@pytest.mark.slow
 def test_scheduler_executor_gives_identical_statistics(cluster, default_run, tmp_path):
     addr, _ = cluster
     out = tmp_path / "sched"
@@ -117,6 +120,7 @@ def test_scheduler_executor_gives_identical_statistics(cluster, default_run, tmp
     assert _stats(out) == _stats(default_run)
 
 
+@pytest.mark.slow
 def test_killing_a_worker_loses_no_run(cluster, default_run, tmp_path):
     """A worker killed mid-campaign: Dask re-runs its tasks on the other one; the campaign ends
     with every run and the same statistics."""
@@ -139,6 +143,7 @@ def test_killing_a_worker_loses_no_run(cluster, default_run, tmp_path):
     assert _stats(out) == _stats(default_run)
 
 
+@pytest.mark.slow
 def test_resume_after_interruption_gives_the_same_statistics(default_run, tmp_path):
     """Resume: a campaign stored in part (runs missing, as after a kill) is completed by
     --resume to the same statistics; without --resume the folder is refused."""

@@ -61,6 +61,7 @@ def env():
 
 # -- foreign files ----------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_greenrun_and_compare_leave_foreign_files_untouched(tmp_path, capsys):
     out = tmp_path / "mydir"
     out.mkdir()

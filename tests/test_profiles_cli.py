@@ -94,6 +94,7 @@ def test_freqresp_bad_frequency_list(tmp_path):
     assert r.returncode == 2 and "--freq-hz" in r.stderr and not out.exists()
 
 
+@pytest.mark.slow
 def test_engine_taos_on_the_command_line(tmp_path):
     """--engine taos: the 3-D model's linear response has the hot-fire notch, and simulate writes
     the 3-D extras (bearing slip, gimbal-half deflections) beside the common arrays."""

@@ -13,6 +13,9 @@ import pytest
 from tests.conftest import MODELS, ROOT, run_cli
 from tests.test_viewer import engine_mask, screenshot
 
+#: slow (make check skips these, make test runs them): the Green Run end to end
+pytestmark = pytest.mark.slow
+
 HOTFIRE = MODELS / "rs25_hotfire.toml"
 DATA = MODELS / "data" / "greenrun_hotfire_synthetic.csv"
 

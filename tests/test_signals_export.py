@@ -54,6 +54,7 @@ def test_data_import_accepts_the_hydraulic_signals(run, tmp_path):
     assert h5.metadata["moment_arm_m"] == run.moment_arm_m
 
 
+@pytest.mark.slow
 def test_measured_record_replays_through_taos_simulate(tmp_path):
     r = run_cli("simulate", MODELS / "rs25_hotfire.toml", "--profile", DATA, "--out", tmp_path / "hot.h5")
     assert r.returncode == 0, r.stderr

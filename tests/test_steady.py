@@ -53,6 +53,7 @@ def test_shooting_without_friction_is_the_linear_orbit():
     assert np.max(np.abs(np.degrees(np.angle(st.engine / lin.engine)))) < 1e-3
 
 
+@pytest.mark.slow
 def test_amplitude_list_equals_single_calls_bit_for_bit(tmp_path):
     args = ["freqresp", MODELS / "rs25_ambient.toml", "--freq-hz", "2,5"]
     r = run_cli(*args, "--amplitude-deg", "0.1,0.4", "--json", tmp_path / "many.json",

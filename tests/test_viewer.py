@@ -218,6 +218,7 @@ def _listen_addresses(port: int) -> set[str]:
     return out
 
 
+@pytest.mark.slow
 def test_live_view_serves_on_loopback_renders_and_stops_on_sigint(tmp_path):
     h5 = tmp_path / "run.h5"
     big_motion_run().to_hdf5(h5)

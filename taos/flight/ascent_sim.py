@@ -140,7 +140,7 @@ class AscentHistory:
         atomic_write(path, write)
 
 
-def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes=AXES, start_s: float = 0.0,
+def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = AXES, start_s: float = 0.0,
                     end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,
                     seed: int = 0, attitude0_rad: float = 0.0, progress: bool = False) -> AscentHistory:
     """Fly ``ascent`` from ``start_s`` to ``end_s`` [s] (default the trajectory's end) with the

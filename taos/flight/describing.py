@@ -141,7 +141,8 @@ class DescribingFunctionMap:
                        provenance=json.loads(h5.attrs["provenance"]))
 
 
-def describing_function_map(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,
+def describing_function_map(model: TvcModel, amplitudes_rad: np.typing.ArrayLike, freq_hz: np.typing.ArrayLike,
+                            axis: str = "pitch", *,
                             settle_cycles: int = 2, measure_cycles: int = 2, settle_s: float | None = None,
                             dt_max_s: float = DEFAULT_DT_S, method: str = "settle") -> DescribingFunctionMap:
     """N(A, w) by sine dwell on the nonlinear simplex model (friction and avionics in the path).

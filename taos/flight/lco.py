@@ -378,7 +378,8 @@ def decision(prediction: dict, time_domain: dict | None) -> dict:
 
 
 def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None,
-                amplitudes_rad=None, freq_hz=None, duration_s: float = 300.0, window_s: float = 120.0,
+                amplitudes_rad: np.typing.ArrayLike | None = None, freq_hz: np.typing.ArrayLike | None = None,
+                duration_s: float = 300.0, window_s: float = 120.0,
                 attitude0_rad: float = 0.2 * DEG, settle_cycles: int = 1, measure_cycles: int = 1,
                 avionics: str = "bounding", time_domain: bool = True, steady: str = "settle") -> LcoReport:
     """Describing-function map, harmonic-balance prediction and (optionally) the time-domain

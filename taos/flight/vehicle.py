@@ -419,7 +419,7 @@ def _margins(lm: LoopMargins) -> Margins:
                    high_gain_margin_db=hi, high_phase_crossover_hz=fhi, crossings=lm)
 
 
-def margins(freq_hz, L) -> Margins:
+def margins(freq_hz: np.typing.ArrayLike, L: np.typing.ArrayLike) -> Margins:
     """Margins of the sampled open loop ``L`` (complex, on an increasing frequency grid [Hz]);
     every crossing located between samples by :func:`taos.stability.loop_margins`."""
     return _margins(loop_margins(freq_hz, L))

@@ -17,12 +17,17 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from taos.model import TvcModel
 from taos.units import from_si
+
+if TYPE_CHECKING:
+    from taos.identify.estimate import MeasuredResponse
 
 
 @dataclass(frozen=True)
@@ -106,7 +111,8 @@ def _numeric_fields(obj) -> dict:
     return out
 
 
-def compare_models(model_a: TvcModel, model_b: TvcModel, data_a=(), data_b=(),
+def compare_models(model_a: TvcModel, model_b: TvcModel, data_a: Sequence[MeasuredResponse] = (),
+                   data_b: Sequence[MeasuredResponse] = (),
                    labels: tuple[str, str] | None = None) -> Comparison:
     """The comparison table of two models (module docstring); ``data_a``/``data_b`` are
     lists of :class:`~taos.identify.estimation.MeasuredResponse` shown on the plots."""

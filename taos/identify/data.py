@@ -329,7 +329,7 @@ def _read_hdf5(path: Path, src: str) -> tuple[dict, dict, dict]:
     return meta, out, labels
 
 
-def load_test_data(path, *, resample: bool = True) -> TestData:
+def load_test_data(path: str | Path, *, resample: bool = True) -> TestData:
     """Read and validate a vectoring record (CSV or HDF5, see the module docstring).
 
     Parameters

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -427,7 +428,7 @@ def choose_method(data: TestData, method: str = "auto") -> tuple[str, list[Excit
     return methods.pop(), exc
 
 
-def estimate(data: TestData, method: str = "auto", **kwargs) -> list[MeasuredResponse]:
+def estimate(data: TestData, method: str = "auto", **kwargs: Any) -> list[MeasuredResponse]:
     """Responses of a record by the estimator :func:`choose_method` picks (``method`` 'auto',
     or forced 'dwell'/'h1'). Each response's ``meta['excitation']`` holds what was detected
     and why; for a sweep the H1 points carry the sweep's envelope amplitude (the amplitude

@@ -36,6 +36,7 @@ from __future__ import annotations
 import datetime as _dt
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -304,7 +305,7 @@ def simulate_points(model: TvcModel, axes, freq_hz, amp_rad) -> tuple[np.ndarray
     return hx, he
 
 
-def fit_frequency_response(model: TvcModel, data, free, *, start: dict | None = None, starts: int = 3,
+def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], free: Sequence[str], *, start: dict | None = None, starts: int = 3,
                            seed: int = 0, use_engine: bool = True, min_coherence: float = 0.5,
                            sigma_floor: float = 1e-3, correct: bool | None = None, max_corrections: int = 6,
                            correction_tol: float = 1e-4, absolute_sigma: bool = False,

@@ -23,12 +23,16 @@ python-control is imported only when a conversion is asked for (it costs seconds
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from taos.planar.freqresp import FrequencyResponse
 from taos.identify.estimation import MeasuredResponse
 from taos.linear import StateSpace
+
+if TYPE_CHECKING:
+    import control
 
 _DOT = "__"
 FR_INPUTS = ("command_rad",)
@@ -63,7 +67,7 @@ def to_control_ss(model, name: str | None = None):
                  states=[_out_name(s) for s in ss.states], **kw)
 
 
-def from_control_ss(sys) -> StateSpace:
+def from_control_ss(sys: control.LTI) -> StateSpace:
     """A continuous-time python-control LTI system (state space or transfer function) as a
     :class:`~taos.linear.StateSpace`, keeping its signal names. A transfer function is realised
     by ``control.ss`` first."""
@@ -139,7 +143,7 @@ def masv_freqresp_to_control(fr):
                [f"{a}.piston" for a in fr.actuators] + [f"{a}.theta_rad" for a in fr.actuators])
 
 
-def to_control(obj):
+def to_control(obj: object) -> control.StateSpace | control.FrequencyResponseData:
     """Whichever of the conversions above fits ``obj``: a StateSpace (or a system with
     ``state_space()``) -> ``control.StateSpace``; a FrequencyResponse, MeasuredResponse or MASV
     frequency response -> ``control.FrequencyResponseData``."""

@@ -105,7 +105,7 @@ def _client(workers: int | None, scheduler: str | None):
     return Client(cluster), cluster
 
 
-def run_campaign(c: Campaign, out_dir, *, runs: int, case: str | None = None, friction: str | None = None,
+def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | None = None, friction: str | None = None,
                  workers: int | None = None, scheduler: str | None = None, resume: bool = False,
                  progress: bool = False) -> CampaignResult:
     """Run ``runs`` dispersed runs of case ``case`` (and the nominal) of campaign ``c`` into

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -142,7 +143,7 @@ class FrequencyResponse:
         return d
 
 
-def linear_freqresp(model: TvcModel, freq_hz, axis: str = "pitch") -> FrequencyResponse:
+def linear_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, axis: str = "pitch") -> FrequencyResponse:
     """Exact response of the linear simplex block (no friction, unity avionics)."""
     ss = simplex_state_space(model, axis)
     h = ss.freqresp(freq_hz, "command_rad", ["x_p_m", "theta_rad"])
@@ -260,7 +261,8 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     return DwellPoints(h[:, 0] / R, h[:, 1], method, **{q: v[back] for q, v in extra.items()})
 
 
-def sine_dwell_grid(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", **kwargs):
+def sine_dwell_grid(model: TvcModel, amplitudes_rad: np.typing.ArrayLike, freq_hz: np.typing.ArrayLike,
+                    axis: str = "pitch", **kwargs: Any) -> tuple[np.ndarray, np.ndarray]:
     """Sine-dwell responses over a grid of amplitudes x frequencies in one parallel call
     (:func:`sine_dwell_points`, whose settings it takes). Returns (piston, engine) complex
     arrays of shape (n_amp, n_freq)."""
@@ -322,7 +324,7 @@ def family_to_dict(family: list[FrequencyResponse]) -> dict:
     return d
 
 
-def sine_dwell_freqresp(model: TvcModel, freq_hz, amplitude_rad: float, axis: str = "pitch",
-                        **kwargs) -> FrequencyResponse:
+def sine_dwell_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, amplitude_rad: float, axis: str = "pitch",
+                        **kwargs: Any) -> FrequencyResponse:
     """Amplitude-dependent response at one command amplitude [rad] (:func:`sine_dwell_family`)."""
     return sine_dwell_family(model, freq_hz, [amplitude_rad], axis, **kwargs)[0]

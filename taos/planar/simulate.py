@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
 from ..errors import SimulationUnstable
 from ..model import TvcModel
-from ..profiles import is_two_axis
+from ..profiles import Profile, is_two_axis
 from ..results import atomic_write, base_provenance, write_provenance
 from .simplex import LurePlant, simplex_plant
 
@@ -177,7 +177,7 @@ def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
             **more}
 
 
-def simulate(model: TvcModel, profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
+def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
              duration_s: float | None = None, progress: bool = False) -> TimeHistory:
     """Run ``profile`` through the simplex model (each axis its own planar model).
 

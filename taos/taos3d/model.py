@@ -290,7 +290,7 @@ def load_stiffness_file(path: str) -> tuple[np.ndarray, np.ndarray]:
     return check_stiffness(data.K_upper, path, "K_upper"), check_stiffness(data.K_lower, path, "K_lower")
 
 
-def taos_model(model: TvcModel, K_upper=None, K_lower=None) -> TaosModel:
+def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.ndarray | None = None) -> TaosModel:
     """Build the TAOS model from a loaded model file; ``K_upper``/``K_lower`` override the
     ``[gimbal] stiffness_file`` (for synthetic or scaled matrices)."""
     gim = parse_gimbal(model)

@@ -22,7 +22,7 @@ from ..planar.actuator import actuator_state_space
 from ..errors import SimulationUnstable
 from ..planar.freqresp import FrequencyResponse, deal_by_cost, settle_time_s
 from ..linear import StateSpace
-from ..profiles import is_two_axis
+from ..profiles import Profile, is_two_axis
 from ..planar.simulate import SolverSettings, TimeHistory, provenance
 from . import dynamics as _dy
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
@@ -133,7 +133,7 @@ def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int =
     return out
 
 
-def simulate_taos(tm: TaosModel, profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
+def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
                   duration_s: float | None = None) -> TaosTimeHistory:
     """Run ``profile`` (a single-axis profile drives pitch; two-axis drives both) through the
     TAOS model from rest; ``dt_s`` integration step [s]; ``duration_s`` default the profile's
@@ -227,7 +227,7 @@ def linear_state_space(tm: TaosModel) -> StateSpace:
                       ("x_p_pitch_m", "x_p_yaw_m", "theta_pitch_rad", "theta_yaw_rad"))
 
 
-def taos_freqresp(tm: TaosModel, freq_hz, amplitude_rad: float | None = None, axis: str = "pitch",
+def taos_freqresp(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitude_rad: float | None = None, axis: str = "pitch",
                   cross: bool = False, *, dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2,
                   measure_cycles: int = 2, settle_s: float | None = None,
                   min_steps_per_cycle: int = 64) -> FrequencyResponse:
@@ -250,7 +250,8 @@ def taos_freqresp(tm: TaosModel, freq_hz, amplitude_rad: float | None = None, ax
                                 min_steps_per_cycle=min_steps_per_cycle)[0]
 
 
-def taos_freqresp_family(tm: TaosModel, freq_hz, amplitudes_rad, axis: str = "pitch", cross: bool = False, *,
+def taos_freqresp_family(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitudes_rad: np.typing.ArrayLike,
+                         axis: str = "pitch", cross: bool = False, *,
                          dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
                          settle_s: float | None = None, min_steps_per_cycle: int = 64) -> list[FrequencyResponse]:
     """Sine-dwell responses of the TAOS model at every command amplitude [rad] x frequency

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import signal
 import threading
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
 from ..results import atomic_write
@@ -21,11 +23,15 @@ from .geometry import EngineDrawing, geometry_for_run
 from .kinematics import ViewerFrames, viewer_frames
 from .meshcat_backend import MeshcatVisualizer, OfflineWindow, legend_html, live_visualizer
 
+if TYPE_CHECKING:
+    from ..planar.simulate import TimeHistory
+    from ..taos3d.simulate import TaosTimeHistory
+
 __all__ = ["BaseVisualizer", "EngineDrawing", "MeshcatVisualizer", "OfflineWindow", "ViewerFrames",
            "load_run", "offline_html", "serve", "viewer_frames", "write_html"]
 
 
-def load_run(path):
+def load_run(path: str | Path) -> TimeHistory | TaosTimeHistory:
     """Read a ``taos simulate`` HDF5 run; InputError (one line) if it is not one."""
     from ..planar.simulate import TimeHistory
 
@@ -79,14 +85,14 @@ def offline_html(th, *, angle_scale: float = 1.0, deflection_scale: float | None
     return v.static_html(paused_at_s=paused_at_s)
 
 
-def write_html(th, path, **kwargs) -> None:
+def write_html(th: TimeHistory | TaosTimeHistory, path: str | Path, **kwargs: Any) -> None:
     """Write :func:`offline_html` to ``path`` atomically."""
     text = offline_html(th, **kwargs)
     atomic_write(path, lambda p: Path(p).write_text(text, encoding="utf-8"))
 
 
-def serve(th, *, angle_scale: float = 1.0, deflection_scale: float | None = None, fps: float = 100.0,
-          on_ready=print, stop: threading.Event | None = None, gimbal_scale: float | None = None) -> int:
+def serve(th: TimeHistory | TaosTimeHistory, *, angle_scale: float = 1.0, deflection_scale: float | None = None,
+          fps: float = 100.0, on_ready: Callable[[str], object] = print, stop: threading.Event | None = None, gimbal_scale: float | None = None) -> int:
     """Serve the animated run on 127.0.0.1 until SIGINT/SIGTERM (or ``stop`` is set).
 
     Calls ``on_ready(url)`` once the scene is loaded; returns 0 after shutting the server down."""
