@@ -52,7 +52,9 @@ if TYPE_CHECKING:
     from taos.model import TvcModel
     from taos.planar.freqresp import FrequencyResponse
     from taos.planar.simulate import TimeHistory
-    from taos.report.spec import SpecResult
+    from taos.identify.data import TestData
+    from taos.profiles import Profile
+    from taos.report.spec import SpecMask, SpecResult
 
 DEFAULT_PROFILE = models_dir() / "profiles" / "greenrun_two_axis.toml"
 DEFAULT_SPEC = models_dir() / "specs" / "tvc_actuator_notional.toml"
@@ -270,8 +272,10 @@ def _measured_responses(data) -> dict:
 
 # -- the analysis ------------------------------------------------------------------------------
 
-def greenrun(model, profile=None, *, engine: str = "simplex", friction: str | None = None, out=None,
-             dt_s: float | None = None, spec=DEFAULT_SPEC, data=None, allow_unstable: bool = False,
+def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None = None, *,
+             engine: str = "simplex", friction: str | None = None, out: str | Path | None = None,
+             dt_s: float | None = None, spec: SpecMask | str | Path | None = DEFAULT_SPEC,
+             data: TestData | str | Path | None = None, allow_unstable: bool = False,
              progress: bool = False, view_angle_scale: float = 5.0, view_fps: float = 100.0) -> GreenRunResult:
     """The Green Run analysis of ``model`` (see the module docstring); with ``out``, also the
     report folder (:meth:`GreenRunResult.write`).
