@@ -326,6 +326,17 @@ PARAMETER_SET_KEY = "parameter_set"
 REFERENCE_TORQUE_KEY = "reference_torque"
 
 
+def resolve_parameter_set(ref: str, model_path: Path) -> Path:
+    """Absolute path of a ``parameter_set`` named by the model file at ``model_path``: relative to
+    the model file, else to the shipped models folder (so a copied model file still finds it)."""
+    ppath = (Path(model_path).parent / ref).resolve()
+    if not ppath.is_file() and not Path(ref).is_absolute():
+        from .shipped import models_dir
+        if (models_dir() / ref).is_file():
+            ppath = (models_dir() / ref).resolve()
+    return ppath
+
+
 def _parameter_set(ref, model_path: Path, src: str, section: str) -> tuple[Path, dict]:
     """Path and ``[section]`` table of the parameter set ``ref`` named by a model file's
     ``[section] parameter_set`` (a path relative to the model file, else to the shipped models
@@ -333,11 +344,7 @@ def _parameter_set(ref, model_path: Path, src: str, section: str) -> tuple[Path,
     if not isinstance(ref, str) or not ref:
         raise InputError(src, f"{section}.{PARAMETER_SET_KEY}", f"a path to a {section} parameter-set TOML file",
                          got=repr(ref))
-    ppath = (Path(model_path).parent / ref).resolve()
-    if not ppath.is_file() and not Path(ref).is_absolute():
-        from .shipped import models_dir  # a copied model file still finds the shipped set
-        if (models_dir() / ref).is_file():
-            ppath = (models_dir() / ref).resolve()
+    ppath = resolve_parameter_set(ref, model_path)
     _, pdoc = read_toml(ppath, f"a readable {section} parameter-set file")
     shared = pdoc.get(section)
     if not isinstance(shared, Mapping):
@@ -403,6 +410,24 @@ def actuator_table_with_parameter_set(atab: Mapping, model_path: Path, src: str)
     ppath, shared = _parameter_set(ref, model_path, src, "actuator")
     _merge_parameter_set(table, shared, set(ACTUATOR_FILE_KEYS), ppath, ref, src, "actuator")
     return table
+
+
+def inline_actuator_parameter_set(doc, model_path: Path, src: str) -> bool:
+    """Replace ``[actuator] parameter_set`` in a tomlkit document of a model file by the set's
+    keys, so the file describes its own actuator (a fitted or edited actuator is a different
+    piece of hardware, hence no longer the shared set). Returns False if there was no set."""
+    import tomlkit
+
+    tab = doc.get("actuator")
+    if tab is None or PARAMETER_SET_KEY not in tab:
+        return False
+    ref = tab[PARAMETER_SET_KEY]
+    ppath, shared = _parameter_set(str(ref), Path(model_path), src, "actuator")
+    del tab[PARAMETER_SET_KEY]
+    tab.add(tomlkit.comment(f"inlined from the shared actuator set {ppath.as_posix()}: this file's own actuator"))
+    for k, v in shared.items():
+        tab[k] = v
+    return True
 
 
 def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> None:
