@@ -160,7 +160,7 @@ def test_one_actuator_parameter_set_for_the_one_servoactuator():
         assert set(d["actuator"]) == {"parameter_set"} | ACTUATOR_FILE_KEYS, n
     acts = [load_model(MODELS / f"{n}.toml").actuator for n in RS25]
     assert acts[0] == acts[1] == acts[2]
-    assert acts[0].loop_gain_per_s == 25.0 and acts[0].pressure_feedback_gain_m_per_s_Pa == pytest.approx(1.5e-8)
+    assert acts[0].loop_gain_per_s == 20.0 and acts[0].pressure_feedback_gain_m_per_s_Pa == pytest.approx(1e-8)
 
 
 def test_model_file_may_not_override_the_shared_actuator_set(tmp_path):
