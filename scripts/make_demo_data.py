@@ -8,7 +8,10 @@ and yaw at the same time at different frequencies, 0.4 deg up to 7 Hz and 0.8 de
 * ambient:  models/rs25_ambient.toml, K_L = 115,000 lbf/in, friction "none" (the paper,
   sec. 1: friction was negligible in the unloaded gimbal);
 * hot fire: models/rs25_hotfire.toml, K_L = 205,000 lbf/in, its modified LuGre friction
-  (144,000 in-lbf bounding level).
+  (117,525 in-lbf: mu N r_b at the 1,860 kN sea-level thrust).
+
+Both files carry the one servoactuator parameter set models/actuators/tvc_actuator.toml (the
+flight-actuator calibration of issue 24.1): regenerate the datasets whenever it changes.
 
 Then: sampled at 250 Hz, Gaussian sensor noise (piston 0.001 in RMS, engine 0.004 deg RMS)
 and a constant engine-angle offset per axis (string pots without an absolute reference,

@@ -5,13 +5,19 @@ physical value is a string with its unit, parsed by pint (:mod:`taos.units`). Th
 a contract (model files written for one release load in the next)::
 
     [engine]    mass, inertia_pitch, inertia_yaw, rotational_stiffness, (thrust)
-    [actuator]  moment_arm, piston_area, supply_pressure, oil_bulk_modulus, trapped_volume,
+    [actuator]  moment_arm, (parameter_set), piston_area, supply_pressure, oil_bulk_modulus, trapped_volume,
                 piston_mass, piston_damping, loop_gain, valve_natural_frequency,
                 valve_damping_ratio, valve_order, flow_pressure_coefficient, leakage_coefficient,
                 (pressure_feedback_gain, pressure_feedback_time_constant)
     [structure] load_stiffness
     [friction]  model, coulomb_torque and the law's own parameters (taos.friction)
     [avionics]  quantization_bits, command_range, rounding, crossover_command, crossover_gain
+
+Shared hardware: ``[actuator] parameter_set`` and ``[friction] parameter_set`` name one TOML
+file per piece of hardware (``models/actuators/tvc_actuator.toml``,
+``models/friction/rs25_gimbal.toml``) whose table is merged into the section; a key given in
+both places is an error (:func:`actuator_table_with_parameter_set`,
+:func:`friction_table_with_parameter_set`).
 
 Other sections (``[gimbal]``, ``[geometry]``) belong to the 3-D model and are kept as raw
 tables in :attr:`TvcModel.extra` for it to validate.
@@ -320,6 +326,47 @@ PARAMETER_SET_KEY = "parameter_set"
 REFERENCE_TORQUE_KEY = "reference_torque"
 
 
+def resolve_parameter_set(ref: str, model_path: Path) -> Path:
+    """Absolute path of a ``parameter_set`` named by the model file at ``model_path``: relative to
+    the model file, else to the shipped models folder (so a copied model file still finds it)."""
+    ppath = (Path(model_path).parent / ref).resolve()
+    if not ppath.is_file() and not Path(ref).is_absolute():
+        from .shipped import models_dir
+        if (models_dir() / ref).is_file():
+            ppath = (models_dir() / ref).resolve()
+    return ppath
+
+
+def _parameter_set(ref, model_path: Path, src: str, section: str) -> tuple[Path, dict]:
+    """Path and ``[section]`` table of the parameter set ``ref`` named by a model file's
+    ``[section] parameter_set`` (a path relative to the model file, else to the shipped models
+    folder, so a copied model file still finds it)."""
+    if not isinstance(ref, str) or not ref:
+        raise InputError(src, f"{section}.{PARAMETER_SET_KEY}", f"a path to a {section} parameter-set TOML file",
+                         got=repr(ref))
+    ppath = resolve_parameter_set(ref, model_path)
+    _, pdoc = read_toml(ppath, f"a readable {section} parameter-set file")
+    shared = pdoc.get(section)
+    if not isinstance(shared, Mapping):
+        raise InputError(str(ppath), f"[{section}]", f"a [{section}] table of the hardware's parameters",
+                         got="nothing (section missing)")
+    return ppath, dict(shared)
+
+
+def _merge_parameter_set(table: dict, shared: Mapping, file_only: set[str], ppath: Path, ref: str,
+                         src: str, section: str) -> None:
+    """Merge the set's keys into the model file's ``table`` in place: a key in both places is an
+    error (one piece of hardware, one value), and so is a key of ``file_only`` in the set."""
+    for k in sorted(shared):
+        if k in file_only or k == PARAMETER_SET_KEY:
+            raise InputError(str(ppath), f"{section}.{k}", "hardware parameters only (this key belongs to "
+                             "the model file)", got="a model-file key")
+        if k in table:
+            raise InputError(src, f"{section}.{k}", f"no value here: it is set once, in the parameter set {ref}",
+                             got="a second value for the same hardware")
+        table[k] = shared[k]
+
+
 def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str) -> dict:
     """The ``[friction]`` table with its shared parameter set merged in.
 
@@ -333,32 +380,54 @@ def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str)
     ref = table.pop(PARAMETER_SET_KEY, None)
     if ref is None:
         return table
-    if not isinstance(ref, str) or not ref:
-        raise InputError(src, f"friction.{PARAMETER_SET_KEY}", "a path to a friction parameter-set TOML file",
-                         got=repr(ref))
-    ppath = (Path(model_path).parent / ref).resolve()
-    if not ppath.is_file() and not Path(ref).is_absolute():
-        from .shipped import models_dir  # a copied model file still finds the shipped set
-        if (models_dir() / ref).is_file():
-            ppath = (models_dir() / ref).resolve()
-    _, pdoc = read_toml(ppath, "a readable friction parameter-set file")
-    shared = pdoc.get("friction")
-    if not isinstance(shared, Mapping):
-        raise InputError(str(ppath), "[friction]", "a [friction] table of law parameters",
-                         got="nothing (section missing)")
-    shared = dict(shared)
+    ppath, shared = _parameter_set(ref, model_path, src, "friction")
     ref_torque = shared.pop(REFERENCE_TORQUE_KEY, None)
-    for k in sorted(shared):
-        if k in ("model", PARAMETER_SET_KEY):
-            raise InputError(str(ppath), f"friction.{k}", "law parameters only (model is chosen by the model file)",
-                             got="a model-file key")
-        if k in table:
-            raise InputError(src, f"friction.{k}", f"no value here: it is set once, in the parameter set {ref}",
-                             got="a second value for the same hardware")
-        table[k] = shared[k]
+    _merge_parameter_set(table, shared, {"model"}, ppath, ref, src, "friction")
     if ref_torque is not None:
         _scale_to_torque_level(table, ref_torque, str(ppath), src)
     return table
+
+
+#: ``[actuator]`` keys of the installation and the modelling choice, not of the actuator
+#: hardware: they stay in each model file and a parameter set may not carry them
+ACTUATOR_FILE_KEYS = frozenset({"moment_arm", "pressure_limited"})
+
+
+def actuator_table_with_parameter_set(atab: Mapping, model_path: Path, src: str) -> dict:
+    """The ``[actuator]`` table with its shared parameter set merged in.
+
+    ``[actuator] parameter_set = "actuators/tvc_actuator.toml"`` names a TOML file whose
+    ``[actuator]`` table holds the servoactuator hardware (piston, oil, servovalve, loop gain,
+    dynamic pressure feedback, rate limit): one piece of hardware, one set, shared by the
+    ambient, hot-fire and flight files. The model file keeps the installation (``moment_arm``,
+    the DESIGN.md contract key) and the modelling switch ``pressure_limited``. As for the
+    friction set, a key in both places is an error: a different actuator is a different set.
+    """
+    table = dict(atab)
+    ref = table.pop(PARAMETER_SET_KEY, None)
+    if ref is None:
+        return table
+    ppath, shared = _parameter_set(ref, model_path, src, "actuator")
+    _merge_parameter_set(table, shared, set(ACTUATOR_FILE_KEYS), ppath, ref, src, "actuator")
+    return table
+
+
+def inline_actuator_parameter_set(doc, model_path: Path, src: str) -> bool:
+    """Replace ``[actuator] parameter_set`` in a tomlkit document of a model file by the set's
+    keys, so the file describes its own actuator (a fitted or edited actuator is a different
+    piece of hardware, hence no longer the shared set). Returns False if there was no set."""
+    import tomlkit
+
+    tab = doc.get("actuator")
+    if tab is None or PARAMETER_SET_KEY not in tab:
+        return False
+    ref = tab[PARAMETER_SET_KEY]
+    ppath, shared = _parameter_set(str(ref), Path(model_path), src, "actuator")
+    del tab[PARAMETER_SET_KEY]
+    tab.add(tomlkit.comment(f"inlined from the shared actuator set {ppath.as_posix()}: this file's own actuator"))
+    for k, v in shared.items():
+        tab[k] = v
+    return True
 
 
 def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> None:
@@ -398,7 +467,8 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     if "name" in doc and not isinstance(doc["name"], str):
         raise InputError(src, "name", "a text name", got=repr(doc["name"])[:60])
     engine = parse_engine(doc, src)
-    actuator = parse_actuator(doc, src)
+    atab = actuator_table_with_parameter_set(_section(doc, "actuator", src), p, src)
+    actuator = parse_actuator({"actuator": atab}, src)
     st = _section(doc, "structure", src)
     _check_keys(st, {"load_stiffness", "load_damping_ratio"}, src, "structure")
     structure = Structure(_need(st, "load_stiffness", "stiffness", src, "structure", positive=True),

@@ -28,3 +28,15 @@ def run_cli(*args, prog="taos", cwd=ROOT):
     """Run the console script in a subprocess; returns CompletedProcess (text)."""
     exe = Path(sys.executable).parent / prog
     return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=300)
+
+
+def inline_actuator_set(text: str, path: Path = MODELS / "rs25_ambient.toml") -> str:
+    """Model-file text with its ``[actuator] parameter_set`` replaced by the set's keys, so a test
+    can edit an actuator value in a copy (the shared set itself may not be overridden)."""
+    import tomlkit
+
+    from taos.model import inline_actuator_parameter_set
+
+    doc = tomlkit.parse(text)
+    inline_actuator_parameter_set(doc, path, str(path))
+    return tomlkit.dumps(doc)

@@ -17,6 +17,8 @@ from typing import Callable
 import numpy as np
 import pytest
 
+from .conftest import inline_actuator_set
+
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
 AMBIENT = MODELS / "rs25_ambient.toml"
@@ -27,8 +29,9 @@ DATA = MODELS / "data" / "greenrun_ambient_synthetic.csv"
 # -- helpers that write bad files ---------------------------------------------------------------
 
 def model_text() -> str:
-    """The ambient model with its stiffness file made absolute (so copies work anywhere)."""
-    t = AMBIENT.read_text()
+    """The ambient model with its stiffness file made absolute (so copies work anywhere) and its
+    shared actuator set inlined."""
+    t = inline_actuator_set(AMBIENT.read_text(), AMBIENT)  # actuator keys editable in the copy
     return t.replace('stiffness_file = "../fem_data/', f'stiffness_file = "{ROOT}/fem_data/')
 
 

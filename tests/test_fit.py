@@ -162,8 +162,10 @@ def test_fitted_model_file_has_units_comments_and_loads_back(tmp_path):
     source = (MODELS / "rs25_hotfire.toml").read_text().splitlines()
     kept = set(text.splitlines())
     changed = [x for x in source if x not in kept]
-    # parameter_set is rewritten to an absolute path so the fitted file still reaches the shared set
-    assert [x.split("=")[0].strip() for x in changed] == ["name", "load_stiffness", "model", "parameter_set"], changed
+    # each parameter_set ([actuator], [friction]) is rewritten to an absolute path so the fitted
+    # file still reaches the shared set
+    assert [x.split("=")[0].strip() for x in changed] == ["name", "parameter_set", "load_stiffness", "model",
+                                                          "parameter_set"], changed
     back = load_model(out)
     assert back.structure.load_stiffness_N_per_m == pytest.approx(r.values[0], rel=1e-5)
     assert back.actuator == truth.actuator and back.engine == truth.engine

@@ -34,9 +34,16 @@ def test_response_figures_of_a_second_order_system_match_the_closed_forms(zeta):
 def test_coulomb_hysteresis_and_threshold_follow_the_friction_band():
     """Slow triangle with stick-slip Coulomb friction: at zero command the engine lags by
     T_c / (K_L R^2 + K_n) either way, so the loop is 2 T_c / (K_L R^2 + K_n) wide; a step
-    cannot move the engine half way before it exceeds the breakaway deflection T_c / (K_L R^2)."""
+    cannot move the engine half way before it exceeds the breakaway deflection T_c / (K_L R^2).
+    K_L is everything outside the actuator loop; in series with it, the slow triangle also sees the
+    servo's static compliance (K_c + C_l) / (A^2 K_v) (the pressure feedback is washed out), 9 %
+    of the band with the flight-like servo of issue 24 (4.8 % with the previous K_v = 40 1/s)."""
     m = load_model(MODELS / "rs25_hotfire.toml", friction="coulomb-switching")
     R, KL, Kn = m.actuator.moment_arm_m, m.structure.load_stiffness_N_per_m, m.engine.rotational_stiffness_Nm_per_rad
+    a = m.actuator
+    c_servo = (a.flow_pressure_coefficient_m3_per_s_Pa + a.leakage_coefficient_m3_per_s_Pa) / (
+        a.piston_area_m2 ** 2 * a.loop_gain_per_s)
+    KL = 1.0 / (1.0 / KL + c_servo)
     band = math.degrees(2 * m.friction.coulomb_torque_Nm / (KL * R * R + Kn))
     st = step_merit(m)
     print(st)

@@ -144,6 +144,46 @@ def test_model_file_may_not_override_the_shared_friction_set(tmp_path):
     assert "friction.bristle_stiffness" in str(e.value) and "parameter set" in str(e.value)
 
 
+def test_one_actuator_parameter_set_for_the_one_servoactuator():
+    """Issue 24: the three files describe one TVC servoactuator, so its hardware (piston, oil,
+    servovalve, loop gain, dynamic pressure feedback, rate limit) comes from one shared file
+    that none of them repeats; each keeps the installation key moment_arm (the DESIGN.md
+    contract) and the modelling switch pressure_limited, which the set may not carry."""
+    from taos.model import ACTUATOR_FILE_KEYS
+    docs = {n: tomllib.loads((MODELS / f"{n}.toml").read_text()) for n in RS25}
+    shared = tomllib.loads((MODELS / "actuators" / "tvc_actuator.toml").read_text())["actuator"]
+    assert {"loop_gain", "pressure_feedback_gain", "pressure_feedback_time_constant", "piston_area",
+            "flow_pressure_coefficient", "valve_natural_frequency"} <= set(shared)
+    assert not set(shared) & ACTUATOR_FILE_KEYS
+    for n, d in docs.items():
+        assert d["actuator"]["parameter_set"] == "actuators/tvc_actuator.toml", n
+        assert set(d["actuator"]) == {"parameter_set"} | ACTUATOR_FILE_KEYS, n
+    acts = [load_model(MODELS / f"{n}.toml").actuator for n in RS25]
+    assert acts[0] == acts[1] == acts[2]
+    assert acts[0].loop_gain_per_s == 20.0 and acts[0].pressure_feedback_gain_m_per_s_Pa == pytest.approx(1e-8)
+
+
+def test_model_file_may_not_override_the_shared_actuator_set(tmp_path):
+    text = (MODELS / "rs25_hotfire.toml").read_text()
+    p = tmp_path / "hot.toml"
+    old = 'parameter_set = "actuators/tvc_actuator.toml"'
+    assert old in text
+    p.write_text(text.replace(old, old + '\nloop_gain = "40 1/s"'))
+    with pytest.raises(InputError) as e:
+        load_model(p)
+    assert "actuator.loop_gain" in str(e.value) and "parameter set" in str(e.value)
+    # a copied model file still finds the shipped set (relative to the shipped models folder)
+    p.write_text(text)
+    assert load_model(p).actuator == load_model(MODELS / "rs25_hotfire.toml").actuator
+    # the set may not carry the installation: moment_arm stays in each model file
+    bad = tmp_path / "set.toml"
+    bad.write_text((MODELS / "actuators" / "tvc_actuator.toml").read_text() + 'moment_arm = "0.9 m"\n')
+    p.write_text(text.replace(old, f'parameter_set = "{bad.as_posix()}"'))
+    with pytest.raises(InputError) as e:
+        load_model(p)
+    assert "actuator.moment_arm" in str(e.value) and str(bad) in str(e.value)
+
+
 @pytest.mark.parametrize("name", RS25)
 def test_planar_friction_level_is_mu_N_rb_as_in_taos(name):
     """Issue 12.1: the planar torque level follows the bearing normal load exactly as the 3-D

@@ -19,6 +19,8 @@ import pytest
 
 from taos.cli import main
 
+from .conftest import inline_actuator_set
+
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
 AMBIENT = MODELS / "rs25_ambient.toml"
@@ -41,7 +43,7 @@ cycles = 3
 
 def unstable_model(tmp: Path) -> Path:
     """The ambient model without dynamic pressure feedback and without friction (issue example)."""
-    t = AMBIENT.read_text().replace('stiffness_file = "../fem_data/', f'stiffness_file = "{ROOT}/fem_data/')
+    t = inline_actuator_set(AMBIENT.read_text(), AMBIENT).replace('stiffness_file = "../fem_data/', f'stiffness_file = "{ROOT}/fem_data/')
     t = re.sub(r'(?m)^pressure_feedback_gain\s*=.*$', 'pressure_feedback_gain = "0 m/s/Pa"', t)
     t = re.sub(r'(?m)^model\s*=.*$', 'model = "none"', t, count=1)
     p = tmp / "unstable.toml"
@@ -211,7 +213,7 @@ def test_info_shows_the_unstable_mode(tmp_path, capsys):
 def test_leaving_the_envelope_stops_with_exit_3_naming_time_state_and_cause(tmp_path, capsys):
     """A supply pressure far too low for the load (stall force A P_s tiny): the load force
     leaves the envelope; the run stops with exit 3 and writes nothing."""
-    t = AMBIENT.read_text().replace('stiffness_file = "../fem_data/', f'stiffness_file = "{ROOT}/fem_data/')
+    t = inline_actuator_set(AMBIENT.read_text(), AMBIENT).replace('stiffness_file = "../fem_data/', f'stiffness_file = "{ROOT}/fem_data/')
     t = re.sub(r'(?m)^supply_pressure\s*=.*$', 'supply_pressure = "5 psi"', t)
     model = tmp_path / "weak.toml"
     model.write_text(t)

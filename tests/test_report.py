@@ -154,23 +154,28 @@ def test_report_shows_figures_of_merit_and_spec_mask_result(report, hotfire, tmp
     k = int(np.argmax(np.abs(he)))
     assert e["low_frequency_gain_db"] + e["peak_gain_db"] == pytest.approx(20 * np.log10(abs(he[k])), abs=0.01)
     assert e["peak_freq_hz"] == pytest.approx(fd[k], abs=0.002)
-    assert e["phase_90_hz"] == pytest.approx(4.74, abs=0.02)
-    assert 6.5 < e["bandwidth_3db_hz"] < 7.6
+    # -90 deg and -3 dB read off the dense grid (the old, peakier servo: 4.74 Hz and 7.3 Hz)
+    ph = np.unwrap(np.angle(he)) * 180 / np.pi
+    g = 20 * np.log10(np.abs(he))
+    assert e["phase_90_hz"] == pytest.approx(fd[np.argmax(ph < -90)], abs=0.02)   # 4.09 Hz
+    assert e["bandwidth_3db_hz"] == pytest.approx(fd[np.argmax(g < e["low_frequency_gain_db"] - 3)], abs=0.05)
     assert fm["notch_hz"] == pytest.approx(s["notch_frequency_hz"]["pitch"], rel=1e-9)
     st = fm["step"]
     assert 0.01 < st["rise_time_s"] < 0.2 and st["overshoot_pct"] >= 0 and st["threshold_deg"] > 0
-    assert s["spec_pass"] is False      # the notional servo peaks ~ +12 dB: the mask's 4-5 Hz bounds fail
-    fails = s["spec"]["pitch"]["failures"]
-    assert fails and all("engine gain" in f for f in fails)
+    # the recalibrated flight-like servo (models/actuators/tvc_actuator.toml) peaks +4.3 dB at hot
+    # fire, inside the mask's 4-5 Hz bounds (+6 dB): the linear response passes; the old servo's
+    # +11.7 dB failed them. Green Run's shortfalls from their real causes (friction, load
+    # stiffness, avionics) are issue 24.3
+    assert s["spec_pass"] is True and not s["spec"]["pitch"]["failures"]
     page = (out / "index.html").read_text()
-    assert 'id="figures-of-merit"' in page and 'id="spec-mask"' in page and "FAIL" in page
+    assert 'id="figures-of-merit"' in page and 'id="spec-mask"' in page and "PASS" in page
     assert f"{e['peak_gain_db']:+.2f} dB at {e['peak_freq_hz']:.2f} Hz" in page
     img = screenshot((out / "index.html").as_uri(), tmp_path / "merit.png", budget_ms=4000, offline=True,
                      size=(1200, 2400))
     below_view = img[1100:]                      # the sections after the 3-D view
-    red = (below_view[..., 0] > 170) & (below_view[..., 1] < 90) & (below_view[..., 2] < 90)   # FAIL in red
+    green = (below_view[..., 0] < 80) & (below_view[..., 1] > 100) & (below_view[..., 2] < 90)  # PASS in green (#1a7f37)
     dark = (below_view < 120).all(axis=2)
-    assert red.sum() > 200 and dark.mean() > 0.005, "figures of merit / spec-mask tables not rendered"
+    assert green.sum() > 200 and dark.mean() > 0.005, "figures of merit / spec-mask tables not rendered"
 
 
 def test_report_overlays_the_measured_record_on_the_model(report):

@@ -45,7 +45,7 @@ import numpy as np
 from taos.errors import InputError
 from taos.identify.estimation import MeasuredResponse
 from taos.identify.surrogate import PARAMETERS, build_surrogate, check_free, solve_implicit
-from taos.model import TvcModel, load_model
+from taos.model import TvcModel, inline_actuator_parameter_set, load_model, resolve_parameter_set
 from taos.results import atomic_write
 from taos.units import from_si
 
@@ -442,10 +442,14 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
     if result.initial.friction.name != file_law:
         todo[("friction", "model")] = (result.initial.friction.name,
                                        f'# law used by the fit (--friction; the file had "{file_law}")')
-    ref = doc.get("friction", {}).get("parameter_set")
-    if ref:  # the shared friction set is named relative to the model file: keep it reachable
-        toml_set(doc, "friction", "parameter_set", (Path(src).parent / str(ref)).resolve().as_posix(),
-                 f"the shared set of {Path(src).name}")
+    if any(s == "actuator" and k not in doc.get("actuator", {}) for s, k in todo):
+        # a fitted actuator value: the fitted file describes its own actuator, not the shared set
+        inline_actuator_parameter_set(doc, Path(src), src)
+    for section in ("actuator", "friction"):
+        ref = doc.get(section, {}).get("parameter_set")
+        if ref:  # a shared set is named relative to the model file: keep it reachable
+            toml_set(doc, section, "parameter_set", resolve_parameter_set(str(ref), Path(src)).as_posix(),
+                     f"the shared set of {Path(src).name}")
     if "name" in doc:
         toml_set(doc, "", "name", f"{result.initial.name} (fitted)")
     for (section, key), (value, comment) in todo.items():

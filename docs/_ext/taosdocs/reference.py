@@ -42,6 +42,7 @@ MEANINGS: dict[str, str] = {
     "engine.hard_stop_stiffness": "rotational stiffness of the hard-stop contact",
     "engine.hard_stop_damping_ratio": "damping ratio of the hard-stop contact",
     "friction.parameter_set": "the shared friction parameter set of the bearing (a TOML file)",
+    "actuator.parameter_set": "the shared parameter set of the servoactuator hardware (a TOML file)",
     "vehicle.bending_frequency": "first bending mode frequency (0: no bending mode)",
     "vehicle.bending_damping_ratio": "damping ratio of the first bending mode",
     "vehicle.bending_gain": "bending-mode slope gain at the sensor and gimbal (rigid-body units)",
@@ -164,7 +165,8 @@ def model_key_table() -> dict[str, list[tuple[str, str, str]]]:
                      ("thrust", _si("force"), "optional"), ("gimbal_range", _si("angle"), "optional"),
                      ("hard_stop_stiffness", _si("rotational_stiffness"), "optional"),
                      ("hard_stop_damping_ratio", "1", "optional")]
-    act = [(k, _si(kind), chk) for k, (kind, chk) in M._ACTUATOR_FIELDS.items()]
+    act = [("parameter_set", "path", "shared set")]
+    act += [(k, _si(kind), chk) for k, (kind, chk) in M._ACTUATOR_FIELDS.items()]
     act.append(("valve_order", "1 or 2", "whole number"))
     if not any(k == "pressure_limited" for k, _, _ in act):
         act.append(("pressure_limited", "true or false", "optional"))
