@@ -206,3 +206,13 @@ def test_python_m_taos_help():
     proc = _run("-m", "taos", "--help")
     assert proc.returncode == 0, proc.stderr
     assert "greenrun" in proc.stdout
+
+
+def test_the_top_level_keeps_to_the_shared_foundations():
+    """The engines live in their packages (taos.planar beside taos.taos3d); directly under taos/
+    stay the shared foundations, at most 14 files (__init__ and __main__ included)."""
+    top = sorted(p.name for p in (ROOT / "taos").glob("*.py"))
+    assert len(top) <= 14, top
+    assert (ROOT / "taos" / "planar" / "__init__.py").exists() and (ROOT / "taos" / "taos3d" / "__init__.py").exists()
+    for engine_module in ("simplex", "simulate", "freqresp", "steady", "actuator", "avionics"):
+        assert not (ROOT / "taos" / f"{engine_module}.py").exists(), engine_module
