@@ -69,8 +69,8 @@ BASES = ("linear", "dwell", "measured", "step")
 #: the laboratory ("rigid") load stiffness [N/m]: 1e9 N/m = 5.7e6 lbf/in, 28 x the hot-fire and
 #: 50 x the ambient K_L and 4 x the oil column (2.4e8 N/m), so the load resonance (36 Hz with the
 #: shipped J_n and R) is far above the servo's band: the shipped servo's engine response is then
-#: within 0.14 dB and 0.8 deg of a truly rigid load (K_L = 1e12 N/m) at 5 Hz and within 0.01 dB /
-#: 0.01 deg up to 2 Hz, while the fastest mode (sqrt((K_L + oil column) / M_p), 5,200 rad/s)
+#: within 0.2 dB and 0.8 deg of a truly rigid load (K_L = 1e12 N/m) at 5 Hz and within 0.03 dB /
+#: 0.1 deg up to 2 Hz, while the fastest mode (sqrt((K_L + oil column) / M_p), 5,200 rad/s)
 #: stays integrable by the explicit step (dt |lambda|max = 1.05 at 2e-4 s; a truly rigid 1e12
 #: would need a 100 x smaller step)
 LAB_LOAD_STIFFNESS_N_PER_M = 1e9
@@ -152,7 +152,8 @@ class Bound:
 @dataclass(frozen=True)
 class SpecCheck:
     """One mask point on one basis and axis (module docstring): its bounds, and for a failing
-    point the ``cause`` and whether each removal (``"friction"``, ..., ``"servo"``) passed."""
+    point the ``cause`` and whether each removal (``"friction"``, ..., ``"servo"``) passed (a
+    measured point also ``"model_dwell"``: the unmodified model's dwell at that point)."""
 
     basis: str
     axis: str
@@ -333,7 +334,7 @@ def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s
         if basis == "measured":    # does the model itself fail there?
             own = _reevaluate(model, [dataclasses.replace(c, basis="dwell") for c in group], mask, dt_s)
             for j, ok in enumerate(own):
-                removed[j]["model"] = ok
+                removed[j]["model_dwell"] = ok
             todo = [j for j in todo if not own[j]]
         for variant in CAUSES + ("servo",):
             if variant == "servo":   # only where no single removal passed
@@ -346,7 +347,7 @@ def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s
                 removed[j][variant] = ok
         for j, i in enumerate(idx):
             rem = removed[j]
-            if rem.get("model"):
+            if rem.get("model_dwell"):
                 cause = ("unexplained",)
             else:
                 cause = cause_of({c: rem.get(c, False) for c in CAUSES}, rem.get("servo"))
@@ -407,8 +408,8 @@ class Verdict:
             if cause in (("combined",), ("servo",), ("unexplained",)):
                 why = CAUSE_WORDS[cause[0]]
             else:
-                why = _and([CAUSE_WORDS[c] for c in cause]) + (" (removing any one of them passes)" if len(cause) > 1
-                                                               else "")
+                why = _and([CAUSE_WORDS[c] for c in cause]) + (", either of which removed alone passes"
+                                                               if len(cause) > 1 else "")
             parts.append(f"at {_and(where)} ({', '.join(cb)}; worst: {worst.where()} {worst.worst().words()}) "
                          f"because of {why}")
         s = f"{self.model_name}: fails the mask ({self.mask_name}) " + "; and ".join(parts)
