@@ -392,7 +392,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     from taos.planar.freqresp import FrequencyResponse
     from taos.planar.simplex import load_resonance_from_notch
 
-    steps = ["simulate", "linear response", "sine dwell"] + (["spec verdict"] if mask is not None else []) + (["plots", "3-D view", "write"] if out is not None else [])
+    steps = ["simulate", "linear response", "sine dwell"] + (["plots", "3-D view", "write"] if out is not None else [])
     bar = tqdm(total=len(steps), desc="greenrun", unit="step", file=sys.stderr, disable=not progress)
     try:
         bar.set_postfix_str("simulate")
@@ -430,13 +430,11 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
             dwell[ax] = tuple(FrequencyResponse(np.array(freqs), p[i], e[i], a, ax, friction_model=model.friction.name)
                               for i, a in enumerate(amps))
         run = {ax: tuple(frs) for ax, frs in run_responses(th, prof, model.actuator.moment_arm_m).items()}
-        bar.update()
-
         verdict = None
-        if mask is not None:
+        if mask is not None:   # part of the dwell step: the mask's dwells and the causes' re-runs
             bar.set_postfix_str("spec verdict")
             verdict = _verdict(model, mask, prof, measured, info, dt_s)
-            bar.update()
+        bar.update()
 
         result = GreenRunResult(
             model=model, profile=prof, profile_file=profile_file, engine=engine, dt_s=dt_s, time_history=th,
