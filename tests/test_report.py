@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import html
 import json
 import math
 import re
@@ -190,6 +191,29 @@ def test_report_overlays_the_measured_record_on_the_model(report):
         assert p["piston_gain_db"] == pytest.approx(p["model_piston_gain_db"], abs=0.3)
         assert p["engine_gain_db"] == pytest.approx(p["model_engine_gain_db"], abs=0.3)
     assert "Test record vs model" in (out / "index.html").read_text()
+
+
+def test_report_says_why_the_model_fails_its_mask(report):
+    """Issue 24.3: the mask on the linear, dwell, measured and step bases; each failing point
+    names its cause; the verdict in words is the report's first line (CLI, summary.json, page).
+    Hot fire: the linear servo passes, the 0.4 deg dwells and the measured record fail through
+    gimbal friction (tests/test_verdict.py pins the model's numbers)."""
+    out, r = report
+    s = json.loads((out / "summary.json").read_text())
+    assert s["spec_pass"] is True                                   # the linear response, as before
+    assert s["spec_pass_by_basis"] == {"linear": True, "dwell": False, "measured": False, "step": True}
+    assert s["spec_verdict_pass"] is False
+    assert {p["basis"] for p in s["spec_points"]} == {"linear", "dwell", "measured", "step"}
+    fails = [p for p in s["spec_points"] if not p["pass"]]
+    assert fails and all("friction" in p["cause"] for p in fails)
+    assert all(p["cause"] is None for p in s["spec_points"] if p["pass"])
+    text = s["spec_verdict_text"]
+    assert "because of gimbal friction" in text and text.endswith("the linear servo passes.")
+    assert r.stdout.splitlines()[0] == text
+    page = (out / "index.html").read_text()
+    h1 = page.index("</h1>")
+    assert page.index('id="spec-verdict"') - h1 < 20 and html.escape(text) in page
+    assert 'id="spec-verdict-table"' in page
 
 
 def test_every_command_reports_the_same_piston_gain_and_phase(report, tmp_path):

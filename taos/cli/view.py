@@ -49,9 +49,11 @@ def cmd_greenrun(args) -> int:
     from taos.report.analysis import DEFAULT_SPEC, greenrun
 
     spec = None if args.spec == "none" else (args.spec or DEFAULT_SPEC)
-    greenrun(args.model, args.profile, engine=args.engine, friction=args.friction, out=args.out,
-             spec=spec, data=args.data, allow_unstable=args.allow_unstable, progress=not args.quiet)
+    res = greenrun(args.model, args.profile, engine=args.engine, friction=args.friction, out=args.out,
+                   spec=spec, data=args.data, allow_unstable=args.allow_unstable, progress=not args.quiet)
     out = Path(args.out)
+    if res.spec_verdict_text:
+        print(res.spec_verdict_text)
     print(f"wrote {out / 'index.html'} and {out / 'greenrun.h5'}")
     return 0
 

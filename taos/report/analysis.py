@@ -17,8 +17,10 @@ computes per axis:
   two whole cycles (:func:`taos.harmonics.fit_sines`), H = (a + j b) / A (piston as
   x_p / (R theta_c));
 * the figures of merit and the model's derived figures (:func:`taos.report.summary.model_summary`),
-  the spec-mask verdict (:mod:`taos.report.spec`) and, given a measured record, its estimated
-  responses (:func:`taos.identify.estimation.estimate`).
+  the spec-mask check of the linear response (:mod:`taos.report.spec`) and, given a measured
+  record, its estimated responses (:func:`taos.identify.estimation.estimate`);
+* the mask on every basis (linear, nonlinear dwell, measured, step) with the cause of each
+  failing point, and the verdict in words (:mod:`taos.report.verdict`).
 
 The result, :class:`GreenRunResult`, holds all of it; ``.summary()`` is the ``summary.json``
 dict and ``.write(DIR)`` writes the report folder: ``DIR/index.html`` (self-contained, drawn by
@@ -55,6 +57,7 @@ if TYPE_CHECKING:
     from taos.identify.data import TestData
     from taos.profiles import Profile
     from taos.report.spec import SpecMask, SpecResult
+    from taos.report.verdict import Verdict
 
 DEFAULT_PROFILE = models_dir() / "profiles" / "greenrun_two_axis.toml"
 DEFAULT_SPEC = models_dir() / "specs" / "tvc_actuator_notional.toml"
@@ -143,6 +146,9 @@ class GreenRunResult:
     spec: Mapping[str, SpecResult] = field(default_factory=dict)
     #: a measured record's estimated responses per axis (None when none was given)
     measured: Mapping[str, MeasuredResponse] | None = None
+    #: the mask on every basis (linear, dwell, measured, step) with each shortfall's cause
+    #: (:func:`taos.report.verdict.spec_verdict`; None when no mask was checked)
+    verdict: Verdict | None = None
     #: when the analysis finished (UTC, ISO 8601)
     created_utc: str = ""
 
@@ -152,8 +158,14 @@ class GreenRunResult:
         return self.model_info["figures_of_merit"]
 
     @property
+    def spec_verdict_text(self) -> str | None:
+        """In words, why the model fails (or passes) its mask (:meth:`taos.report.verdict.Verdict.text`)."""
+        return None if self.verdict is None else self.verdict.text()
+
+    @property
     def spec_pass(self) -> bool | None:
-        """All axes within the spec mask (None when no mask was checked)."""
+        """All axes' LINEAR responses within the spec mask (None when no mask was checked); the
+        verdict on every basis is ``verdict.passed``."""
         return all(r.passed for r in self.spec.values()) if self.spec else None
 
     def dwell_grid(self, axis: str) -> dict:
@@ -247,15 +259,34 @@ def _profile_of(profile) -> tuple[TwoAxis, str, Path | None]:
     return prof, src, path
 
 
-def _spec_results(model, spec) -> dict:
-    """{axis: SpecResult} of the model's linear response against the mask (a file or a
-    :class:`taos.report.spec.SpecMask`; empty if None)."""
+def _spec_mask(spec) -> SpecMask | None:
+    """The mask (a file or a :class:`taos.report.spec.SpecMask`; None if None)."""
     if spec is None:
-        return {}
-    from .spec import SpecMask, check_spec, load_spec
+        return None
+    from .spec import SpecMask, load_spec
 
-    mask = spec if isinstance(spec, SpecMask) else load_spec(spec)
+    return spec if isinstance(spec, SpecMask) else load_spec(spec)
+
+
+def _spec_results(model, mask) -> dict:
+    """{axis: SpecResult} of the model's linear response against ``mask`` (empty if None)."""
+    if mask is None:
+        return {}
+    from .spec import check_spec
+
     return {ax: check_spec(model, mask, ax) for ax in AXES}
+
+
+def _verdict(model, mask, prof, measured, info, dt_s) -> Verdict | None:
+    """The mask on every basis with causes (:func:`taos.report.verdict.spec_verdict`): dwells at
+    the profile's amplitudes, the measured record, the step figures ``info`` already holds."""
+    if mask is None:
+        return None
+    from .verdict import spec_verdict
+
+    segs = {ax: [(s.frequency_hz, s.amplitude_rad) for _, s in dwell_segments(getattr(prof, ax))] for ax in AXES}
+    steps = {ax: m["step"] for ax, m in info["figures_of_merit"].items() if "step" in m}
+    return spec_verdict(model, mask, segments=segs, measured=measured, step_figures=steps, dt_s=dt_s)
 
 
 def _measured_responses(data) -> dict:
@@ -303,7 +334,9 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     dt_s : float, optional
         Integration step [s]; default the engine's own (:func:`taos.planar.envelope.default_dt_s`).
     spec : str, Path or SpecMask, optional
-        Spec mask (:mod:`taos.report.spec`) checked against each axis' linear response; default
+        Spec mask (:mod:`taos.report.spec`), checked on the linear response, the nonlinear sine
+        dwells at the profile's amplitudes, the measured record (with ``data``) and the step
+        figures, each failing point with its cause (:mod:`taos.report.verdict`); default
         ``models/specs/tvc_actuator_notional.toml``; None: no check.
     data : str, Path or TestData, optional
         A measured record (e.g. ``models/data/greenrun_hotfire_synthetic.csv``): its estimated
@@ -337,7 +370,8 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
         dt_s = run_checks.default_dt_s(engine)
     run_checks.check_run(model, prof, dt_s)
     run_checks.check_linear_stability(model, allow=allow_unstable)
-    specs = _spec_results(model, spec)
+    mask = _spec_mask(spec)
+    specs = _spec_results(model, mask)
     measured = _measured_responses(data) if data is not None else None
     info = model_summary(model)
     if engine == "taos":
@@ -396,12 +430,16 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
             dwell[ax] = tuple(FrequencyResponse(np.array(freqs), p[i], e[i], a, ax, friction_model=model.friction.name)
                               for i, a in enumerate(amps))
         run = {ax: tuple(frs) for ax, frs in run_responses(th, prof, model.actuator.moment_arm_m).items()}
+        verdict = None
+        if mask is not None:   # part of the dwell step: the mask's dwells and the causes' re-runs
+            bar.set_postfix_str("spec verdict")
+            verdict = _verdict(model, mask, prof, measured, info, dt_s)
         bar.update()
 
         result = GreenRunResult(
             model=model, profile=prof, profile_file=profile_file, engine=engine, dt_s=dt_s, time_history=th,
             linear=linear, dwell=dwell, run=run, notch_hz=notch, load_resonance_hz=wl, model_info=info,
-            spec=specs, measured=measured,
+            spec=specs, measured=measured, verdict=verdict,
             created_utc=_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
         if out is not None:
             result.write(out, view_angle_scale=view_angle_scale, view_fps=view_fps, progress=bar)

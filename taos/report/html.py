@@ -113,7 +113,8 @@ h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccd
 table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #ccd;padding:3px 8px;text-align:right}
 th{background:#eef}td:first-child,th:first-child{text-align:left}img{max-width:100%}
 .note{color:#555;font-size:12px}iframe{width:100%;height:620px;border:1px solid #ccd}
-.pass{color:#1a7f37}.fail{color:#c62828}tr.fail td{background:#fdecea}"""
+.verdict{font-size:15px;padding:8px 12px;border-left:4px solid}.verdict.pass{border-color:#1a7f37}
+.verdict.fail{border-color:#c62828}.pass{color:#1a7f37}.fail{color:#c62828}tr.fail td{background:#fdecea}"""
 
 
 def _page(model, s, figs, view, scale) -> str:
@@ -154,6 +155,7 @@ def _page(model, s, figs, view, scale) -> str:
 <html><head><meta charset="utf-8"><title>Green Run report: {_h(model.name)}</title><style>{_CSS}</style></head>
 <body>
 <h1>Green Run two-axis vectoring: {_h(model.name)}</h1>
+{verdict_line_html(s)}
 <p>Model <code>{_h(s['model_file'])}</code> (sha256 {_h(s['model_sha256'][:12])}…), profile
 <code>{_h(s['profile_file'])}</code> ({_h(s['profile'])}), friction <b>{_h(s['friction_model'])}</b>,
 {_h(s['engine_model'])} engine model, taos {_h(s['package_version'])}, {_h(s['created_utc'])}.</p>
@@ -226,6 +228,7 @@ way (threshold), and a slow ±0.2 deg triangle (hysteresis: engine angle down mi
         out.append(f"""<h2 id="spec-mask">Spec mask: {_h(name)} — <span class="{'pass' if s['spec_pass'] else 'fail'}">{verdict}</span></h2>
 <table><tr><th>axis</th><th>bound</th><th>freq [Hz]</th><th>limits</th><th>model (linear)</th><th>result</th></tr>{''.join(srows)}</table>
 <p class="note">Mask file <code>{_h(next(iter(s['spec'].values()))['spec_file'])}</code>; the same marks are on the Bode plots.</p>""")
+    out.append(verdict_table_html(s))
     if "test_data" in s:
         trs = []
         for ax, r in s["test_data"]["axes"].items():
@@ -238,3 +241,41 @@ way (threshold), and a slow ±0.2 deg triangle (hysteresis: engine angle down mi
 <table><tr><th>axis</th><th>freq [Hz]</th><th>amplitude [deg]</th><th>test piston [dB]</th><th>model piston [dB]</th>
 <th>test engine [dB]</th><th>model engine [dB]</th></tr>{''.join(trs)}</table>""")
     return "\n".join(out)
+
+
+def verdict_line_html(s: dict) -> str:
+    """The report's first line: why the model fails (or passes) its mask, in words
+    (``spec_verdict_text``; :mod:`taos.report.verdict`); empty when no mask was checked."""
+    if "spec_verdict_text" not in s:
+        return ""
+    cls = "pass" if s["spec_verdict_pass"] else "fail"
+    return f'<p id="spec-verdict" class="verdict {cls}"><b>{_h(s["spec_verdict_text"])}</b></p>'
+
+
+def verdict_table_html(s: dict) -> str:
+    """The "Spec mask on every basis" section: each point on the linear, dwell, measured and step
+    bases, its value, bounds, result and (failing) cause."""
+    if "spec_points" not in s:
+        return ""
+    trs = []
+    for p in s["spec_points"]:
+        for q in [k for k in p if k + "_bounds" in p]:
+            b, v, ok = p[q + "_bounds"], p[q], p[q + "_pass"]
+            where = "step" if p["response"] == "step" else f"{p['response']} {p['freq_hz']:g} Hz"
+            amp = "–" if p["amplitude_deg"] is None else f"{p['amplitude_deg']:.2g}"
+            cause = ", ".join(p["cause"]) if (p["cause"] and not ok) else ""
+            trs.append(f"<tr class='{'pass' if ok else 'fail'}'><td>{_h(p['basis'])}</td><td>{_h(p['axis'])}</td>"
+                       f"<td>{_h(where)}</td><td>{amp}</td><td>{_h(q)}</td><td>{_fmt(v, '.2f')}</td>"
+                       f"<td>[{b[0]:g}, {b[1]:g}]</td><td><b>{'pass' if ok else 'FAIL'}</b></td><td>{_h(cause)}</td></tr>")
+    by = ", ".join(f"{k} {'pass' if v else 'FAIL'}" for k, v in s["spec_pass_by_basis"].items())
+    att = s["spec_attribution"]
+    return f"""<h2 id="spec-verdict-table">Spec mask on every basis: {_h(by)}</h2>
+<p>{_h(s['spec_verdict_text'])}</p>
+<table><tr><th>basis</th><th>axis</th><th>point</th><th>amplitude [deg]</th><th>quantity</th><th>value</th><th>limits</th>
+<th>result</th><th>cause</th></tr>{''.join(trs)}</table>
+<p class="note">Bases: linear (exact linear response), dwell (nonlinear sine dwell, friction and avionics included,
+at the profile's amplitude for that frequency), measured (the record's points at mask frequencies), step (the
+simulated step figures). Cause of a failing point: the factor(s) whose removal alone makes it pass, found by
+re-evaluating it with gimbal friction none, the laboratory load (K_L ≥ {att['laboratory_load_stiffness_N_per_m']:.3g} N/m)
+or unity avionics; "combined" when only removing all three passes, "servo" when even the servo alone fails,
+"unexplained" when the model's own dwell passes where the measurement fails.</p>"""

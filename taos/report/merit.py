@@ -159,13 +159,11 @@ def _axis_model(model: TvcModel, axis: str) -> TvcModel:
     return dataclasses.replace(model, engine=dataclasses.replace(e, inertia_pitch_kgm2=e.inertia_yaw_kgm2))
 
 
-def step_merit(model: TvcModel, axis: str = "pitch", *, step_amplitude_rad: float = math.radians(0.5),
-               hysteresis_amplitude_rad: float = math.radians(0.2), ramp_rate_rad_s: float = math.radians(0.05),
-               threshold_tol_rad: float = math.radians(0.002), dt_s: float = 2e-4) -> StepMerit:
-    """Step, threshold and hysteresis figures of ``axis`` by simulation (module docstring)."""
-    from ..profiles import MultiRamp
-    from ..planar.simulate import simulate
-
+def step_response_figures(model: TvcModel, axis: str = "pitch", step_amplitude_rad: float = math.radians(0.5),
+                          dt_s: float = 2e-4) -> tuple[float | None, float | None]:
+    """(rise time 10-90 % [s], overshoot [%]) of the engine angle after a command step of
+    ``step_amplitude_rad`` [rad] on the nonlinear simplex model (module docstring), relative to
+    the final value (the mean of the last tenth of the 1.5 s hold); None when undefined."""
     t, th = _engine_step(model, axis, step_amplitude_rad, dt_s=dt_s)
     t0 = 0.2
     m = t >= t0
@@ -179,6 +177,17 @@ def step_merit(model: TvcModel, axis: str = "pitch", *, step_amplitude_rad: floa
         if i10.size and i90.size:
             rise = float(tt[i90[0]] - tt[i10[0]])
         over = float(100.0 * max(0.0, (np.max(s) - 1.0)))
+    return rise, over
+
+
+def step_merit(model: TvcModel, axis: str = "pitch", *, step_amplitude_rad: float = math.radians(0.5),
+               hysteresis_amplitude_rad: float = math.radians(0.2), ramp_rate_rad_s: float = math.radians(0.05),
+               threshold_tol_rad: float = math.radians(0.002), dt_s: float = 2e-4) -> StepMerit:
+    """Step, threshold and hysteresis figures of ``axis`` by simulation (module docstring)."""
+    from ..profiles import MultiRamp
+    from ..planar.simulate import simulate
+
+    rise, over = step_response_figures(model, axis, step_amplitude_rad, dt_s=dt_s)
 
     def moves(a):
         _, e = _engine_step(model, axis, a, hold=1.0, dt_s=dt_s)

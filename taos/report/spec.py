@@ -9,6 +9,11 @@ A mask file (TOML, shipped ones in ``models/specs/``)::
     gain_db = [-2.0, 2.0]        # optional [min, max], dB of the dimensionless gain
     phase_deg = [-45.0, 5.0]     # optional [min, max], phase continuous from low frequency
 
+    [step]                       # optional: step requirements on the simulated step figures
+    amplitude = "0.5 deg"        # the command step (default 0.5 deg)
+    rise_time_s = [0.0, 0.1]     # [min, max] of any of STEP_FIGURES (taos.report.merit.StepMerit)
+    overshoot_pct = [0.0, 25.0]
+
 :func:`check_spec` evaluates the exact linear response of a model at each point
 (:func:`taos.planar.freqresp.linear_freqresp`, the project's conventions) and returns a
 :class:`SpecResult` with one row per point and the overall verdict.
@@ -27,6 +32,9 @@ from ..errors import InputError
 from ..units import to_si
 
 RESPONSES = ("engine", "piston")
+#: the step figures a ``[step]`` table may bound (keys of :class:`taos.report.merit.StepMerit`)
+STEP_FIGURES = ("rise_time_s", "overshoot_pct", "threshold_deg", "hysteresis_deg")
+DEFAULT_STEP_AMPLITUDE_RAD = math.radians(0.5)
 
 
 @dataclass(frozen=True)
@@ -38,10 +46,21 @@ class SpecPoint:
 
 
 @dataclass(frozen=True)
+class StepRequirement:
+    """Bounds [min, max] on one step figure (``figure`` in :data:`STEP_FIGURES`, in its unit)
+    of a command step of ``amplitude_rad`` [rad]."""
+
+    figure: str
+    bounds: tuple[float, float]
+    amplitude_rad: float
+
+
+@dataclass(frozen=True)
 class SpecMask:
     name: str
     source: str
     points: tuple[SpecPoint, ...]
+    steps: tuple[StepRequirement, ...] = ()
 
 
 def _pair(v, src, field):
@@ -64,9 +83,9 @@ def load_spec(path) -> SpecMask:
         raise InputError(src, "(file)", "a readable spec-mask TOML file", got=e.strerror) from None
     except tomllib.TOMLDecodeError as e:
         raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
-    unknown = set(tab) - {"name", "point"}
+    unknown = set(tab) - {"name", "point", "step"}
     if unknown:
-        raise InputError(src, sorted(unknown)[0], "only 'name' and [[point]] tables", got="an unknown key")
+        raise InputError(src, sorted(unknown)[0], "only 'name', [[point]] and [step] tables", got="an unknown key")
     pts = []
     for i, pt in enumerate(tab.get("point", [])):
         f = f"point[{i}]"
@@ -85,7 +104,25 @@ def load_spec(path) -> SpecMask:
         pts.append(SpecPoint(resp, fz, g, ph))
     if not pts:
         raise InputError(src, "point", "at least one [[point]]", got="none")
-    return SpecMask(str(tab.get("name", p.stem)), src, tuple(pts))
+    return SpecMask(str(tab.get("name", p.stem)), src, tuple(pts), _steps(tab.get("step"), src))
+
+
+def _steps(tab, src) -> tuple[StepRequirement, ...]:
+    """The ``[step]`` table's requirements (module docstring); () when there is none."""
+    if tab is None:
+        return ()
+    if not isinstance(tab, dict):
+        raise InputError(src, "step", "a [step] table", got=type(tab).__name__)
+    bad = set(tab) - {"amplitude", *STEP_FIGURES}
+    if bad:
+        raise InputError(src, f"step.{sorted(bad)[0]}", "amplitude or one of " + ", ".join(STEP_FIGURES),
+                         got="unknown key")
+    amp = (to_si(tab["amplitude"], "angle", source=src, field="step.amplitude", positive=True)
+           if "amplitude" in tab else DEFAULT_STEP_AMPLITUDE_RAD)
+    out = tuple(StepRequirement(k, _pair(tab[k], src, f"step.{k}"), amp) for k in STEP_FIGURES if k in tab)
+    if not out:
+        raise InputError(src, "step", "bounds on at least one of " + ", ".join(STEP_FIGURES), got="none")
+    return out
 
 
 @dataclass(frozen=True)

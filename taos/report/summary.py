@@ -173,6 +173,8 @@ def greenrun_summary(result) -> dict:
     if result.spec:
         s["spec"] = {ax: r.to_dict() for ax, r in result.spec.items()}
         s["spec_pass"] = all(r.passed for r in result.spec.values())
+    if getattr(result, "verdict", None) is not None:
+        s.update(result.verdict.to_dict())
     if result.measured:
         s["test_data"] = _test_data(result.measured, {ax: result.dwell_grid(ax) for ax in result.dwell}, model)
     return s

@@ -1,0 +1,470 @@
+"""Why a model passes or fails its spec mask: the mask on every basis, and each shortfall's cause.
+
+The paper (sec. 1, 2) says Green Run missed its step and frequency-response specifications
+through three phenomena outside the heritage linear servo: the load stiffness (structure), gimbal
+friction and the avionics gain nonlinearity. This module checks a mask (:mod:`taos.report.spec`)
+on four **bases** and names the **cause** of every failing point.
+
+Bases (``basis`` of each :class:`SpecCheck`):
+
+* ``linear``: the exact linear response (:func:`taos.planar.freqresp.linear_freqresp`; no friction,
+  unity avionics) at the mask's frequencies;
+* ``dwell``: the nonlinear sine dwell (:func:`taos.planar.freqresp.sine_dwell_points`, friction and
+  avionics included, all points in one batched call) at the mask's frequencies, at the command
+  amplitude the profile uses there: the amplitude of the profile's lowest-frequency dwell segment
+  at or above the point's frequency on that axis (the test's band: 0.4 deg for commands up to
+  7 Hz), or of its highest-frequency segment above them all;
+* ``measured``: a measured record's estimated responses (:mod:`taos.identify.estimation`) at its
+  points whose frequency is a mask frequency (within :data:`FREQ_MATCH_RTOL`); no interpolation;
+* ``step``: the step figures (:func:`taos.report.merit.step_response_figures` /
+  :func:`taos.report.merit.step_merit`, nonlinear simplex model) against the mask's ``[step]``
+  requirements.
+
+Phases are continuous from low frequency on the branch of the (evaluated) model's linear phase
+(:func:`taos.planar.freqresp.linear_phase_reference`), as everywhere in the project.
+
+Causes, found by re-evaluating each FAILING point (only those: the passing ones are never
+re-simulated; the dwells of one basis and axis go in one batched call per variant) on the model
+with one factor removed (:func:`remove_causes`):
+
+* ``friction``: the gimbal friction law set to ``none``;
+* ``load_stiffness``: the laboratory load, K_L -> :data:`LAB_LOAD_STIFFNESS_N_PER_M` (kept when
+  the model's own K_L is stiffer), the "rigid load" an actuator is specified and accepted against;
+* ``avionics``: a unity command path (no quantisation, crossover gain 1:
+  :meth:`taos.planar.avionics.Avionics.ideal`);
+* and, when no single removal passes, the **servo alone** (all three removed).
+
+The cause (:func:`cause_of`) is the tuple of single factors whose removal alone makes the point
+pass (several when each alone suffices); ``("combined",)`` when only removing all three passes;
+``("servo",)`` when even the servo alone fails. A failing ``measured`` point is attributed on the
+model at the same amplitude and frequency: if the model's dwell there passes, the model does not
+reproduce the shortfall and the cause is ``("unexplained",)``; otherwise as a ``dwell`` point.
+With ``--engine taos`` the dwell basis and the causes still come from the planar simplex model
+(the 3-D model's own dwells stay in the report's Bode plots and tables).
+
+:class:`Verdict` holds the checks; :meth:`Verdict.text` says in words why the model fails (or
+passes) its mask, as the report's first line; :meth:`Verdict.to_dict` is what ``summary.json``
+adds (docs/reference/outputs.md).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Mapping, Sequence
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from taos.identify.estimation import MeasuredResponse
+    from taos.model import TvcModel
+
+    from .spec import SpecMask
+
+AXES = ("pitch", "yaw")
+#: the factors a shortfall is attributed to, in the order they are tried
+CAUSES = ("friction", "load_stiffness", "avionics")
+BASES = ("linear", "dwell", "measured", "step")
+#: the laboratory ("rigid") load stiffness [N/m]: 1e9 N/m = 5.7e6 lbf/in, 28 x the hot-fire and
+#: 50 x the ambient K_L and 4 x the oil column (2.4e8 N/m), so the load resonance (36 Hz with the
+#: shipped J_n and R) is far above the servo's band: the shipped servo's engine response is then
+#: within 0.2 dB and 0.8 deg of a truly rigid load (K_L = 1e12 N/m) at 5 Hz and within 0.03 dB /
+#: 0.1 deg up to 2 Hz, while the fastest mode (sqrt((K_L + oil column) / M_p), 5,200 rad/s)
+#: stays integrable by the explicit step (dt |lambda|max = 1.05 at 2e-4 s; a truly rigid 1e12
+#: would need a 100 x smaller step)
+LAB_LOAD_STIFFNESS_N_PER_M = 1e9
+#: a measured point is on a mask point when their frequencies agree within this relative tolerance
+FREQ_MATCH_RTOL = 0.02
+#: words of each cause in the verdict text
+CAUSE_WORDS = {"friction": "gimbal friction", "load_stiffness": "the load stiffness (structure)",
+               "avionics": "the avionics gain", "combined": "friction, load stiffness and avionics together",
+               "servo": "the servo itself", "unexplained": "something the model does not reproduce"}
+_UNITS = {"gain_db": "dB", "phase_deg": "deg", "rise_time_s": "s", "overshoot_pct": "%", "threshold_deg": "deg",
+          "hysteresis_deg": "deg"}
+_NAMES = {"gain_db": "gain", "phase_deg": "phase", "rise_time_s": "rise time", "overshoot_pct": "overshoot",
+          "threshold_deg": "threshold", "hysteresis_deg": "hysteresis"}
+
+
+# -- the causes --------------------------------------------------------------------------------
+
+def laboratory_model(model: TvcModel) -> TvcModel:
+    """``model`` on the laboratory load: K_L = max(K_L, :data:`LAB_LOAD_STIFFNESS_N_PER_M`)."""
+    k = max(model.structure.load_stiffness_N_per_m, LAB_LOAD_STIFFNESS_N_PER_M)
+    return model.replace(structure=dataclasses.replace(model.structure, load_stiffness_N_per_m=k))
+
+
+def remove_causes(model: TvcModel, causes: Sequence[str]) -> TvcModel:
+    """``model`` with each factor in ``causes`` (names in :data:`CAUSES`) removed (module docstring)."""
+    bad = set(causes) - set(CAUSES)
+    if bad:
+        raise ValueError(f"unknown cause {sorted(bad)[0]!r}; expected one of {CAUSES}")
+    m = model
+    if "friction" in causes:
+        m = m.with_friction("none")
+    if "load_stiffness" in causes:
+        m = laboratory_model(m)
+    if "avionics" in causes:
+        m = m.replace(avionics=m.avionics.ideal())
+    return m
+
+
+def cause_of(single_passes: Mapping[str, bool], servo_passes: bool | None) -> tuple[str, ...]:
+    """The cause of a failing point from its re-evaluations: the factors whose removal alone
+    makes it pass (in :data:`CAUSES` order); else ``("combined",)`` if the servo alone (all
+    removed) passes, ``("servo",)`` if not."""
+    singles = tuple(c for c in CAUSES if single_passes.get(c))
+    if singles:
+        return singles
+    return ("combined",) if servo_passes else ("servo",)
+
+
+# -- checks ------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Bound:
+    """One bounded quantity of a check: ``value`` (None when undefined: fails) in [lo, hi]."""
+
+    quantity: str
+    value: float | None
+    lo: float
+    hi: float
+
+    @property
+    def passed(self) -> bool:
+        return self.value is not None and self.lo <= self.value <= self.hi
+
+    def excess(self) -> float:
+        """How far outside the bounds (0 inside; inf when undefined), in the quantity's unit."""
+        if self.value is None:
+            return math.inf
+        return max(self.lo - self.value, self.value - self.hi, 0.0)
+
+    def words(self) -> str:
+        u = _UNITS.get(self.quantity, "")
+        if self.value is None:
+            return f"{_NAMES.get(self.quantity, self.quantity)} undefined"
+        side = f"below the lower bound {self.lo:g}" if self.value < self.lo else f"above the upper bound {self.hi:g}"
+        fmt = "+.1f" if u in ("dB", "deg") else ".3g"
+        return f"{_NAMES.get(self.quantity, self.quantity)} {self.value:{fmt}} {u}, {self.excess():.3g} {u} {side}"
+
+
+@dataclass(frozen=True)
+class SpecCheck:
+    """One mask point on one basis and axis (module docstring): its bounds, and for a failing
+    point the ``cause`` and whether each removal (``"friction"``, ..., ``"servo"``) passed (a
+    measured point also ``"model_dwell"``: the unmodified model's dwell at that point)."""
+
+    basis: str
+    axis: str
+    response: str                 # "engine", "piston" or "step"
+    freq_hz: float | None
+    amplitude_rad: float | None
+    bounds: tuple[Bound, ...]
+    cause: tuple[str, ...] = ()
+    removed: Mapping[str, bool] = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return all(b.passed for b in self.bounds)
+
+    def worst(self) -> Bound:
+        """The failing bound furthest outside, relative to its bounds' width."""
+        return max(self.bounds, key=lambda b: b.excess() / max(b.hi - b.lo, 1e-12))
+
+    def where(self) -> str:
+        """e.g. "pitch engine at 2 Hz (dwell, 0.4 deg)" or "pitch step (0.5 deg)"."""
+        amp = "" if self.amplitude_rad is None else f", {math.degrees(self.amplitude_rad):.2g} deg"
+        if self.response == "step":
+            return f"{self.axis} step ({math.degrees(self.amplitude_rad):.2g} deg)"
+        return f"{self.axis} {self.response} at {self.freq_hz:g} Hz ({self.basis}{amp})"
+
+    def to_dict(self) -> dict:
+        d = {"basis": self.basis, "axis": self.axis, "response": self.response, "freq_hz": self.freq_hz,
+             "amplitude_deg": None if self.amplitude_rad is None else math.degrees(self.amplitude_rad),
+             "pass": self.passed}
+        for b in self.bounds:
+            d[b.quantity] = b.value
+            d[f"{b.quantity}_bounds"] = [b.lo, b.hi]
+            d[f"{b.quantity}_pass"] = b.passed
+        d["cause"] = list(self.cause) if not self.passed else None
+        d["removed_pass"] = dict(self.removed) if not self.passed else None
+        return d
+
+
+def _finite(x) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _freq_bounds(point, h: complex, ref_deg: float) -> tuple[Bound, ...]:
+    """Gain and phase bounds of a mask point for response value ``h`` (phase on the branch
+    nearest ``ref_deg``)."""
+    from taos.linear import phase_deg_continuous
+
+    out = []
+    if point.gain_db is not None:
+        g = 20 * math.log10(abs(h)) if abs(h) > 0 else -math.inf
+        out.append(Bound("gain_db", _finite(g), *point.gain_db))
+    if point.phase_deg is not None:
+        ph = float(phase_deg_continuous([point.freq_hz], [h], [ref_deg])[0]) if abs(h) > 0 else math.nan
+        out.append(Bound("phase_deg", _finite(ph), *point.phase_deg))
+    return tuple(out)
+
+
+def _responses(model: TvcModel, axis: str, freq_hz, amplitudes_rad, dt_s: float):
+    """{"piston": (h, phase ref), "engine": (h, phase ref)} of ``model`` at paired points:
+    linear when ``amplitudes_rad`` is None, else sine dwells (one batched call)."""
+    from taos.planar.freqresp import linear_freqresp, linear_phase_reference, sine_dwell_points
+
+    f = np.asarray(freq_hz, float)
+    if amplitudes_rad is None:
+        fr = linear_freqresp(model, f, axis)
+        p, e = fr.piston, fr.engine
+    else:
+        d = sine_dwell_points(model, np.asarray(amplitudes_rad, float), f, axis, dt_max_s=_dwell_dt(model, dt_s))
+        p, e = d.piston, d.engine
+    fu, inv = np.unique(f, return_inverse=True)
+    rp, re = linear_phase_reference(model, fu, axis)
+    return {"piston": (p, rp[inv]), "engine": (e, re[inv])}
+
+
+def _dwell_dt(model: TvcModel, dt_s: float) -> float:
+    """``dt_s``, or smaller where the (stiffened) model's fastest mode asks for it (RK4 limit,
+    with a factor 2 of margin)."""
+    from taos.bounds import RK4_STEP_LIMIT
+    from taos.planar.envelope import fastest_mode_rad_s
+
+    lam = fastest_mode_rad_s(model)
+    return min(dt_s, 0.5 * RK4_STEP_LIMIT / lam) if dt_s * lam > 0.5 * RK4_STEP_LIMIT else dt_s
+
+
+def dwell_amplitude_rad(segments: Sequence[tuple[float, float]], freq_hz: float) -> float | None:
+    """The profile's command amplitude at ``freq_hz`` (module docstring): of the lowest-frequency
+    dwell segment at or above it, else of the highest one. ``segments``: (frequency [Hz],
+    amplitude [rad]) of one axis' dwell segments; None when there are none."""
+    if not segments:
+        return None
+    segs = sorted(segments)
+    above = [a for f, a in segs if f >= freq_hz * (1 - 1e-9)]
+    return above[0] if above else segs[-1][1]
+
+
+def _freq_checks(model, mask, axis, basis, amps, dt_s) -> list[SpecCheck]:
+    pts = mask.points
+    f = [p.freq_hz for p in pts]
+    r = _responses(model, axis, f, amps, dt_s)
+    return [SpecCheck(basis, axis, p.response, p.freq_hz, None if amps is None else float(amps[k]),
+                      _freq_bounds(p, complex(r[p.response][0][k]), float(r[p.response][1][k])))
+            for k, p in enumerate(pts)]
+
+
+def _measured_checks(model, mask, m: MeasuredResponse) -> list[SpecCheck]:
+    """Mask points on a measured record's points at the mask's frequencies (module docstring)."""
+    from taos.planar.freqresp import linear_phase_reference
+
+    R = model.actuator.moment_arm_m
+    out = []
+    for p in mask.points:
+        h_all = m.piston_m_per_rad / R if p.response == "piston" else m.engine
+        if h_all is None:
+            continue
+        for k in np.flatnonzero(np.isclose(m.freq_hz, p.freq_hz, rtol=FREQ_MATCH_RTOL)):
+            a = float(m.amplitude_rad[k])
+            if not math.isfinite(a):
+                continue
+            rp, re = linear_phase_reference(model, [float(m.freq_hz[k])], m.axis)
+            ref = float((rp if p.response == "piston" else re)[0])
+            out.append(SpecCheck("measured", m.axis, p.response, float(m.freq_hz[k]), a,
+                                 _freq_bounds(p, complex(h_all[k]), ref)))
+    return out
+
+
+def _step_values(model, axis, reqs, dt_s) -> dict:
+    """The step figures the requirements name, simulated on ``model``."""
+    from .merit import step_merit, step_response_figures
+
+    amp = reqs[0].amplitude_rad
+    if {r.figure for r in reqs} <= {"rise_time_s", "overshoot_pct"}:
+        rise, over = step_response_figures(model, axis, amp, dt_s=dt_s)
+        return {"rise_time_s": rise, "overshoot_pct": over}
+    return step_merit(model, axis, step_amplitude_rad=amp, dt_s=dt_s).to_dict()
+
+
+def _step_check(axis, reqs, values) -> SpecCheck:
+    return SpecCheck("step", axis, "step", None, reqs[0].amplitude_rad,
+                     tuple(Bound(r.figure, None if values.get(r.figure) is None else _finite(values[r.figure]),
+                                 *r.bounds) for r in reqs))
+
+
+def _reevaluate(model, checks: list[SpecCheck], mask, dt_s) -> list[bool]:
+    """Whether each check (one basis and axis) passes on ``model``."""
+    c0 = checks[0]
+    if c0.basis == "step":
+        return [_step_check(c0.axis, mask.steps, _step_values(model, c0.axis, mask.steps, dt_s)).passed]
+    amps = None if c0.basis == "linear" else [c.amplitude_rad for c in checks]
+    r = _responses(model, c0.axis, [c.freq_hz for c in checks], amps, dt_s)
+    out = []
+    for k, c in enumerate(checks):
+        h, ref = r[c.response][0][k], r[c.response][1][k]
+        out.append(all(Bound(b.quantity, v.value, b.lo, b.hi).passed
+                       for b, v in zip(c.bounds, _bounds_like(c, complex(h), float(ref)))))
+    return out
+
+
+def _bounds_like(c: SpecCheck, h: complex, ref: float) -> tuple[Bound, ...]:
+    from .spec import SpecPoint
+
+    q = {b.quantity: (b.lo, b.hi) for b in c.bounds}
+    return _freq_bounds(SpecPoint(c.response, c.freq_hz, q.get("gain_db"), q.get("phase_deg")), h, ref)
+
+
+def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s: float) -> list[SpecCheck]:
+    """``checks`` with the cause of each failing one (module docstring); passing ones unchanged.
+    Each basis and axis is re-evaluated once per removal, on its failing points only."""
+    out = list(checks)
+    groups: dict[tuple[str, str], list[int]] = {}
+    for i, c in enumerate(checks):
+        if not c.passed:
+            groups.setdefault((c.basis, c.axis), []).append(i)
+    for (basis, axis), idx in groups.items():
+        group = [checks[i] for i in idx]
+        removed = [dict() for _ in idx]
+        todo = list(range(len(idx)))
+        if basis == "measured":    # does the model itself fail there?
+            own = _reevaluate(model, [dataclasses.replace(c, basis="dwell") for c in group], mask, dt_s)
+            for j, ok in enumerate(own):
+                removed[j]["model_dwell"] = ok
+            todo = [j for j in todo if not own[j]]
+        for variant in CAUSES + ("servo",):
+            if variant == "servo":   # only where no single removal passed
+                todo = [j for j in todo if not any(removed[j].get(c) for c in CAUSES)]
+            if not todo:
+                break
+            mv = remove_causes(model, CAUSES if variant == "servo" else (variant,))
+            sub = [dataclasses.replace(group[j], basis="dwell") if basis == "measured" else group[j] for j in todo]
+            for j, ok in zip(todo, _reevaluate(mv, sub, mask, dt_s)):
+                removed[j][variant] = ok
+        for j, i in enumerate(idx):
+            rem = removed[j]
+            if rem.get("model_dwell"):
+                cause = ("unexplained",)
+            else:
+                cause = cause_of({c: rem.get(c, False) for c in CAUSES}, rem.get("servo"))
+            out[i] = dataclasses.replace(checks[i], cause=cause, removed=rem)
+    return out
+
+
+# -- the verdict -------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Verdict:
+    """A model's mask on every basis, with the causes of its shortfalls (module docstring)."""
+
+    model_name: str
+    mask_name: str
+    mask_source: str
+    checks: tuple[SpecCheck, ...]
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+    def passed_by_basis(self) -> dict:
+        """{basis: all its checks pass} for the bases checked."""
+        out = {}
+        for c in self.checks:
+            out[c.basis] = out.get(c.basis, True) and c.passed
+        return out
+
+    def failures(self) -> list[SpecCheck]:
+        return [c for c in self.checks if not c.passed]
+
+    def text(self) -> str:
+        """In words: why the model fails (or passes) its mask, e.g. "RS-25 hot fire: fails the
+        mask at 1 and 2 Hz (dwell; worst ...) because of gimbal friction; the linear response
+        passes." """
+        by = self.passed_by_basis()
+        bases = ", ".join(b for b in BASES if b in by)
+        if self.passed:
+            return f"{self.model_name}: passes the mask ({self.mask_name}) on every basis checked ({bases})."
+        groups: dict[tuple[str, ...], list[SpecCheck]] = {}
+        for c in self.failures():
+            groups.setdefault(c.cause, []).append(c)
+        parts = []
+        for cause, cs in sorted(groups.items(), key=lambda kv: -len(kv[1])):
+            freqs = sorted({c.freq_hz for c in cs if c.freq_hz is not None})
+            where = []
+            if freqs:
+                where.append(_and([f"{f:g}" for f in freqs]) + " Hz")
+            if any(c.response == "step" for c in cs):
+                where.append("the step")
+            cb = [b for b in BASES if any(c.basis == b for c in cs)]
+            amps = sorted({round(math.degrees(c.amplitude_rad), 6) for c in cs
+                           if c.amplitude_rad is not None and c.basis in ("dwell", "measured")})
+            if amps:
+                cb.append(_and([f"{a:g}" for a in amps]) + " deg")
+            worst = max(cs, key=lambda c: (c.worst().excess() / max(c.worst().hi - c.worst().lo, 1e-12)))
+            if cause in (("combined",), ("servo",), ("unexplained",)):
+                why = CAUSE_WORDS[cause[0]]
+            else:
+                why = _and([CAUSE_WORDS[c] for c in cause]) + (", either of which removed alone passes"
+                                                               if len(cause) > 1 else "")
+            parts.append(f"at {_and(where)} ({', '.join(cb)}; worst: {worst.where()} {worst.worst().words()}) "
+                         f"because of {why}")
+        s = f"{self.model_name}: fails the mask ({self.mask_name}) " + "; and ".join(parts)
+        if by.get("linear"):
+            s += "; the linear servo passes"
+        return s + "."
+
+    def to_dict(self) -> dict:
+        """The ``summary.json`` keys this adds (docs/reference/outputs.md)."""
+        return {"spec_verdict_text": self.text(), "spec_verdict_pass": self.passed,
+                "spec_pass_by_basis": self.passed_by_basis(),
+                "spec_points": [c.to_dict() for c in self.checks],
+                "spec_attribution": {
+                    "causes": list(CAUSES) + ["combined", "servo", "unexplained"],
+                    "laboratory_load_stiffness_N_per_m": LAB_LOAD_STIFFNESS_N_PER_M,
+                    "method": "each failing point re-evaluated with one factor removed (friction law none; load "
+                              "stiffness K_L -> max(K_L, laboratory); unity avionics) and, if none passes, all three "
+                              "(the servo alone); the cause is the factors whose removal alone passes, 'combined' "
+                              "when only the servo alone passes, 'servo' when it fails too; a measured point the "
+                              "model's own dwell passes is 'unexplained'"}}
+
+
+def _and(items: Sequence[str]) -> str:
+    items = list(items)
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def spec_verdict(model: TvcModel, mask: SpecMask, *, segments: Mapping[str, Sequence[tuple[float, float]]] | None = None,
+                 measured: Mapping[str, MeasuredResponse] | None = None, step_figures: Mapping[str, dict] | None = None,
+                 dt_s: float = 2e-4, axes: Sequence[str] = AXES, attribute_causes: bool = True) -> Verdict:
+    """``model`` against ``mask`` on every basis (module docstring), with causes.
+
+    ``segments``: per axis the profile's dwell segments as (frequency [Hz], amplitude [rad])
+    (none: no dwell basis); ``measured``: per axis a measured record's responses (none: no
+    measured basis); ``step_figures``: per axis the step figures already simulated
+    (``StepMerit.to_dict()``, reused when their amplitude is the mask's); ``dt_s``: the
+    integration step [s] of dwells and steps."""
+    checks: list[SpecCheck] = []
+    for ax in axes:
+        checks += _freq_checks(model, mask, ax, "linear", None, dt_s)
+    for ax in axes:
+        segs = (segments or {}).get(ax)
+        if segs:
+            amps = [dwell_amplitude_rad(segs, p.freq_hz) for p in mask.points]
+            checks += _freq_checks(model, mask, ax, "dwell", amps, dt_s)
+    for ax in axes:
+        if measured and ax in measured:
+            checks += _measured_checks(model, mask, measured[ax])
+    if mask.steps:
+        for ax in axes:
+            have = (step_figures or {}).get(ax)
+            amp_deg = math.degrees(mask.steps[0].amplitude_rad)
+            if have is None or not math.isclose(have.get("step_amplitude_deg", math.nan), amp_deg, rel_tol=1e-9):
+                have = _step_values(model, ax, mask.steps, dt_s)
+            checks.append(_step_check(ax, mask.steps, have))
+    if attribute_causes:
+        checks = attribute(model, checks, mask, dt_s)
+    return Verdict(model.name, mask.name, mask.source, tuple(checks))
