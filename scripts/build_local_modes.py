@@ -5,8 +5,9 @@ finding F12): fem_data/thrust_structure_modes_local.npz and its provenance .toml
 Why: the paper (sec. 1) says MASV confirmed that the engine-section local modes, *despite their
 frequency density near the actuator bandwidth*, do not couple adversely with the actuator
 position loops, and that engine-to-engine coupling exists but is small. The shipped notional
-frame (fem_data/thrust_structure_modes.npz) has its lowest mode at 14.5 Hz, twice the ~7 Hz
-actuator bandwidth, so that claim is never exercised there. The real engine section's modes are
+frame (fem_data/thrust_structure_modes.npz) has its lowest mode at 14.5 Hz, well above the
+actuator band (hot-fire engine -3 dB bandwidth 6.3 Hz with models/actuators/tvc_actuator.toml),
+so that claim is never exercised there. The real engine section's modes are
 not public.
 
 What: the same notional frame (taos.fem.thrust_structure), same geometry and mass, with every

@@ -35,8 +35,16 @@ def test_coulomb_numeric_describing_function_is_4Tc_over_pi_V(law):
 def test_rigid_limit_engine_response_matches_relay_in_loop_describing_function():
     """Very stiff load path (100 x), ideal avionics, Coulomb friction at the Green Run
     amplitude 0.4 deg: the sine-dwell engine response equals the analytic relay-in-loop
-    prediction G_c / (1 + j w G_f 4 T_c/(pi w |theta|)) within 2 % while friction moves it
-    more than 10 % from the linear response."""
+    prediction G_c / (1 + j w G_f 4 T_c/(pi w |theta|)) within 3 % while friction moves it
+    more than 10 % from the linear response (23-26 %).
+
+    Measured: 1.9, 2.7, 2.2, 2.2 % at 2, 5, 8, 12 Hz (the same to 0.02 % with the periodic
+    orbit by shooting or dt 2.5e-5 s: not numerics). It was within 2 % (0.2-0.8 %) with the previous
+    notional servo (K_v 40 1/s); the difference is the first-harmonic approximation itself: the
+    recalibrated servo's dynamic pressure feedback makes it a damper in series with the load path
+    between its 1.06 Hz washout corner and the loop bandwidth, so more of the relay torque's
+    odd harmonics reach the engine angle (its 3rd harmonic 1.6 % / 1.3 % of the fundamental at
+    5 / 8 Hz, against 0.8 % / 0.5 % before), and the describing function neglects them."""
     m = rigid_limit_model(load_model(FLIGHT, friction="coulomb-switching"), 100.0)
     f = np.array([2.0, 5.0, 8.0, 12.0])
     dfm = describing_function_map(m, [0.4 * DEG], f)
@@ -44,7 +52,7 @@ def test_rigid_limit_engine_response_matches_relay_in_loop_describing_function()
     for j, fj in enumerate(f):
         ana = rigid_engine_response(m, 0.4 * DEG, fj)
         num = dfm.engine[0, j]
-        assert abs(num / ana - 1) < 0.02, (fj, num, ana)
+        assert abs(num / ana - 1) < 0.03, (fj, num, ana)
         assert abs(num / lin[j] - 1) > 0.10
 
 

@@ -5,21 +5,29 @@ modes lie at 5.0, 5.0, 7.4, 9.7 and 14.9 Hz; scripts/build_local_modes.py).
 The paper (sec. 1): MASV confirmed that the local modes, "despite their frequency density near the
 actuator bandwidth, do not adversely couple with the actuator position feedback servocontrol loop",
 and that engine-to-engine coupling "was present" but not significant. What this notional structure
-gives (measured with the hot-fire servo of models/rs25_hotfire.toml; re-measure after a servo
-recalibration):
+gives with the recalibrated flight servo (models/actuators/tvc_actuator.toml, issue 24.1; measured
+by `masv coupling models/masv/core_stage_local_modes.toml` and the analysis calls below; re-measure
+after any servo recalibration):
 
-* the first claim holds: all eight loops stable, no position-loop margin lost against a rigid
-  structure (phase margin 35 deg against 30 rigid);
-* the second holds only in part: engine-to-engine coupling rises from -6.0 dB (nominal structure,
-  17.6 dB below the direct response) to +5.9 dB at 3.1 Hz, which is 3.1 dB below the commanded
-  engine's own peak (+9.0 dB). The "+3..+5 dB" of the issue is the cross gain relative to the
-  *other* engine's command (|theta_i / theta_c,j|), not relative to the direct response. It comes
-  from the engines' inertia (tail wags dog) on the aft section's lateral sway: the four engines
-  (14 t) on the softened sway modes make a 3.1 Hz mode with 1.1 % damping in which they all move;
-  through the elastic path alone (no c.g. offset) the coupling is -8.9 dB. Reaching the same
-  frequencies with a heavier rather than a softer structure keeps it about 10 dB below the direct
-  response: what decides the coupling is the engines' mass against the structure's modal mass at
-  the gimbals, which the public data do not fix.
+* the first claim holds, with a measurable cost: all eight loops stable and inside the flight
+  specification (worst phase margin 51.4 deg, gain margin 33.2 dB, against >= 45 deg / 6 dB), but
+  each loop loses 7.4-7.5 deg of phase margin against a rigid structure (58.9 deg), where the
+  nominal frame costs 0.45 deg. Physical reason: the engines-on-sway mode (3.04 Hz) lies at the
+  servo's position-loop gain crossover (3.29 Hz rigid, 2.94 Hz with the structure). With the
+  previous, faster notional servo (K_v 40 1/s) the crossover sat above that mode and no margin was
+  lost (35.4 deg against 30.3 rigid); the credible servo is slower, so the mode is now in its
+  crossover region. Its gain margin rises (15.6 -> 33.2 dB) because the structure's phase moves
+  the -180 deg crossing from 6.0 Hz to the valve's 99 Hz;
+* the second holds: engine-to-engine coupling rises by 12 dB, from -15.4 dB at 12.8 Hz (nominal
+  structure, 19.6 dB below the direct response) to -3.4 dB at 3.06 Hz, which stays 6.8 dB below
+  the commanded engine's own peak (+3.5 dB). (With the old servo: +5.9 dB, only 3.1 dB below the
+  direct response: a peaky servo amplified the sway mode; the credible servo's dynamic pressure
+  feedback damps it, 3.3 % against 1.1 %.) It still comes from the engines' inertia (tail wags dog)
+  on the aft section's lateral sway: the four engines (14 t) on the softened sway modes make a
+  3.04 Hz mode in which they all move; through the elastic path alone (no c.g. offset) the
+  coupling is -13.2 dB. Reaching the same frequencies with a heavier rather than a softer
+  structure keeps it 12.3 dB below the direct response (-8.2 dB): the engines' mass against the
+  structure's modal mass at the gimbals, which the public data do not fix, still decides it.
 """
 
 from __future__ import annotations
@@ -67,22 +75,31 @@ def test_local_modes_lie_in_the_actuator_band_with_the_papers_damping(local):
 def test_f12_loops_stay_stable_and_keep_their_margins_with_local_modes_in_band(local):
     assert closed_loop_eigenvalues(local).stable
     eff = structure_effect(local)
-    # measured: worst PM 35.4 deg (rigid 30.3), worst GM 27.1 dB (rigid 11.6)
-    assert eff["worst_phase_margin_deg"] > 25.0 and eff["worst_gain_margin_db"] > 6.0
-    assert eff["largest_phase_margin_loss_deg"] < 2.0
+    # measured: worst PM 51.4 deg (rigid 58.9), worst GM 33.2 dB (rigid 15.6): inside the flight
+    # specification (>= 45 deg, >= 6 dB) the servo was calibrated to (tests/test_servo_calibration.py)
+    assert eff["worst_phase_margin_deg"] > 45.0 and eff["worst_gain_margin_db"] > 6.0
+    assert 48.0 < eff["worst_phase_margin_deg"] < 55.0
+    # ... but not for free: 7.46 deg of phase margin lost, the engines-on-sway mode (3.04 Hz) sitting
+    # at the loop's gain crossover (3.29 Hz rigid); the nominal frame (modes from 14.5 Hz) costs 0.45
+    assert 5.0 < eff["largest_phase_margin_loss_deg"] < 10.0
+    rigid = eff["loops"][0]["rigid"]
+    assert 2.9 < rigid["gain_crossover_hz"] < 3.6
+    assert structure_effect(build_system(load_config(NOMINAL)))["largest_phase_margin_loss_deg"] < 1.0
 
 
 def test_f12_engine_to_engine_coupling_rises_but_stays_below_the_direct_response(local, nominal):
     c, n = coupling(local), coupling(nominal)
     e, e0 = c.engine_to_engine("engine"), n.engine_to_engine("engine")
-    # nominal structure: -6.0 dB, 17.6 dB below the direct response
-    assert -9.0 < e0["cross_db"] < -3.0 and 14.0 < e0["below_direct_db"] < 21.0
-    # modes in band: +5.9 dB at 3.09 Hz, 3.1 dB below the commanded engine's own peak (+9.0 dB)
-    assert e["cross_db"] - e0["cross_db"] > 8.0
-    assert 3.0 < e["cross_db"] < 9.0 and 2.7 < e["cross_hz"] < 3.5
-    assert 1.5 < e["below_direct_db"] < 6.0
-    p = c.engine_to_engine("piston")   # piston: +1.1 dB, 4.0 dB below the direct +5.1 dB
-    assert 2.0 < p["below_direct_db"] < 8.0 and -2.0 < p["cross_db"] < 4.0
+    # nominal structure: -15.4 dB at 12.8 Hz, 19.6 dB below the direct response (+4.3 dB)
+    assert -18.0 < e0["cross_db"] < -12.0 and 17.0 < e0["below_direct_db"] < 22.0
+    # modes in band: -3.4 dB at 3.06 Hz (12.0 dB up), 6.8 dB below the commanded engine's own peak
+    # (+3.5 dB). With the old peaky servo it was +5.9 dB, only 3.1 dB below: the credible servo's
+    # pressure feedback damps the engines-on-sway mode (3.3 % against 1.1 %)
+    assert 9.0 < e["cross_db"] - e0["cross_db"] < 15.0
+    assert -6.0 < e["cross_db"] < -1.0 and 2.7 < e["cross_hz"] < 3.5
+    assert 5.0 < e["below_direct_db"] < 9.0
+    p = c.engine_to_engine("piston")   # piston: -7.2 dB, 8.4 dB below the direct +1.2 dB
+    assert 6.0 < p["below_direct_db"] < 11.0 and -10.0 < p["cross_db"] < -4.5
     # the reported peak is the 8x8 response itself at that frequency
     fr = frequency_response(local, [e["cross_hz"]])
     i, j = fr.index(e["response"]), fr.index(e["command"])
@@ -90,25 +107,27 @@ def test_f12_engine_to_engine_coupling_rises_but_stays_below_the_direct_response
     # per engine pair: every cross pair below its diagonal
     pk = np.asarray(c.engine_pairs("engine")["peak_db"])
     off = ~np.eye(4, dtype=bool)
-    assert np.all((pk - np.diag(pk)[None, :])[off] < -1.5)
+    assert np.all((pk - np.diag(pk)[None, :])[off] < -5.0)
 
 
 def test_f12_coupling_is_the_engines_inertia_on_a_lightly_damped_sway_mode(local):
-    # the least damped closed-loop mode: the engines on the lateral sway, 3.09 Hz, 1.1 % damping
+    # the least damped closed-loop mode: the engines on the lateral sway, 3.04 Hz, 3.3 % damping
+    # (1.1 % with the old servo; the structure alone has 0.5 %: the rest is the actuators' pressure
+    # feedback, which makes each actuator a damper in series with its load path near w_L)
     z = closed_loop_eigenvalues(local).least_damped(1)[0]
-    assert 2.7 < z["freq_hz"] < 3.5 and 0.005 < z["damping_ratio"] < 0.03
-    # the elastic path alone (engines as point masses at the gimbals): -8.9 dB
+    assert 2.7 < z["freq_hz"] < 3.5 and 0.02 < z["damping_ratio"] < 0.05
+    # the elastic path alone (engines as point masses at the gimbals): -13.2 dB, 10 dB less
     cfg = local.config
     point = dataclasses.replace(cfg, engines=tuple(dataclasses.replace(e, cg_offset_m=(0.0, 0.0, 0.0))
                                                   for e in cfg.engines))
-    assert coupling(build_system(point)).engine_to_engine("engine")["cross_db"] < -5.0
+    assert coupling(build_system(point)).engine_to_engine("engine")["cross_db"] < -10.0
     # the same frequencies from a heavier (mass x s^2, shapes / s) instead of a softer structure:
-    # -0.1 dB, 10 dB below the direct response
+    # -8.2 dB, 12.3 dB below the direct response (the softer one: 6.8 dB)
     s = float(load_config(NOMINAL).structure.freq_hz[0] / cfg.structure.freq_hz[0])
     st = cfg.structure
     heavy = dataclasses.replace(cfg, structure=dataclasses.replace(st, phi=st.phi / s))
     h = coupling(build_system(heavy)).engine_to_engine("engine")
-    assert h["below_direct_db"] > 7.0 and h["cross_db"] < 2.0
+    assert h["below_direct_db"] > 10.0 and h["cross_db"] < -6.0
 
 
 def test_cli_coupling_reports_engine_pairs_against_the_reference(capsys):
