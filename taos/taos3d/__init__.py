@@ -6,14 +6,13 @@ spherical-bearing friction (vector forms of every planar law) between the halves
 :mod:`.dynamics` for the formulation (massless halves condensed, implicit bearing step).
 """
 
+from .calibrate import load_taos_model, taos_model
 from .model import (
     ActuatorGeometry,
     GimbalParams,
     TaosModel,
     beam_half_stiffness,
     engine_pin_model,
-    load_taos_model,
-    taos_model,
 )
 from .simulate import (
     TaosTimeHistory,
