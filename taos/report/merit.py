@@ -120,7 +120,7 @@ def frequency_merit(model: TvcModel, axis: str = "pitch", f_min_hz: float = 0.01
     ``taos``: a :class:`taos.taos3d.TaosModel` of ``model``: the figures are then the 3-D model's
     own, from its linearisation (:func:`taos.taos3d.linear_state_space`, via
     :func:`taos.taos3d.taos_freqresp`), and ``notch_hz`` the minimum of its command -> piston gain
-    (refined between the dense grid's neighbours, :func:`taos.linear.notch_hz`);
+    between 0.5 and 30 Hz (:func:`taos.linear.notch_hz`, as the planar notch);
     ``load_resonance_hz`` stays the planar w_L, the target the 3-D line stiffness is derived for."""
     f = np.logspace(math.log10(f_min_hz), math.log10(f_max_hz), n)
     if taos is None:
@@ -134,9 +134,8 @@ def frequency_merit(model: TvcModel, axis: str = "pitch", f_min_hz: float = 0.01
         from ..taos3d import taos_freqresp
 
         fr = taos_freqresp(taos, f, None, axis)
-        k = int(np.argmin(np.abs(fr.piston)))
-        notch = notch_hz(lambda x: np.abs(taos_freqresp(taos, x, None, axis).piston), f[max(k - 1, 0)],
-                         f[min(k + 1, f.size - 1)], n_grid=21, xatol=1e-6)
+        # the same search band as the planar notch (load_resonance_from_notch)
+        notch = notch_hz(lambda x: np.abs(taos_freqresp(taos, x, None, axis).piston), 0.5, 30.0)
     return FrequencyMerit(axis, response_merit("engine", f, fr.engine, fr.engine_phase_deg()),
                           response_merit("piston", f, fr.piston, fr.piston_phase_deg()),
                           model.load_resonance_hz(axis), notch, (f_min_hz, f_max_hz),

@@ -22,7 +22,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import scipy.optimize as so
 
 from ..errors import InputError
 from ..model import TvcModel, load_model
@@ -34,6 +33,8 @@ _NPM_PER_LBF_IN = 175.12683524647636
 
 def taos_notch_hz(tm: TaosModel, guess_hz: float, axis: str = "pitch") -> float:
     """Frequency [Hz] of the 3-D linear command -> piston notch near ``guess_hz``."""
+    import scipy.optimize as so
+
     from .simulate import taos_freqresp
     res = so.minimize_scalar(lambda f: abs(taos_freqresp(tm, [f], None, axis).piston[0]),
                              bounds=(0.7 * guess_hz, 1.3 * guess_hz), method="bounded", options={"xatol": 1e-5})
@@ -41,7 +42,10 @@ def taos_notch_hz(tm: TaosModel, guess_hz: float, axis: str = "pitch") -> float:
 
 
 def _line_stiffness(model: TvcModel, tm0: TaosModel, rtol: float) -> float:
-    """Line stiffness [N/m] putting the notch of ``tm0``'s gimbal on the planar load resonance."""
+    """Line stiffness [N/m] putting the notch of ``tm0``'s gimbal on the planar load resonance
+    (SciPy and the compiled dynamics are imported here, after every cheap input check)."""
+    import scipy.optimize as so
+
     target = model.load_resonance_hz()
     K = model.structure.load_stiffness_N_per_m
 
@@ -86,7 +90,7 @@ def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.n
         lbf = _NPM_PER_LBF_IN
         raise InputError(model.source, "gimbal.line_load_stiffness",
                          f"{expected:.6g} N/m ({expected / lbf:.6g} lbf/in) within 1 %, derived from "
-                         f"[structure] load_stiffness = {K:.6g} N/m ({K / lbf:.6g} lbf/in) with the gimbal "
+                         f"structure.load_stiffness = {K:.6g} N/m ({K / lbf:.6g} lbf/in) with the gimbal "
                          f"{tm0.stiffness_source} in series (3-D notch on the load resonance "
                          f"{model.load_resonance_hz():.4g} Hz); delete the key to have it derived",
                          got=f"{given:.6g} N/m ({given / lbf:.6g} lbf/in)")

@@ -279,7 +279,7 @@ def check_friction_coefficient(model: TvcModel, mu: float | None, bearing_radius
     if model.friction.name != "none" and abs(mu - expected) > DERIVED_RTOL * expected:
         load = f"thrust {N / 1e3:.6g} kN" if model.engine.thrust_N > 0 else f"engine weight m g0 {N / 1e3:.6g} kN"
         raise InputError(model.source, "gimbal.friction_coefficient",
-                         f"{expected:.4g} within 1 %, from [friction] coulomb_torque = {tc:.6g} N m "
+                         f"{expected:.4g} within 1 %, from friction.coulomb_torque = {tc:.6g} N m "
                          f"({tc / _NM_PER_INLBF:.6g} in*lbf) = mu N r_b with N = {load}, r_b = {bearing_radius_m:.4g} m "
                          f"(one friction for the planar and 3-D models; delete the key to have it derived)",
                          got=f"{mu:.6g} (mu N r_b = {mu * N * bearing_radius_m:.6g} N m)")
