@@ -56,11 +56,12 @@ def _line_stiffness(model: TvcModel, tm0: TaosModel, rtol: float) -> float:
     lo, hi = 0.9 * K, 3.0 * K
     e_lo, e_hi = err(lo), err(hi)
     if not (np.sign(e_lo) != np.sign(e_hi)):
-        raise InputError(model.source, "gimbal.stiffness_file",
-                         f"a gimbal stiff enough that a line stiffness of 0.9 to 3 x [structure] load_stiffness "
-                         f"({K:.6g} N/m) puts the 3-D notch on the load resonance {target:.4g} Hz",
-                         got=f"notch {100 * e_lo:+.2g} % to {100 * e_hi:+.2g} % off over that range "
-                             f"({tm0.stiffness_source})")
+        raise InputError(model.source, "gimbal.line_load_stiffness",
+                         f"a value derivable from structure.load_stiffness ({K:.6g} N/m): a line stiffness of "
+                         f"0.9 to 3 x that putting the 3-D command -> piston notch on the load resonance "
+                         f"{target:.4g} Hz with the gimbal {tm0.stiffness_source} in series",
+                         got=f"a notch {100 * e_lo:+.2g} % to {100 * e_hi:+.2g} % off over that range (a gimbal too "
+                             f"soft, or a servo without a notch)")
     return float(so.brentq(err, lo, hi, rtol=rtol))
 
 
