@@ -155,6 +155,11 @@ class TvcModel:
     avionics: Avionics
     source: str = "<code>"
     sha256: str = ""
+    #: role -> (resolved path, SHA-256) of every file the model was read from: ``model``, and the
+    #: ``actuator_parameter_set``, ``friction_parameter_set`` and ``stiffness_file`` it names;
+    #: ``sha256`` is their combined hash (:func:`combined_sha256`)
+    input_files: Mapping[str, tuple[str, str]] = field(default_factory=lambda: types.MappingProxyType({}),
+                                                       compare=False)
     friction_table: Mapping[str, Any] = field(default_factory=lambda: types.MappingProxyType({}),
                                               compare=False, repr=False)
     extra: Mapping[str, Any] = field(default_factory=lambda: types.MappingProxyType({}),
@@ -455,6 +460,38 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
             table[key] = f"{v * level / ref!r} {DIMENSIONS[kind][1]}"
 
 
+def _input_files(p: Path, raw: bytes, doc: Mapping) -> dict[str, tuple[str, str]]:
+    """role -> (path, SHA-256) of the model file and the shared files it names (parameter sets,
+    the 3-D ``[gimbal] stiffness_file`` when it exists; a missing one is the 3-D loader's error)."""
+    files = {"model": (str(p), hashlib.sha256(raw).hexdigest())}
+    for sec in ("actuator", "friction"):
+        ref = doc.get(sec, {}).get(PARAMETER_SET_KEY) if isinstance(doc.get(sec), Mapping) else None
+        if isinstance(ref, str) and ref:
+            q = resolve_parameter_set(ref, p)
+            files[f"{sec}_parameter_set"] = (str(q), hashlib.sha256(q.read_bytes()).hexdigest())
+    gim = doc.get("gimbal")
+    ref = gim.get("stiffness_file") if isinstance(gim, Mapping) else None
+    if isinstance(ref, str) and ref:
+        q = (p.parent / ref).resolve()
+        if q.is_file():
+            files["stiffness_file"] = (str(q), hashlib.sha256(q.read_bytes()).hexdigest())
+    return files
+
+
+def combined_sha256(files: Mapping[str, tuple[str, str]]) -> str:
+    """The model's recorded hash (``model_sha256``): SHA-256 of the lines ``role sha256`` of
+    every input file, sorted by role (contents only: moving the files keeps it); a change to
+    the model file or to any shared file it names (parameter sets, stiffness file) changes it.
+    Per-file hashes are in :attr:`TvcModel.input_files` (``model_inputs`` in the outputs)."""
+    text = "".join(f"{role} {files[role][1]}\n" for role in sorted(files))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def model_inputs(model: "TvcModel") -> dict:
+    """``{role: {"file": path, "sha256": hex}}`` of a model's input files (provenance)."""
+    return {role: {"file": f, "sha256": h} for role, (f, h) in model.input_files.items()}
+
+
 def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
 
@@ -478,11 +515,12 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     law = friction_from_table(ftab, src, model=friction)
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}
+    files = _input_files(p, raw, doc)
     from .bounds import check_model_plausible
 
     check_model_plausible(src, engine, actuator, structure)
     return TvcModel(name=str(doc.get("name", p.stem)), engine=engine, actuator=actuator,
                     structure=structure, friction=law, avionics=avionics, source=src,
-                    sha256=hashlib.sha256(raw).hexdigest(),
+                    sha256=combined_sha256(files), input_files=types.MappingProxyType(files),
                     friction_table=types.MappingProxyType(dict(ftab)),
                     extra=types.MappingProxyType(extra))

@@ -106,12 +106,16 @@ def file_sha256(path: str | Path) -> str:
 
 def output_provenance(models=(), inputs=()) -> dict:
     """Provenance block of a JSON output: package version, git revision, and the path and
-    SHA-256 of each model (``TvcModel``) and input file (``(kind, path)``)."""
+    SHA-256 of each model (``TvcModel``: ``model_sha256`` the combined hash of the model file and
+    the shared files it names, ``model_inputs`` each one's path and hash) and input file
+    (``(kind, path)``)."""
     out = base_provenance()
     for i, m in enumerate(models):
         sfx = "" if len(models) == 1 else f"_{i + 1}"
         out[f"model_file{sfx}"] = str(m.source)
         out[f"model_sha256{sfx}"] = m.sha256
+        if getattr(m, "input_files", None):   # per-file hashes behind the combined model_sha256
+            out[f"model_inputs{sfx}"] = {r: {"file": f, "sha256": h} for r, (f, h) in m.input_files.items()}
     for i, (kind, path) in enumerate(inputs):
         sfx = "" if sum(k == kind for k, _ in inputs) == 1 else f"_{i + 1}"
         out[f"{kind}_file{sfx}"] = str(path)

@@ -113,7 +113,7 @@ def test_rate_limit_phase_loss_shows_in_the_describing_function_map(ambient_idea
 # -- 3-D TAOS model: the same limits ---------------------------------------------------------
 @pytest.fixture(scope="module")
 def taos_ambient():
-    from taos.taos3d.model import load_taos_model
+    from taos.taos3d import load_taos_model
     tm = load_taos_model(MODELS / "rs25_ambient.toml", friction="none")
     return dataclasses.replace(tm, base=_ideal(tm.base))
 

@@ -189,7 +189,7 @@ def test_planar_friction_level_is_mu_N_rb_as_in_taos(name):
     """Issue 12.1: the planar torque level follows the bearing normal load exactly as the 3-D
     TAOS model computes it (mu N r_b; N the thrust, or the engine weight when hanging): the
     hanging ambient engine carries 1.5 % of the flight friction."""
-    from taos.taos3d.model import load_taos_model
+    from taos.taos3d import load_taos_model
     m = load_model(MODELS / f"{name}.toml")
     t3 = load_taos_model(MODELS / f"{name}.toml")
     assert m.friction.coulomb_torque_Nm == pytest.approx(t3.coulomb_torque_Nm, rel=1e-3)

@@ -149,7 +149,8 @@ def _free_engine(hot, law, halves=()):
                               pressure_feedback_gain_m_per_s_Pa=0.0)
     base = hot.with_friction(law).replace(actuator=act,  # and no structural damping (issue 12.6)
                                           structure=dataclasses.replace(hot.structure, load_damping_ratio=0.0))
-    pk = pack(taos_model(base, *halves))
+    # the line stiffness derived for the working servo (issue 24.5), then the servo switched off
+    pk = pack(taos_model(hot, *halves).replace(base=base))
     P = pk.P
     sts = actuator_state_space(act).states
     na = len(sts)

@@ -26,6 +26,17 @@ def model_from_args(args) -> TvcModel:
     return load_model(args.model, friction=getattr(args, "friction", None))
 
 
+def taos_from_args(args, model: TvcModel):
+    """The 3-D model of ``model`` when ``--engine taos`` (else None), built right after loading:
+    every 3-D input check (geometry, stiffness file, derived keys) runs before any simulation,
+    and the 3-D model carries the same friction (``--friction`` included) as ``model``."""
+    if getattr(args, "engine", "simplex") != "taos":
+        return None
+    from taos.taos3d import taos_model
+
+    return taos_model(model)
+
+
 def cmd_info(args) -> int:
     model = model_from_args(args)
     d = model_summary(model, steps=args.steps)
@@ -71,6 +82,7 @@ def cmd_freqresp(args) -> int:
         if getattr(args, opt) not in (None, "-"):
             check_output_file(getattr(args, opt), f"--{opt}", suf)
     model = model_from_args(args)
+    tm = taos_from_args(args, model)
     amps_rad: list[float] = []
     if args.amplitude_deg is not None and not args.linear:
         amps_rad = [math.radians(a) for a in parse_float_list(args.amplitude_deg, "--amplitude-deg")]
@@ -81,9 +93,8 @@ def cmd_freqresp(args) -> int:
                              "simplex engine)", got="shoot")
         run_checks.check_linear_stability(model, (args.axis,), allow=args.allow_unstable)
         run_checks.check_dwell(model, freqs, axis=args.axis, n_amplitudes=len(amps_rad))
-    if args.engine == "taos":
-        from taos.taos3d import taos_freqresp, taos_freqresp_family, taos_model
-        tm = taos_model(model)
+    if tm is not None:
+        from taos.taos3d import taos_freqresp, taos_freqresp_family
         fam = (taos_freqresp_family(tm, freqs, amps_rad, args.axis, cross=args.cross) if amps_rad
                else [taos_freqresp(tm, freqs, None, args.axis, cross=args.cross)])
     elif not amps_rad:
@@ -101,7 +112,8 @@ def cmd_freqresp(args) -> int:
     d["provenance"]["seeds"] = "none (deterministic)"
     if not args.cross:
         from taos.report.merit import frequency_merit
-        d["figures_of_merit"] = frequency_merit(model, args.axis).to_dict()
+        # figures of the model that answered: the 3-D model's own linearisation with --engine taos
+        d["figures_of_merit"] = frequency_merit(model, args.axis, taos=tm).to_dict()
     if args.json:
         write_json(args.json, d)
     else:
@@ -143,13 +155,14 @@ def cmd_simulate(args) -> int:
 
     check_output_file(args.out, "--out")
     model = model_from_args(args)
+    tm = taos_from_args(args, model)
     profile = load_command_source(args.profile)
     dt = run_checks.default_dt_s(args.engine) if args.dt is None else args.dt
     run_checks.check_run(model, profile, dt)
     run_checks.check_linear_stability(model, allow=args.allow_unstable)
-    if args.engine == "taos":
-        from taos.taos3d import simulate_taos, taos_model
-        th = simulate_taos(taos_model(model), profile, dt_s=dt)
+    if tm is not None:
+        from taos.taos3d import simulate_taos
+        th = simulate_taos(tm, profile, dt_s=dt)
     else:
         th = simulate(model, profile, dt_s=dt, progress=sys.stderr.isatty())
     if not args.allow_unstable:

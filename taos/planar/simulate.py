@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     import h5py
 
 from ..errors import SimulationUnstable
-from ..model import TvcModel
+from ..model import TvcModel, model_inputs
 from ..profiles import Profile, is_two_axis
 from ..results import atomic_write, base_provenance, write_provenance
 from .simplex import LurePlant, simplex_plant
@@ -172,6 +172,7 @@ def _with_spool_output(plant: LurePlant) -> LurePlant:
 
 def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
     return {"model_file": model.source, "model_sha256": model.sha256, "model_name": model.name,
+            "model_inputs": model_inputs(model),
             **base_provenance(), "seeds": "none (deterministic)", "friction_model": model.friction.name,
             "solver": {"method": solver.method, "dt_s": solver.dt_s, "record_every": solver.record_every},
             **more}

@@ -363,9 +363,12 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
         model = model.with_friction(friction) if friction is not None else model
     else:
         model = load_model(model, friction=friction)
-    prof, profile_file, ppath = _profile_of(profile)
     if engine not in run_checks.ENGINES:
         raise InputError("command line", "--engine", " or ".join(run_checks.ENGINES), got=repr(engine))
+    if engine == "taos":   # every 3-D input check before any work; one model object, one friction
+        from taos.taos3d import taos_model
+        tm = taos_model(model)
+    prof, profile_file, ppath = _profile_of(profile)
     if dt_s is None:
         dt_s = run_checks.default_dt_s(engine)
     run_checks.check_run(model, prof, dt_s)
@@ -375,8 +378,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     measured = _measured_responses(data) if data is not None else None
     info = model_summary(model)
     if engine == "taos":
-        from taos.taos3d import simulate_taos, taos_freqresp, taos_model
-        tm = taos_model(model)
+        from taos.taos3d import simulate_taos, taos_freqresp
         run_sim = lambda: simulate_taos(tm, prof, dt_s=dt_s)  # noqa: E731
         lin_fr = lambda f, ax: taos_freqresp(tm, f, None, ax)  # noqa: E731
 

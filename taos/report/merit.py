@@ -72,11 +72,12 @@ class FrequencyMerit:
     load_resonance_hz: float
     notch_hz: float
     f_range_hz: tuple[float, float]
+    engine_model: str = "simplex"
 
     def to_dict(self) -> dict:
         return {"axis": self.axis, "engine": self.engine.to_dict(), "piston": self.piston.to_dict(),
                 "load_resonance_hz": self.load_resonance_hz, "notch_hz": self.notch_hz,
-                "f_range_hz": list(self.f_range_hz),
+                "f_range_hz": list(self.f_range_hz), "engine_model": self.engine_model,
                 "definition": "linear response; gains relative to the low-frequency gain; -3 dB and -90 deg: "
                               "lowest crossing; piston x_p/(R theta_c); phase continuous from low frequency"}
 
@@ -113,16 +114,32 @@ def response_merit(name: str, freq_hz, h, phase_deg) -> ResponseMerit:
 
 
 def frequency_merit(model: TvcModel, axis: str = "pitch", f_min_hz: float = 0.01, f_max_hz: float = 50.0,
-                    n: int = 1500) -> FrequencyMerit:
-    """Frequency figures of merit of ``axis`` from the exact linear response (module docstring)."""
-    from ..planar.freqresp import linear_freqresp
-    from ..planar.simplex import load_resonance_from_notch
+                    n: int = 1500, *, taos=None) -> FrequencyMerit:
+    """Frequency figures of merit of ``axis`` from the exact linear response (module docstring).
 
+    ``taos``: a :class:`taos.taos3d.TaosModel` of ``model``: the figures are then the 3-D model's
+    own, from its linearisation (:func:`taos.taos3d.linear_state_space`, via
+    :func:`taos.taos3d.taos_freqresp`), and ``notch_hz`` the minimum of its command -> piston gain
+    between 0.5 and 30 Hz (:func:`taos.linear.notch_hz`, as the planar notch);
+    ``load_resonance_hz`` stays the planar w_L, the target the 3-D line stiffness is derived for."""
     f = np.logspace(math.log10(f_min_hz), math.log10(f_max_hz), n)
-    fr = linear_freqresp(model, f, axis)
+    if taos is None:
+        from ..planar.freqresp import linear_freqresp
+        from ..planar.simplex import load_resonance_from_notch
+
+        fr = linear_freqresp(model, f, axis)
+        notch = load_resonance_from_notch(model, axis)
+    else:
+        from ..linear import notch_hz
+        from ..taos3d import taos_freqresp
+
+        fr = taos_freqresp(taos, f, None, axis)
+        # the same search band as the planar notch (load_resonance_from_notch)
+        notch = notch_hz(lambda x: np.abs(taos_freqresp(taos, x, None, axis).piston), 0.5, 30.0)
     return FrequencyMerit(axis, response_merit("engine", f, fr.engine, fr.engine_phase_deg()),
                           response_merit("piston", f, fr.piston, fr.piston_phase_deg()),
-                          model.load_resonance_hz(axis), load_resonance_from_notch(model, axis), (f_min_hz, f_max_hz))
+                          model.load_resonance_hz(axis), notch, (f_min_hz, f_max_hz),
+                          "taos" if taos is not None else "simplex")
 
 
 @dataclass(frozen=True)

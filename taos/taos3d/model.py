@@ -8,12 +8,16 @@ plane. Engine angles are the pitch/yaw components of the engine's rotation vecto
 
 Model-file tables read here (the loader keeps them raw in ``TvcModel.extra``)::
 
-    [gimbal]    friction_coefficient  mu [-], bearing friction coefficient
+    [gimbal]    friction_coefficient  mu [-], bearing friction coefficient [derived key: optional;
+                                      when absent mu = T_c / (N r_b) from [friction] coulomb_torque,
+                                      when given checked against it within 1 %]
                 bearing_radius        r_b [m], effective friction radius of the spherical seat
                 stiffness_file        fem_data .npz with K_upper, K_lower (path relative to the
                                       model file)
-                line_load_stiffness   (optional) actuator-line stiffness outside the gimbal [N/m];
-                                      default [structure] load_stiffness
+                line_load_stiffness   actuator-line stiffness outside the gimbal [N/m] [derived key:
+                                      optional; when absent derived from [structure] load_stiffness
+                                      with the FEM gimbal in series, when given checked against that
+                                      within 1 % (:mod:`taos.taos3d.calibrate`)]
     [geometry]  pitch_structure_attach, pitch_engine_attach, yaw_structure_attach,
                 yaw_engine_attach     [x, y, z] attach points [m] (engine points at zero angle)
                 engine_cg             [x, y, z] engine centre of mass [m]
@@ -24,8 +28,18 @@ same J_n as the planar model), so the inertia about the c.g. is J_n - m (distanc
 axis)^2; the roll inertia comes from ``engine_roll_inertia``.
 
 Bearing normal load N: the thrust when firing, the engine weight m g0 when hanging. The
-friction torque level is T_c = mu N r_b; the planar law's torque-like parameters are scaled by
-lambda = T_c / T_c,file (:meth:`taos.friction.FrictionLaw.scaled`).
+bearing's friction torque level is T_c = mu N r_b: one friction for the planar and the 3-D
+model. The model file's ``[friction] coulomb_torque`` is that level (the planar contract key),
+so ``friction_coefficient`` is derived from it, or checked against it within 1 % when given
+(:func:`check_friction_coefficient`), at load; the 3-D model then simulates the model's own
+friction law, unscaled (:attr:`TaosModel.bearing_friction`): the law and levels every summary
+shows, including a ``--friction`` swap.
+
+Every check here (keys, units, ranges, geometry, moment arms against ``[actuator]
+moment_arm``, the engine's c.g. inertia, the stiffness file symmetric positive definite, the
+friction coefficient) runs in :func:`assemble_taos_model`, before any simulation; the derived
+line stiffness is then derived or checked by :func:`taos.taos3d.calibrate.taos_model`, the
+builder every command uses.
 """
 
 from __future__ import annotations
@@ -37,7 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..model import TvcModel, load_model
+from ..model import TvcModel
 from ..units import to_si
 
 G0 = 9.80665  # standard gravity [m/s^2]
@@ -52,7 +66,9 @@ GEOMETRY_KEYS = {"pitch_structure_attach", "pitch_engine_attach", "yaw_structure
 
 @dataclass(frozen=True)
 class GimbalParams:
-    """Bearing friction scaling and the FEM stiffness source (SI)."""
+    """Bearing friction and the FEM stiffness source (SI). ``friction_coefficient`` and
+    ``line_load_stiffness_N_per_m`` are derived keys: the built model carries the value given
+    (and checked) or derived at load."""
 
     friction_coefficient: float
     bearing_radius_m: float
@@ -91,7 +107,8 @@ class TaosModel:
 
     ``base`` is the planar model (actuator, avionics, friction law, K_L, K_n, J_n);
     ``K_upper``/``K_lower`` (6, 6) are the halves' stiffness at O in DOF order
-    (ux, uy, uz, rx, ry, rz) [N/m, N/rad, N m/m, N m/rad]; ``friction_scale`` is lambda.
+    (ux, uy, uz, rx, ry, rz) [N/m, N/rad, N m/m, N m/rad]. The bearing friction simulated is
+    ``base.friction`` itself (:attr:`bearing_friction`).
     """
 
     base: TvcModel
@@ -105,20 +122,28 @@ class TaosModel:
     @property
     def normal_load_N(self) -> float:
         """Bearing normal load N [N]: thrust if firing, else the engine weight m g0."""
-        e = self.base.engine
-        return e.thrust_N if e.thrust_N > 0 else e.mass_kg * G0
+        return normal_load_N(self.base)
 
     @property
     def coulomb_torque_Nm(self) -> float:
-        """T_c = mu N r_b [N m]."""
+        """T_c = mu N r_b [N m]: the bearing's friction level (equal to the law's
+        ``coulomb_torque`` within 1 %, checked at load)."""
         g = self.gimbal
         return g.friction_coefficient * self.normal_load_N * g.bearing_radius_m
 
     @property
+    def bearing_friction(self):
+        """The friction law the 3-D model simulates at the bearing: the model's own law
+        (``base.friction``, a ``--friction`` swap included) with its own levels, the one the
+        summaries show. Its level follows the normal load through ``[friction] coulomb_torque``
+        = mu N r_b (:func:`check_friction_coefficient`), not through a second scaling."""
+        return self.base.friction
+
+    @property
     def friction_scale(self) -> float:
-        """lambda = mu N r_b / T_c,file (1 when the file's law has no torque level)."""
-        tc = self.base.friction.coulomb_torque_Nm
-        return self.coulomb_torque_Nm / tc if tc > 0 else 1.0
+        """lambda, the factor on the law's torque-like parameters in the 3-D run: 1 (one
+        friction for both models, :attr:`bearing_friction`); kept in the records."""
+        return 1.0
 
     @property
     def line_load_stiffness_N_per_m(self) -> float:
@@ -203,16 +228,19 @@ def _table(model: TvcModel, name: str, keys: set[str]) -> dict:
 
 
 def parse_gimbal(model: TvcModel) -> GimbalParams:
-    """Validate ``[gimbal]`` (InputError on a missing key, wrong unit or bad range)."""
+    """Validate ``[gimbal]`` (InputError on a missing key, wrong unit or bad range); the
+    friction coefficient derived or checked (:func:`check_friction_coefficient`); the line
+    stiffness as given, or None (derived by :func:`taos.taos3d.calibrate.taos_model`)."""
     src = model.source
     g = _table(model, "gimbal", GIMBAL_KEYS)
-    for k in ("friction_coefficient", "bearing_radius"):
-        if k not in g:
-            raise InputError(src, f"gimbal.{k}", "a value (mu like 0.08; radius like '0.11 m')",
-                             got="nothing (key missing)")
-    mu = to_si(g["friction_coefficient"], "dimensionless", source=src, field="gimbal.friction_coefficient",
-               nonnegative=True)
+    if "bearing_radius" not in g:
+        raise InputError(src, "gimbal.bearing_radius", "a value like '0.11 m'", got="nothing (key missing)")
     rb = to_si(g["bearing_radius"], "length", source=src, field="gimbal.bearing_radius", positive=True)
+    mu = None
+    if "friction_coefficient" in g:
+        mu = to_si(g["friction_coefficient"], "dimensionless", source=src, field="gimbal.friction_coefficient",
+                   nonnegative=True)
+    mu = check_friction_coefficient(model, mu, rb)
     path = None
     if "stiffness_file" in g:
         if not isinstance(g["stiffness_file"], str):
@@ -223,6 +251,39 @@ def parse_gimbal(model: TvcModel) -> GimbalParams:
         kl = to_si(g["line_load_stiffness"], "stiffness", source=src, field="gimbal.line_load_stiffness",
                    positive=True)
     return GimbalParams(mu, rb, path, kl)
+
+
+def normal_load_N(model: TvcModel) -> float:
+    """Bearing normal load N [N]: the thrust if firing, else the engine weight m g0."""
+    e = model.engine
+    return e.thrust_N if e.thrust_N > 0 else e.mass_kg * G0
+
+
+#: relative tolerance of a derived key given in a file against its source keys
+DERIVED_RTOL = 0.01
+#: N m per in*lbf (for the messages, which quote the files' units too)
+_NM_PER_INLBF = 0.1129848290276167
+
+
+def check_friction_coefficient(model: TvcModel, mu: float | None, bearing_radius_m: float) -> float:
+    """The bearing friction coefficient mu [-]: derived as T_c / (N r_b) from the law's level
+    ``[friction] coulomb_torque`` T_c [N m], the normal load N [N] (:func:`normal_load_N`) and the
+    bearing radius r_b [m] when ``mu`` is None; else ``mu`` checked against that within
+    :data:`DERIVED_RTOL` (InputError naming both keys, their values and the expected mu).
+    A law without friction (``none``) checks nothing."""
+    N = normal_load_N(model)
+    tc = model.friction.coulomb_torque_Nm
+    expected = tc / (N * bearing_radius_m)
+    if mu is None:
+        return expected
+    if model.friction.name != "none" and abs(mu - expected) > DERIVED_RTOL * expected:
+        load = f"thrust {N / 1e3:.6g} kN" if model.engine.thrust_N > 0 else f"engine weight m g0 {N / 1e3:.6g} kN"
+        raise InputError(model.source, "gimbal.friction_coefficient",
+                         f"{expected:.4g} within 1 %, from friction.coulomb_torque = {tc:.6g} N m "
+                         f"({tc / _NM_PER_INLBF:.6g} in*lbf) = mu N r_b with N = {load}, r_b = {bearing_radius_m:.4g} m "
+                         f"(one friction for the planar and 3-D models; delete the key to have it derived)",
+                         got=f"{mu:.6g} (mu N r_b = {mu * N * bearing_radius_m:.6g} N m)")
+    return mu
 
 
 def parse_geometry(model: TvcModel) -> ActuatorGeometry:
@@ -290,9 +351,12 @@ def load_stiffness_file(path: str) -> tuple[np.ndarray, np.ndarray]:
     return check_stiffness(data.K_upper, path, "K_upper"), check_stiffness(data.K_lower, path, "K_lower")
 
 
-def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.ndarray | None = None) -> TaosModel:
-    """Build the TAOS model from a loaded model file; ``K_upper``/``K_lower`` override the
-    ``[gimbal] stiffness_file`` (for synthetic or scaled matrices)."""
+def assemble_taos_model(model: TvcModel, K_upper: np.ndarray | None = None,
+                        K_lower: np.ndarray | None = None) -> TaosModel:
+    """The TAOS model of a loaded model file with every input check done (keys, units, geometry,
+    stiffness matrices, the friction coefficient) and the line stiffness as given (None when the
+    file leaves it to be derived: :func:`taos.taos3d.calibrate.taos_model` derives or checks it;
+    use that). ``K_upper``/``K_lower`` override the ``[gimbal] stiffness_file``."""
     gim = parse_gimbal(model)
     geo = parse_geometry(model)
     if K_upper is None or K_lower is None:
@@ -306,11 +370,6 @@ def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.n
         Kl = check_stiffness(K_lower, "<code>", "K_lower")
         src = "<code>"
     return TaosModel(model, gim, geo, Ku, Kl, src)
-
-
-def load_taos_model(path, friction: str | None = None, K_upper=None, K_lower=None) -> TaosModel:
-    """Load a model file (with ``[gimbal]`` and ``[geometry]``) as a TAOS model."""
-    return taos_model(load_model(path, friction=friction), K_upper, K_lower)
 
 
 def beam_half_stiffness(axial_N_per_m: float, shear_N_per_m: float, bending_Nm_per_rad: float,

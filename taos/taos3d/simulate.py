@@ -84,8 +84,8 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
         line_damping_Ns_per_m=float(tm.base.structure.load_damping_Ns_per_m(R, tm.base.engine.inertia("pitch"))),
         act_vp_index=act.states.index("v_p_m_s"), limits=f64(actuator_limits(tm)),
         torque_wrench=f64(Ks @ S @ Kc))
-    law = tm.base.friction
-    fp = law.scaled(tm.friction_scale).pack()
+    law = tm.bearing_friction   # the model's own law and levels: one friction for every summary
+    fp = law.pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
     na = act.A.shape[0]
     return Packed(P, law.entry.bearing_step, fp, av.pack(), _dy.N_BODY + 2 * na, na)
@@ -154,7 +154,8 @@ def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S
     solver = SolverSettings(method="rk4, trapezoidal bearing torque + BDF2 bearing", dt_s=dt_s, record_every=record_every)
     prov = provenance(tm.base, solver, engine="taos", profile=getattr(profile, "name", type(profile).__name__),
                       stiffness_source=tm.stiffness_source, friction_scale=tm.friction_scale,
-                      bearing_coulomb_torque_Nm=tm.coulomb_torque_Nm)
+                      bearing_coulomb_torque_Nm=tm.bearing_friction.coulomb_torque_Nm,
+                      line_load_stiffness_N_per_m=tm.line_load_stiffness_N_per_m)
     return TaosTimeHistory(
         t_s=t[::record_every], axes=AXES, moment_arm_m=tm.base.actuator.moment_arm_m, provenance=prov,
         command_rad=cmd[::record_every].T.copy(), command_avionics_rad=two("u_pitch", "u_yaw"),

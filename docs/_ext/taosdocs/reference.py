@@ -68,10 +68,10 @@ MEANINGS: dict[str, str] = {
     "avionics.crossover_command": "command magnitudes of the servo-amplifier gain table",
     "avionics.crossover_gain": "servo-amplifier gain at each command magnitude",
     # [gimbal] (3-D)
-    "gimbal.friction_coefficient": "bearing friction coefficient mu (friction torque = mu N r_b)",
+    "gimbal.friction_coefficient": "bearing friction coefficient mu: derived key, checked against friction.coulomb_torque = mu N r_b (1 %), derived when absent",
     "gimbal.bearing_radius": "effective friction radius r_b of the spherical seat",
     "gimbal.stiffness_file": "FEM stiffness of the two gimbal halves (.npz in fem_data/)",
-    "gimbal.line_load_stiffness": "load stiffness along the actuator lines outside the gimbal (optional)",
+    "gimbal.line_load_stiffness": "load stiffness along the actuator lines outside the gimbal: derived key, from structure.load_stiffness with the gimbal in series when absent, checked (1 %) when given",
     # [geometry] (3-D)
     "geometry.pitch_structure_attach": "pitch actuator attach point on the structure (x, y, z)",
     "geometry.pitch_engine_attach": "pitch actuator attach point on the engine (x, y, z)",
