@@ -91,7 +91,12 @@ class Actuator:
     (a velocity servo with oil compressibility alone gives the load mode negative damping
     unless K_c > A^2 K_v / K_h). Limits (:mod:`taos.planar.saturation`, nonlinear, time domain only):
     ``max_rate_m_per_s`` the valve flow saturation as a no-load piston rate [m/s] (0: none);
-    ``pressure_limited`` the supply-pressure limit, stall force A P_s.
+    ``pressure_limited`` the supply-pressure limit, stall force A P_s: the critical-centre
+    valve's square-root pressure-drop law Q = K_q x_v sqrt((P_s - sgn(x_v) P_L) / P_s) (K_q the
+    no-load flow gain, so the null linearisation is the linear model above) with a cross-port
+    relief valve, Q_r = K_r (|P_L| - P_r) sgn(P_L) for |P_L| > P_r:
+    ``relief_pressure_Pa`` P_r [Pa] (>= P_s; 0: no relief) and
+    ``relief_flow_coefficient_m3_per_s_Pa`` K_r [m^3/(s Pa)] (Merritt 1967, ch. 3).
     """
 
     moment_arm_m: float
@@ -111,6 +116,8 @@ class Actuator:
     pressure_feedback_time_constant_s: float = 0.0
     max_rate_m_per_s: float = 0.0
     pressure_limited: bool = False
+    relief_pressure_Pa: float = 0.0
+    relief_flow_coefficient_m3_per_s_Pa: float = 0.0
 
     @property
     def oil_column_stiffness_N_per_m(self) -> float:
@@ -251,6 +258,8 @@ _ACTUATOR_FIELDS = {  # key -> (kind, check)
     "pressure_feedback_gain": ("velocity_per_pressure", "nonnegative"),
     "pressure_feedback_time_constant": ("time", "nonnegative"),
     "max_rate": ("velocity", "positive"),
+    "relief_pressure": ("pressure", "positive"),
+    "relief_flow_coefficient": ("flow_pressure", "positive"),
 }
 _ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "supply_pressure": "supply_pressure_Pa", "oil_bulk_modulus": "oil_bulk_modulus_Pa",
@@ -262,13 +271,17 @@ _ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "leakage_coefficient": "leakage_coefficient_m3_per_s_Pa",
                 "pressure_feedback_gain": "pressure_feedback_gain_m_per_s_Pa",
                 "pressure_feedback_time_constant": "pressure_feedback_time_constant_s",
-                "max_rate": "max_rate_m_per_s"}
+                "max_rate": "max_rate_m_per_s", "relief_pressure": "relief_pressure_Pa",
+                "relief_flow_coefficient": "relief_flow_coefficient_m3_per_s_Pa"}
+#: the relief valve's cracking pressure against the supply: P_s <= P_r <= RELIEF_PRESSURE_MAX P_s
+RELIEF_PRESSURE_MAX = 1.5
 
 
 def parse_actuator(doc: Mapping, src: str) -> Actuator:
     s = _section(doc, "actuator", src)
     _check_keys(s, set(_ACTUATOR_FIELDS) | {"valve_order", "pressure_limited"}, src, "actuator")
-    optional = {"pressure_feedback_gain", "pressure_feedback_time_constant", "max_rate"}
+    optional = {"pressure_feedback_gain", "pressure_feedback_time_constant", "max_rate", "relief_pressure",
+                "relief_flow_coefficient"}
     kw = {_ACTUATOR_SI[k]: _need(s, k, kind, src, "actuator", **{chk: True})
           for k, (kind, chk) in _ACTUATOR_FIELDS.items() if k not in optional or k in s}
     if kw.get("pressure_feedback_gain_m_per_s_Pa", 0.0) > 0 and not kw.get(
@@ -278,10 +291,26 @@ def parse_actuator(doc: Mapping, src: str) -> Actuator:
     order = s.get("valve_order", 2)
     if order not in (1, 2) or isinstance(order, bool):
         raise InputError(src, "actuator.valve_order", "1 or 2", got=repr(order))
+    _check_relief(s, kw, src)
     plim = s.get("pressure_limited", False)
     if not isinstance(plim, bool):
         raise InputError(src, "actuator.pressure_limited", "true or false", got=repr(plim))
     return Actuator(valve_order=int(order), pressure_limited=plim, **kw)
+
+
+def _check_relief(s: Mapping, kw: dict, src: str) -> None:
+    """The relief valve's two keys come together, and it cracks between P_s and
+    :data:`RELIEF_PRESSURE_MAX` P_s (a relief below the supply would cut the stall force)."""
+    has = [k for k in ("relief_pressure", "relief_flow_coefficient") if k in s]
+    if len(has) == 1:
+        other = ({"relief_pressure", "relief_flow_coefficient"} - set(has)).pop()
+        raise InputError(src, f"actuator.{other}", f"a value with its unit when actuator.{has[0]} is set "
+                         "(the relief valve needs both)")
+    if has:
+        pr, ps = kw["relief_pressure_Pa"], kw["supply_pressure_Pa"]
+        if not ps <= pr <= RELIEF_PRESSURE_MAX * ps:
+            raise InputError(src, "actuator.relief_pressure", f"a cracking pressure from the supply pressure "
+                             f"({ps:.4g} Pa) to {RELIEF_PRESSURE_MAX:g} times it", got=f"{pr:.4g} Pa")
 
 
 def parse_avionics(doc: Mapping, src: str) -> Avionics:

@@ -8,6 +8,7 @@ kernel is compiled here (the tables are plain integers)."""
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -80,12 +81,15 @@ def test_limits_packer_and_kernel_layout_agree():
     """pack_limits puts every head value and every row where the LIM_/ROW_ tables say."""
     m = 4
     rows = {k: np.arange(m) + 10.0 * (i + 1) for i, k in enumerate(saturation.ROWS)}
-    lim = saturation.pack_limits(0.5, 2.0, 2e7, 0.18, 1e9, 3e5, rows)
+    lim = saturation.pack_limits(0.5, 2.0, 2e7, 0.18, 1e9, 3e5, rows, p_relief=2.1e7, k_relief_per_area=5e-8)
     assert lim.shape == (saturation.N_HEAD + saturation.N_ROWS * m,)
     assert saturation.n_limit_states(lim) == m
-    assert (lim[saturation.LIM_VMAX], lim[saturation.LIM_KVR], lim[saturation.LIM_PS], lim[saturation.LIM_BAND],
-            lim[saturation.LIM_THMAX], lim[saturation.LIM_KS], lim[saturation.LIM_CS]) == (
-        0.5, 2.0, 2e7, saturation.PRESSURE_BAND, 0.18, 1e9, 3e5)
+    assert (lim[saturation.LIM_VMAX], lim[saturation.LIM_KVR], lim[saturation.LIM_PS], lim[saturation.LIM_EPS],
+            lim[saturation.LIM_PR], lim[saturation.LIM_KRA], lim[saturation.LIM_THMAX], lim[saturation.LIM_KS],
+            lim[saturation.LIM_CS]) == (0.5, 2.0, 2e7, saturation.SQRT_LAW_EPS, 2.1e7, 5e-8, 0.18, 1e9, 3e5)
+    # the pressure limit off turns the relief off with it (no relief slot left set)
+    off = saturation.pack_limits(0.5, 2.0, 0.0, 0.18, 1e9, 3e5, rows, p_relief=2.1e7, k_relief_per_area=5e-8)
+    assert off[saturation.LIM_PR] == math.inf and off[saturation.LIM_KRA] == 0.0
     for i, k in enumerate(saturation.ROWS):
         b = saturation.row_start(i, m)
         np.testing.assert_array_equal(lim[b:b + m], rows[k])
@@ -110,7 +114,7 @@ def test_taos3d_state_bearing_aux_and_record_tables():
     _tiles(rec, {"REC_W": 6, "REC_P": 3, **{k: 2 for k in rec if k not in ("REC_W", "REC_P")}}, len(dy.REC))
     for name, col in rec.items():  # each group starts at its pitch (or x) column
         assert dy.REC[col] in ("theta_pitch", "xp_pitch", "fl_pitch", "tf_pitch", "z_pitch", "phi_pitch",
-                               "u_pitch", "w_fx", "px"), name
+                               "u_pitch", "w_fx", "px", "pl_pitch", "q_pitch"), name
     assert [dy.REC[c] for c in dy._DWELL_COLS] == ["xp_pitch", "xp_yaw", "theta_pitch", "theta_yaw"]
 
 
@@ -150,6 +154,7 @@ def test_taos3d_pack_fills_every_field(packed):
     assert P.engine_stiffness_Nm_per_rad == tm.base.engine.rotational_stiffness_Nm_per_rad
     act = actuator_state_space(tm.base.actuator)
     assert act.states[P.act_vp_index] == "v_p_m_s"
+    assert act.states[P.act_pl_index] == "p_load_Pa" and act.states[P.act_q_index] == "q_m_s"
     assert P.limits.size == 0 or saturation.n_limit_states(P.limits) == na
     np.testing.assert_allclose(P.torque_wrench, P.chain_stiffness @ P.bearing_selection @ P.bearing_compliance)
 

@@ -25,6 +25,19 @@ def _ideal(m):
     return m.with_friction("none").replace(avionics=Avionics(gain_table_rad=(0.0,), gain_table=(1.0,)))
 
 
+def _ideal_valve(m):
+    """The same model with the supply-pressure limit off (an ideal valve on an unlimited supply):
+    the piston then slews at exactly the valve's no-load rate v_max."""
+    return m.replace(actuator=dataclasses.replace(m.actuator, pressure_limited=False))
+
+
+def _load_flow_slew(p, sign, act):
+    """The slew rate the square-root law gives with the valve open at its no-load rate v_max:
+    v_max times the time mean of sqrt(1 - sgn(v) P_L / P_s) over the recorded load pressures
+    ``p`` [Pa] (the static load-flow curve, Merritt 1967 ch. 3, oil compressibility neglected)."""
+    return sign * act.max_rate_m_per_s * float(np.mean(np.sqrt(1.0 - sign * p / act.supply_pressure_Pa)))
+
+
 def _step(m, amp_rad, t_end=1.5, t0=0.05):
     plant = simplex_plant(m)
     n = int(t_end / DT)
@@ -50,9 +63,10 @@ def test_shipped_limits_documented_values(ambient_ideal):
 def test_5_deg_step_is_rate_limited_at_the_documented_rate(ambient_ideal):
     """The piston slews at the valve's no-load rate v_max (20 in/s, engine 36 deg/s) through the
     middle of the step; the engine follows it through the load spring, ringing at the load
-    resonance (peak rate below twice the slew), where the unlimited servo reaches > 100 deg/s.
+    resonance (peak rate below twice the slew), where the unlimited servo reaches twice the slew
+    (78 deg/s with the recalibrated K_v = 20 1/s; > 100 deg/s with the former K_v = 40 1/s).
     The piston exceeds v_max only by the oil column's decompression as the load force falls."""
-    m = ambient_ideal
+    m = _ideal_valve(ambient_ideal)
     vmax = m.actuator.max_rate_m_per_s
     R = m.actuator.moment_arm_m
     t, xp, th, _, _ = _step(m, 5 * DEG)
@@ -63,9 +77,19 @@ def test_5_deg_step_is_rate_limited_at_the_documented_rate(ambient_ideal):
     assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(vmax, rel=0.03)
     assert np.gradient(th, DT).max() < 2 * vmax / R
     assert th[-1] > 4.5 * DEG  # still arriving: K_n and the slow pressure-feedback filter
+    # with the supply-pressure limit (the shipped default) the valve's square-root law slows the
+    # slew to the load-flow curve's rate at the load pressure the engine's acceleration asks for
+    # (measured 0.80 v_max, within 2.7 % of the curve: oil compressibility and K_c), and the load
+    # pressure stays below P_s (measured 0.81 P_s)
+    t, xp, th, _, p = _step(ambient_ideal, 5 * DEG)
+    i0, i1 = np.argmax(xp > 0.2 * x5), np.argmax(xp > 0.8 * x5)
+    slew = (xp[i1] - xp[i0]) / (t[i1] - t[i0])
+    assert slew == pytest.approx(_load_flow_slew(p[i0:i1], 1.0, ambient_ideal.actuator), rel=0.04)
+    assert slew < 0.9 * vmax
+    assert np.abs(p).max() <= 1.05 * ambient_ideal.actuator.supply_pressure_Pa
     free = m.replace(actuator=dataclasses.replace(m.actuator, max_rate_m_per_s=0.0))
     _, _, th_free, _, _ = _step(free, 5 * DEG, t_end=0.5)
-    assert np.gradient(th_free, DT).max() > 100 * DEG
+    assert np.gradient(th_free, DT).max() > 2 * vmax / R
 
 
 def test_command_beyond_the_hard_stop_holds_the_engine_in_range(ambient_ideal):
@@ -91,11 +115,12 @@ def test_supply_pressure_limits_the_piston_force_to_stall(ambient_ideal):
     act = dataclasses.replace(ambient_ideal.actuator, pressure_limited=True)
     m = ambient_ideal.replace(actuator=act)
     t, xp, th, fl, p = _step(m, 14 * DEG, t_end=2.0)
-    # transient: at the stop's impact the load spring drives the piston back into the oil column
-    # faster than the valve relieves it (measured 1.23 P_s; a relief valve's job)
-    assert np.abs(p).max() <= act.supply_pressure_Pa * 1.3
+    # transient: at the stop's impact the load spring drives the piston back into the oil column;
+    # the valve's square-root law flows back to supply past P_s and the cross-port relief opens
+    # above P_r = P_s (measured 1.004 P_s; the soft flow factor without relief reached 1.23 P_s)
+    assert np.abs(p).max() <= act.supply_pressure_Pa * 1.05
     assert p[t > 1.5].mean() == pytest.approx(act.supply_pressure_Pa, rel=0.05)
-    _, _, _, _, p_free = _step(ambient_ideal, 14 * DEG, t_end=2.0)
+    _, _, _, _, p_free = _step(_ideal_valve(ambient_ideal), 14 * DEG, t_end=2.0)
     assert np.abs(p_free).max() > 1.5 * act.supply_pressure_Pa
 
 
@@ -118,7 +143,12 @@ def taos_ambient():
     return dataclasses.replace(tm, base=_ideal(tm.base))
 
 
-def _step3d(tm, amp_rad, t_end=1.5, t0=0.05):
+def _ideal_valve_3d(tm):
+    """The 3-D model with the supply-pressure limit off (:func:`_ideal_valve`)."""
+    return dataclasses.replace(tm, base=_ideal_valve(tm.base))
+
+
+def _step3d(tm, amp_rad, t_end=1.5, t0=0.05, pressure=False):
     from taos.taos3d import dynamics as _dy
     from taos.taos3d.simulate import run_samples
     n = int(t_end / DT)
@@ -127,18 +157,26 @@ def _step3d(tm, amp_rad, t_end=1.5, t0=0.05):
     cmd[:, 0] = np.where(t >= t0, amp_rad, 0.0)
     out = run_samples(tm, cmd, DT, 1)
     col = {k: i for i, k in enumerate(_dy.REC)}
-    return t, out[:, col["xp_pitch"]], out[:, col["theta_pitch"]], out[:, col["fl_pitch"]]
+    res = (t, out[:, col["xp_pitch"]], out[:, col["theta_pitch"]], out[:, col["fl_pitch"]])
+    return res + (out[:, col["pl_pitch"]],) if pressure else res
 
 
 def test_3d_5_deg_step_is_rate_limited_at_the_documented_rate(taos_ambient):
-    """TAOS: the pitch piston slews at v_max through the middle of a 5 deg step."""
-    vmax = taos_ambient.base.actuator.max_rate_m_per_s
-    R = taos_ambient.base.actuator.moment_arm_m
-    t, xp, th, _ = _step3d(taos_ambient, 5 * DEG)
+    """TAOS: the pitch piston slews at v_max through the middle of a 5 deg step with an ideal
+    valve, and at the square-root law's load-flow rate with the supply-pressure limit on (the
+    shipped default), the load pressure within 1.05 P_s."""
+    act = taos_ambient.base.actuator
+    vmax = act.max_rate_m_per_s
+    R = act.moment_arm_m
+    t, xp, th, _ = _step3d(_ideal_valve_3d(taos_ambient), 5 * DEG)
     x5 = R * 5 * DEG
     i0, i1 = np.argmax(xp > 0.2 * x5), np.argmax(xp > 0.8 * x5)
     assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(vmax, rel=0.03)
     assert np.gradient(th, DT).max() < 2 * vmax / R
+    t, xp, th, _, p = _step3d(taos_ambient, 5 * DEG, pressure=True)
+    i0, i1 = np.argmax(xp > 0.2 * x5), np.argmax(xp > 0.8 * x5)
+    assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(_load_flow_slew(p[i0:i1], 1.0, act), rel=0.04)
+    assert np.abs(p).max() <= 1.05 * act.supply_pressure_Pa
 
 
 def test_3d_command_beyond_the_hard_stop_holds_the_engine_in_range(taos_ambient):
@@ -181,7 +219,7 @@ def test_step_slews_at_the_no_load_valve_rate_in_both_directions(ambient_ideal, 
     """The valve's flow saturation Q_max gives the piston the no-load rate v_max = Q_max / A
     whichever way it moves: a +-5 deg step crosses 20-80 % of its stroke at +-v_max, and the
     piston never moves faster than v_max (plus the oil column's decompression) either way."""
-    m = ambient_ideal
+    m = _ideal_valve(ambient_ideal)
     vmax = m.actuator.max_rate_m_per_s
     R = m.actuator.moment_arm_m
     t, xp, th, _, _ = _step(m, sign * 5 * DEG)
@@ -191,6 +229,13 @@ def test_step_slews_at_the_no_load_valve_rate_in_both_directions(ambient_ideal, 
     vp = np.gradient(xp, DT)
     assert np.abs(vp).max() <= vmax * 1.10
     assert np.abs(np.gradient(th, DT)).max() < 2 * vmax / R
+    # the supply-pressure limit on (the shipped default): the load-flow curve's slew either way
+    t, xp, th, _, p = _step(ambient_ideal, sign * 5 * DEG)
+    i0, i1 = np.argmax(sign * xp > 0.2 * x5), np.argmax(sign * xp > 0.8 * x5)
+    assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(
+        _load_flow_slew(p[i0:i1], sign, ambient_ideal.actuator), rel=0.04)
+    assert np.abs(np.gradient(xp, DT)).max() <= vmax * 1.10
+    assert np.abs(p).max() <= 1.05 * ambient_ideal.actuator.supply_pressure_Pa
 
 
 @pytest.mark.parametrize("sign", [1.0, -1.0], ids=["positive", "negative"])
@@ -279,11 +324,16 @@ def test_3d_limits_in_both_directions(taos_ambient, sign):
     base = taos_ambient.base
     e, R = base.engine, base.actuator.moment_arm_m
     vmax = base.actuator.max_rate_m_per_s
-    t, xp, th, _ = _step3d(taos_ambient, sign * 5 * DEG)
+    t, xp, th, _ = _step3d(_ideal_valve_3d(taos_ambient), sign * 5 * DEG)
     x5 = R * 5 * DEG
     i0, i1 = np.argmax(sign * xp > 0.2 * x5), np.argmax(sign * xp > 0.8 * x5)
     assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(sign * vmax, rel=0.03)
     assert np.abs(np.gradient(th, DT)).max() < 2 * vmax / R
+    t, xp, th, _, p = _step3d(taos_ambient, sign * 5 * DEG, pressure=True)  # the shipped limit on
+    i0, i1 = np.argmax(sign * xp > 0.2 * x5), np.argmax(sign * xp > 0.8 * x5)
+    assert (xp[i1] - xp[i0]) / (t[i1] - t[i0]) == pytest.approx(_load_flow_slew(p[i0:i1], sign, base.actuator),
+                                                                rel=0.04)
+    assert np.abs(p).max() <= 1.05 * base.actuator.supply_pressure_Pa
     t, xp, th, fl = _step3d(taos_ambient, sign * 12 * DEG, t_end=2.0)
     torque = 2.0 * base.structure.load_stiffness_N_per_m * R * R * (12 * DEG - e.gimbal_range_rad)
     assert np.abs(R * fl).max() <= torque

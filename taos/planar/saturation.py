@@ -13,20 +13,41 @@ the model is exactly the linear one the fits and the frequency responses use):
 
   v_max is the no-load piston rate [m/s]; the engine slews at most v_max / R [rad/s]
   (Merritt, *Hydraulic Control Systems*, 1967, sec. 5.2: flow limited by the valve opening).
-* **Supply-pressure limit (stall force).** A critical-centre valve delivers
-  Q = C_d w x_v sqrt((P_s - sgn(x_v) P_L) / rho) (Merritt 1967, ch. 3): no flow into the loaded
-  side once P_L reaches P_s, so the piston force cannot exceed the stall force A P_s. Implemented
-  as a flow factor that keeps the LINEAR (null-linearised) flow gain below (1 - b) P_s and ramps
-  it to zero between (1 - b) P_s and P_s in the direction of the flow::
+* **Supply-pressure limit (stall force): the square-root law of a critical-centre valve.** The
+  valve's flow through its orifices is Q = C_d w x_v sqrt((P_s - sgn(x_v) P_L) / rho) (Merritt,
+  *Hydraulic Control Systems*, 1967, eq. 3-92 to 3-95, return pressure 0): no flow into the
+  loaded side once P_L reaches P_s, so the piston force cannot exceed the stall force A P_s.
+  Written with the linear model's state q = K_q x_v / A (the valve's NO-LOAD flow over the
+  piston area, :mod:`taos.planar.actuator`) it is Q = A q g(d), d = (P_s - sgn(q) P_L) / P_s,
+  g(d) = sqrt(d): the linear model's flow gain K_q is the no-load (P_L = 0) gain, which is
+  what a flow-gain figure of a servovalve means (rated at no load). The continuity equation
+  becomes::
 
-      continuity:  P_L' = (4 beta / V_t) (A q f - (K_c + C_l) P_L - A v_p),
-      f = clip((P_s - sgn(q) P_L) / (b P_s), -1, 1),  b = :data:`PRESSURE_BAND`
+      P_L' = (4 beta / V_t) (A q g(d) - (K_c + C_l) P_L - A v_p - Q_r(P_L)),
+      g(d) = sgn(d) sqrt(|d|)  for |d| >= eps,   g(d) = d / sqrt(eps)  for |d| < eps,
+      eps = :data:`SQRT_LAW_EPS`
 
-  (f < 0: a load pressure driven past P_s by the load flows back to supply, as the square-root
-  law does with its sign reversed)
-
-  (a conservative simplification of the square-root law: the linear model is unchanged where
-  it is valid, and the static stall force is exactly A P_s).
+  g is the square-root law, exact outside a pressure margin of eps P_s from stall and linear
+  inside it (continuous, slope 1 / sqrt(eps) instead of an infinite one at d = 0, so the
+  explicit RK4 step stays stable at stall: :func:`pressure_limit_rate_per_s`); for d < 0 (a
+  load driving P_L past P_s) the valve flows back to supply, as the square-root law does with
+  its sign reversed.
+  **Why the linear model, the fits and the linear frequency responses are unchanged:** at the
+  null (q = 0, P_L = 0) the flow A q g(d) has d(.)/dq = A g(1) = A and d(.)/dP_L = A q g'(1)
+  / P_s = 0, so the null linearisation is exactly the linear model A q - K_c P_L (the ideal
+  critical-centre valve's own pressure coefficient is zero at null; K_c stays the fitted
+  one). In the time domain the law departs from the linear model by the factor g(d) - 1,
+  -sgn(q) P_L / (2 P_s) to first order: the valve's real load sensitivity (a flow gain 13 %
+  lower at P_L = P_s / 4 in the loaded quadrant, higher in the overrunning one).
+  The static load-flow curve follows: a piston moving against a constant load force F with
+  the valve open at its no-load rate v_nl moves at v = v_nl sqrt(1 - F / (A P_s)).
+* **Cross-port relief valve.** A relief valve between the two actuator chambers cracks at
+  P_r (the model file's ``relief_pressure``, a documented fraction at or above P_s) and passes
+  Q_r = K_r (|P_L| - P_r) sgn(P_L) for |P_L| > P_r (0 below; K_r the file's
+  ``relief_flow_coefficient`` [m^3/(s Pa)]), so |P_L| exceeds P_r by at most Q / K_r for a
+  flow Q forced into the chamber: the steady relief curve is P_L = P_r + Q / K_r. The pressure
+  limit off (``pressure_limited = false``) turns off the square-root law and the relief
+  together (an ideal valve on an unlimited supply: the linear model, bit for bit).
 * **Hard stops** at the gimbal range +-theta_max: a stiff, damped, one-sided contact torque on
   the engine (Hunt-Crossley style, never pulling)::
 
@@ -43,11 +64,14 @@ kernels both index by::
     slot  name        quantity                                          unit
     0     LIM_VMAX    valve no-load piston rate v_max (<= 0: off)       m/s
     1     LIM_KVR     K_v R, the command's weight in u_v                m/(s rad)
-    2     LIM_PS      supply pressure P_s (<= 0: off)                   Pa
-    3     LIM_BAND    pressure band b (:data:`PRESSURE_BAND`)           -
-    4     LIM_THMAX   gimbal range theta_max (<= 0: off)                rad
-    5     LIM_KS      hard-stop stiffness k_s                           N m/rad
-    6     LIM_CS      hard-stop damping c_s                             N m s/rad
+    2     LIM_PS      supply pressure P_s (<= 0: pressure limit off)    Pa
+    3     LIM_EPS     square-root law regularisation eps                -
+                      (:data:`SQRT_LAW_EPS`)
+    4     LIM_PR      relief cracking pressure P_r (inf: no relief)     Pa
+    5     LIM_KRA     relief flow coefficient over piston area K_r / A  m/(s Pa)
+    6     LIM_THMAX   gimbal range theta_max (<= 0: off)                rad
+    7     LIM_KS      hard-stop stiffness k_s                           N m/rad
+    8     LIM_CS      hard-stop damping c_s                             N m s/rad
 
 then, from slot :data:`N_HEAD`, the :data:`ROWS` (index ``ROW_*``), each of length m over the
 state the kernel sees: ``uv`` u_v row, ``uv_in`` u_v input column, ``q`` valve-flow row, ``p``
@@ -63,17 +87,20 @@ import math
 import numpy as np
 from numba import njit
 
-#: fraction of P_s over which the pressure-limit flow factor ramps from 1 to 0 [-]
-PRESSURE_BAND = 0.05
+#: regularisation of the square-root law: the pressure margin d = (P_s - sgn(q) P_L) / P_s
+#: below which g(d) turns from sqrt(d) to linear [-] (module docstring; g'(0) = 1 / sqrt(eps))
+SQRT_LAW_EPS = 0.05
 #: head slots of the packed limits (module docstring)
 LIM_VMAX = 0    # valve no-load piston rate v_max [m/s] (<= 0: off)
 LIM_KVR = 1     # K_v R, the command's weight in u_v [m/(s rad)]
-LIM_PS = 2      # supply pressure P_s [Pa] (<= 0: off)
-LIM_BAND = 3    # pressure band b [-]
-LIM_THMAX = 4   # gimbal range theta_max [rad] (<= 0: off)
-LIM_KS = 5      # hard-stop stiffness k_s [N m/rad]
-LIM_CS = 6      # hard-stop damping c_s [N m s/rad]
-N_HEAD = 7
+LIM_PS = 2      # supply pressure P_s [Pa] (<= 0: pressure limit and relief off)
+LIM_EPS = 3     # square-root law regularisation eps [-]
+LIM_PR = 4      # relief cracking pressure P_r [Pa] (inf: no relief)
+LIM_KRA = 5     # relief flow coefficient over piston area K_r / A [m/(s Pa)]
+LIM_THMAX = 6   # gimbal range theta_max [rad] (<= 0: off)
+LIM_KS = 7      # hard-stop stiffness k_s [N m/rad]
+LIM_CS = 8      # hard-stop damping c_s [N m s/rad]
+N_HEAD = 9
 #: the state rows after the head, in packed order; ``ROW_*`` their indices
 ROWS = ("uv", "uv_in", "q", "p", "flow_in", "theta", "omega", "stop_in")
 ROW_UV, ROW_UV_IN, ROW_Q, ROW_P, ROW_FLOW_IN, ROW_THETA, ROW_OMEGA, ROW_STOP_IN = range(len(ROWS))
@@ -83,9 +110,12 @@ _FM = {"reassoc", "contract", "arcp", "nsz"}
 
 
 def pack_limits(v_max: float, kvr: float, p_s: float, theta_max: float, k_s: float, c_s: float,
-                rows: dict[str, np.ndarray]) -> np.ndarray:
-    """Pack limit parameters and state rows (see the module docstring) for the kernels.
-    All limits off gives an empty array."""
+                rows: dict[str, np.ndarray], p_relief: float = math.inf, k_relief_per_area: float = 0.0
+                ) -> np.ndarray:
+    """Pack limit parameters and state rows (see the module docstring) for the kernels:
+    ``v_max`` [m/s], ``kvr`` K_v R [m/(s rad)], ``p_s`` [Pa] (0: no pressure limit),
+    ``theta_max`` [rad], ``k_s`` [N m/rad], ``c_s`` [N m s/rad], ``p_relief`` P_r [Pa] (inf: no
+    relief), ``k_relief_per_area`` K_r / A [m/(s Pa)]. All limits off gives an empty array."""
     if not (v_max > 0 or p_s > 0 or theta_max > 0):
         return np.zeros(0)
     m = len(next(iter(rows.values())))
@@ -93,7 +123,9 @@ def pack_limits(v_max: float, kvr: float, p_s: float, theta_max: float, k_s: flo
     out[LIM_VMAX] = v_max
     out[LIM_KVR] = kvr
     out[LIM_PS] = p_s
-    out[LIM_BAND] = PRESSURE_BAND
+    out[LIM_EPS] = SQRT_LAW_EPS
+    out[LIM_PR] = p_relief if p_s > 0 else math.inf
+    out[LIM_KRA] = k_relief_per_area if p_s > 0 else 0.0
     out[LIM_THMAX] = theta_max
     out[LIM_KS] = k_s
     out[LIM_CS] = c_s
@@ -189,10 +221,19 @@ def apply_valve_pressure(lim, x, off, u, dx):
         q = _dot(lim, ROW_Q, m, x, off)
         p = _dot(lim, ROW_P, m, x, off)
         sg = 1.0 if q >= 0 else -1.0
-        f = (ps - sg * p) / (lim[LIM_BAND] * ps)
-        if f < 1.0:
-            f = max(f, -1.0)  # beyond P_s the valve flows back to supply (at most |q|)
-            _axpy(lim, ROW_FLOW_IN, m, q * (f - 1.0), dx, off)
+        d = (ps - sg * p) / ps  # pressure margin across the metering orifices [-]
+        eps = lim[LIM_EPS]
+        if d >= eps:  # square-root law (d < 0: back to supply), linear within eps of stall
+            g = math.sqrt(d)
+        elif d <= -eps:
+            g = -math.sqrt(-d)
+        else:
+            g = d / math.sqrt(eps)
+        corr = q * (g - 1.0)
+        over = abs(p) - lim[LIM_PR]
+        if over > 0.0:  # cross-port relief: Q_r / A = (K_r / A) (|P_L| - P_r) sgn(P_L)
+            corr -= lim[LIM_KRA] * over * (1.0 if p > 0 else -1.0)
+        _axpy(lim, ROW_FLOW_IN, m, corr, dx, off)
 
 
 @njit(cache=True, fastmath=_FM)
@@ -209,6 +250,33 @@ def apply(lim, x, u, dx):
                         lim[LIM_KS], lim[LIM_CS])
         if t != 0.0:
             _axpy(lim, ROW_STOP_IN, m, t, dx, 0)
+
+
+def pack_model_limits(act, eng, axis: str, rows: dict[str, np.ndarray]) -> np.ndarray:
+    """The limits of actuator ``act`` (:class:`taos.model.Actuator`) and engine ``eng``
+    (:class:`taos.model.Engine`, hard stops with the damping of ``axis``) packed over the state
+    rows ``rows`` (:func:`pack_limits`): the one place the model's limit parameters go into the
+    pack (planar and 3-D alike)."""
+    plim = act.pressure_limited
+    return pack_limits(act.max_rate_m_per_s, act.loop_gain_per_s * act.moment_arm_m,
+                       act.supply_pressure_Pa if plim else 0.0, eng.gimbal_range_rad,
+                       eng.hard_stop_stiffness_Nm_per_rad, eng.hard_stop_damping_Nms_per_rad(axis), rows,
+                       p_relief=act.relief_pressure_Pa if (plim and act.relief_pressure_Pa > 0) else math.inf,
+                       k_relief_per_area=(act.relief_flow_coefficient_m3_per_s_Pa / act.piston_area_m2
+                                          if plim else 0.0))
+
+
+def pressure_limit_rate_per_s(act) -> float:
+    """The fastest rate [1/s] the pressure limit adds to the continuity equation (0 when off):
+    (4 beta / V_t) (A v_max g'(0) / P_s + K_r), the slope of the regularised square-root law
+    at stall with the valve wide open (q = v_max) plus the relief's; an explicit RK4 step must
+    keep dt times it within the stability bound, as for the linear modes."""
+    if not act.pressure_limited:
+        return 0.0
+    ch = 4.0 * act.oil_bulk_modulus_Pa / act.trapped_volume_m3
+    gp0 = 1.0 / math.sqrt(SQRT_LAW_EPS)
+    valve = act.piston_area_m2 * act.max_rate_m_per_s * gp0 / act.supply_pressure_Pa
+    return ch * (valve + act.relief_flow_coefficient_m3_per_s_Pa)
 
 
 def limit_rows_for_actuator(act) -> tuple[dict[str, np.ndarray], float]:

@@ -192,10 +192,11 @@ def simplex_plant(model: TvcModel, axis: str = "pitch") -> LurePlant:
 
 def simplex_limits(model: TvcModel, axis: str = "pitch") -> np.ndarray:
     """The model's actuator and gimbal limits packed over the simplex state (:mod:`taos.planar.saturation`):
-    valve flow saturation, supply-pressure limit, hard stops at the gimbal range."""
-    from .saturation import limit_rows_for_actuator, pack_limits
+    valve flow saturation, supply-pressure limit (square-root law and relief valve), hard stops at
+    the gimbal range."""
+    from .saturation import limit_rows_for_actuator, pack_model_limits
     act, eng = model.actuator, model.engine
-    rows, kv = limit_rows_for_actuator(act)
+    rows, _ = limit_rows_for_actuator(act)
     ss = simplex_state_space(model, axis)
     n = len(ss.states)
     full = {k: np.concatenate([v, np.zeros(n - v.size)]) for k, v in rows.items()}
@@ -204,10 +205,7 @@ def simplex_limits(model: TvcModel, axis: str = "pitch") -> np.ndarray:
     full["omega"] = np.zeros(n)
     full["omega"][ss.state_index("omega_rad_s")] = 1.0
     full["stop_in"] = full["omega"] / eng.inertia(axis)
-    return pack_limits(act.max_rate_m_per_s, kv * act.moment_arm_m,
-                       act.supply_pressure_Pa if act.pressure_limited else 0.0,
-                       eng.gimbal_range_rad, eng.hard_stop_stiffness_Nm_per_rad,
-                       eng.hard_stop_damping_Nms_per_rad(axis), full)
+    return pack_model_limits(act, eng, axis, full)
 
 
 def load_resonance_from_notch(model: TvcModel, axis: str = "pitch",

@@ -47,6 +47,11 @@ class TaosParams(NamedTuple):
                                            (:mod:`taos.planar.saturation`; empty: none)
     torque_wrench               (6, 2)     K_s S Kc: the chain wrench per unit bearing torque
                                            [N/(N m), N m/(N m)] (:func:`taos.taos3d.dynamics._torque_kick`)
+    act_pl_index                int        index of the load pressure P_L [Pa] in the actuator
+                                           state (recorded, ``REC_PL``)
+    act_q_index                 int        index of the servovalve's no-load flow over piston
+                                           area q [m/s] in the actuator state (the spool signal,
+                                           recorded, ``REC_Q``)
     =========================== ========== ===================================================
     """
 
@@ -71,6 +76,8 @@ class TaosParams(NamedTuple):
     act_vp_index: int
     limits: np.ndarray
     torque_wrench: np.ndarray
+    act_pl_index: int
+    act_q_index: int
 
 
 #: the engine's body state in ``x``: position [m], quaternion (xyzw), linear [m/s] and angular
@@ -87,13 +94,17 @@ N_BEARING = 11
 #: engine angles (2) [rad] (pitch, yaw)
 AUX_W, AUX_FL, AUX_PHI, AUX_THETA = 0, 6, 8, 10
 N_AUX = 12
-#: recorded columns of :func:`taos.taos3d.dynamics.integrate` (SI: rad, m, N, N m)
+#: recorded columns of :func:`taos.taos3d.dynamics.integrate` (SI: rad, m, N, N m; the load
+#: pressures ``pl_*`` [Pa] and the spool signals ``q_*`` [m/s], the servovalve's no-load flow over
+#: piston area, as the planar :class:`taos.planar.simulate.TimeHistory` records them)
 REC = ("theta_pitch", "theta_yaw", "xp_pitch", "xp_yaw", "fl_pitch", "fl_yaw", "tf_pitch", "tf_yaw",
        "z_pitch", "z_yaw", "phi_pitch", "phi_yaw", "u_pitch", "u_yaw",
-       "w_fx", "w_fy", "w_fz", "w_mx", "w_my", "w_mz", "px", "py", "pz")
+       "w_fx", "w_fy", "w_fz", "w_mx", "w_my", "w_mz", "px", "py", "pz",
+       "pl_pitch", "pl_yaw", "q_pitch", "q_yaw")
 #: first column of each group of :data:`REC` (pitch then yaw; wrench fx..mz; point x, y, z)
 REC_THETA, REC_XP, REC_FL, REC_TF = (REC.index(k) for k in ("theta_pitch", "xp_pitch", "fl_pitch", "tf_pitch"))
 REC_Z, REC_PHI, REC_U, REC_W, REC_P = (REC.index(k) for k in ("z_pitch", "phi_pitch", "u_pitch", "w_fx", "px"))
+REC_PL, REC_Q = (REC.index(k) for k in ("pl_pitch", "q_pitch"))
 #: the stage commands of :func:`taos.taos3d.dynamics.stage_inputs` (pitch, then yaw at each):
 #: step start, middle, end
 U_START, U_MID, U_END = 0, 2, 4

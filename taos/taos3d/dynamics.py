@@ -89,8 +89,8 @@ from ..planar._avionics_slots import AV_LSB, AV_ROUND
 # the packed model and the index tables, shared with the packer (re-exported: the kernels' layout)
 from ._layout import (  # noqa: F401
     AUX_FL, AUX_PHI, AUX_THETA, AUX_W, BS_PHI, BS_PHI_PREV, BS_SLIP, BS_T, BS_Z, BS_Z_PREV, N_AUX, N_BEARING,
-    N_BODY, REC, REC_FL, REC_P, REC_PHI, REC_TF, REC_THETA, REC_U, REC_W, REC_XP, REC_Z, U_END, U_MID,
-    U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams)
+    N_BODY, REC, REC_FL, REC_P, REC_PHI, REC_PL, REC_Q, REC_TF, REC_THETA, REC_U, REC_W, REC_XP, REC_Z, U_END,
+    U_MID, U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams)
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 
@@ -490,6 +490,8 @@ def _record(x, bs, c, u0, u1, P, avp, aux, dxs, out):
         out[REC_Z + a] = bs[BS_Z + a]
         out[REC_PHI + a] = bs[BS_PHI + a]
         out[REC_U + a] = _av.apply(c[a], avp)
+        out[REC_PL + a] = x[N_BODY + a * na + P.act_pl_index]
+        out[REC_Q + a] = x[N_BODY + a * na + P.act_q_index]
     for i in range(6):
         out[REC_W + i] = aux[AUX_W + i]
     for i in range(3):

@@ -49,14 +49,11 @@ class Packed:
 
 def actuator_limits(tm: TaosModel) -> np.ndarray:
     """The actuator and gimbal limits (:mod:`taos.planar.saturation`) packed over one actuator's state:
-    valve flow saturation and supply-pressure limit per actuator, hard stops per axis (the
+    valve flow saturation, supply-pressure limit (square-root law, relief valve) per actuator, hard stops per axis (the
     stop damping from the pitch inertia; the 3-D engine is axisymmetric about its axis)."""
-    from ..planar.saturation import limit_rows_for_actuator, pack_limits
-    act, eng = tm.base.actuator, tm.base.engine
-    rows, kv = limit_rows_for_actuator(act)
-    return pack_limits(act.max_rate_m_per_s, kv * act.moment_arm_m,
-                       act.supply_pressure_Pa if act.pressure_limited else 0.0, eng.gimbal_range_rad,
-                       eng.hard_stop_stiffness_Nm_per_rad, eng.hard_stop_damping_Nms_per_rad("pitch"), rows)
+    from ..planar.saturation import limit_rows_for_actuator, pack_model_limits
+    rows, _ = limit_rows_for_actuator(tm.base.actuator)
+    return pack_model_limits(tm.base.actuator, tm.base.engine, "pitch", rows)
 
 
 def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
@@ -83,7 +80,8 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
         line_length0_m=f64([np.linalg.norm(geo.engine_attach_m[i] - geo.structure_attach_m[i]) for i in range(2)]),
         line_damping_Ns_per_m=float(tm.base.structure.load_damping_Ns_per_m(R, tm.base.engine.inertia("pitch"))),
         act_vp_index=act.states.index("v_p_m_s"), limits=f64(actuator_limits(tm)),
-        torque_wrench=f64(Ks @ S @ Kc))
+        torque_wrench=f64(Ks @ S @ Kc), act_pl_index=act.states.index("p_load_Pa"),
+        act_q_index=act.states.index("q_m_s"))
     law = tm.bearing_friction   # the model's own law and levels: one friction for every summary
     fp = law.pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
@@ -161,7 +159,9 @@ def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S
         command_rad=cmd[::record_every].T.copy(), command_avionics_rad=two("u_pitch", "u_yaw"),
         piston_m=two("xp_pitch", "xp_yaw"), engine_rad=two("theta_pitch", "theta_yaw"),
         friction_torque_Nm=two("tf_pitch", "tf_yaw"), friction_state_rad=two("z_pitch", "z_yaw"),
-        load_force_N=two("fl_pitch", "fl_yaw"), extra=extra)
+        load_force_N=two("fl_pitch", "fl_yaw"), load_pressure_Pa=two("pl_pitch", "pl_yaw"),
+        spool_flow_m_s=two("q_pitch", "q_yaw"),
+        supply_pressure_Pa=np.full((2, out.shape[0]), tm.base.actuator.supply_pressure_Pa), extra=extra)
 
 
 # -- linearisation -----------------------------------------------------------------------

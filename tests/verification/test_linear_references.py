@@ -72,6 +72,7 @@ def test_rk4_step_response_against_matrix_exponential(verify):
     x(T) = A^-1 (e^{AT} - I) b of the linear ODE; halving a large step divides the error by ~16."""
     m0 = load_model("rs25_ambient")
     m = m0.with_friction("none").replace(avionics=m0.avionics.ideal())
+    m = m.replace(actuator=dataclasses.replace(m.actuator, pressure_limited=False))  # the ideal valve: linear
     e0 = _step_error(m, 2e-4)
     verify("exact solution of the linear ODE (matrix exponential)", 1e-9, e0, unit="relative to the step",
            case="RK4 step response, dt = 2e-4 s")
@@ -87,6 +88,7 @@ def test_sine_dwell_equals_exact_linear_response(verify):
     between two computations), 0.1 to 20 Hz."""
     a = load_model("rs25_ambient")
     m = a.with_friction("none").replace(avionics=a.avionics.ideal())
+    m = m.replace(actuator=dataclasses.replace(m.actuator, pressure_limited=False))  # the ideal valve: linear
     f = np.array([0.1, 0.5, 2.0, 5.3, 10.0, 20.0])
     piston, engine = sine_dwell_grid(m, [0.4 * DEG], f)
     lin = linear_freqresp(m, f)
