@@ -106,7 +106,8 @@ def test_taos3d_state_bearing_aux_and_record_tables():
 
     _tiles({"X_P": dy.X_P, "X_Q": dy.X_Q, "X_V": dy.X_V, "X_W": dy.X_W},
            {"X_P": 3, "X_Q": 4, "X_V": 3, "X_W": 3}, dy.N_BODY)
-    _tiles(_consts(dy, "BS_"), {"BS_PHI": 2, "BS_Z": 2, "BS_T": 2, "BS_PHI_PREV": 2, "BS_Z_PREV": 2},
+    _tiles(_consts(dy, "BS_"), {"BS_PHI": 2, "BS_Z": 2, "BS_T": 2, "BS_PHI_PREV": 2, "BS_Z_PREV": 2,
+                                     "BS_W": 2},
            dy.N_BEARING)
     _tiles(_consts(dy, "AUX_"), {"AUX_W": 6, "AUX_FL": 2, "AUX_PHI": 2, "AUX_THETA": 2}, dy.N_AUX)
     _tiles(_consts(dy, "U_"), {"U_START": 2, "U_MID": 2, "U_END": 2}, 6)

@@ -86,9 +86,10 @@ X_P, X_Q, X_V, X_W = 0, 3, 7, 10
 N_BODY = 13
 #: the bearing state ``bs``: slip phi (2) [rad], bristle state z (2) [rad], torque T (2) [N m],
 #: phi and z one step back (BDF2; 2 each), the slip speed [rad/s] the next bearing solve
-#: continues from (components pitch, yaw)
-BS_PHI, BS_Z, BS_T, BS_PHI_PREV, BS_Z_PREV, BS_SLIP = 0, 2, 4, 6, 8, 10
-N_BEARING = 11
+#: continues from (components pitch, yaw), the slip rate w (2) [rad/s] and the length [s] of the
+#: last bearing (sub)step (0 at rest: no history yet)
+BS_PHI, BS_Z, BS_T, BS_PHI_PREV, BS_Z_PREV, BS_SLIP, BS_W, BS_H = 0, 2, 4, 6, 8, 10, 11, 13
+N_BEARING = 14
 #: what :func:`taos.taos3d.dynamics.rhs` writes to ``aux``: the chain wrench at O in the gimbal
 #: frame (6) [N, N m], the actuator load forces F_L (2) [N], the bearing slip phi (2) [rad], the
 #: engine angles (2) [rad] (pitch, yaw)

@@ -18,10 +18,11 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
                  (c_L the load path's structural damping, taos.model.Structure)
     actuators    the one linear actuator model (taos.planar.actuator), x_c,i = R avionics(theta_c,i),
                  load input F_L,i
-    bearing      (phi, z, T) advanced once per step by the friction law's implicit bearing solve
-                 (its registry entry's ``bearing_step``, passed to the kernels as the
-                 first-class function ``fid``; :mod:`taos.friction._vector`), given the pose
-                 at the step end
+    bearing      (phi, z, T) advanced over each step by the friction law's implicit bearing solve
+                 (its registry entry's ``bearing_step``; :mod:`taos.friction._vector`) in
+                 substeps (:mod:`taos.taos3d._bearing`), given the pose at the step ends; the
+                 kernels take the law as ``fid`` = (bearing_step, zdot3, torque3), a tuple
+                 of first-class functions
 
 Time stepping (second order in the bearing coupling):
 
@@ -30,23 +31,26 @@ Time stepping (second order in the bearing coupling):
   (:func:`_torque_kick`; the body acceleration is affine in T, so this makes the velocity
   increment the trapezoid of T over the step; the position's share of the ramp is
   O(dt^2 dT), third order);
-* the bearing (phi, z) by BDF2: y_{n+1} = (4 y_n - y_{n-1}) / 3 + (2 dt / 3) y'_{n+1}, which
-  is the law's backward-Euler step with y_n replaced by (4 y_n - y_{n-1}) / 3 and dt by
-  2 dt / 3 (so every law's own ``bearing_step`` serves; L-stable, as the stiff
-  chain-rotation / bristle-damping time constant Kc (sigma_1 + sigma_2) ~ 1e-4 s needs);
-  the history starts at rest (y_{-1} = y_0);
-* the bearing solve continues from the previous step's slip speed (``bs[BS_SLIP]``), so where a
-  Stribeck law makes the implicit step multi-valued it keeps the bearing's branch
+* the bearing (phi, z) by variable-step BDF2 under its own step-size control
+  (:func:`taos.taos3d._bearing.advance`): psi = G e linear over the body step, substeps where
+  the local error estimate or the law's unstable fast mode asks for them, one substep
+  (h_b = dt, the constant-step BDF2 y_{n+1} = (4 y_n - y_{n-1}) / 3 + (2 dt / 3) y'_{n+1},
+  i.e. the law's backward-Euler step with y_n -> (4 y_n - y_{n-1}) / 3 and dt -> 2 dt / 3)
+  elsewhere; L-stable, as the stiff chain-rotation / bristle-damping time constant
+  Kc (sigma_1 + sigma_2) needs; the history starts at rest (y_{-1} = y_0); the velocity kick
+  uses the torque's mean over the substeps;
+* the bearing solve continues from the previous (sub)step's slip speed (``bs[BS_SLIP]``), so
+  where a Stribeck law makes the implicit step multi-valued it keeps the bearing's branch
   (stick-slip hysteresis; :func:`taos.friction._vector.solve_slip`).
 
-Against a 6.25e-6 s reference on the 60 s two-axis Green Run (first 4 s) the smooth laws'
-error at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler
-bearing) at 2e-4 s, and modified LuGre's is the same (set by one stick-slip event's
-timing); small-amplitude modified-LuGre sine dwells now converge with the step
-(tests/test_taos3d_step.py, benchmarks/bench_taos3d.py). The implicit bearing equation is
-multi-valued only where Kc |dT/ds| > 2 dt / 3, so a Stribeck law's stick-slip hysteresis is
-resolved only at fine steps (modified LuGre at 0.4 deg near the resonance: up to 0.6 dB
-between 4e-4 s and 1.25e-5 s, as with the former kernel; benchmarks/RESULTS.md). The stiff bearing time constant
+Against a fine reference on the 60 s two-axis Green Run (first 4 s) the smooth laws' error
+at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler bearing) at
+2e-4 s. Modified LuGre's massless bearing has an unstable fast mode where its torque falls
+with the slip rate at fixed z (the bristle damping sigma_1(s) s decays above v_1 / sqrt 2):
+the fine-step solution chatters there (relaxation oscillation of the slip rate), which a
+fixed 4e-4 s (or anything down to 2.5e-5 s) implicit step damped away (error 1.1e-2 deg at
+every step); the bearing substeps resolve it: 6.0e-4 deg at 4e-4 s, falling with the step
+(tests/test_taos3d_step.py, benchmarks/RESULTS.md). The stiff bearing time constant
 never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
 the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
 omega dt < 2.8 for RK4); accuracy sets the default 4e-4 s. A quantised command is piecewise
@@ -86,11 +90,12 @@ from numba import njit, prange
 from ..planar import _avionics_kernels as _av
 from ..planar import saturation as _lim
 from ..planar._avionics_slots import AV_LSB, AV_ROUND
+from . import _bearing as _bg
 # the packed model and the index tables, shared with the packer (re-exported: the kernels' layout)
 from ._layout import (  # noqa: F401
-    AUX_FL, AUX_PHI, AUX_THETA, AUX_W, BS_PHI, BS_PHI_PREV, BS_SLIP, BS_T, BS_Z, BS_Z_PREV, N_AUX, N_BEARING,
-    N_BODY, REC, REC_FL, REC_P, REC_PHI, REC_PL, REC_Q, REC_TF, REC_THETA, REC_U, REC_W, REC_XP, REC_Z, U_END,
-    U_MID, U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams)
+    AUX_FL, AUX_PHI, AUX_THETA, AUX_W, BS_H, BS_PHI, BS_PHI_PREV, BS_SLIP, BS_T, BS_W, BS_Z, BS_Z_PREV, N_AUX,
+    N_BEARING, N_BODY, REC, REC_FL, REC_P, REC_PHI, REC_PL, REC_Q, REC_TF, REC_THETA, REC_U, REC_W, REC_XP, REC_Z,
+    U_END, U_MID, U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams)
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
 
@@ -408,8 +413,9 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
         Step [s].
     P : TaosParams
         The packed model.
-    fid : first-class function
-        The friction law's ``bearing_step`` (:data:`taos.friction.registry.BEARING_SIG`).
+    fid : tuple of first-class functions
+        The friction law's ``bearing_step``, ``zdot3``, ``torque3``
+        (:data:`taos.friction.registry.BEARING_SIG`, ``ZDOT3_SIG``, ``TORQUE3_SIG``).
     fp : (NPARAM,) float64
         The law's packed (normal-load scaled) parameters (:mod:`taos.friction._slots`).
     avp : float64 array
@@ -424,6 +430,7 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     Returns True while the state stays finite."""
     n = x.shape[0]
     T0, T1 = bs[BS_T], bs[BS_T + 1]
+    qa0, qa1 = pose_psi(x, P)  # the pose-demanded bearing angle at the step start
     if not k1_ready:
         rhs(x, T0, T1, u[U_START], u[U_START + 1], P, k1, aux)
     um0, um1 = u[U_MID], u[U_MID + 1]
@@ -444,26 +451,12 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     for i in range(X_Q, X_Q + 4):
         x[i] /= qn
     ps0, ps1 = pose_psi(x, P)
-    # BDF2 on the bearing (phi, z): y_{n+1} = (4 y_n - y_{n-1}) / 3 + h y'_{n+1}, h = 2 dt / 3,
-    # the backward-Euler step's form with y_n -> (4 y_n - y_{n-1}) / 3 and dt -> h
-    h = dt * (2.0 / 3.0)
-    ph0 = (4.0 * bs[BS_PHI] - bs[BS_PHI_PREV]) * (1.0 / 3.0)
-    ph1 = (4.0 * bs[BS_PHI + 1] - bs[BS_PHI_PREV + 1]) * (1.0 / 3.0)
-    zh0 = (4.0 * bs[BS_Z] - bs[BS_Z_PREV]) * (1.0 / 3.0)
-    zh1 = (4.0 * bs[BS_Z + 1] - bs[BS_Z_PREV + 1]) * (1.0 / 3.0)
-    w0, w1, z0, z1, t0, t1 = fid(fp, P.bearing_compliance, ps0 - ph0, ps1 - ph1, zh0, zh1, h, bs[BS_SLIP])
-    bs[BS_SLIP] = math.sqrt(w0 * w0 + w1 * w1)  # the slip speed the next solve continues from
-    bs[BS_PHI_PREV] = bs[BS_PHI]
-    bs[BS_PHI_PREV + 1] = bs[BS_PHI + 1]
-    bs[BS_Z_PREV] = bs[BS_Z]
-    bs[BS_Z_PREV + 1] = bs[BS_Z + 1]
-    bs[BS_PHI] = ph0 + w0 * h
-    bs[BS_PHI + 1] = ph1 + w1 * h
-    bs[BS_Z] = z0
-    bs[BS_Z + 1] = z1
-    _torque_kick(x, t0 - T0, t1 - T1, 0.5 * dt, P)  # trapezoidal T over the step (second order)
-    bs[BS_T] = t0
-    bs[BS_T + 1] = t1
+    # the bearing by variable-step BDF2 under its own error control (taos.taos3d._bearing),
+    # psi linear over the step; the engine gets the mean torque over the step
+    m0, m1, _ = _bg.advance(bs, fid, fp, P.bearing_compliance, dt, qa0, qa1, ps0, ps1, _bg.TOL_RAD, _bg.MAX_SPLIT,
+                            _bg.FAST_STEPS)
+    _torque_kick(x, m0 - T0, m1 - T1, dt, P)  # the mean of T over the step (second order)
+    t0, t1, z0, z1 = bs[BS_T], bs[BS_T + 1], bs[BS_Z], bs[BS_Z + 1]
     s = t0 + t1 + z0 + z1  # a NaN or an infinity anywhere makes the sum non-finite
     for i in range(n):
         s += x[i]
@@ -506,8 +499,9 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     ----------
     P : TaosParams
         The packed model (:func:`taos.taos3d.simulate.pack`).
-    fid : first-class function
-        The friction law's ``bearing_step`` (:data:`taos.friction.registry.BEARING_SIG`).
+    fid : tuple of first-class functions
+        The friction law's ``bearing_step``, ``zdot3``, ``torque3``
+        (:data:`taos.friction.registry.BEARING_SIG`, ``ZDOT3_SIG``, ``TORQUE3_SIG``).
     fp : (NPARAM,) float64
         The law's packed (normal-load scaled) parameters (:mod:`taos.friction._slots`).
     avp : float64 array

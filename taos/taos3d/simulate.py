@@ -35,8 +35,8 @@ DEFAULT_DT_S = 4e-4
 @dataclass(frozen=True, eq=False)
 class Packed:
     """Arrays the compiled kernels take (see :func:`pack`): the model ``P``
-    (:class:`taos.taos3d.dynamics.TaosParams`), the friction law's ``bearing_step`` kernel
-    ``fid`` (its registry entry) and packed parameters ``fp`` (scaled by the normal load), the
+    (:class:`taos.taos3d.dynamics.TaosParams`), the friction law's kernels
+    ``fid`` = (``bearing_step``, ``zdot3``, ``torque3``) (its registry entry's) and packed parameters ``fp`` (scaled by the normal load), the
     packed avionics ``avp``, the state length and the actuator's state length."""
 
     P: _dy.TaosParams
@@ -86,7 +86,7 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     fp = law.pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
     na = act.A.shape[0]
-    return Packed(P, law.entry.bearing_step, fp, av.pack(), _dy.N_BODY + 2 * na, na)
+    return Packed(P, (law.entry.bearing_step, law.entry.zdot3, law.entry.torque3), fp, av.pack(), _dy.N_BODY + 2 * na, na)
 
 
 def rest_state(pk: Packed) -> np.ndarray:
@@ -149,7 +149,7 @@ def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S
     extra = {"bearing_slip_rad": two("phi_pitch", "phi_yaw"), "chain_wrench": W,
              "upper_deflection": np.linalg.solve(tm.K_upper, W), "lower_deflection": np.linalg.solve(tm.K_lower, W),
              "engine_point_m": out[:, [col["px"], col["py"], col["pz"]]].T}
-    solver = SolverSettings(method="rk4, trapezoidal bearing torque + BDF2 bearing", dt_s=dt_s, record_every=record_every)
+    solver = SolverSettings(method="rk4, trapezoidal bearing torque + BDF2 bearing substeps", dt_s=dt_s, record_every=record_every)
     prov = provenance(tm.base, solver, engine="taos", profile=getattr(profile, "name", type(profile).__name__),
                       stiffness_source=tm.stiffness_source, friction_scale=tm.friction_scale,
                       bearing_coulomb_torque_Nm=tm.bearing_friction.coulomb_torque_Nm,
