@@ -149,8 +149,10 @@ def test_toy_viscous_law_dwell_equals_linear_model_with_that_damping(toy, flight
     """Planar simulation (the DF map's sine dwell and taos.planar.simulate) of the pure viscous toy law
     (T_c = 0) equals the linear model with the damper in the loop."""
     c = damping(flight)
+    # the ideal valve: the square-root valve law is a nonlinearity of its own, not the law's
     m = flight.replace(friction=ViscousCoulomb(coulomb_torque_Nm=0.0, viscous_damping_Nms_per_rad=c),
-                       avionics=flight.avionics.ideal())
+                       avionics=flight.avionics.ideal(),
+                       actuator=dataclasses.replace(flight.actuator, pressure_limited=False))
     f = np.array([0.5, 2.0, 5.0, 8.0])
     dfm = describing_function_map(m, [0.2 * DEG], f)
     eng, pis = linear_with_damper(m, c, f)
@@ -169,16 +171,19 @@ def test_toy_viscous_law_dwell_equals_linear_model_with_that_damping(toy, flight
 
 def test_toy_law_describing_function_in_the_rigid_loop(toy, flight):
     """Viscous + Coulomb in the rigid-load limit: the DF map (sine dwell) equals the analytic
-    friction-in-loop response from the toy's describing function c + 4 T_c / (pi V)."""
+    friction-in-loop response from the toy's describing function c + 4 T_c / (pi V) within 3 %
+    (the first-harmonic approximation: as in tests/test_describing.py's relay case, the servo's
+    dynamic pressure feedback passes the friction torque's odd harmonics to the engine angle);
+    ideal valve (the square-root valve law is a nonlinearity of its own against a stiff load)."""
     c = 0.2 * damping(flight)
     law = ViscousCoulomb(coulomb_torque_Nm=flight.friction.coulomb_torque_Nm, viscous_damping_Nms_per_rad=c,
                          regularization_velocity_rad_s=1e-3)
-    m = rigid_limit_model(flight.replace(friction=law), 100.0)
+    m = rigid_limit_model(flight.replace(friction=law, actuator=dataclasses.replace(flight.actuator, pressure_limited=False)), 100.0)
     f = np.array([2.0, 5.0, 8.0])
     dfm = describing_function_map(m, [0.4 * DEG], f)
     for j, fj in enumerate(f):
         ana = rigid_engine_response(m, 0.4 * DEG, fj)
-        assert abs(dfm.engine[0, j] / ana - 1) < 0.02, (fj, dfm.engine[0, j], ana)
+        assert abs(dfm.engine[0, j] / ana - 1) < 0.03, (fj, dfm.engine[0, j], ana)
 
 
 def test_toy_law_runs_in_the_3d_model(toy):

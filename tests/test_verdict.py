@@ -200,7 +200,8 @@ def test_hotfire_fails_its_mask_through_friction_and_the_linear_servo_passes(hot
 
 def test_ambient_fails_its_mask_through_the_soft_load_path(amb, segments, shipped_mask):
     """Measured: the soft ambient load resonance (5.3 Hz) sits in the servo's band: engine +8.2 dB
-    at 4 Hz linear (+7.6 dB dwell) against +6 dB, and the 0.5 deg step overshoots 41 % against
+    at 4 Hz linear (+6.3 dB dwell: the square-root valve law of the pressure-limited servo takes
+    flow gain at the resonance's load pressure) against +6 dB, and the 0.5 deg step overshoots 41 % against
     25 %; every one is the load stiffness (the laboratory load passes), none is friction (ambient
     friction is 1.5 % of hot fire's) or the avionics."""
     v = spec_verdict(amb, shipped_mask, segments=segments)
@@ -210,7 +211,7 @@ def test_ambient_fails_its_mask_through_the_soft_load_path(amb, segments, shippe
         ("linear", "engine", 4.0), ("dwell", "engine", 4.0), ("step", "step", None)}
     assert all(c.cause == ("load_stiffness",) for c in fails)
     g = {c.basis: c.bounds[0].value for c in fails if c.basis != "step"}
-    assert g["linear"] == pytest.approx(8.2, abs=0.5) and g["dwell"] == pytest.approx(7.6, abs=1.0)
+    assert g["linear"] == pytest.approx(8.2, abs=0.5) and g["dwell"] == pytest.approx(6.3, abs=0.2)
     over = [b.value for c in fails if c.basis == "step" for b in c.bounds if b.quantity == "overshoot_pct"]
     assert over and all(o == pytest.approx(40.7, abs=6.0) for o in over)
     assert "because of the load stiffness (structure)" in v.text()
