@@ -68,15 +68,25 @@ _API = {
 __all__ = sorted(_API) + ["__version__"]
 
 
-def __getattr__(name: str):
-    try:
-        module = _API[name]
-    except KeyError:
-        raise AttributeError(f"module 'taos' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+def lazy_api(package: str, table: dict[str, str], namespace: dict):
+    """The PEP 562 ``__getattr__`` and ``__dir__`` of a package whose public names live in its
+    submodules: ``table`` maps each name to its module (absolute, or relative to ``package``); a
+    name is imported on first use and cached in the package's ``namespace``; ``dir()`` lists the
+    package's ``__all__``. Used by ``taos`` and its subpackages alike."""
+
+    def __getattr__(name: str):
+        try:
+            module = table[name]
+        except KeyError:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}") from None
+        value = getattr(importlib.import_module(module, package), name)
+        namespace[name] = value
+        return value
+
+    def __dir__():
+        return sorted(namespace.get("__all__", table))
+
+    return __getattr__, __dir__
 
 
-def __dir__():
-    return __all__
+__getattr__, __dir__ = lazy_api(__name__, _API, globals())

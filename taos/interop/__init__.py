@@ -10,7 +10,7 @@ Names are resolved on first use (python-control costs seconds to import).
 
 from __future__ import annotations
 
-import importlib
+from taos import lazy_api
 
 _API = {
     "to_control": ".python_control", "to_control_ss": ".python_control", "from_control_ss": ".python_control",
@@ -21,13 +21,4 @@ _API = {
 __all__ = sorted(_API)
 
 
-def __getattr__(name: str):
-    try:
-        module = _API[name]
-    except KeyError:
-        raise AttributeError(f"module 'taos.interop' has no attribute {name!r}") from None
-    return getattr(importlib.import_module(module, __name__), name)
-
-
-def __dir__():
-    return __all__
+__getattr__, __dir__ = lazy_api(__name__, _API, globals())

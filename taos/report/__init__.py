@@ -15,7 +15,7 @@ report draws it. Names are resolved on first use, so ``taos info`` imports none 
 
 from __future__ import annotations
 
-import importlib
+from taos import lazy_api
 
 #: public name -> module that defines it
 _API = {
@@ -27,15 +27,4 @@ _API = {
 __all__ = sorted(_API)
 
 
-def __getattr__(name: str):
-    try:
-        module = _API[name]
-    except KeyError:
-        raise AttributeError(f"module 'taos.report' has no attribute {name!r}") from None
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return __all__
+__getattr__, __dir__ = lazy_api(__name__, _API, globals())

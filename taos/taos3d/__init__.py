@@ -12,8 +12,9 @@ dynamics or SciPy: a bad model file is refused in a blink, before any simulation
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from taos import lazy_api
 
 if TYPE_CHECKING:
     from .calibrate import load_taos_model, taos_model
@@ -35,13 +36,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    if name in _WHERE:
-        value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_api(__name__, {k: f".{m}" for k, m in _WHERE.items()}, globals())
