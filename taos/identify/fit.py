@@ -18,9 +18,12 @@ Method (:func:`fit_frequency_response`):
    [lo, hi] times its start, see :data:`taos.identify.surrogate.PARAMETERS`) and the implicit
    amplitudes, with exact first and second derivatives (SX). ``starts`` multiple starts
    (the start values, then log-uniform draws within a factor of 2), best objective kept.
-4. Defect correction (when the model has friction): the describing function neglects
-   harmonics, so the surrogate is corrected against the time-domain sine dwell of the full
-   nonlinear model (:func:`taos.planar.freqresp.sine_dwell_grid`) at the current estimate:
+4. Defect correction (when the model has friction, or its actuator is pressure limited): the
+   describing function neglects harmonics, and the surrogate knows nothing of the square-root
+   valve law and cross-port relief (:mod:`taos.planar.saturation`, of which the linear block is
+   the null-load-pressure linearisation), so the surrogate is corrected against the
+   time-domain sine dwell of the full nonlinear model (:func:`simulate_points`, the path of
+   :func:`taos.planar.freqresp.sine_dwell_points`) at the current estimate:
    c_k = H_sim / H_surrogate, data H_d / c_k refitted, until the parameters change by less
    than ``correction_tol`` (a fixed point where the *simulated* responses match the data to
    first order; noise-free data from the model class are recovered exactly).
@@ -326,7 +329,8 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
         Number of starts (the first at the start values).
     correct : bool, optional
         Defect correction against the time-domain sine dwell (default: when the model has
-        friction).
+        friction or a pressure-limited actuator, i.e. whenever the surrogate is not the
+        model's exact response).
     problem : FitProblem, optional
         A built problem to reuse (same model, free set and points).
     bounds : dict name -> (lower, upper) SI, optional
@@ -350,8 +354,8 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
             best = (s, u, cost)
     s, u, cost = best
     fam = prob.sur.family
-    if correct is None:
-        correct = fam != "none"
+    if correct is None:  # the surrogate is exact only for a linear valve without friction
+        correct = fam != "none" or m0.actuator.pressure_limited
     ncorr = 0
     history = [s * prob.p_ref]
     if correct:

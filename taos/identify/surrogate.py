@@ -28,7 +28,9 @@ torque, T = N Omega; :mod:`taos.friction.registry`). Two loop solutions:
 
 Then Omega = G_wc C / (1 - G_wT N), x_p = G_xc C + G_xT N Omega, theta = Omega / (j w), and the
 responses are x_p / (A) [m/rad] and theta / A. The DF neglects harmonics (the engine rate is
-not sinusoidal while friction holds it); :mod:`taos.identify.fit` removes that bias by defect
+not sinusoidal while friction holds it), and the surrogate's valve is the linear one (the
+null-load-pressure linearisation of the square-root valve law and relief of
+:mod:`taos.planar.saturation`); :mod:`taos.identify.fit` removes both biases by defect
 correction against the time-domain sine dwell of the full nonlinear model.
 """
 
