@@ -174,7 +174,7 @@ def test_null_linearisation_is_the_linear_model_and_off_is_bit_for_bit():
 
 @pytest.fixture(scope="module")
 def taos_ambient():
-    from taos.taos3d.model import load_taos_model
+    from taos.taos3d.calibrate import load_taos_model
     tm = load_taos_model(MODELS / "rs25_ambient.toml", friction="none")
     return dataclasses.replace(tm, base=_ideal(tm.base))
 
@@ -205,7 +205,7 @@ def test_3d_record_carries_load_pressure_spool_and_supply(tmp_path):
     does (tests/test_signals_export.py), and writes them to the .h5 the same way."""
     from taos.planar.simulate import TimeHistory
     from taos.profiles import SineDwell
-    from taos.taos3d.model import load_taos_model
+    from taos.taos3d.calibrate import load_taos_model
     from taos.taos3d.simulate import TaosTimeHistory, simulate_taos
     tm = load_taos_model(MODELS / "rs25_hotfire.toml", friction="none")
     run = simulate_taos(tm, SineDwell(math.radians(0.4), 0.5, 3), record_every=5)
