@@ -75,6 +75,33 @@ def test_one_segment_equals_the_constant_flight_loop(ascent):
     np.testing.assert_allclose(h.signal("attitude_rad", "yaw"), ref.attitude_rad, rtol=0, atol=1e-12)
 
 
+def test_ascent_plant_keeps_every_limit_of_the_flight_plant(ascent):
+    """The ascent plant is the flight plant grown by the booster state: the packed actuator and
+    gimbal limits (valve rate, supply pressure and relief, hard stops) are the flight plant's
+    over the same states, zero on the booster state; a limit pack over the wrong number of
+    states is refused."""
+    from taos.flight.ascent_sim import ascent_plant
+    from taos.flight.vehicle import flight_plant
+    from taos.planar import saturation as sat
+    from taos.planar.simplex import LurePlant
+
+    m = load_model(ascent.tvc_model, friction="dahl")
+    assert m.actuator.pressure_limited
+    base = flight_plant(ascent.flight, m, "yaw")
+    grown = ascent_plant(ascent.flight, m, "yaw", 1.0, 0.1)
+    n0, n = base.ss.A.shape[0], grown.ss.A.shape[0]
+    assert n == n0 + 1 and sat.n_limit_states(grown.limits) == n
+    assert base.limits[sat.LIM_PS] > 0.0
+    np.testing.assert_array_equal(grown.limits[:sat.N_HEAD], base.limits[:sat.N_HEAD])
+    for i in range(sat.N_ROWS):
+        row = grown.limits[sat.row_start(i, n):sat.row_start(i + 1, n)]
+        np.testing.assert_array_equal(row[:n0], base.limits[sat.row_start(i, n0):sat.row_start(i + 1, n0)])
+        assert row[n0] == 0.0
+    with pytest.raises(ValueError, match="limits packed over"):
+        LurePlant(ss=grown.ss, n_ext=2, cmd_c=grown.cmd_c, cmd_d=grown.cmd_d, rate_c=grown.rate_c,
+                  applied_c=grown.applied_c, inertia_kgm2=grown.inertia_kgm2, limits=base.limits)
+
+
 def test_pti_windows_and_signals(ascent):
     t = np.linspace(0, 480, 48001)
     u = pti_command(ascent, "yaw", t)

@@ -2,8 +2,8 @@
 time-varying vehicle, boosters until separation, PTIs and winds; and the LCO read off its windows.
 
 Each axis (pitch, yaw) is the planar flight loop of :func:`taos.flight.vehicle.flight_plant`
-(vehicle + FCS + the simplex TVC with its friction and avionics, integrated by the compiled RK4
-kernel of :mod:`taos.planar.dynamics`) augmented with
+(vehicle + FCS + the simplex TVC with its friction, avionics and actuator/gimbal limits,
+integrated by the compiled RK4 kernel of :mod:`taos.planar.dynamics`) augmented with
 
 * the booster TVC, a first-order servo on the FCS command (state ``booster_deflection_rad``),
   adding n_b T_b l_b / I_v delta_b to the attitude acceleration until separation;
@@ -32,7 +32,7 @@ from taos.harmonics import fit_sines
 from taos.linear import StateSpace
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
-from taos.planar.simplex import LurePlant
+from taos.planar.simplex import LurePlant, extend_plant
 from taos.planar.simulate import check_friction_step, integrate_plant
 
 AXES = ("pitch", "yaw")
@@ -65,7 +65,8 @@ def ascent_plant(flight: FlightModel, model: TvcModel, axis: str, booster_accel_
                  booster_time_constant_s: float) -> LurePlant:
     """:func:`~taos.flight.vehicle.flight_plant` with the booster TVC state and the disturbance
     input added (module docstring). External inputs ``pti_rad`` [rad], ``disturbance_rad_s2``
-    [rad/s^2]. Outputs: the flight plant's, ``booster_deflection_rad``, then every state
+    [rad/s^2]; the flight plant's limits carried (:func:`~taos.planar.simplex.extend_plant`).
+    Outputs: the flight plant's, ``booster_deflection_rad``, then every state
     (``state:<name>``) so a run can be continued."""
     base = flight_plant(flight, model, axis)
     ss = base.ss
@@ -90,9 +91,7 @@ def ascent_plant(flight: FlightModel, model: TvcModel, axis: str, booster_accel_
     outputs = ss.outputs + ("booster_deflection_rad",) + tuple(f"state:{s}" for s in states)
     full = StateSpace(A, B, C, np.zeros((C.shape[0], 4)), states,
                       ("pti_rad", "disturbance_rad_s2", "command_rad", "friction_torque_Nm"), outputs)
-    pad = lambda v: np.append(v, 0.0)  # noqa: E731
-    return LurePlant(ss=full, n_ext=2, cmd_c=pad(base.cmd_c), cmd_d=np.array([1.0, 0.0]),
-                     rate_c=pad(base.rate_c), applied_c=pad(base.applied_c), inertia_kgm2=base.inertia_kgm2)
+    return extend_plant(base, full, n_ext=2, cmd_d=[1.0, 0.0])
 
 
 @dataclass(frozen=True, eq=False)

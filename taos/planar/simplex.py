@@ -74,9 +74,33 @@ class LurePlant:
     inertia_kgm2: float
     limits: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
+    def __post_init__(self):
+        from .saturation import n_limit_states
+        n = self.ss.A.shape[0]
+        if self.limits.size and n_limit_states(self.limits) != n:
+            raise ValueError(f"LurePlant: limits packed over {n_limit_states(self.limits)} states, "
+                             f"the plant has {n}")
+
     @property
     def ext_inputs(self) -> tuple[str, ...]:
         return self.ss.inputs[: self.n_ext]
+
+
+def extend_plant(base: LurePlant, ss: StateSpace, n_ext: int, cmd_d) -> LurePlant:
+    """``base`` grown by states appended after its own: ``ss`` is the new linear block (its first
+    states are ``base``'s, in order; external inputs first, then ``command_rad`` and
+    ``friction_torque_Nm``), ``n_ext`` its number of external inputs and ``cmd_d`` the avionics
+    input's weights on them. The command, rate and applied-torque rows are padded with zeros
+    and the actuator/gimbal limits are embedded over the larger state, so a grown plant keeps
+    every limit of the one it grew from (the one construction for this)."""
+    from .saturation import embed_limits
+    n0, n = base.ss.A.shape[0], ss.A.shape[0]
+    if n < n0 or ss.states[:n0] != base.ss.states:
+        raise ValueError("extend_plant: the new block's first states must be the base plant's")
+    pad = lambda v: np.concatenate([v, np.zeros(n - n0)])  # noqa: E731
+    return LurePlant(ss=ss, n_ext=n_ext, cmd_c=pad(base.cmd_c), cmd_d=np.asarray(cmd_d, float),
+                     rate_c=pad(base.rate_c), applied_c=pad(base.applied_c), inertia_kgm2=base.inertia_kgm2,
+                     limits=embed_limits(base.limits, n, 0))
 
 
 def simplex_state_space(model: TvcModel, axis: str = "pitch", *, structure_inputs: bool = False,
