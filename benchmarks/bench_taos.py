@@ -1,6 +1,6 @@
 """TAOS speed and physics figures (writes nothing; paste the output into benchmarks/RESULTS.md).
 
-Run:  .venv/bin/python benchmarks/bench_taos.py [--naive-seconds 0.05]
+Run:  .venv/bin/python benchmarks/bench_taos.py [--naive-seconds 0.05] [--physics-only]
 
 1. Speed: 60 s two-axis Green Run profile (models/profiles/greenrun_two_axis.toml repeated to
    60 s), hot-fire FEM gimbal matrices, modified-LuGre bearing friction, dt = 2e-4 s: simulated
@@ -77,10 +77,19 @@ def naive_rhs_factory(tm, cmd_fun):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--naive-seconds", type=float, default=0.05)
+    ap.add_argument("--physics-only", action="store_true",
+                    help="only the physics figures (part 3): no timing, no scipy baseline")
     args = ap.parse_args()
     tm = load_taos_model("models/rs25_hotfire.toml", friction="modified-lugre")
     print(f"model: hot fire, gimbal {tm.stiffness_source}, friction {tm.base.friction.name}, "
           f"T_c = {tm.coulomb_torque_Nm:.0f} N m (lambda {tm.friction_scale:.4f})")
+    if not args.physics_only:
+        timing_and_baseline(tm, args)
+    physics_figures(tm)
+
+
+def timing_and_baseline(tm, args):
+    """Parts 1 and 2: speed against the scipy baseline, and step convergence."""
     prof = greenrun60()
     t, cmd = commands(prof, 60.0, DT)
     run_samples(tm, cmd[:11], DT, 10)  # compile / load cache
@@ -129,7 +138,10 @@ def main():
               f"max |theta_naive - theta_condensed| = {err:.2e} deg; speed-up of the condensed "
               f"integrator {(w / Tn) / (wall / 60):.0f}x")
 
-    # physics figures
+
+
+def physics_figures(tm):
+    """Part 3: two-axis dither and the out-of-plane effect (LuGre)."""
     m = tm.base.with_friction("lugre")
     tl = tm.with_friction("lugre")
     print("[dither] LuGre, pitch 0.5 Hz alone vs with yaw 0.4 deg at 5 Hz: pitch engine gain dB")
