@@ -30,7 +30,7 @@ from taos.model import load_model
 from taos.planar.simplex import simplex_state_space
 from taos.stability import loop_margins
 
-from .conftest import MODELS
+from .conftest import MODELS, run_cli
 
 LBF_PER_IN = 4.4482216152605 / 0.0254  # N/m
 RS25 = ["rs25_ambient", "rs25_hotfire", "rs25_flight"]
@@ -183,3 +183,33 @@ def test_servo_stiff_in_the_flight_lco_band(hot):
     assert k_model == pytest.approx(k_formula, rel=0.03)  # 2.4 %: the formula neglects the oil column and valve
     assert k_model / LBF_PER_IN == pytest.approx([694_000, 537_000], rel=0.005)
     assert np.all(k_model >= 4.6 * 115000 * LBF_PER_IN)
+
+
+@pytest.mark.parametrize("name", RS25)
+def test_taos_info_shows_the_servo_figures_python_control_finds(name):
+    """``taos info --json`` reports the servo's figures (``servo``: position-loop margins with the
+    model's load and in the laboratory, laboratory peaking and bandwidth, load-mode frequency and
+    damping); checked against python-control on the state-space loop (``control.margin`` of
+    T/(1-T), eigenvalues of A), not against the sampled route that computes them."""
+    import json
+
+    import control
+
+    m = load_model(MODELS / f"{name}.toml")
+    r = run_cli("info", name, "--json", "-")
+    assert r.returncode == 0, r.stderr
+    sv = json.loads(r.stdout)["servo"]["pitch"]
+    for cond, mm in (("position_loop", m), ("laboratory", _lab(m))):
+        gm, pm, _, wcp = control.margin(control.feedback(_T(mm), 1, sign=1))
+        got = sv[cond]
+        assert got["gain_margin_db"] == pytest.approx(20 * math.log10(gm), abs=0.02)
+        assert got["phase_margin_deg"] == pytest.approx(pm, abs=0.02)
+        assert got["crossover_hz"] == pytest.approx(wcp / (2 * math.pi), rel=2e-3)
+    zeta, f = _least_damped_load_mode(m)
+    assert sv["load_mode"]["damping_ratio"] == pytest.approx(zeta, rel=1e-9)
+    assert sv["load_mode"]["freq_hz"] == pytest.approx(f, rel=1e-9)
+    sys_ = _ctl(_lab(m), out="theta_rad")
+    mag = np.abs(control.frequency_response(sys_, 2 * math.pi * np.logspace(-2, 2, 8000)).frdata[0, 0])
+    assert sv["laboratory"]["engine_peaking_db"] == pytest.approx(20 * math.log10(mag.max() / abs(control.dcgain(sys_))),
+                                                                  abs=0.02)
+    assert sv["laboratory"]["engine_bandwidth_3db_hz"] == pytest.approx(5.6, abs=0.03)

@@ -37,6 +37,19 @@ def taos_from_args(args, model: TvcModel):
     return taos_model(model)
 
 
+def servo_line(ax: str, sv: dict) -> str:
+    """``taos info``'s servo lines of one axis (:mod:`taos.report.servo`)."""
+    def loop(d):
+        gm = "no phase crossover" if d["gain_margin_db"] is None else f"{d['gain_margin_db']:.1f} dB"
+        pm = "no gain crossover" if d["phase_margin_deg"] is None else f"{d['phase_margin_deg']:.1f} deg"
+        return f"{gm} / {pm}"
+    lab, lm = sv["laboratory"], sv["load_mode"]
+    bw = "none below 50 Hz" if lab["engine_bandwidth_3db_hz"] is None else f"{lab['engine_bandwidth_3db_hz']:.2f} Hz"
+    mode = "none" if lm["freq_hz"] is None else f"{lm['freq_hz']:.2f} Hz, zeta {lm['damping_ratio']:.3f}"
+    return (f"  {ax} servo        loop margins {loop(sv['position_loop'])} (lab {loop(lab)}); lab peak "
+            f"{lab['engine_peaking_db']:+.2f} dB, -3 dB {bw}; load mode {mode}")
+
+
 def cmd_info(args) -> int:
     model = model_from_args(args)
     d = model_summary(model, steps=args.steps)
@@ -58,6 +71,7 @@ def cmd_info(args) -> int:
             print(f"  {ax} engine       -3 dB {bw}, -90 deg {p90}, peak {e['peak_gain_db']:+.2f} dB at "
                   f"{e['peak_freq_hz']:.2f} Hz (linear, relative to low frequency)")
             print(f"  {ax} notch        {fm['notch_hz']:.3f} Hz, load resonance {fm['load_resonance_hz']:.3f} Hz")
+            print(servo_line(ax, d["servo"][ax]))
             if st:
                 rt = "n/a" if st["rise_time_s"] is None else f"{1e3 * st['rise_time_s']:.1f} ms"
                 ov = "n/a" if st["overshoot_pct"] is None else f"{st['overshoot_pct']:.1f} %"

@@ -5,7 +5,10 @@ Run report writes to ``summary.json``.
   resonance w_L = sqrt((K_L R^2 + K_n) / J_n) (paper eq. 1), the piston notch
   (:func:`taos.planar.simplex.load_resonance_from_notch`), the breakaway deflection
   T_c / (K_L R^2), the oil-column stiffness, K_L R^2, the stall force A P_s, the avionics LSB, the
-  linear modes of the pitch block, and the figures of merit (:func:`figures_of_merit`);
+  linear modes of the pitch block, the figures of merit (:func:`figures_of_merit`) and the
+  servo's own figures per axis (:func:`taos.report.servo.servo_figures`: position-loop margins
+  with the model's load and in the laboratory condition, laboratory peaking and bandwidth, the
+  load mode's frequency and damping);
 * :func:`figures_of_merit` - per axis, the frequency figures of the exact linear response
   (:func:`taos.report.merit.frequency_merit`) and, with ``steps``, the step, threshold and
   hysteresis figures simulated on the nonlinear model (:func:`taos.report.merit.step_merit`);
@@ -52,6 +55,8 @@ def model_summary(model: TvcModel, steps: bool = True) -> dict:
 
     from taos.planar.simplex import load_resonance_from_notch, simplex_state_space
 
+    from .servo import servo_figures
+
     poles = simplex_state_space(model, "pitch").poles()
     p = poles[poles.imag >= 0]
     p = p[np.argsort(np.abs(p))]
@@ -70,6 +75,7 @@ def model_summary(model: TvcModel, steps: bool = True) -> dict:
         "stall_force_N": model.actuator.stall_force_N,
         "avionics_lsb_deg": math.degrees(av.lsb_rad),
         "figures_of_merit": figures_of_merit(model, steps=steps),
+        "servo": {ax: servo_figures(model, ax).to_dict() for ax in AXES},
         "linear_modes": [{"freq_hz": float(abs(x) / (2 * math.pi)),
                           "damping_ratio": float(-x.real / abs(x)) if abs(x) > 0 else 1.0} for x in p],
         "parameters": {
