@@ -110,3 +110,32 @@ def test_taos_family_equals_single_amplitude_calls(hotfire):
         one = taos_freqresp(tm, f, a, settle_s=0.3)
         assert np.array_equal(one.engine, fam[k].engine) and np.array_equal(one.piston, fam[k].piston)
         assert one.amplitude_rad == fam[k].amplitude_rad
+
+
+def test_lco_map_makes_one_describing_function_per_tvc_variant(monkeypatch):
+    """The describing function depends on the TVC only: a verdict map over a TVC parameter and a
+    flight-loop gain makes one map per TVC value (2, not 4), and every point equals the
+    stand-alone prediction for that point exactly."""
+    import taos.flight.lco as lco
+    from taos.flight.lco_map import SweepAxis, apply_value, lco_map
+    from taos.flight.vehicle import load_flight
+    from taos.model import load_model
+
+    fl = load_flight(MODELS / "flight" / "core_stage.toml")
+    m = load_model(MODELS / "rs25_flight.toml", friction="dahl")
+    amps, f = np.array([0.02, 0.1, 0.5]) * DEG, np.array([0.08, 0.15, 0.3])
+    calls = []
+    real = lco.describing_function_map
+    monkeypatch.setattr(lco, "describing_function_map", lambda *a, **k: calls.append(1) or real(*a, **k))
+    axes = (SweepAxis("bristle_stiffness", (0.8e7, 2.2e7)), SweepAxis("integral_gain", (0.6, 0.9)))
+    mp = lco_map(fl, m, axes, amplitudes_rad=amps, freq_hz=f)
+    assert len(calls) == 2
+    for i, s0 in enumerate(axes[0].values):
+        for j, ki in enumerate(axes[1].values):
+            fl2, m2 = apply_value(*apply_value(fl, m, "bristle_stiffness", s0), "integral_gain", ki)
+            d = lco.analyse_lco(fl2, m2, amplitudes_rad=amps, freq_hz=f, time_domain=False).to_dict()
+            assert bool(mp.lco[i, j]) == d["lco"]
+            if d["lco"]:
+                assert mp.engine_amplitude_deg[i, j] == d["engine_amplitude_deg"]
+            else:
+                assert mp.margin_db[i, j] == d["margin_db"]

@@ -377,11 +377,40 @@ def decision(prediction: dict, time_domain: dict | None) -> dict:
             "prediction_lco": bool(prediction["lco"]), "note": note}
 
 
+def flown_model(model: TvcModel, avionics: str = "bounding") -> TvcModel:
+    """The TVC model with the avionics of the analysis: "bounding" (the paper's -1 dB gain,
+    :func:`with_bounding_avionics`) or "model" (the file's quantiser and crossover curve)."""
+    if avionics == "bounding":
+        return with_bounding_avionics(model)
+    if avionics != "model":
+        raise ValueError(f"avionics must be 'bounding' or 'model', got {avionics!r}")
+    return model
+
+
+def describing_function_map_for(model: TvcModel, axis: str, *, amplitudes_rad=None, freq_hz=None,
+                                avionics: str = "bounding", settle_cycles: int = 1, measure_cycles: int = 1,
+                                steady: str = "settle", flown: bool = False) -> DescribingFunctionMap:
+    """The describing-function map :func:`analyse_lco` uses for ``model`` on ``axis`` with
+    ``avionics`` (``flown=True``: ``model`` already carries them, :func:`flown_model`). Default
+    grid: :data:`DEFAULT_AMPLITUDES_DEG` x :data:`DEFAULT_FREQ_HZ`; with the file's avionics the
+    amplitudes reach half an LSB (:func:`model_avionics_amplitudes_rad`)."""
+    if not flown:
+        model = flown_model(model, avionics)
+    if amplitudes_rad is None and avionics == "model" and model.avionics.lsb_rad > 0:
+        amps = model_avionics_amplitudes_rad(model)  # the quantiser's own cycle lives below 0.01 deg
+    else:
+        amps = np.radians(DEFAULT_AMPLITUDES_DEG) if amplitudes_rad is None else np.asarray(amplitudes_rad, float)
+    f = np.asarray(DEFAULT_FREQ_HZ if freq_hz is None else freq_hz, float)
+    return describing_function_map(model, amps, f, axis, settle_cycles=settle_cycles, measure_cycles=measure_cycles,
+                                   method=steady)
+
+
 def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None,
                 amplitudes_rad: np.typing.ArrayLike | None = None, freq_hz: np.typing.ArrayLike | None = None,
                 duration_s: float = 300.0, window_s: float = 120.0,
                 attitude0_rad: float = 0.2 * DEG, settle_cycles: int = 1, measure_cycles: int = 1,
-                avionics: str = "bounding", time_domain: bool = True, steady: str = "settle") -> LcoReport:
+                avionics: str = "bounding", time_domain: bool = True, steady: str = "settle",
+                df: DescribingFunctionMap | None = None) -> LcoReport:
     """Describing-function map, harmonic-balance prediction and (optionally) the time-domain
     run for one flight file and TVC model. Defaults: :data:`DEFAULT_AMPLITUDES_DEG` x
     :data:`DEFAULT_FREQ_HZ`, one settling and one measured cycle beyond the linear settling
@@ -390,19 +419,19 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
     file's quantisation and crossover curve, as flown; the default amplitudes then reach half an
     LSB, :func:`model_avionics_amplitudes_rad`). ``steady``: how each dwell of the map reaches
     its periodic orbit ("settle", or "shoot": the periodic steady state by shooting,
-    :func:`taos.planar.freqresp.sine_dwell_points`)."""
+    :func:`taos.planar.freqresp.sine_dwell_points`). ``df``: a describing-function map already
+    made for this TVC model, avionics and axis (:func:`describing_function_map_for`), reused
+    instead of computed: the map depends on the TVC only, so a sweep over the flight loop's gains
+    makes it once."""
     axis = axis or flight.axis
-    if avionics == "bounding":
-        model = with_bounding_avionics(model)
-    elif avionics != "model":
-        raise ValueError(f"avionics must be 'bounding' or 'model', got {avionics!r}")
-    if amplitudes_rad is None and avionics == "model" and model.avionics.lsb_rad > 0:
-        amps = model_avionics_amplitudes_rad(model)  # the quantiser's own cycle lives below 0.01 deg
-    else:
-        amps = np.radians(DEFAULT_AMPLITUDES_DEG) if amplitudes_rad is None else np.asarray(amplitudes_rad, float)
-    f = np.asarray(DEFAULT_FREQ_HZ if freq_hz is None else freq_hz, float)
-    df = describing_function_map(model, amps, f, axis, settle_cycles=settle_cycles, measure_cycles=measure_cycles,
-                                 method=steady)
+    model = flown_model(model, avionics)
+    if df is None:
+        df = describing_function_map_for(model, axis, amplitudes_rad=amplitudes_rad, freq_hz=freq_hz,
+                                         avionics=avionics, settle_cycles=settle_cycles,
+                                         measure_cycles=measure_cycles, steady=steady, flown=True)
+    elif df.axis != axis or df.friction_model != model.friction.name:
+        raise ValueError(f"the describing-function map given is for the {df.axis} axis and "
+                         f"{df.friction_model!r}, not {axis} and {model.friction.name!r}")
     pred = predict_lco(flight, df, axis)
     hist = meas = None
     if time_domain:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from taos.errors import InputError
-from taos.flight.lco import analyse_lco
+from taos.flight.lco import analyse_lco, describing_function_map_for
 from taos.flight.vehicle import FlightModel, loop_freqresp, margins
 from taos.model import TvcModel
 from taos.units import to_si
@@ -145,14 +145,22 @@ def lco_map(flight: FlightModel, model: TvcModel, axes, *, amplitudes_rad=None, 
     lco = np.zeros(shape, bool)
     amp, eamp, fr, mg = (np.full(shape, np.nan) for _ in range(4))
     lgm = {}
+    maps = {}   # the describing function depends on the TVC only: one map per TVC variant
     for idx in np.ndindex(shape):
         fl, m = flight, model
+        tvc_key = []
         for a, i in zip(axes, idx):
             fl, m = apply_value(fl, m, a.name, a.values[i])
             if SWEEPABLE[a.name][0] == "fcs":
                 lgm[f"{a.name}={a.values[i]:.6g}"] = loop_low_gain_margin_db(fl)
+            else:
+                tvc_key.append((a.name, a.values[i]))
+        key = tuple(tvc_key)
+        if key not in maps:
+            maps[key] = describing_function_map_for(m, fl.axis, amplitudes_rad=amplitudes_rad, freq_hz=freq_hz,
+                                                    avionics=avionics)
         d = analyse_lco(fl, m, amplitudes_rad=amplitudes_rad, freq_hz=freq_hz, avionics=avionics,
-                        time_domain=False).to_dict()
+                        time_domain=False, df=maps[key]).to_dict()
         lco[idx] = bool(d["lco"])
         if d["lco"]:
             amp[idx], eamp[idx], fr[idx], mg[idx] = (d["amplitude_deg"], d["engine_amplitude_deg"],
