@@ -239,15 +239,15 @@ def nichols_figure(pred, amplitudes_rad=None, n_freq: int = 400, title: str | No
     fig.add_trace(go.Scatter(x=[-180], y=[0], mode="markers", name="critical point",
                              marker=dict(symbol="cross-thin", size=16, line=dict(width=3, color="red")),
                              hovertemplate="critical point (-180 deg, 0 dB)<extra></extra>"))
+    from .nichols import cycles_label
+
     for stable in (True, False):
         cs = [c for c in pred.cycles if c.stable == stable]
         if not cs:
             continue
         kind = "stable LCO" if stable else "unstable harmonic-balance solution (threshold)"
-        lo, hi = min(math.degrees(c.amplitude_rad) for c in cs), max(math.degrees(c.amplitude_rad) for c in cs)
-        span = f"{lo:.3g} deg" if len(cs) == 1 else f"{len(cs)} solutions, {lo:.3g}-{hi:.3g} deg"
         text = "<br>".join(f"{math.degrees(c.amplitude_rad):.3g} deg, {c.freq_hz:.3g} Hz" for c in cs)
-        fig.add_trace(go.Scatter(x=[-180], y=[0], mode="markers", name=f"{kind}: {span}",
+        fig.add_trace(go.Scatter(x=[-180], y=[0], mode="markers", name=cycles_label(cs, stable),
                                  marker=dict(symbol="circle-open", size=18 if stable else 24,
                                              line=dict(width=2), color="green" if stable else "magenta"),
                                  hovertemplate=f"<b>{kind}</b><br>{text}<extra></extra>"))

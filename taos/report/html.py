@@ -64,6 +64,7 @@ def _h(x) -> str:
 def decorate_bode(fig, spec_result, test, axis, linear_fr, moment_arm_m: float) -> None:
     """Spec marks and the measured record's points on one axis' Bode figure."""
     from taos.plotting import bode
+    from taos.plotting._common import legend_once
     from taos.plotting.spec import bode_axes, draw_spec
 
     ax = bode_axes(fig)
@@ -71,7 +72,7 @@ def decorate_bode(fig, spec_result, test, axis, linear_fr, moment_arm_m: float) 
         fr = test[axis].to_freqresp(moment_arm_m)
         bode.draw_response(ax, fr, 1.0, color="tab:orange", label=f"test record ({test[axis].method})",
                            gid="test-data", marker="s", linestyle="none", ref=linear_fr)
-        ax[0, 0].legend(fontsize=8, loc="best")
+        legend_once(fig, ax[0, 0], fontsize=8, loc="best")
     if spec_result is not None:
         draw_spec(ax, spec_result)
 
