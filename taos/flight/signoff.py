@@ -35,11 +35,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Iterable
 
 import numpy as np
 
 from taos.errors import InputError
 from taos.linear import phase_deg
+
+if TYPE_CHECKING:
+    from taos.flight.lco import LcoPrediction, LcoReport
+    from taos.flight.lco_map import SweepAxis
+    from taos.flight.vehicle import FlightModel
+    from taos.model import TvcModel
 
 #: the requirement keys and what each is: key -> (unit kind or "dB", expected text)
 KEYS = {"low_gain_margin_min_db": "a gain margin in dB (a number, e.g. 6)",
@@ -74,7 +82,7 @@ class Requirements:
                 "margin_amplitude_min_deg": math.degrees(self.margin_amplitude_min_rad)}
 
 
-def load_requirements(path) -> Requirements:
+def load_requirements(path: str | Path) -> Requirements:
     """Read a requirements file; :class:`InputError` (file, key, what was expected) on bad input."""
     from taos.model import read_toml
     from taos.errors import check_keys
@@ -202,7 +210,7 @@ def _fmt_limit(lim) -> str:
 
 # -- the checks ----------------------------------------------------------------------------------
 
-def low_frequency_crossing_hz(pred, n: int = 800) -> float | None:
+def low_frequency_crossing_hz(pred: LcoPrediction, n: int = 800) -> float | None:
     """The -180 deg crossing [Hz] of the rigid loop L0 where |L0| > 1 (the conditionally stable
     crossing), over the describing-function map's frequency range; None when there is none."""
     from taos.flight.vehicle import margins
@@ -211,7 +219,7 @@ def low_frequency_crossing_hz(pred, n: int = 800) -> float | None:
     return margins(f, pred.loop(f)).low_phase_crossover_hz
 
 
-def signed_low_gain_margin(pred, amplitude_rad: float, f0_hz: float, n: int = 800) -> tuple[float | None, float | None]:
+def signed_low_gain_margin(pred: LcoPrediction, amplitude_rad: float, f0_hz: float, n: int = 800) -> tuple[float | None, float | None]:
     """(20 log10 |L0 N(A)| [dB], frequency [Hz]) at the -180 deg crossing of L0 N(A, .) nearest
     ``f0_hz`` in log frequency; (None, None) without a crossing."""
     f = np.logspace(np.log10(pred.df.freq_hz[0]), np.log10(pred.df.freq_hz[-1]), n)
@@ -227,7 +235,8 @@ def signed_low_gain_margin(pred, amplitude_rad: float, f0_hz: float, n: int = 80
     return float(g[k[j]] + t[j] * (g[k[j] + 1] - g[k[j]])), float(10 ** lf[j])
 
 
-def check_case(req: Requirements, report, label: str = "nominal", parameters: dict | None = None) -> CaseResult:
+def check_case(req: Requirements, report: LcoReport, label: str = "nominal",
+               parameters: dict | None = None) -> CaseResult:
     """The requirements' checks on one :class:`taos.flight.lco.LcoReport`."""
     pred = report.prediction
     amps = [a for a in pred.df.amplitude_rad if a >= req.margin_amplitude_min_rad * (1 - 1e-9)]
@@ -277,7 +286,7 @@ def check_case(req: Requirements, report, label: str = "nominal", parameters: di
     return CaseResult(label, dict(parameters or {}), tuple(checks), report.verdict().text, report)
 
 
-def _grows_beyond_map(pred) -> str:
+def _grows_beyond_map(pred: LcoPrediction) -> str:
     """Why the motion outgrows the describing-function map ("" when it does not): the loop with
     the TVC at the map's largest amplitude is still unstable (a negative phase margin, or a
     negative signed low-frequency gain margin), so any cycle lies above that amplitude."""
@@ -291,7 +300,7 @@ def _grows_beyond_map(pred) -> str:
     return ""
 
 
-def _cycles(report) -> list[tuple[float, str, float]]:
+def _cycles(report: LcoReport) -> list[tuple[float, str, float]]:
     """(engine amplitude [deg], source, frequency [Hz]) of each self-sustained cycle: the
     describing function's stable cycle and the time-domain run's when it oscillates."""
     out = []
@@ -304,7 +313,8 @@ def _cycles(report) -> list[tuple[float, str, float]]:
     return out
 
 
-def sign_off(req: Requirements, flight, model, *, sweep_axes=(), progress: bool = False, **lco_kw) -> SignOff:
+def sign_off(req: Requirements, flight: FlightModel, model: TvcModel, *, sweep_axes: Iterable[SweepAxis] = (),
+             progress: bool = False, **lco_kw: Any) -> SignOff:
     """The sign-off of ``model`` in ``flight`` against ``req``: the nominal case, or every point
     of the grid of ``sweep_axes`` (:class:`taos.flight.lco_map.SweepAxis`; prediction only).
     ``lco_kw``: :func:`taos.flight.lco.analyse_lco`'s settings. The number of cases is checked
