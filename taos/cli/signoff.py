@@ -31,7 +31,7 @@ def run_signoff(args, flight, model, amps, freqs) -> int:
                   window_s=min(120.0, 0.5 * args.duration), time_domain=not args.no_time_domain, steady=args.steady)
     d = {"signoff": so.to_dict(), "avionics": args.avionics}
     if args.signoff:
-        from taos.report.signoff_page import render_signoff_html
+        from taos.plotting.signoff_page import render_signoff_html
         page = render_signoff_html(so)
         text = json.dumps(d, indent=2, allow_nan=False) + "\n"
         write_output_folder(args.signoff, {"signoff.json": lambda p: p.write_text(text),

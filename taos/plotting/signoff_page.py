@@ -34,7 +34,7 @@ th{background:#eef}td:first-child,th:first-child,td.l{text-align:left}.note{colo
 
 def render_signoff_html(so) -> str:
     """The page of ``so`` (a :class:`taos.flight.signoff.SignOff`)."""
-    from taos.plotting import interactive as ia
+    from . import interactive as ia
 
     d = so.to_dict()
     req = d["requirements"]
