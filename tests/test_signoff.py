@@ -129,3 +129,24 @@ def test_bad_requirements_and_options_stop_before_any_work(tmp_path):
     r = run_cli(*LCO, "--requirements", REQ, "--signoff", tmp_path / "afile")
     assert r.returncode == 2 and (tmp_path / "afile").read_text() == "mine"
     assert "sign-off" not in r.stderr          # refused before the analysis started (no progress bar)
+
+
+@pytest.mark.slow
+def test_a_loop_unstable_at_the_largest_amplitude_is_not_called_cycle_free():
+    """Soft load path (60000 lbf/in): on a map up to 0.3 deg the loop with the TVC is unstable at
+    every amplitude, so the verdict says the motion grows beyond the map (it used to read "no
+    limit cycle expected"); the map extended to 3 deg finds the cycle above 0.3 deg, and the
+    time-domain run (another method) oscillates near it."""
+    soft = ("--load-stiffness", "60000 lbf/in")
+    r = run_cli(*LCO, *soft, "--json", "-")
+    assert r.returncode == 0, r.stderr
+    v = json.loads(r.stdout)["verdict"]
+    assert v["kind"] == "grows-beyond-map" and "motion grows beyond it" in v["text"]
+    r = run_cli("lco", "rs25_flight", "--flight", "core_stage", "--amplitudes-deg", "0.03,0.1,0.3,1,3",
+                "--freq-hz", GRID[3], "--duration", "100", *soft, "--json", "-")
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["verdict"]["kind"] == "limit-cycle" and d["amplitude_deg"] > 0.3
+    td = d["time_domain"]
+    assert td["lco"] and td["amplitude_deg"] == pytest.approx(d["amplitude_deg"], rel=0.25)
+    assert td["frequency_hz"] == pytest.approx(d["frequency_hz"], rel=0.1)

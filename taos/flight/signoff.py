@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Any, Iterable
 import numpy as np
 
 from taos.errors import InputError
-from taos.linear import phase_deg
+from taos.flight.lco_verdict import grows_beyond_map, low_frequency_crossing_hz, signed_low_gain_margin
 
 if TYPE_CHECKING:
     from taos.flight.lco import LcoPrediction, LcoReport
@@ -210,31 +210,6 @@ def _fmt_limit(lim) -> str:
 
 # -- the checks ----------------------------------------------------------------------------------
 
-def low_frequency_crossing_hz(pred: LcoPrediction, n: int = 800) -> float | None:
-    """The -180 deg crossing [Hz] of the rigid loop L0 where |L0| > 1 (the conditionally stable
-    crossing), over the describing-function map's frequency range; None when there is none."""
-    from taos.flight.vehicle import margins
-
-    f = np.logspace(np.log10(pred.df.freq_hz[0]), np.log10(pred.df.freq_hz[-1]), n)
-    return margins(f, pred.loop(f)).low_phase_crossover_hz
-
-
-def signed_low_gain_margin(pred: LcoPrediction, amplitude_rad: float, f0_hz: float, n: int = 800) -> tuple[float | None, float | None]:
-    """(20 log10 |L0 N(A)| [dB], frequency [Hz]) at the -180 deg crossing of L0 N(A, .) nearest
-    ``f0_hz`` in log frequency; (None, None) without a crossing."""
-    f = np.logspace(np.log10(pred.df.freq_hz[0]), np.log10(pred.df.freq_hz[-1]), n)
-    L = pred.open_loop(amplitude_rad, f)
-    e = (phase_deg(L) + 360.0) % 360.0 - 180.0          # 0 at -180 deg (mod 360)
-    g = 20 * np.log10(np.abs(L))
-    k = np.flatnonzero((np.sign(e[:-1]) != np.sign(e[1:])) & (np.abs(e[:-1] - e[1:]) < 180))
-    if not k.size:
-        return None, None
-    t = e[k] / (e[k] - e[k + 1])
-    lf = np.log10(f[k]) + t * (np.log10(f[k + 1]) - np.log10(f[k]))
-    j = int(np.argmin(np.abs(lf - math.log10(f0_hz))))
-    return float(g[k[j]] + t[j] * (g[k[j] + 1] - g[k[j]])), float(10 ** lf[j])
-
-
 def check_case(req: Requirements, report: LcoReport, label: str = "nominal",
                parameters: dict | None = None) -> CaseResult:
     """The requirements' checks on one :class:`taos.flight.lco.LcoReport`."""
@@ -266,7 +241,7 @@ def check_case(req: Requirements, report: LcoReport, label: str = "nominal",
                  f"A = {math.degrees(a):.3g} deg, crossover {fc:.3g} Hz ({span})")
         checks.append(Check("phase margin", "deg", lim, pm, pm - lim, pm >= lim, where))
     cycles = _cycles(report)
-    grows = _grows_beyond_map(pred)
+    grows = grows_beyond_map(pred)
     if req.lco_engine_amplitude_max_rad is not None:
         lim = math.degrees(req.lco_engine_amplitude_max_rad)
         if grows:   # no cycle inside the map because the motion outgrows it
@@ -284,20 +259,6 @@ def check_case(req: Requirements, report: LcoReport, label: str = "nominal",
         else:
             checks.append(Check("LCO frequency band", "Hz", (lo, hi), None, None, True, "no limit cycle"))
     return CaseResult(label, dict(parameters or {}), tuple(checks), report.verdict().text, report)
-
-
-def _grows_beyond_map(pred: LcoPrediction) -> str:
-    """Why the motion outgrows the describing-function map ("" when it does not): the loop with
-    the TVC at the map's largest amplitude is still unstable (a negative phase margin, or a
-    negative signed low-frequency gain margin), so any cycle lies above that amplitude."""
-    a = pred.df.amplitude_rad[-1]
-    pm = pred.margins_by_amplitude[-1].phase_margin_deg
-    f0 = low_frequency_crossing_hz(pred)
-    g = signed_low_gain_margin(pred, a, f0)[0] if f0 is not None else None
-    if (pm is not None and pm < 0) or (g is not None and g < 0):
-        return (f"the loop is unstable at the map's largest amplitude {math.degrees(a):.3g} deg "
-                f"(phase margin {_fmt(pm)} deg, low-frequency gain margin {_fmt(g)} dB): motion grows beyond it")
-    return ""
 
 
 def _cycles(report: LcoReport) -> list[tuple[float, str, float]]:
