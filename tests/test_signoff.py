@@ -129,6 +129,8 @@ def test_bad_requirements_and_options_stop_before_any_work(tmp_path):
     r = run_cli(*LCO, "--requirements", REQ, "--signoff", tmp_path / "afile")
     assert r.returncode == 2 and (tmp_path / "afile").read_text() == "mine"
     assert "sign-off" not in r.stderr          # refused before the analysis started (no progress bar)
+    r = run_cli(*LCO, "--requirements", REQ, "--plot", tmp_path / "n.png")
+    assert r.returncode == 2 and "--plot" in r.stderr and not (tmp_path / "n.png").exists()
 
 
 @pytest.mark.slow

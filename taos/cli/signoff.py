@@ -20,6 +20,12 @@ def run_signoff(args, flight, model, amps, freqs) -> int:
     from taos.flight.signoff import load_requirements, sign_off
     from taos.results import check_output_folder, write_output_folder
 
+    from taos.errors import InputError
+
+    for flag in ("plot", "plot_df", "plot_time", "df_out", "plot_map"):   # outputs of the other modes
+        if getattr(args, flag, None):
+            raise InputError("command line", "--" + flag.replace("_", "-"), "no plot or map file with --requirements "
+                             "(the sign-off page, --signoff DIR, has the Nichols chart)", got=str(getattr(args, flag)))
     req = load_requirements(args.requirements)
     axes = [parse_sweep(s) for s in args.sweep or ()]
     if args.signoff:   # every input and output checked before any work
