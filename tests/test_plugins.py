@@ -162,6 +162,7 @@ def test_plugin_law_in_freqresp_equals_the_builtin_law_it_reimplements(plugin_pa
     assert abs(json.loads(r.stdout)["engine"]["gain_db"][0] - b["engine"]["gain_db"][0]) > 0.1
 
 
+@pytest.mark.slow
 def test_plugin_law_in_the_lco_prediction(plugin_path):
     """``taos lco --friction NAME``: the describing-function map uses the plug-in law's kernel."""
     res = {}
@@ -186,3 +187,36 @@ def test_a_broken_plugin_stops_with_one_line_naming_it(tmp_path):
     # a broken plug-in does not touch models using other laws
     r = taos_with(target, "info", MODELS / "rs25_hotfire.toml")
     assert r.returncode == 0, r.stderr
+
+
+@pytest.mark.slow
+def test_plugin_law_in_simulate_fit_and_the_3d_model(plugin_path, tmp_path):
+    """The same law through the planar run (``simulate``), the fit's describing function
+    (``fit --friction``: the plug-in's fit entry) and the 3-D model's bearing kernel
+    (``freqresp --engine taos``), each against the built-in coulomb-smooth law."""
+    prof = tmp_path / "dwell.toml"
+    prof.write_text('type = "sine_dwell"\namplitude = "0.2 deg"\nfrequency = "2 Hz"\ncycles = 6\n')
+    runs = {}
+    for law in (LAW, "coulomb-smooth"):
+        out = tmp_path / f"{law}.h5"
+        r = taos_with(plugin_path, "simulate", MODELS / "rs25_hotfire.toml", "--friction", law, "--profile", prof,
+                      "--out", out)
+        assert r.returncode == 0, r.stderr
+        from taos.planar.simulate import TimeHistory
+        runs[law] = TimeHistory.from_hdf5(out).engine_rad
+    assert runs[LAW] == pytest.approx(runs["coulomb-smooth"], abs=1e-9)
+    fits = {}
+    for law in (LAW, "coulomb-smooth"):
+        r = taos_with(plugin_path, "fit", MODELS / "data" / "greenrun_hotfire_synthetic.csv", "--model",
+                      MODELS / "rs25_hotfire.toml", "--friction", law, "--free", "coulomb_torque", "--starts", "1",
+                      "--no-correction", "--json", "-")
+        assert r.returncode == 0, r.stderr
+        fits[law] = json.loads(r.stdout)["parameters"]["coulomb_torque"]["value"]
+    assert fits[LAW] == pytest.approx(fits["coulomb-smooth"], rel=1e-6)
+    three = {}
+    for law in (LAW, "coulomb-smooth"):
+        r = taos_with(plugin_path, "freqresp", MODELS / "rs25_hotfire.toml", "--engine", "taos", "--friction", law,
+                      "--amplitude-deg", "0.2", "--freq-hz", "3", "--json", "-")
+        assert r.returncode == 0, r.stderr
+        three[law] = json.loads(r.stdout)["engine"]["gain_db"][0]
+    assert three[LAW] == pytest.approx(three["coulomb-smooth"], abs=1e-4)
