@@ -10,8 +10,6 @@ fitted from the model file's values, with standard errors and the adequacy verdi
 
 import math
 
-import numpy as np
-
 import taos
 from taos.identify.data import from_time_history
 from taos.profiles import Sequence, SineDwell

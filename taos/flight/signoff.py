@@ -44,7 +44,7 @@ from taos.errors import InputError
 from taos.flight.lco_verdict import grows_beyond_map, low_frequency_crossing_hz, signed_low_gain_margin
 
 if TYPE_CHECKING:
-    from taos.flight.lco import LcoPrediction, LcoReport
+    from taos.flight.lco import LcoReport
     from taos.flight.lco_map import SweepAxis
     from taos.flight.vehicle import FlightModel
     from taos.model import TvcModel
