@@ -29,12 +29,14 @@ extensions = [
     "myst_parser",
     "sphinx-mathjax-offline",   # MathJax shipped with the site: equations render without a network
     "taosdocs.ext",
+    "sphinx_gallery.gen_gallery",
 ]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
 # docs/verification.md (written by the verification suite) is pulled in through
 # verification_page.md when present; _generated holds what the build makes
-exclude_patterns = ["_build", "_generated", "verification.md", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build", "_generated", "verification.md", "Thumbs.db", ".DS_Store", "gallery/*.ipynb",
+                    "gallery/*.py", "gallery/*.zip"]
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 
@@ -52,3 +54,20 @@ html_title = f"taos {release}"
 html_static_path: list[str] = []
 html_theme_options = {"description": "TVC gimbal and actuator simulation", "page_width": "1100px",
                       "sidebar_width": "240px"}
+
+# The examples gallery (sphinx-gallery): every examples/plot_*.py is run by the build (an error
+# stops it) and shown with its output and pictures in docs/gallery (generated, not in git);
+# tests/test_examples.py runs the same scripts.
+sphinx_gallery_conf = {
+    "examples_dirs": str(ROOT / "examples"),
+    "gallery_dirs": str(HERE / "gallery"),
+    "filename_pattern": r"/plot_",
+    "abort_on_example_error": True,
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "show_memory": False,
+    "show_signature": False,
+    "matplotlib_animations": False,
+    "image_scrapers": ("matplotlib",),
+    "within_subsection_order": "FileNameSortKey",
+}

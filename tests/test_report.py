@@ -37,7 +37,11 @@ def test_greenrun_cli_writes_index_h5_and_shows_progress(report, hotfire):
     assert "index.html" in r.stdout
     page = (out / "index.html").read_text()
     assert "<script src" not in page.lower() and "<link" not in page.lower()
-    assert set(re.findall(r"https?://[^\s\"'()<>&]+", page)) <= {"http://www.w3.org/1999/xhtml"}
+    # (the inline plotly.js bundle names web addresses in its own text; it fetches nothing:
+    # tests/test_report_interactive.py opens the page with the network blocked)
+    i = page.index('<script type="text/javascript">')
+    rest = page[:i] + page[page.index("</script>", i):]
+    assert set(re.findall(r"https?://[^\s\"'()<>&\\]+", rest)) <= {"http://www.w3.org/1999/xhtml"}
     assert len(re.findall(r'<img [^>]*src="data:image/png;base64,', page)) == 4
     assert page.count("<iframe") == 1 and "srcdoc=" in page and "MeshCat.Viewer" in page
     s = json.loads((out / "summary.json").read_text())

@@ -160,11 +160,14 @@ def cmd_fit(args) -> int:
     if args.json:
         write_json(args.json, d)
     out = sys.stderr if args.json == "-" else sys.stdout
-    print(res.table(), file=out)
+    table = res.table()
+    if not adequacy.ok:  # the warning once, on standard error (the table's last line is the same message)
+        table = table.rsplit("\n", 1)[0]
+    print(table, file=out)
     if args.out_model:
         print(f"wrote {args.out_model}", file=out)
     if not adequacy.ok:
-        print(adequacy.message(), file=sys.stderr if out is sys.stdout else out)
+        print(adequacy.message(), file=sys.stderr)
         if args.strict:
             return 4
     return 0

@@ -34,6 +34,11 @@ def cmd_lco(args) -> int:
     for name, v in (("--amplitudes-deg", amps), ("--freq-hz", freqs)):
         if v is not None and len(v) < 2:
             raise InputError("command line", name, "at least two values for the describing-function grid")
+    if args.requirements:   # the flight sign-off (taos/cli/signoff.py), over the --sweep grid if given
+        from taos.cli.signoff import run_signoff
+        return run_signoff(args, flight, model, amps, freqs)
+    if args.signoff:
+        raise InputError("command line", "--signoff", "--requirements FILE with it", got="no --requirements")
     if args.sweep:
         return _sweep(args, flight, model, amps, freqs)
     rep = analyse_lco(flight, model, axis=args.axis, duration_s=args.duration, avionics=args.avionics,
@@ -125,4 +130,8 @@ def add_parsers(sub) -> None:
                    "bristle_stiffness, coulomb_torque, load_stiffness, integral_gain, attitude_gain, rate_gain; "
                    "values in SI or each with its unit")
     p.add_argument("--plot-map", metavar="PNG_OR_SVG", help="with --sweep: the verdict map")
+    p.add_argument("--requirements", metavar="TOML", help="flight sign-off: check the stated limits (gain and phase "
+                   "margins, LCO amplitude and frequency band) over the nominal case or every --sweep point; "
+                   "e.g. models/specs/flight_signoff_notional.toml")
+    p.add_argument("--signoff", metavar="DIR", help="with --requirements: write DIR/signoff.json and DIR/signoff.html")
     p.set_defaults(func=cmd_lco)

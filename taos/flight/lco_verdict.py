@@ -10,6 +10,9 @@ From a :class:`taos.flight.lco.LcoReport` (describing-function prediction and ti
   of L0 N(A, .) at its -180 deg (mod 360) crossings over all command amplitudes of the map,
   with the amplitude and frequency where it occurs, and whether the loop gain would have to
   rise or fall by it.
+  When the loop with the TVC is still unstable at the map's largest amplitude (a negative phase
+  margin, or a negative signed low-frequency gain margin: :func:`signed_low_gain_margin`), there
+  is no cycle inside the map because the motion outgrows it, and the text says so.
 * ``margin_table``: for each describing-function amplitude, the loop margins of L0 N(A, .)
   (:func:`taos.flight.vehicle.margins`): the low-frequency gain margin (how far the gain may
   fall, which friction does as the amplitude falls) and its frequency, the high-frequency gain
@@ -70,7 +73,7 @@ class NearestMargin:
 
 @dataclass(frozen=True)
 class LcoVerdict:
-    kind: str            # "limit-cycle", "threshold-only" or "none"
+    kind: str            # "limit-cycle", "threshold-only", "grows-beyond-map" or "none"
     text: str
     margin_table: tuple[dict, ...]
     nearest: NearestMargin | None
@@ -122,6 +125,49 @@ def nearest_margin(pred, n_amp: int = 60, n_freq: int = 600) -> NearestMargin | 
     return best
 
 
+def low_frequency_crossing_hz(pred, n: int = 800) -> float | None:
+    """The -180 deg crossing [Hz] of the rigid loop L0 where |L0| > 1 (the conditionally stable
+    crossing), over the describing-function map's frequency range; None when there is none."""
+    from taos.flight.vehicle import margins
+
+    f = np.logspace(np.log10(pred.df.freq_hz[0]), np.log10(pred.df.freq_hz[-1]), n)
+    return margins(f, pred.loop(f)).low_phase_crossover_hz
+
+
+def signed_low_gain_margin(pred, amplitude_rad: float, f0_hz: float, n: int = 800) -> tuple[float | None, float | None]:
+    """(20 log10 |L0 N(A)| [dB], frequency [Hz]) at the -180 deg crossing of L0 N(A, .) nearest
+    ``f0_hz`` in log frequency; (None, None) without a crossing."""
+    f = np.logspace(np.log10(pred.df.freq_hz[0]), np.log10(pred.df.freq_hz[-1]), n)
+    L = pred.open_loop(amplitude_rad, f)
+    e = (phase_deg(L) + 360.0) % 360.0 - 180.0          # 0 at -180 deg (mod 360)
+    g = 20 * np.log10(np.abs(L))
+    k = np.flatnonzero((np.sign(e[:-1]) != np.sign(e[1:])) & (np.abs(e[:-1] - e[1:]) < 180))
+    if not k.size:
+        return None, None
+    t = e[k] / (e[k] - e[k + 1])
+    lf = np.log10(f[k]) + t * (np.log10(f[k + 1]) - np.log10(f[k]))
+    j = int(np.argmin(np.abs(lf - math.log10(f0_hz))))
+    return float(g[k[j]] + t[j] * (g[k[j] + 1] - g[k[j]])), float(10 ** lf[j])
+
+
+def grows_beyond_map(pred) -> str:
+    """Why the motion outgrows the describing-function map ("" when it does not): the loop with
+    the TVC at the map's largest amplitude is still unstable (a negative phase margin, or a
+    negative signed low-frequency gain margin), so any cycle lies above that amplitude."""
+    a = pred.df.amplitude_rad[-1]
+    pm = pred.margins_by_amplitude[-1].phase_margin_deg
+    f0 = low_frequency_crossing_hz(pred)
+    g = signed_low_gain_margin(pred, a, f0)[0] if f0 is not None else None
+    if (pm is not None and pm < 0) or (g is not None and g < 0):
+        return (f"the loop is unstable at the map's largest amplitude {math.degrees(a):.3g} deg "
+                f"(phase margin {_num(pm)} deg, low-frequency gain margin {_num(g)} dB): motion grows beyond it")
+    return ""
+
+
+def _num(x) -> str:
+    return "-" if x is None else f"{x:.4g}"
+
+
 def lco_verdict(report) -> LcoVerdict:
     """The verdict of a :class:`taos.flight.lco.LcoReport` (module docstring)."""
     pred = report.prediction
@@ -158,6 +204,10 @@ def lco_verdict(report) -> LcoVerdict:
                 f"{math.degrees(u.amplitude_rad):.3g} deg command, {u.freq_hz:.3g} Hz is a threshold (smaller "
                 f"motion decays, larger grows)")
         kind = "threshold-only"
+    elif grows_beyond_map(pred):
+        text = "no limit cycle inside the describing-function map: " + grows_beyond_map(pred) + \
+               " (extend the amplitudes, or see the time-domain run)"
+        kind = "grows-beyond-map"
     else:
         text = "no limit cycle expected"
         kind = "none"

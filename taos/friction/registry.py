@@ -25,6 +25,21 @@ vector ``p`` (float64, C-contiguous, the law's :meth:`pack`), chain compliance `
 
 An unknown id stops with :class:`~taos.errors.InputError` naming it and the known ids.
 
+Plug-ins: an installed package registers a law through the entry-point group
+:data:`ENTRY_POINT_GROUP` (``taos.friction_laws``), the entry point's name being the law id and
+its object a :class:`FrictionLawEntry` or a function of no argument returning one, e.g. in the
+plug-in's ``pyproject.toml``::
+
+    [project.entry-points."taos.friction_laws"]
+    my-law = "my_package.friction:ENTRY"
+
+The entry points are read (not imported) the first time the list of ids is needed or an id is
+not known otherwise; a plug-in is imported when its law is first asked for (its parameter class
+by :func:`params_of`, its kernels, compiled then, by :func:`get`), so ``--friction my-law``
+works in every command and installed plug-ins cost nothing until used. A plug-in that fails to
+import, or whose object is not an entry with its entry point's id, stops with
+:class:`~taos.errors.InputError` naming the plug-in; it never shadows a built-in law.
+
 Nothing here imports numba until a kernel is needed: the built-in laws' parameter classes are
 known without their kernels (:func:`params_of`, :func:`param_classes`; model loading and
 ``taos info`` use these), and their entries, whose kernels are compiled C callbacks loaded from
@@ -104,6 +119,52 @@ class FrictionLawEntry:
 _REGISTRY: dict[str, FrictionLawEntry] = {}
 _BUILTINS: dict = {"params": {}, "loader": None, "loaded": False}
 
+#: the entry-point group through which installed packages add friction laws
+ENTRY_POINT_GROUP = "taos.friction_laws"
+#: plug-ins: entry points by id (read once, on first need) and their loaded, not yet compiled, entries
+_PLUGINS: dict = {"points": None, "loaded": {}}
+
+
+def _plugin_points() -> dict:
+    """id -> entry point of every installed plug-in law (read once per process; a plug-in
+    naming a built-in id is ignored: built-ins are never shadowed)."""
+    if _PLUGINS["points"] is None:
+        from importlib.metadata import entry_points
+
+        _PLUGINS["points"] = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)
+                              if ep.name not in _builtin_params()}
+    return _PLUGINS["points"]
+
+
+def refresh_plugins() -> None:
+    """Read the installed plug-ins again (after installing one into a running process); laws
+    already registered stay."""
+    import importlib
+
+    _PLUGINS["points"] = None
+    importlib.invalidate_caches()
+
+
+def _plugin_entry(law_id: str) -> FrictionLawEntry | None:
+    """The (uncompiled) entry of plug-in ``law_id``, importing the plug-in on first use; None
+    when no installed plug-in has that id."""
+    if law_id in _PLUGINS["loaded"]:
+        return _PLUGINS["loaded"][law_id]
+    ep = _plugin_points().get(law_id) if isinstance(law_id, str) else None
+    if ep is None:
+        return None
+    where = f"friction plug-in {ep.value!r} ({ENTRY_POINT_GROUP})"
+    try:
+        obj = ep.load()
+        entry = obj if isinstance(obj, FrictionLawEntry) else (obj() if callable(obj) else obj)
+    except Exception as e:  # a broken plug-in is the user's input: one line naming it
+        raise InputError(where, law_id, "an importable plug-in", got=f"{type(e).__name__}: {e}") from None
+    if not isinstance(entry, FrictionLawEntry) or entry.id != law_id:
+        raise InputError(where, law_id, f"a FrictionLawEntry with id {law_id!r} (or a function returning one)",
+                         got=repr(getattr(entry, "id", type(entry).__name__)))
+    _PLUGINS["loaded"][law_id] = entry
+    return entry
+
 
 def declare_builtins(params: dict, loader: Callable[[], None]) -> None:
     """The built-in laws: their parameter classes by id, and the function that registers their
@@ -129,6 +190,10 @@ class _Laws(Mapping):
     def __getitem__(self, law_id: str) -> FrictionLawEntry:
         if law_id not in _REGISTRY and law_id in _builtin_params():
             _load_builtins()
+        if law_id not in _REGISTRY:
+            plugin = _plugin_entry(law_id)
+            if plugin is not None:   # compiled and stored on first use
+                return register(plugin)
         return _REGISTRY[law_id]
 
     def __iter__(self):
@@ -195,24 +260,29 @@ def get(law_id: str, source: str = "friction registry", field: str = "friction.m
 
 
 def ids() -> tuple[str, ...]:
-    """The law ids: the built-in ones, then those registered at run time, in order."""
-    return tuple(dict.fromkeys((*_builtin_params(), *_REGISTRY)))
+    """The law ids: the built-in ones, then those registered at run time, then the installed
+    plug-ins' (:data:`ENTRY_POINT_GROUP`), in order."""
+    return tuple(dict.fromkeys((*_builtin_params(), *_REGISTRY, *_plugin_points())))
 
 
 def param_classes() -> dict[str, type]:
-    """id -> parameter class of every law, without loading any kernel."""
-    return {i: (_REGISTRY[i].params if i in _REGISTRY else _builtin_params()[i]) for i in ids()}
+    """id -> parameter class of every law known so far (built-in, registered, plug-ins already
+    imported), without loading any kernel or importing any plug-in."""
+    known = dict.fromkeys((*_builtin_params(), *_REGISTRY, *_PLUGINS["loaded"]))
+    return {i: (_REGISTRY[i].params if i in _REGISTRY else
+                _builtin_params()[i] if i in _builtin_params() else _PLUGINS["loaded"][i].params) for i in known}
 
 
 def params_of(law_id: str, source: str = "friction registry", field: str = "friction.model") -> type:
-    """The parameter class of ``law_id`` (no kernel is loaded); an unknown id raises
-    :class:`InputError` naming the known ids."""
+    """The parameter class of ``law_id`` (no kernel is loaded; a plug-in law's package is
+    imported); an unknown id raises :class:`InputError` naming the known ids."""
     classes = param_classes()
-    try:
+    if law_id in classes:
         return classes[law_id]
-    except (KeyError, TypeError):
-        raise InputError(source, field, "a friction law id, one of " + ", ".join(classes),
-                         got=repr(law_id)) from None
+    plugin = _plugin_entry(law_id) if isinstance(law_id, str) else None
+    if plugin is not None:
+        return plugin.params
+    raise InputError(source, field, "a friction law id, one of " + ", ".join(ids()), got=repr(law_id))
 
 
 def entry_of(law) -> FrictionLawEntry:

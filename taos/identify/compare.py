@@ -92,7 +92,7 @@ def _num(v: float):
 def _unit_of(fieldname: str) -> str:
     for suf, u in (("_N_per_m", "N/m"), ("_Nm_per_rad", "N*m/rad"), ("_Nms_per_rad", "N*m*s/rad"),
                    ("_Ns_per_m", "N*s/m"), ("_kgm2", "kg*m**2"), ("_kg", "kg"), ("_m2", "m**2"), ("_m3", "m**3"),
-                   ("_m_per_s_Pa", "m/(s*Pa)"), ("_m3_per_s_Pa", "m**3/(s*Pa)"), ("_Pa", "Pa"), ("_per_s", "1/s"),
+                   ("_m_per_s_Pa", "m/(s*Pa)"), ("_m3_per_s_Pa", "m**3/(s*Pa)"), ("_Pa", "Pa"), ("_m_per_s", "m/s"), ("_per_s", "1/s"),
                    ("_hz", "Hz"), ("_rad_s", "rad/s"), ("_Nm", "N*m"), ("_N", "N"), ("_rad", "rad"), ("_s", "s"),
                    ("_m", "m")):
         if fieldname.endswith(suf):

@@ -1,4 +1,5 @@
-"""Plots (matplotlib): thin functions over result objects; analysis never draws.
+"""Plots (matplotlib; Plotly for the pages: :mod:`.interactive`) and the flight sign-off page
+(:mod:`.signoff_page`): thin functions over result objects; analysis never draws.
 
 Submodules: :mod:`._common` (saving, engineering units). Import plot functions from their
 submodules, e.g. ``from taos.plotting import bode``.

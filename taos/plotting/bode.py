@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._common import LENGTH_UNITS, finish_bode_axes  # (importing _common also sets the Agg backend)
+from ._common import LENGTH_UNITS, finish_bode_axes, legend_once, wrapped_title  # (sets the Agg backend)
 from ..errors import InputError
 from ..linear import gain_db, phase_deg, phase_deg_continuous, sampled_notch_hz
 
@@ -62,7 +62,7 @@ def new_bode_figure(title: str | None = None, piston_label: str = "x_p / (R θ_c
     ax[1, 1].set_ylabel("phase [deg]")
     finish_bode_axes(ax)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(wrapped_title(fig, title))
     return fig, ax
 
 
@@ -85,8 +85,9 @@ def draw_response(ax, fr, scale: float, *, color, label: str, gid: str = "respon
     held = fr.engine_held() if hasattr(fr, "engine_held") else np.zeros(f.size, bool)
     ax[0, 1].plot(f, np.where(held, np.nan, gain_db(fr.engine)), label=label, **kw)
     ax[1, 1].plot(f, np.where(held, np.nan, phase_deg_continuous(f, fr.engine, re, rf)), **kw)
-    if held.any():  # no motion is not a number: say so on the plot
-        ax[0, 1].text(0.02, 0.04, f"engine held (no motion) at {', '.join(f'{x:g}' for x in f[held])} Hz, "
+    if held.any():  # no motion is not a number: say so on the plot, one line per response, stacked
+        n = sum(1 for t in ax[0, 1].texts if t.get_gid() == "engine-held")
+        ax[0, 1].text(0.02, 0.04 + 0.06 * n, f"engine held (no motion) at {', '.join(f'{x:g}' for x in f[held])} Hz, "
                       f"{label}", transform=ax[0, 1].transAxes, fontsize=8, color=kw["color"], gid="engine-held")
 
 
@@ -156,6 +157,5 @@ def plot_freqresp(responses, resonance_hz: float | None = None, length_unit: str
         nf = sampled_notch_hz(ref.freq_hz, ref.piston) if notch_hz is None else float(notch_hz)
         if math.isfinite(nf):
             mark_notch(ax, ref, nf, scale)
-    ax[0, 0].legend(fontsize=8, loc="best")
-    ax[0, 1].legend(fontsize=8, loc="best")
+    legend_once(fig, ax[0, 0], fontsize=8, loc="best")
     return fig

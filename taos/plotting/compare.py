@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from . import bode
+from ._common import legend_once, wrapped_title
 from ..linear import sampled_notch_hz
 from .timehist import units
 
@@ -66,8 +67,7 @@ def plot_compare_freqresp(sets, *, resonance_hz=None, notch_hz=None, data=None, 
                                marker="o", linestyle="none", ref=ref)
             for a in ax.flat:
                 a.lines[-1].set_markerfacecolor("none")
-    ax[0, 0].legend(fontsize=7, loc="best")
-    ax[0, 1].legend(fontsize=7, loc="best")
+    legend_once(fig, ax[0, 0], fontsize=7, loc="best")
     return fig
 
 
@@ -91,5 +91,5 @@ def plot_compare_timehist(runs, axis: str = "pitch", length_unit: str = "in", an
     for a in ax:
         a.grid(True, alpha=0.3)
         a.legend(fontsize=8, loc="upper right")
-    fig.suptitle(title or f"{axis}: " + " vs ".join(runs))
+    fig.suptitle(wrapped_title(fig, title or f"{axis}: " + " vs ".join(runs)))
     return fig

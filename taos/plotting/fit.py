@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ._common import finish_bode_axes  # (importing _common also sets the Agg backend)
+from ._common import finish_bode_axes, wrapped_title  # (importing _common also sets the Agg backend)
 from ..linear import gain_db as _db
 from ..linear import phase_deg, phase_deg_continuous
 from ..units import from_si
@@ -94,7 +94,7 @@ def plot_fit(result, linear: dict, title: str | None = None):
     ax[0, 0].legend(fontsize=7)
     txt = "  ".join(f"{n} = {result.eng(i):.5g} ± {abs(result.eng(i, result.values[i] + result.std_errors[i]) - result.eng(i)):.2g}"
                     f" {unit}" for i, (n, unit) in enumerate(zip(result.names, result.units())))
-    fig.suptitle(title or f"fit: {txt}", fontsize=10)
+    fig.suptitle(wrapped_title(fig, title or f"fit: {txt}", 10), fontsize=10)
     return fig
 
 
@@ -175,5 +175,5 @@ def plot_compare_overlay(curves):
         a.set_xscale("log")
         a.grid(True, which="both", alpha=0.3)
     ax[0, 0].legend(fontsize=7)
-    fig.suptitle(f"{curves[0].label} vs {curves[1].label}")
+    fig.suptitle(wrapped_title(fig, f"{curves[0].label} vs {curves[1].label}"))
     return fig

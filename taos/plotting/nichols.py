@@ -49,26 +49,38 @@ def plot_lco_nichols(pred, amplitudes_rad=None, n_freq: int = 400, ax=None):
         mark(pred.loop, "k", True)
     cmap = plt.get_cmap("plasma")
     for i, a in enumerate(amps):
-        col = cmap(i / max(len(amps) - 1, 1))
+        col = cmap(0.85 * i / max(len(amps) - 1, 1))   # (not the top of plasma: pale yellow on white)
         draw(pred.open_loop(a, f), color=col, lw=1, label=f"L0 N, A = {math.degrees(a):.3g} deg")
         if marks:
             mark(lambda x, a=a: pred.open_loop(a, x), col, False)
     ax.plot([-180], [0], "r+", ms=14, mew=2, label="critical point")
-    for c in pred.cycles:
-        ax.plot([-180], [0], "o", mfc="none", mec="g" if c.stable else "m", ms=12,
-                label=f"{'stable' if c.stable else 'unstable'} LCO {math.degrees(c.amplitude_rad):.3g} deg, "
-                      f"{c.freq_hz:.3g} Hz")
+    for stable in (True, False):   # one marker per kind: every solution sits at the critical point
+        cs = [c for c in pred.cycles if c.stable == stable]
+        if cs:
+            ax.plot([-180], [0], "o", mfc="none", mec="g" if stable else "m", ms=12 if stable else 16,
+                    gid="stable-lco" if stable else "unstable-lco", label=cycles_label(cs, stable))
     ax.axhline(0, color="0.6", lw=0.5)
     ax.axvline(-180, color="0.6", lw=0.5)
     ax.set_xlim(-330, -30)
     ax.set_ylim(-25, 30)
     ax.set_xlabel("open-loop phase [deg]")
     ax.set_ylabel("open-loop gain [dB]")
-    ax.set_title(f"FCS open loop with TVC describing function ({df.friction_model})")
+    ax.set_title(f"FCS open loop with TVC describing function ({df.friction_model})", fontsize=11)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
     return fig
+
+
+def cycles_label(cycles, stable: bool) -> str:
+    """Legend text of the harmonic-balance solutions ``cycles`` of one kind: each one when there
+    are at most three, else their number and the ranges of command amplitude and frequency."""
+    kind = "stable LCO" if stable else "unstable solution (threshold)"
+    if len(cycles) <= 3:
+        return f"{kind}: " + "; ".join(f"{math.degrees(c.amplitude_rad):.3g} deg, {c.freq_hz:.3g} Hz" for c in cycles)
+    a = [math.degrees(c.amplitude_rad) for c in cycles]
+    f = [c.freq_hz for c in cycles]
+    return (f"{len(cycles)} {kind}s: {min(a):.3g}-{max(a):.3g} deg, {min(f):.3g}-{max(f):.3g} Hz")
 
 
 def plot_flight_histories(histories, labels=None, ax=None):

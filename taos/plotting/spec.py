@@ -32,6 +32,6 @@ def draw_spec(ax, result, piston_scale_db: float = 0.0) -> None:
                    marker="o" if ok else "X", markersize=7, color="tab:green" if ok else "tab:red",
                    gid="spec-pass" if ok else "spec-fail")
     verdict = "PASS" if result.passed else f"FAIL ({len(result.failures())})"
-    ax[1, 1].text(0.02, 0.04, f"spec: {result.mask.name}: {verdict}", transform=ax[1, 1].transAxes, ha="left",
+    ax[1, 1].text(0.02, 0.04, f"spec, linear response: {result.mask.name}: {verdict}", transform=ax[1, 1].transAxes, ha="left",
                   va="bottom", fontsize=8, color="tab:green" if result.passed else "tab:red", gid="spec-verdict",
                   bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.85))

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import LENGTH_UNITS
+from ._common import LENGTH_UNITS, wrapped_title
 from ..errors import InputError
 from ..units import ureg
 
@@ -87,6 +87,6 @@ def plot_timehistory(th, length_unit: str = "in", angle_unit: str = "deg", *, t_
         a.grid(True, alpha=0.3)
         a.legend(fontsize=8, loc="upper right")
     prov = getattr(th, "provenance", {}) or {}
-    fig.suptitle(title or f"{prov.get('model_name', '')}  {prov.get('profile', '')}  "
-                          f"(friction {prov.get('friction_model', '?')})".strip())
+    fig.suptitle(wrapped_title(fig, title or f"{prov.get('model_name', '')}  {prov.get('profile', '')}  "
+                                        f"(friction {prov.get('friction_model', '?')})".strip()))
     return fig

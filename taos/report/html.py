@@ -1,13 +1,17 @@
 """The Green Run report page (``index.html``) of a :class:`taos.report.analysis.GreenRunResult`.
 
 Rendering only: the numbers come from the analysis (:func:`taos.report.greenrun`, its
-``summary()``); the plots from :mod:`taos.plotting` (Bode plots with the spec marks and the
-measured record, time histories) and the 3-D view from :func:`taos.viewer.offline_html`. The page
-is self-contained: plots inline as base64 PNG, a summary table, the figures of merit, the spec-mask
-verdict, the measured record beside the model, and the meshcat 3-D animation inline in an
-``iframe srcdoc``. Plotted traces are decimated to at most :data:`MAX_PLOT_POINTS` samples per
-line (the HDF5 keeps every sample); the 3-D view holds at most :data:`MAX_VIEW_FRAMES` keyframes
-(the page stays under 15 MB for any run length).
+``summary()``); the plots from :mod:`taos.plotting` and the 3-D view from
+:func:`taos.viewer.offline_html`. The page opens with the verdict in words (why the model fails
+or passes its mask, and which cause) and is self-contained and works offline: interactive
+Bode and time-history plots (Plotly: zoom, pan, hover readouts; :mod:`taos.plotting.interactive`)
+with the plotly.js bundle inline once, the same plots as static PNG figures (matplotlib, inline
+base64, in a closed "Static figures" section: for print and the documentation), a summary
+table, the figures of merit, the spec-mask verdict on every basis, the measured record beside
+the model, and the meshcat 3-D animation inline in an ``iframe srcdoc``. Plotted traces are
+decimated to at most :data:`MAX_PLOT_POINTS` samples per line (:data:`MAX_INTERACTIVE_POINTS`
+in the interactive plots; the HDF5 keeps every sample); the 3-D view holds at most
+:data:`MAX_VIEW_FRAMES` keyframes (the page stays under 15 MB for any run length).
 """
 
 from __future__ import annotations
@@ -21,6 +25,8 @@ import numpy as np
 #: keyframes of the embedded 3-D view (fps lowered for long runs) and samples per plotted trace
 MAX_VIEW_FRAMES = 4000
 MAX_PLOT_POINTS = 20000
+#: samples per trace of the interactive time history (10 traces: about 0.5 MB of the page)
+MAX_INTERACTIVE_POINTS = 6000
 AXES = ("pitch", "yaw")
 
 
@@ -58,6 +64,7 @@ def _h(x) -> str:
 def decorate_bode(fig, spec_result, test, axis, linear_fr, moment_arm_m: float) -> None:
     """Spec marks and the measured record's points on one axis' Bode figure."""
     from taos.plotting import bode
+    from taos.plotting._common import legend_once
     from taos.plotting.spec import bode_axes, draw_spec
 
     ax = bode_axes(fig)
@@ -65,7 +72,7 @@ def decorate_bode(fig, spec_result, test, axis, linear_fr, moment_arm_m: float) 
         fr = test[axis].to_freqresp(moment_arm_m)
         bode.draw_response(ax, fr, 1.0, color="tab:orange", label=f"test record ({test[axis].method})",
                            gid="test-data", marker="s", linestyle="none", ref=linear_fr)
-        ax[0, 0].legend(fontsize=8, loc="best")
+        legend_once(fig, ax[0, 0], fontsize=8, loc="best")
     if spec_result is not None:
         draw_spec(ax, spec_result)
 
@@ -77,26 +84,13 @@ def render_html(result, summary: dict | None = None, *, view_angle_scale: float 
     ``view_angle_scale``: engine-angle exaggeration of the 3-D view [-]; ``view_fps``: its
     keyframe rate [1/s], lowered to keep at most :data:`MAX_VIEW_FRAMES` keyframes;
     ``progress``: a tqdm bar advanced after the plots and after the 3-D view, or None."""
-    from taos.plotting import bode, timehist
     from taos.viewer import offline_html
 
     s = result.summary() if summary is None else summary
-    model, th = result.model, result.time_history
-    R = model.actuator.moment_arm_m
+    th = result.time_history
     if progress is not None:
         progress.set_postfix_str("plots")
-    figs = {}
-    for ax in AXES:
-        fig = bode.plot_freqresp(
-            [result.linear[ax]] + list(result.dwell[ax]), resonance_hz=result.load_resonance_hz[ax],
-            notch_hz=result.notch_hz[ax], data=result.run.get(ax), data_label="two-axis run",
-            title=f"{ax}: command → piston and engine ({model.name})")
-        decorate_bode(fig, result.spec.get(ax), result.measured, ax, result.linear[ax], R)
-        figs[f"bode_{ax}"] = _png(fig)
-    figs["timehist"] = _png(timehist.plot_timehistory(decimated(th, MAX_PLOT_POINTS), "in", "deg"))
-    zoom = decimated(th, MAX_PLOT_POINTS, t_range_s=(0.0, 4.0))
-    figs["timehist_zoom"] = _png(timehist.plot_timehistory(
-        zoom, "in", "deg", t_range_s=(0.0, 4.0), title="first 4 s (0.4 deg dwell, stick-slip onset)"))
+    figs = {**_static_figures(result), **_interactive_figures(result)}
     if progress is not None:
         progress.update()
         progress.set_postfix_str("3-D view")
@@ -105,7 +99,52 @@ def render_html(result, summary: dict | None = None, *, view_angle_scale: float 
     if progress is not None:
         progress.update()
         progress.set_postfix_str("write")
-    return _page(model, s, figs, view, view_angle_scale)
+    return _page(result.model, s, figs, view, view_angle_scale)
+
+
+def _bode_title(result, ax: str) -> str:
+    return f"{ax}: command → piston and engine ({result.model.name})"
+
+
+def _static_figures(result) -> dict:
+    """The static PNG figures (matplotlib) as data URLs: Bode per axis, time history and its zoom."""
+    from taos.plotting import bode, timehist
+
+    th, R = result.time_history, result.model.actuator.moment_arm_m
+    figs = {}
+    for ax in AXES:
+        fig = bode.plot_freqresp(
+            [result.linear[ax]] + list(result.dwell[ax]), resonance_hz=result.load_resonance_hz[ax],
+            notch_hz=result.notch_hz[ax], data=result.run.get(ax), data_label="two-axis run",
+            title=_bode_title(result, ax))
+        decorate_bode(fig, result.spec.get(ax), result.measured, ax, result.linear[ax], R)
+        figs[f"bode_{ax}"] = _png(fig)
+    figs["timehist"] = _png(timehist.plot_timehistory(decimated(th, MAX_PLOT_POINTS), "in", "deg"))
+    zoom = decimated(th, MAX_PLOT_POINTS, t_range_s=(0.0, 4.0))
+    figs["timehist_zoom"] = _png(timehist.plot_timehistory(
+        zoom, "in", "deg", t_range_s=(0.0, 4.0), title="first 4 s (0.4 deg dwell, stick-slip onset)"))
+    return figs
+
+
+def _interactive_figures(result) -> dict:
+    """The interactive plots (Plotly ``<div>``s): Bode per axis (ids ``bode-pitch``, ``bode-yaw``)
+    and the time history (``timehist``)."""
+    from taos.plotting import interactive as ia
+
+    R = result.model.actuator.moment_arm_m
+    out = {}
+    for ax in AXES:
+        meas = result.measured.get(ax) if result.measured else None
+        fig = ia.bode_figure([result.linear[ax]] + list(result.dwell[ax]), resonance_hz=result.load_resonance_hz[ax],
+                             notch_hz=result.notch_hz[ax], data=result.run.get(ax), data_label="two-axis run",
+                             measured=None if meas is None else meas.to_freqresp(R),
+                             measured_label=None if meas is None else f"test record ({meas.method})",
+                             spec_result=result.spec.get(ax), title=_bode_title(result, ax))
+        out[f"i_bode_{ax}"] = ia.page_html(fig, f"bode-{ax}")
+    th = decimated(result.time_history, MAX_INTERACTIVE_POINTS)
+    out["i_timehist"] = ia.page_html(ia.timehistory_figure(th, title="two-axis run (zoom: drag; reset: double-click)"),
+                                     "timehist")
+    return out
 
 
 _CSS = """body{font:14px/1.45 system-ui,sans-serif;margin:24px auto;max-width:1150px;color:#1d1f23}
@@ -118,6 +157,8 @@ th{background:#eef}td:first-child,th:first-child{text-align:left}img{max-width:1
 
 
 def _page(model, s, figs, view, scale) -> str:
+    from taos.plotting.interactive import plotly_script
+
     rows = [
         ("load resonance w_L (pitch / yaw)", f"{s['load_resonance_hz']['pitch']:.3f} / {s['load_resonance_hz']['yaw']:.3f} Hz"),
         ("piston notch, linear (pitch / yaw)", f"{s['notch_frequency_hz']['pitch']:.3f} / {s['notch_frequency_hz']['yaw']:.3f} Hz"),
@@ -152,7 +193,8 @@ def _page(model, s, figs, view, scale) -> str:
             f"<th>run: engine gain [dB]</th><th>run: engine phase [deg]</th></tr>{''.join(trs)}</table>")
     srcdoc = view.replace("&", "&amp;").replace('"', "&quot;")
     return f"""<!DOCTYPE html>
-<html><head><meta charset="utf-8"><title>Green Run report: {_h(model.name)}</title><style>{_CSS}</style></head>
+<html><head><meta charset="utf-8"><title>Green Run report: {_h(model.name)}</title><style>{_CSS}</style>
+{plotly_script()}</head>
 <body>
 <h1>Green Run two-axis vectoring: {_h(model.name)}</h1>
 {verdict_line_html(s)}
@@ -166,11 +208,12 @@ time and speed (timeScale) are under “Open Controls” → Animations.</p>
 <iframe title="3-D gimbal animation" srcdoc="{srcdoc}"></iframe>
 {extras_html(s)}
 <h2>Frequency response: pitch</h2>
-<img alt="pitch Bode plot" src="{figs['bode_pitch']}">
+{figs['i_bode_pitch']}
 <h2>Frequency response: yaw</h2>
-<img alt="yaw Bode plot" src="{figs['bode_yaw']}">
-<p class="note">Lines: exact linear response (no friction, unity avionics). Dashed/markers: sine-dwell
-describing function at the profile amplitudes (friction and avionics included). Open circles: the
+{figs['i_bode_yaw']}
+<p class="note">Interactive: drag to zoom, double-click to reset, hover for the values; a click on a legend
+entry hides or shows that curve. Lines: exact linear response (no friction, unity avionics). Lines with markers:
+sine-dwell describing function at the profile amplitudes (friction and avionics included). Open circles: the
 response read off the two-axis run, dwell by dwell (last two cycles). Triangle: the linear
 command → piston notch; dashed vertical: load resonance w_L = sqrt((K_L R² + K_n)/J_n).
 Piston gain is x_p/(R θ_c) (dimensionless, 0 dB at low frequency); phase is continuous from low
@@ -178,8 +221,13 @@ frequency. Grey bars: spec-mask bounds; green circle / red cross: the linear res
 Squares: the measured record (when given), estimated from its dwells.</p>
 <h2>Sine-dwell points</h2>{''.join(dwell_tables)}
 <h2>Time history</h2>
+{figs['i_timehist']}
+<details id="static-figures"><summary>Static figures (PNG, for print and documents)</summary>
+<img alt="pitch Bode plot" src="{figs['bode_pitch']}">
+<img alt="yaw Bode plot" src="{figs['bode_yaw']}">
 <img alt="time history" src="{figs['timehist']}">
 <img alt="time history, first 4 s" src="{figs['timehist_zoom']}">
+</details>
 </body></html>
 """
 
@@ -225,7 +273,7 @@ way (threshold), and a slow ±0.2 deg triangle (hysteresis: engine angle down mi
                                  f"<td>{p['freq_hz']:g}</td><td>[{b[0]:g}, {b[1]:g}]</td><td>{v:.2f}</td>"
                                  f"<td><b>{'pass' if ok else 'FAIL'}</b></td></tr>")
         name = next(iter(s["spec"].values()))["spec"]
-        out.append(f"""<h2 id="spec-mask">Spec mask: {_h(name)} — <span class="{'pass' if s['spec_pass'] else 'fail'}">{verdict}</span></h2>
+        out.append(f"""<h2 id="spec-mask">Spec mask on the linear response: {_h(name)} — <span class="{'pass' if s['spec_pass'] else 'fail'}">{verdict}</span></h2>
 <table><tr><th>axis</th><th>bound</th><th>freq [Hz]</th><th>limits</th><th>model (linear)</th><th>result</th></tr>{''.join(srows)}</table>
 <p class="note">Mask file <code>{_h(next(iter(s['spec'].values()))['spec_file'])}</code>; the same marks are on the Bode plots.</p>""")
     out.append(verdict_table_html(s))

@@ -83,6 +83,10 @@ STEPS: tuple[Step, ...] = (
          outputs=("out/lco_stiff.json", "out/lco_stiff.png"), figures=("out/lco_stiff.png",)),
     Step("lco_coulomb", f"taos lco rs25_flight --flight core_stage --friction coulomb-switching "
          f"{LCO_SHORT} --no-time-domain --json out/lco_coulomb.json", outputs=("out/lco_coulomb.json",)),
+    Step("signoff", f"taos lco rs25_flight --flight core_stage {LCO_SHORT} --no-time-domain "
+         "--requirements models/specs/flight_signoff_notional.toml --sweep load_stiffness=90000lbf/in,205000lbf/in "
+         "--signoff out/signoff", outputs=("out/signoff/signoff.json", "out/signoff/signoff.html"), show_stdout=12,
+         downloads=("out/signoff/signoff.html",)),
     # -- identification ----------------------------------------------------------------------
     Step("estimate", f"taos estimate {DATA_B} --json out/estimate_hotfire.json",
          outputs=("out/estimate_hotfire.json",)),
