@@ -32,7 +32,9 @@ from ._fmu import CONFIG, RESOURCE_DIR, UNITS, fmi_unit, fmu_model, model_parame
 
 
 class _Real(Real):
-    """A pythonfmu Real with an FMI ``unit`` attribute."""
+    """A pythonfmu Real with an FMI ``unit`` attribute and a start value written to round-trip
+    (pythonfmu writes 16 significant digits, which can lose the last bit: a host that sets every
+    parameter to its start value would then change the model)."""
 
     def __init__(self, name: str, unit: str | None = None, **kwargs):
         super().__init__(name, **kwargs)
@@ -40,8 +42,11 @@ class _Real(Real):
 
     def to_xml(self) -> Element:
         el = super().to_xml()
+        real = el.find("Real")
         if self.unit:
-            el.find("Real").set("unit", self.unit)
+            real.set("unit", self.unit)
+        if self.start is not None:
+            real.set("start", repr(float(self.start)))
         return el
 
 
