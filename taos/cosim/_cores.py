@@ -62,6 +62,15 @@ def _pair(a, b) -> tuple[float, float]:
     return (float(a), float(b))
 
 
+def compiled_entry(disp, args):
+    """The compiled entry point of the numba kernel ``disp`` for the types of ``args`` (loaded
+    from numba's cache or compiled, as a call would), without running it. Calling it skips
+    numba's typing of every argument at every call, which for these kernels (the friction law's
+    first-class functions, the 3-D model's named tuple) costs several times the work of a short
+    chunk; the machine code is the one a call through ``disp`` runs."""
+    return disp.compile(tuple(disp.typeof_pyval(a) for a in args))
+
+
 class PlanarCore:
     """Both axes of the simplex model (each axis its own planar plant, as ``taos simulate``)."""
 
@@ -84,6 +93,7 @@ class PlanarCore:
         self._fp = model.friction.pack()
         self._avp = model.avionics.pack()
         self._label = f"{model.friction.name} friction, dt = {dt_s} s"
+        self._entry = None
         self.reset()
 
     def reset(self) -> None:
@@ -103,8 +113,11 @@ class PlanarCore:
             y = np.empty((nrec, cy.shape[0]))
             aux = np.empty((nrec, dyn.N_AUX))
             ri = np.ascontiguousarray(r[:, i:i + 1])
-            status = dyn.integrate_samples(*args, cy, self._fid, self._fp, self._avp, self._x[i], self._z[i], ri,
-                                           dt_s, every, y, aux)
+            call = (*args, cy, self._fid, self._fp, self._avp, self._x[i], float(self._z[i]), ri, float(dt_s), int(every),
+                    y, aux)
+            if self._entry is None:
+                self._entry = compiled_entry(dyn.integrate_samples, call)
+            status = self._entry(*call)
             if status >= 0:
                 raise SimulationUnstable(t0_s + status * dt_s, f"{AXES[i]}: {self._label}")
             self._x[i] = y[-1, :n].copy()
@@ -131,6 +144,7 @@ class TaosCore:
         self._pk = pack(tm)
         self._col = {k: i for i, k in enumerate(dy.REC)}
         self._label = f"TAOS, {tm.base.friction.name} friction, dt = {dt_s} s"
+        self._entry = None
         self.reset()
 
     def reset(self) -> None:
@@ -146,8 +160,11 @@ class TaosCore:
         nsteps = r.shape[0] - 1
         every = max(nsteps, 1)
         out = np.empty((nsteps // every + 1, len(dy.REC)))
-        status = dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, self._x, self._bs, np.ascontiguousarray(r), dt_s, every,
-                              out)
+        call = (pk.P, pk.fid, pk.fp, pk.avp, self._x, self._bs, np.ascontiguousarray(r, dtype=np.float64), float(dt_s),
+                int(every), out)
+        if self._entry is None:
+            self._entry = compiled_entry(dy.integrate, call)
+        status = self._entry(*call)
         if status >= 0:
             raise SimulationUnstable(t0_s + status * dt_s, self._label)
         rec = out[-1]
