@@ -18,7 +18,7 @@ def cmd_fmu(args) -> int:
 
 
 def add_parsers(sub) -> None:
-    from taos.cosim._fmu import AVIONICS
+    from taos.cosim._options import AVIONICS
 
     p = sub.add_parser("fmu", help="the nonlinear TVC (both axes) as an FMI 2.0 co-simulation FMU")
     p.add_argument("model", help="model file (TOML), e.g. models/rs25_hotfire.toml")

@@ -17,10 +17,11 @@ from typing import TYPE_CHECKING
 from taos import lazy_api
 
 if TYPE_CHECKING:
-    from ._block import HOLDS, BlockOutputs, TvcBlock
+    from ._block import BlockOutputs, TvcBlock
     from ._fmu import FmuBuild, build_fmu
+    from ._options import HOLDS
 
-_WHERE = {"TvcBlock": "._block", "BlockOutputs": "._block", "HOLDS": "._block",
+_WHERE = {"TvcBlock": "._block", "BlockOutputs": "._block", "HOLDS": "._options",
           "build_fmu": "._fmu", "FmuBuild": "._fmu"}
 
 __all__ = sorted(_WHERE)

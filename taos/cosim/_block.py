@@ -32,12 +32,14 @@ from ..bounds import HARD_STOP_RAD, LOAD_FORCE_FACTOR, check_command_angle
 from ..errors import EnvelopeExceeded, InputError
 from ..model import TvcModel
 from ._cores import AXES, EndValues, PlanarCore, TaosCore
+from ._options import HOLDS
 
-#: how the command moves between communication points (module docstring)
-HOLDS = ("hold", "ramp")
 #: a communication step counts as a whole multiple of the internal step within this fraction of it
 STEP_TOLERANCE = 1e-6
 SOURCE = "taos.cosim"
+#: the most internal steps one communication step may take (the command samples of a step are
+#: held in memory: 16 MB at this bound)
+MAX_SUBSTEPS = 10 ** 6
 
 
 @dataclass(frozen=True)
@@ -160,6 +162,9 @@ class TvcBlock:
         if n < 1 or abs(step_s - n * self.dt_s) > STEP_TOLERANCE * self.dt_s:
             raise InputError(SOURCE, "communication step", f"a positive whole multiple of the internal step "
                              f"{self.dt_s:g} s (or set the internal step to divide it)", got=f"{step_s!r} s")
+        if n > MAX_SUBSTEPS:
+            raise InputError(SOURCE, "communication step", f"at most {MAX_SUBSTEPS:.0e} internal steps "
+                             f"({MAX_SUBSTEPS * self.dt_s:g} s)", got=f"{step_s!r} s")
         return n
 
     def step(self, dt_s: float, pitch_command_rad: float, yaw_command_rad: float) -> BlockOutputs:

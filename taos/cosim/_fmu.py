@@ -39,10 +39,10 @@ from ..errors import InputError
 from ..model import TvcModel, load_model
 from ..results import atomic_write, base_provenance, check_output_file
 
+from ._options import AVIONICS
+
 #: the FMU's model identifier (its binary's and entry script's name)
 MODEL_IDENTIFIER = "TaosTvc"
-#: ``--avionics``: the model file's avionics, or the paper's bounding -1 dB gain without quantisation
-AVIONICS = ("model", "bounding")
 CONFIG = "config.json"
 RESOURCE_DIR = "taos_fmu"
 #: the model sections whose values are FMU parameters
@@ -110,6 +110,8 @@ def with_parameters(model: TvcModel, values: dict) -> TvcModel:
                 if not math.isfinite(v) or v < 0 or (old > 0 and v <= 0):
                     raise InputError(model.source, k, f"a finite {need} value in {fmi_unit(f) or '1'} (FMU parameter)",
                                      got=repr(v))
+            elif isinstance(old, int) and not isinstance(old, bool) and not (float(v) == int(v) and int(v) >= 1):
+                raise InputError(model.source, k, "a positive whole number (FMU parameter)", got=repr(v))
             kw[f] = type(old)(v)
         secs[sec] = dataclasses.replace(getattr(model, sec), **kw) if kw else getattr(model, sec)
     check_model_plausible(model.source, secs["engine"], secs["actuator"], secs["structure"])

@@ -26,9 +26,10 @@ from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Intege
 from pythonfmu.default_experiment import DefaultExperiment
 from pythonfmu.enums import Fmi2Status
 
-from ..errors import InputError, SimulationUnstable
-from ._block import HOLDS, BlockOutputs, TvcBlock
+from ..errors import InputError
+from ._block import BlockOutputs, TvcBlock
 from ._fmu import CONFIG, RESOURCE_DIR, UNITS, fmi_unit, fmu_model, model_parameters, with_parameters
+from ._options import HOLDS
 
 
 class _Real(Real):
@@ -145,7 +146,7 @@ class TvcSlave(Fmi2Slave):
             self._block = TvcBlock(model, engine=cfg["engine"], dt_s=self._dt, hold=HOLDS[self._hold],
                                    allow_unstable=cfg["allow_unstable"])
             self._out = self._block.reset(self.pitch_command_rad, self.yaw_command_rad)
-        except (InputError, SimulationUnstable) as e:
+        except Exception as e:   # every refusal (and any other failure) logged, then fmi2Fatal
             self._fail(e)
 
     def do_step(self, current_time: float, step_size: float) -> bool:
@@ -155,7 +156,7 @@ class TvcSlave(Fmi2Slave):
         (a NaN or out-of-range command never reaches the state)."""
         try:
             self._out = self._block.step(step_size, self.pitch_command_rad, self.yaw_command_rad)
-        except (InputError, SimulationUnstable) as e:
+        except Exception as e:   # InputError, SimulationUnstable; anything else is logged alike
             self.log(f"t = {current_time:.9g} s: {e}", Fmi2Status.error)
             return False
         return True
