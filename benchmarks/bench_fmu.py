@@ -119,7 +119,9 @@ def main(argv=None) -> int:
                              worst_deg(eng, th, every, shift=1 if hold == 1 else 0), wall))
     print(f"{'engine':8s} {'run':42s} {'h [s]':>8s} {'max |d engine| [deg]':>21s} {'wall [s]':>9s} {'x real time':>12s}")
     for engine, what, h, d, w in rows:
-        print(f"{engine:8s} {what:42s} {h:8.1e} {d:21.3g} {w:9.2f} {args.duration / w:12.1f}")
+        one = math.isnan(d)   # the start-up row: one step, no agreement or real-time figure
+        print(f"{engine:8s} {what:42s} {h:8.1e} {'-' if one else f'{d:.3g}':>21s} {w:9.2f} "
+              f"{'-' if one else f'{args.duration / w:.1f}':>12s}")
     return 0
 
 
