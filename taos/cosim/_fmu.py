@@ -118,6 +118,23 @@ def with_parameters(model: TvcModel, values: dict) -> TvcModel:
     return model.replace(**secs)
 
 
+def check_fmu_output(out: Path) -> None:
+    """Refuse an ``--out`` that exists and is not an FMU ``taos fmu`` wrote (a zip holding
+    ``resources/taos_fmu/config.json``): an output never replaces a file the program did not write."""
+    import zipfile
+
+    if not out.exists():
+        return
+    try:
+        with zipfile.ZipFile(out) as z:
+            ours = f"resources/{RESOURCE_DIR}/{CONFIG}" in z.namelist()
+    except (OSError, zipfile.BadZipFile):
+        ours = False
+    if not ours:
+        raise InputError(str(out), "--out", "a new file or an FMU that taos fmu wrote (it never replaces a file it "
+                         "did not write)", got="an existing file it did not write")
+
+
 def fmu_model(path: str | Path, friction: str | None, avionics: str) -> TvcModel:
     """The model an FMU runs: the file (``--friction`` applied) with its avionics or the bounding ones."""
     if avionics not in AVIONICS:
@@ -176,6 +193,7 @@ def build_fmu(model_path: str | Path, out: str | Path, *, engine: str = "simplex
     from ..planar.envelope import check_run_step
 
     out = check_output_file(out, "--out", (".fmu",))
+    check_fmu_output(out)
     model = fmu_model(model_path, friction, avionics)
     if dt_s is not None:
         check_run_step(dt_s, model, field="--dt")
