@@ -251,3 +251,20 @@ def test_cli_builds_and_refuses_bad_input_without_writing(tmp_path):
     again = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu")   # its own FMU: replaced
     assert again.returncode == 0, again.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.fmu", "bad.toml", "keep.fmu"]
+
+
+def test_a_tampered_model_copy_is_refused_at_instantiation(simplex_fmu, tmp_path):
+    """The FMU checks its model copy against the SHA-256 it was built from: a changed byte in
+    the copied model file (a comment) and the FMU refuses to start, naming the hash."""
+    import zipfile
+
+    bad = tmp_path / "tampered.fmu"
+    with zipfile.ZipFile(simplex_fmu) as zin, zipfile.ZipFile(bad, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename.endswith("models/rs25_hotfire.toml"):
+                data += b"\n# edited after the build\n"
+            zout.writestr(item, data)
+    res, msgs, err, _ = fmpy_in_child(bad, tmp_path, stop_time=0.01, step_size=2e-4)
+    assert res is None and "instantiate" in err
+    assert any("model_sha256" in m and "files changed" in m for _, m in msgs)
