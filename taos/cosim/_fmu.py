@@ -158,9 +158,22 @@ def _copy_model_files(model: TvcModel, dest: Path) -> str:
     return files["model"].relative_to(root).as_posix()
 
 
-SCRIPT = f'''"""Entry point of a taos TVC FMU (written by ``taos fmu``): needs a Python with taos importable."""
+#: environment variable of a host without Python of its own: the site-packages folders (os.pathsep
+#: separated) of the Python environment with taos, added as site directories (their .pth files
+#: processed: editable installs, pinocchio's cmeel prefix) before the FMU imports taos
+SITE_VARIABLE = "TAOS_FMU_SITE_PACKAGES"
 
-from taos.cosim._slave import TvcSlave
+SCRIPT = f'''"""Entry point of a taos TVC FMU (written by ``taos fmu``): needs a Python with taos importable
+(or ${SITE_VARIABLE} naming the site-packages of an environment with taos)."""
+
+import os
+import site
+
+for _d in os.environ.get("{SITE_VARIABLE}", "").split(os.pathsep):
+    if _d:
+        site.addsitedir(_d)
+
+from taos.cosim._slave import TvcSlave  # noqa: E402
 
 
 class {MODEL_IDENTIFIER}(TvcSlave):
