@@ -32,6 +32,14 @@ from ._fmu import CONFIG, RESOURCE_DIR, UNITS, fmi_unit, fmu_model, model_parame
 from ._options import HOLDS
 
 
+#: every block an FMU instance built, kept until the process ends. pythonfmu 0.7.0's
+#: fmi2FreeInstance deallocates the slave's Python objects in a way that corrupts the heap once
+#: compiled-kernel objects are among them (measured: the host aborts at exit in most runs, or on
+#: the next instantiation; with the blocks kept alive, never in the runs tried), so they are never
+#: deallocated; a few hundred kB per instantiation.
+_ALIVE: list = []
+
+
 class _Real(Real):
     """A pythonfmu Real with an FMI ``unit`` attribute and a start value written to round-trip
     (pythonfmu writes 16 significant digits, which can lose the last bit: a host that sets every
@@ -80,6 +88,7 @@ class TvcSlave(Fmi2Slave):
         self._dt = float(cfg["dt_s"])
         self._hold = 0
         self._block = TvcBlock(model, engine=cfg["engine"], dt_s=self._dt, allow_unstable=cfg["allow_unstable"])
+        _ALIVE.append(self._block)
         self._out = self._block.outputs
         self._register()
 
@@ -145,6 +154,7 @@ class TvcSlave(Fmi2Slave):
             cfg = self._cfg
             self._block = TvcBlock(model, engine=cfg["engine"], dt_s=self._dt, hold=HOLDS[self._hold],
                                    allow_unstable=cfg["allow_unstable"])
+            _ALIVE.append(self._block)
             self._out = self._block.reset(self.pitch_command_rad, self.yaw_command_rad)
         except Exception as e:   # every refusal (and any other failure) logged, then fmi2Fatal
             self._fail(e)
