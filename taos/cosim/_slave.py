@@ -34,9 +34,9 @@ from ._options import HOLDS
 
 #: every block an FMU instance built, kept until the process ends. pythonfmu 0.7.0's
 #: fmi2FreeInstance deallocates the slave's Python objects in a way that corrupts the heap once
-#: compiled-kernel objects are among them (measured: the host aborts at exit in most runs, or on
-#: the next instantiation; with the blocks kept alive, never in the runs tried), so they are never
-#: deallocated; a few hundred kB per instantiation.
+#: compiled-kernel objects are among them (measured: FMPy hosts aborted at exit in most runs;
+#: with the blocks kept alive, in none of the runs tried; tests/test_fmu.py), so they are never
+#: deallocated: a few hundred kB per instantiation.
 _ALIVE: list = []
 
 
