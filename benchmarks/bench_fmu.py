@@ -12,7 +12,7 @@ Green Run profile (models/profiles/greenrun_two_axis.toml) over ``--duration`` s
   staircase command at 1/10 the rate: the difference is the zero-order hold's, not the
   block's);
 * the FMU (``taos fmu``) in FMPy (``fmpy.simulate_fmu`` in a child process ended with
-  ``os._exit``, see docs/guide/fmu.md), at h = dt with ``command_hold = 1`` (its output at
+  ``os._exit``, as tests/test_fmu.py runs it), at h = dt with ``command_hold = 1`` (its output at
   t + h against ``taos simulate`` at t) and at h = 10 dt with ``command_hold = 0``.
 
 Agreement: the largest |engine angle - taos simulate| over both axes [deg] at the common

@@ -2,10 +2,10 @@
 
 FMPy validates the model description and runs the FMU as any host would (its own input
 interpolation, communication loop and output recorder); the reference is ``taos simulate``'s
-own run. Every FMPy run is a child process that ends with ``os._exit`` (:func:`fmpy_in_child`):
-pythonfmu 0.7.0's binary cannot instantiate an FMU again in a process where an instance was
-freed (NTNU-IHB/PythonFMU issue 228), so the FMU's binary is never loaded into the test process
-itself (one test checks that a host that frees the FMU and exits normally does not crash). With ``command_hold = 1`` (ramp) the FMU reads the command FMPy sets at t_k as the end
+own run. Every FMPy run is a child process that ends with ``os._exit`` (:func:`fmpy_in_child`),
+so the FMU's binary is never loaded into the test process itself (pythonfmu 0.7.0's binary
+mishandles references; the FMU works around the two faults found, and one test runs several
+instances in one host process that then exits normally). With ``command_hold = 1`` (ramp) the FMU reads the command FMPy sets at t_k as the end
 point of the ramp over [t_k, t_k + h], i.e. ``taos simulate``'s linear interpolation one
 communication step later: FMPy's row k + 1 is ``taos simulate``'s sample k, compared within the
 acceptance's 1e-6 deg (achieved: bit for bit)."""
@@ -347,14 +347,38 @@ def test_the_fmu_runs_in_a_host_without_python(simplex_fmu, tmp_path, hotfire):
     assert got == out.pitch_engine_rad
 
 
-def test_a_host_that_frees_the_fmu_exits_cleanly(simplex_fmu, tmp_path):
-    """FMPy frees the instance and unloads the FMU after a run; the host then exits normally with
-    status 0 (pythonfmu 0.7.0 corrupted the heap when it deallocated a slave holding compiled
-    kernels: the FMU keeps its blocks alive, :data:`taos.cosim._slave._ALIVE`; without that, most
-    of these exits aborted)."""
-    script = ("import fmpy\n"
-              f"r = fmpy.simulate_fmu({str(simplex_fmu)!r}, stop_time=0.02, step_size=2e-4)\n"
-              "print('rows', len(r))\n")
+def test_one_host_process_runs_several_instances_and_exits_cleanly(simplex_fmu, tmp_path, hotfire):
+    """Two instances at once (two engines), then a third after both were freed, in one FMPy
+    process that then exits normally (status 0); each run equals the Python block's. pythonfmu
+    0.7.0 released a reference to the entry script's globals at every instantiation (a second
+    instance crashed or found no class: :func:`taos.cosim._slave.keep_alive`) and corrupted the
+    heap when it deallocated a slave holding compiled kernels (about half of the exits aborted:
+    :data:`taos.cosim._slave._ALIVE`). Without the first workaround this test fails every time,
+    without the second in about half of its processes (three are run)."""
+    script = f"""
+import fmpy
+from fmpy.simulation import instantiate_fmu
+md = fmpy.read_model_description({str(simplex_fmu)!r})
+unz = fmpy.extract({str(simplex_fmu)!r})
+out = []
+a = instantiate_fmu(unz, md, "CoSimulation")
+b = instantiate_fmu(unz, md, "CoSimulation")
+for inst, c in ((a, 0.004), (b, 0.002)):
+    r = fmpy.simulate_fmu(unz, model_description=md, fmu_instance=inst, stop_time=0.02, step_size=2e-4,
+                          start_values={{"pitch_command_rad": c}})
+    out.append(r["pitch_engine_rad"][-1])
+a.freeInstance()
+b.freeInstance()
+r = fmpy.simulate_fmu({str(simplex_fmu)!r}, stop_time=0.02, step_size=2e-4, start_values={{"pitch_command_rad": 0.004}})
+out.append(r["pitch_engine_rad"][-1])
+print("ENGINE", repr(out))
+"""
+    want = []
+    for c in (0.004, 0.002, 0.004):
+        blk = TvcBlock(hotfire)
+        blk.reset(c, 0.0)
+        want.append([blk.step(2e-4, c, 0.0) for _ in range(100)][-1].pitch_engine_rad)
     for _ in range(3):
         r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
-        assert r.returncode == 0 and "rows 101" in r.stdout, r.stderr[-1000:]
+        assert r.returncode == 0 and "ENGINE" in r.stdout, r.stdout[-1000:] + r.stderr[-1000:]
+        assert eval(r.stdout.split("ENGINE", 1)[1]) == want

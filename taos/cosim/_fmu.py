@@ -173,11 +173,14 @@ for _d in os.environ.get("{SITE_VARIABLE}", "").split(os.pathsep):
     if _d:
         site.addsitedir(_d)
 
-from taos.cosim._slave import TvcSlave  # noqa: E402
+from taos.cosim._slave import TvcSlave, keep_alive  # noqa: E402
 
 
 class {MODEL_IDENTIFIER}(TvcSlave):
     """One engine's nonlinear TVC (taos.cosim.TvcBlock); resources/{RESOURCE_DIR}/ holds its model."""
+
+
+keep_alive(globals())   # one reference per execution of this script (taos.cosim._slave.keep_alive)
 '''
 
 

@@ -34,10 +34,19 @@ from ._options import HOLDS
 
 #: every block an FMU instance built, kept until the process ends. pythonfmu 0.7.0's
 #: fmi2FreeInstance deallocates the slave's Python objects in a way that corrupts the heap once
-#: compiled-kernel objects are among them (measured: FMPy hosts aborted at exit in most runs;
+#: compiled-kernel objects are among them (measured: about half of the FMPy hosts aborted at exit;
 #: with the blocks kept alive, in none of the runs tried; tests/test_fmu.py), so they are never
 #: deallocated: a few hundred kB per instantiation.
 _ALIVE: list = []
+
+
+def keep_alive(obj) -> None:
+    """Keep ``obj`` referenced until the process ends (:data:`_ALIVE`). The FMU's entry script
+    passes its own ``globals()`` at every execution: pythonfmu 0.7.0 runs the script again at each
+    instantiation (to find the slave class) and then releases one reference to the module's
+    dictionary that it never took, so without this the dictionary is freed under the module (a
+    second instance in the same process crashed or found no class)."""
+    _ALIVE.append(obj)
 
 
 class _Real(Real):
