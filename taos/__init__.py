@@ -25,7 +25,8 @@ Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.
    steady state, run envelope) and ``taos3d`` (3-D), with ``fem``, ``profiles``,
    ``engine_geometry``;
 4. ``flight``, ``identify``, ``report`` (figures of merit, spec masks, summaries), ``montecarlo``,
-   ``interop`` - analyses built on them, and the models leaving for other tools;
+   ``interop``, ``cosim`` - analyses built on them, and the models leaving for other tools (linear
+   models and responses; the nonlinear TVC as a co-simulation block and FMU);
 5. ``plotting``, ``viewer`` - drawing only; ``report.analysis`` and ``report.html`` - the Green Run
    report, whose folder holds its drawn page;
 6. ``cli`` - the ``taos`` command: argument parsing over the layers below.

@@ -161,7 +161,7 @@ LAYERS = {
     "taos.planar.saturation": 2,
     "taos.planar": 3, "taos.taos3d": 3, "taos.fem": 3, "taos.profiles": 3, "taos.engine_geometry": 3,
     "taos.flight": 4, "taos.identify": 4, "taos.report": 4, "taos.montecarlo": 4,
-    "taos.interop": 4,
+    "taos.interop": 4, "taos.cosim": 4,
     "taos.plotting": 5, "taos.viewer": 5, "taos.report.analysis": 5, "taos.report.html": 5,
     "taos.cli": 6, "taos.__main__": 6,
     "masv.structure": 7, "masv.config": 7, "masv.system": 7, "masv.synthetic": 7,

@@ -15,7 +15,7 @@ from taos.errors import run_cli as run
 
 #: subcommand modules, in help order
 COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.export",
-            "taos.cli.montecarlo"]
+            "taos.cli.montecarlo", "taos.cli.fmu"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,129 @@
+"""The FMU and the co-simulation block against ``taos simulate`` in the same run: agreement and
+speed (writes nothing but a temporary FMU; paste the output into benchmarks/RESULTS.md).
+
+Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_fmu.py [--duration 61] [--engine simplex|taos|both]
+
+For each engine (hot-fire model, its default step dt: 2e-4 s simplex, 4e-4 s taos), the two-axis
+Green Run profile (models/profiles/greenrun_two_axis.toml) over ``--duration`` seconds:
+
+* peer: ``taos simulate``'s own run (the uncut kernel, every sample recorded);
+* the Python block (:class:`taos.cosim.TvcBlock`) stepped at h = dt with ``ramp`` (the samples
+  of the profile: ``taos simulate`` bit for bit), and at h = 10 dt with ``hold`` (a host's
+  staircase command at 1/10 the rate: the difference is the zero-order hold's, not the
+  block's);
+* the FMU (``taos fmu``) in FMPy (``fmpy.simulate_fmu`` in a child process ended with
+  ``os._exit``, as tests/test_fmu.py runs it), at h = dt with ``command_hold = 1`` (its output at
+  t + h against ``taos simulate`` at t) and at h = 10 dt with ``command_hold = 0``.
+
+Agreement: the largest |engine angle - taos simulate| over both axes [deg] at the common
+samples. Speed: wall time of the run (FMU: of ``simulate_fmu`` inside the child, instantiation
+included) and real-time factor (simulated / wall time). The machine is shared: ``uptime`` is
+printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from taos.cosim import TvcBlock, build_fmu  # noqa: E402
+from taos.model import load_model  # noqa: E402
+from taos.profiles import load_profile  # noqa: E402
+from tests.test_fmu import fmpy_in_child, profile_input  # noqa: E402  (the tests' child-process runner)
+
+
+def reference(model, prof, engine: str, dt: float, T: float):
+    """``taos simulate`` (the library call the command makes; the 3-D model built beforehand) and
+    its wall time [s], the better of two runs (the first loads the kernels)."""
+    walls = []
+    if engine == "taos":
+        from taos.taos3d import simulate_taos, taos_model
+        tm = taos_model(model)
+        run = lambda: simulate_taos(tm, prof, dt_s=dt, record_every=1, duration_s=T)  # noqa: E731
+    else:
+        from taos.planar.simulate import simulate
+        run = lambda: simulate(model, prof, dt_s=dt, record_every=1, duration_s=T)  # noqa: E731
+    for _ in range(2):
+        t0 = time.perf_counter()
+        th = run()
+        walls.append(time.perf_counter() - t0)
+    return th, min(walls)
+
+
+def block_run(model, prof, engine: str, dt: float, T: float, every: int, hold: str):
+    """The block stepped every ``every`` internal steps; engine angles (2, n) and wall time [s]."""
+    b = TvcBlock(model, engine=engine, hold=hold)
+    n = int(round(T / dt)) // every
+    t = np.arange(n + 1) * every * dt
+    c = np.atleast_2d(prof(t))
+    out = [b.reset(c[0, 0], c[1, 0]) if hold == "ramp" else b.reset()]
+    t0 = time.perf_counter()
+    for k in range(1, n + 1):
+        out.append(b.step(every * dt, *(c[:, k] if hold == "ramp" else c[:, k - 1])))
+    wall = time.perf_counter() - t0
+    return np.array([[o.pitch_engine_rad for o in out], [o.yaw_engine_rad for o in out]]), wall
+
+
+def worst_deg(eng: np.ndarray, th, every: int, shift: int = 0) -> float:
+    """max |engine - taos simulate| [deg] over both axes, at every ``every``-th sample; the
+    block's sample k + shift against the reference's k."""
+    ref = th.engine_rad[:, ::every]
+    m = min(ref.shape[1], eng.shape[1] - shift)
+    return math.degrees(float(np.max(np.abs(eng[:, shift:shift + m] - ref[:, :m]))))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--duration", type=float, default=61.0, help="simulated time [s] (default: the whole profile)")
+    ap.add_argument("--engine", choices=("simplex", "taos", "both"), default="both")
+    args = ap.parse_args(argv)
+    print("uptime:", subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip())
+    print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores; Green Run two-axis, hot fire, {args.duration:g} s")
+    model = load_model("rs25_hotfire")
+    prof = load_profile("greenrun_two_axis")
+    engines = ("simplex", "taos") if args.engine == "both" else (args.engine,)
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="bench_fmu_") as tmp:
+        for engine in engines:
+            dt = 2e-4 if engine == "simplex" else 4e-4
+            T = args.duration
+            th, w_ref = reference(model, prof, engine, dt, T)
+            rows.append((engine, "taos simulate (peer)", dt, 0.0, w_ref))
+            for every, hold in ((1, "ramp"), (10, "hold")):
+                eng, w = block_run(model, prof, engine, dt, T, every, hold)
+                rows.append((engine, f"TvcBlock, h = {every} dt, {hold}", every * dt, worst_deg(eng, th, every), w))
+            fmu = build_fmu(ROOT / "models" / "rs25_hotfire.toml", Path(tmp) / f"{engine}.fmu", engine=engine).path
+            *_, fixed = fmpy_in_child(fmu, tmp, stop_time=dt, step_size=dt, output_interval=dt)
+            rows.append((engine, "FMU in FMPy, one step (start-up cost)", dt, float("nan"), fixed))
+            for every, hold in ((1, 1), (10, 0)):
+                h = every * dt
+                sig = profile_input(prof, dt, T + h)
+                sig = sig[::every]
+                res, msgs, err, wall = fmpy_in_child(fmu, tmp, sig, stop_time=float(sig["time"][-1]), step_size=h,
+                                                     output_interval=h, start_values={"command_hold": hold})
+                if err:
+                    raise SystemExit(f"FMPy: {err}")
+                eng = np.vstack([res["pitch_engine_rad"], res["yaw_engine_rad"]])
+                rows.append((engine, f"FMU in FMPy, h = {every} dt, command_hold {hold}", h,
+                             worst_deg(eng, th, every, shift=1 if hold == 1 else 0), wall))
+    print(f"{'engine':8s} {'run':42s} {'h [s]':>8s} {'max |d engine| [deg]':>21s} {'wall [s]':>9s} {'x real time':>12s}")
+    for engine, what, h, d, w in rows:
+        one = math.isnan(d)   # the start-up row: one step, no agreement or real-time figure
+        print(f"{engine:8s} {what:42s} {h:8.1e} {'-' if one else f'{d:.3g}':>21s} {w:9.2f} "
+              f"{'-' if one else f'{args.duration / w:.1f}':>12s}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
