@@ -162,3 +162,31 @@ def test_bearing_step_solves_the_series_balance(base, name):
                 assert abs(T[0] * w[1] - T[1] * w[0]) < 1e-7 * tc * np.linalg.norm(w)
         elif not law.has_state:  # memoryless: the torque at the slip rate
             np.testing.assert_allclose(T, e.torque3(w0, w1, 0, 0, 0, 0, 0, 0, p), rtol=1e-8, atol=1e-300)
+
+
+def test_modified_lugre_bearing_torque_folds_with_no_fast_branch(base):
+    """The shipped modified LuGre (hot fire) at a frozen bristle state z = zeta T_c / sigma_0
+    along the slip: from V_d up (h = 1; g = T_c as T_s = T_c) the torque is, in closed form,
+    T(s) = sigma_0 z + sigma_1 e^{-(s/v_1)^2} s (1 - zeta), with its maximum at s = v_1/sqrt 2,
+    sigma_1 v_1 e^{-1/2} / sqrt 2 (1 - zeta) above sigma_0 z, and it falls back to sigma_0 z
+    as s grows (no viscous term: sigma_2 = 0). So the massless bearing's balance
+    Kc T(w, z) = psi - phi has no root once psi - phi passes Kc T_max: the slip jumps (an
+    impasse of the condensed equations, taos.taos3d._bearing), whatever the step. The law
+    still meets its documented passivity condition: passivity is not what fails."""
+    law = base.with_friction("modified-lugre").friction
+    e, p = law.entry, law.pack()
+    s0, s1, v1, tc = (law.bristle_stiffness_Nm_per_rad, law.bristle_damping_Nms_per_rad,
+                      law.damping_decay_velocity_rad_s, law.coulomb_torque_Nm)
+    assert law.viscous_damping_Nms_per_rad == 0 and law.static_torque_Nm == tc
+    s = np.geomspace(law.vibration_velocity_rad_s, 1e3 * v1, 4001)  # h = 1 from V_d up; g = T_c (T_s = T_c)
+    for zeta in (0.8, 0.3, -0.5):
+        z = zeta * tc / s0
+        T = np.array([e.torque3(v, 0.0, z, 0.0, *e.zdot3(v, 0.0, z, 0.0, p), 0.0, 0.0, p)[0] for v in s])
+        closed = s0 * z + s1 * np.exp(-(s / v1) ** 2) * s * (1 - zeta)
+        np.testing.assert_allclose(T, closed, rtol=1e-12, atol=1e-9 * tc)
+        k = np.argmax(T)
+        assert s[k] == pytest.approx(v1 / math.sqrt(2), rel=3e-3)
+        assert T[k] - s0 * z == pytest.approx(s1 * v1 * math.exp(-0.5) / math.sqrt(2) * (1 - zeta), rel=1e-5)
+        assert T[-1] == pytest.approx(s0 * z, abs=1e-6 * tc)  # no fast branch to land on
+    v = np.geomspace(1e-6, 10.0, 2001)
+    assert law.passive_at(v).all()
