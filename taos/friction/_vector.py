@@ -28,6 +28,14 @@ by one backward-Euler step, solved exactly (:func:`coeff_bearing_step` for every
 torque is T = a(|w|) w + b(|w|) z_n, :func:`switching_bearing_step` for the stick-slip law).
 The 3-D model's normal-load scaling of the torque levels is
 :meth:`taos.friction.FrictionLaw.scaled`.
+
+Well-posedness of that series connection needs the torque at a frozen bristle state not to
+fall with the slip rate, dT_u/ds >= 0 (beyond the law's passivity): for LuGre above V_d,
+(1 - sigma_0 z.u / g) d(s sigma_1(s))/ds + sigma_2 >= 0. The exponential decay of sigma_1
+(:func:`._kernels._sigma1`) breaks it above v_1 / sqrt 2, where the torque peaks and falls
+back to sigma_0 z: the bearing equation then has impasse points (the slip jumps;
+docs/theory/taos3d.md). :func:`bristle_coeffs` and :func:`bristle_torque3` take the damping's
+value, so another decay law reuses them (benchmarks/bench_taos3d.py).
 """
 
 from __future__ import annotations

@@ -39,11 +39,18 @@ implicit equation single-valued) or places its jumps at the step's grid; the sub
 them to the tolerance.
 
 Measured (two-axis Green Run, hot fire; benchmarks/RESULTS.md, tests/test_taos3d_step.py): on
-the first 4 s, against the former kernel at a uniform 1.5625e-6 s, the engine angle error of
-modified LuGre is 6.0e-4 / 3.7e-4 / 6.3e-5 deg at 4e-4 / 2e-4 / 1e-4 s (former kernel
-1.08e-2 deg at all three: it smoothed the chatter out). Over 60 s the fine references
-themselves differ by 4-7e-3 deg (chatter events near t = 13.6 and 32.5 s whose jump timing
-the finest steps do not settle), so 60 s figures below that level are not meaningful.
+the first 4 s (ideal valve), against the former kernel at a uniform 1.5625e-6 s, the engine
+angle error of modified LuGre is 7.0e-4 / 6.2e-5 deg at 4e-4 / 1e-4 s (former kernel
+1.08e-2 deg at every step: it smoothed the chatter out). Over 60 s there is no step-converged
+solution to compare with: the shipped law's torque at a frozen bristle state peaks at
+v_1 / sqrt 2 and falls back to sigma_0 z with no rising branch, so where the chain torque
+passes the peak the massless bearing's equations have no nearby solution (an impasse: the
+slip jumps in one substep, at a speed growing as 1 / h_b), and where the trajectory only
+grazes the fold whether it jumps is decided by the step (docs/theory/taos3d.md). Fine
+references then differ by 4-8e-3 deg, a 1e-10 rad offset of the commands moves a 2.5e-5 s
+run by 4.3e-3 deg, and no step setting changes that; with a law whose torque rises with the
+slip rate (constant or rational decay of sigma_1) the same substeps converge at second order
+over the whole 60 s (2-3e-5 deg at 4e-4 s; benchmarks/bench_taos3d.py part 4).
 Cost: the 60 s run at 4e-4 s takes about 2.5x the former kernel's time (the chatter is
 frequent in the 0.8 deg segments).
 

@@ -49,8 +49,11 @@ at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler be
 with the slip rate at fixed z (the bristle damping sigma_1(s) s decays above v_1 / sqrt 2):
 the fine-step solution chatters there (relaxation oscillation of the slip rate), which a
 fixed 4e-4 s (or anything down to 2.5e-5 s) implicit step damped away (error 1.1e-2 deg at
-every step); the bearing substeps resolve it: 6.0e-4 deg at 4e-4 s, falling with the step
-(tests/test_taos3d_step.py, benchmarks/RESULTS.md). The stiff bearing time constant
+every step); the bearing substeps resolve it on the first 4 s: 7.0e-4 deg at 4e-4 s, falling
+with the step (tests/test_taos3d_step.py, benchmarks/RESULTS.md). Over 60 s the shipped law's
+massless bearing reaches impasse points (slip jumps the equations do not define) and has no
+step-converged solution below about 8e-3 deg; laws whose torque rises with the slip rate
+converge there too (:mod:`taos.taos3d._bearing`, docs/theory/taos3d.md). The stiff bearing time constant
 never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
 the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
 omega dt < 2.8 for RK4); accuracy sets the default 4e-4 s. A quantised command is piecewise
