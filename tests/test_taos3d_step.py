@@ -1,13 +1,11 @@
 """TAOS 3-D time step: the kernel (allocation-free right-hand side without reference counting,
 the quantised command's mean over each step in every RK4 stage, second-order bearing coupling:
-trapezoidal bearing torque in the RK4 step, BDF2 bearing, the bearing solve continued from
-the previous slip speed) against a converged reference 16x finer than its default step,
-beside the former kernel (bearing torque held over the step, backward-Euler bearing, the
-quantised command sampled at the stages), whose records at 2e-4 s are stored in
-tests/data/taos3d_kernel_2e-4_held.npz (see its ``about`` entry). The default step (4e-4 s)
-must be at least as accurate as the former kernel at 2e-4 s, and the smooth laws must show
-the second-order convergence that allows it; the mean of the command path is checked
-against brute-force quadrature."""
+trapezoidal bearing torque in the RK4 step, BDF2 bearing with its own substeps, the bearing
+solve continued from the previous slip speed) against references 16x finer than its default
+step: the smooth laws must show the second-order convergence that allows the default step;
+modified LuGre against an independent uniform-step reference on 4 s, and on the whole 60 s
+run as far as the model is well posed; the mean of the command path is checked against
+brute-force quadrature."""
 
 from __future__ import annotations
 
@@ -20,10 +18,8 @@ from taos.profiles import Sequence, TwoAxis, load_profile
 from taos.taos3d import load_taos_model
 from taos.taos3d.simulate import DEFAULT_DT_S, run_samples
 
-DATA = Path(__file__).parent / "data" / "taos3d_kernel_2e-4_held.npz"
 T_RUN = 4.0
 REF_DT = 2.5e-5  # 16x below the default step
-FORMER_DT_S = 2e-4  # the stored former kernel's step
 REC_S = 0.01  # the stored records' interval [s]
 
 
@@ -48,24 +44,20 @@ def _err(a, ref):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("law", ["modified-lugre", "coulomb-smooth", "coulomb-switching", "dahl"])
-def test_default_step_is_at_least_as_accurate_as_the_former_kernel_at_half_of_it(law):
-    """Error of the default step (4e-4 s) against a 2.5e-5 s reference within 1.05 x the former
-    kernel's error at 2e-4 s (max and rms of theta and x_p), and for the laws whose error the
-    step sets, within 0.1 x. Measured ratios: modified LuGre 0.995-1.000 (its error is one
-    stick-slip event's timing near t = 2.07 s, the same at every step from 2e-4 s up), Coulomb
-    smooth, Coulomb switching and Dahl 0.010-0.031."""
-    old = np.load(DATA)[law]
+def test_default_step_against_a_16x_finer_reference(law):
+    """Error of the default step (4e-4 s) against a 2.5e-5 s reference, first 4 s of the
+    Green Run (+-0.45 deg): Coulomb smooth and switching, Dahl within 5 microdegrees (measured
+    0.7-1.2); modified LuGre within 1 millidegree (measured 0.28: a fold grazing of its
+    massless bearing near t = 2.07 s that the fine steps themselves do not settle,
+    docs/theory/taos3d.md). The former kernel's stored records
+    (tests/data/taos3d_kernel_2e-4_held.npz, 2e-4 s) predate the servo recalibration and the
+    pressure limit (issue 24.1, 24.2): against this model they are 1.1-1.3e-3 rad off, a
+    different model, so the former-kernel ratios (0.010-0.031 for the smooth laws,
+    benchmarks/RESULTS.md) are history, not re-measured here."""
     tm = load_taos_model("models/rs25_hotfire.toml", friction=law)
-    ref = _run(tm, REF_DT)
-    new = _run(tm, DEFAULT_DT_S)
-    e_old, e_new = _err(old, ref), _err(new, ref)
-    print(law, "former", e_old, "default", e_new, "ratio", e_new / e_old)
-    assert DEFAULT_DT_S == 2 * FORMER_DT_S
-    assert np.all(e_new <= (1.05 if law == "modified-lugre" else 0.1) * e_old)
-    # and small on a +-0.5 deg run: modified LuGre 15 millidegrees (measured 9.4, one stick-slip
-    # event near t = 2.07 s that every step from 5e-5 s up places alike), the others 5
-    # microdegrees (measured 1.0-1.4)
-    assert e_new[0] < np.radians(1.5e-2 if law == "modified-lugre" else 5e-6)
+    e = _err(_run(tm, DEFAULT_DT_S), _run(tm, REF_DT))
+    print(law, "default step: max |d theta|, |d x_p|, rms", e)
+    assert e[0] < np.radians(1e-3 if law == "modified-lugre" else 5e-6)
 
 
 @pytest.mark.slow
