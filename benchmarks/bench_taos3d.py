@@ -31,6 +31,8 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
    above v_1 / sqrt 2, the massless bearing's implicit equation folds with no fast branch to
    land on, and the limit of fine steps does not exist at the 1e-3 deg level
    (docs/theory/taos3d.md); the other two keep the torque monotone in the slip rate.
+   ``--decay-impact`` alone: the planar model's sine dwells with the proposed decay against
+   the shipped law (what adopting it would change).
 5. Peer: MuJoCo (mujoco.rollout, native loop, one thread) with the same rigid engine (mass,
    c.g. and inertia of the Pinocchio model, pivot at the gimbal point O, gravity off as in
    TAOS where it is inside K_n) on two hinges (pitch about +y, yaw about -x, the TAOS axes)
@@ -329,6 +331,46 @@ def conv60_variants():
             ("proposed, sigma_1 v_1/(v_1 + s)", tm, prop)]
 
 
+def decay_impact():
+    """``--decay-impact``: what the proposed decay changes in the planar (simplex) model: engine
+    sine-dwell responses of the hot-fire and ambient files with the proposed decay registered
+    at run time as ``modified-lugre-rational`` (same parameters, planar kernel below) against
+    the shipped law, ratio in dB and deg."""
+    from taos.friction import _kernels as K
+    from taos.friction import registry
+    from taos.friction._laws import ModifiedLuGre
+    from taos.friction.registry import RATES_SIG, FrictionLawEntry
+    from taos.model import load_model
+    from taos.planar.freqresp import sine_dwell_family
+
+    class RationalDecay(ModifiedLuGre):  # the same fields; only sigma_1(v) differs
+        name = "modified-lugre-rational"
+
+        def _sigma1(self, v):
+            v1 = self.damping_decay_velocity_rad_s
+            return self.bristle_damping_Nms_per_rad * v1 / (v1 + np.abs(np.asarray(v, float)))
+
+    @cfunc(RATES_SIG)
+    def rates(v, z, t_app, p):
+        dz = K.lugre_zdot(v, z, p)
+        return dz, p[K.SLOT_SIGMA0] * z + _sigma1_rational(abs(v), p) * dz + p[K.SLOT_SIGMA2] * v
+
+    e = registry.get(FRICTION)
+    registry.register(FrictionLawEntry(RationalDecay.name, RationalDecay, rates, e.zdot3, rational_torque3,
+                                       rational_bearing), replace_existing=True)
+    f = np.array([0.5, 1.0, 2.0, 4.0, 5.0, 7.0, 10.0])
+    amps = np.radians([0.05, 0.2, 0.8])
+    for mf in (MODEL, "models/rs25_ambient.toml"):
+        m = load_model(mf)
+        new, old = (sine_dwell_family(m.with_friction(law), f, amps) for law in (RationalDecay.name, FRICTION))
+        print(f"[decay-impact] {mf}, planar engine response, proposed / shipped decay at "
+              + " ".join(f"{v:g}" for v in f) + " Hz: dB | deg")
+        for a, rn, ro in zip(np.degrees(amps), new, old):
+            r = rn.engine / ro.engine
+            print(f"    {a:.2f} deg: " + " ".join(f"{v:+.2f}" for v in 20 * np.log10(np.abs(r))) + " | "
+                  + " ".join(f"{v:+.1f}" for v in np.degrees(np.angle(r))))
+
+
 def convergence60(prof):
     """Point 4 of the module docstring."""
     refs, dts = (2.5e-5, 1.25e-5), (DEFAULT_DT_S, ALT_DT, 1e-4)
@@ -363,6 +405,8 @@ def main():
     ap.add_argument("--no-dwells", action="store_true", help="skip the sine-dwell accuracy part")
     ap.add_argument("--no-conv60", action="store_true", help="skip the 60 s modified-LuGre convergence part")
     ap.add_argument("--only-conv60", action="store_true", help="run the 60 s convergence part alone")
+    ap.add_argument("--decay-impact", action="store_true",
+                    help="run only the planar impact of the proposed bristle-damping decay")
     args = ap.parse_args()
     up = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     print(f"machine load (uptime): {up}")
@@ -370,6 +414,9 @@ def main():
     print(f"model: hot fire, gimbal {tm.stiffness_source}, friction {tm.base.friction.name}, "
           f"T_c = {tm.coulomb_torque_Nm:.0f} N m; default step {DEFAULT_DT_S:g} s; {len(dy.REC)} recorded columns")
     prof = greenrun60()
+    if args.decay_impact:
+        decay_impact()
+        return
     if args.only_conv60:
         convergence60(prof)
         return
