@@ -360,8 +360,13 @@ def decay_impact():
                                        rational_bearing), replace_existing=True)
     f = np.array([0.5, 1.0, 2.0, 4.0, 5.0, 7.0, 10.0])
     amps = np.radians([0.05, 0.2, 0.8])
+    v = np.geomspace(1e-7, 1e2, 4001)  # [rad/s]
     for mf in (MODEL, "models/rs25_ambient.toml"):
         m = load_model(mf)
+        law = m.with_friction(RationalDecay.name).friction
+        ds1 = np.diff(v * law._sigma1(v))
+        print(f"[decay-impact] {mf}: proposed decay passive (LuGre's documented condition) at every rate "
+              f"1e-7-1e2 rad/s: {bool(law.passive_at(v).all())}; s sigma_1(s) non-decreasing: {bool((ds1 >= 0).all())}")
         new, old = (sine_dwell_family(m.with_friction(law), f, amps) for law in (RationalDecay.name, FRICTION))
         print(f"[decay-impact] {mf}, planar engine response, proposed / shipped decay at "
               + " ".join(f"{v:g}" for v in f) + " Hz: dB | deg")
