@@ -31,11 +31,13 @@ The 3-D model's normal-load scaling of the torque levels is
 
 Well-posedness of that series connection needs the torque at a frozen bristle state not to
 fall with the slip rate, dT_u/ds >= 0 (beyond the law's passivity): for LuGre above V_d,
-(1 - sigma_0 z.u / g) d(s sigma_1(s))/ds + sigma_2 >= 0. The exponential decay of sigma_1
-(:func:`._kernels._sigma1`) breaks it above v_1 / sqrt 2, where the torque peaks and falls
-back to sigma_0 z: the bearing equation then has impasse points (the slip jumps;
-docs/theory/taos3d.md). :func:`bristle_coeffs` and :func:`bristle_torque3` take the damping's
-value, so another decay law reuses them (benchmarks/bench_taos3d.py).
+(1 - sigma_0 z.u / g) d(s sigma_1(s))/ds + sigma_2 >= 0. The rational decay of sigma_1
+(:func:`._kernels._sigma1`, sigma_1 v_1 / (v_1 + s)) meets it at every slip rate; the
+exponential decay of Canudas de Wit et al. (1995) broke it above v_1 / sqrt 2, where the
+torque peaked and fell back to sigma_0 z, and the bearing equation had impasse points (the
+slip jumped; docs/theory/taos3d.md, :class:`taos.friction.LuGre`).
+:func:`bristle_coeffs` and :func:`bristle_torque3` take the damping's value, so a reference
+decay law reuses them (benchmarks/bench_taos3d.py keeps the exponential that way).
 """
 
 from __future__ import annotations
