@@ -25,14 +25,15 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
 4. Modified LuGre over the whole 60 s (issue 24, point 6; ``--no-conv60`` skips it): engine
    angle at 4e-4, 2e-4 and 1e-4 s against 2.5e-5 and 1.25e-5 s references, the references
    against each other and against a 2.5e-5 s run whose commands are offset by 1e-10 rad (data
-   sensitivity at a fixed step), for the shipped law, the same law with constant bristle
-   damping (v_1 = 0) and the proposed decay sigma_1 v_1 / (v_1 + s) (kernels below: not a
-   shipped law). The shipped law's torque at a frozen bristle state falls with the slip rate
-   above v_1 / sqrt 2, the massless bearing's implicit equation folds with no fast branch to
-   land on, and the limit of fine steps does not exist at the 1e-3 deg level
-   (docs/theory/taos3d.md); the other two keep the torque monotone in the slip rate.
-   ``--decay-impact`` alone: the planar model's sine dwells with the proposed decay against
-   the shipped law (what adopting it would change).
+   sensitivity at a fixed step), for the shipped law (rational bristle-damping decay
+   sigma_1 v_1 / (v_1 + s)), the same law with constant bristle damping (v_1 = 0) and, as a
+   bench-local reference (kernels below, not shipped), the former exponential decay
+   sigma_1 exp(-(s/v_1)^2), whose torque at a frozen bristle state falls with the slip rate
+   above v_1 / sqrt 2: the massless bearing's implicit equation then folds with no fast
+   branch to land on, and the limit of fine steps does not exist at the 1e-3 deg level
+   (docs/theory/taos3d.md, why the decay is rational). ``--decay-impact`` alone: the planar
+   model's sine dwells with the shipped decay against the former exponential (what the
+   change moved).
 5. Peer: MuJoCo (mujoco.rollout, native loop, one thread) with the same rigid engine (mass,
    c.g. and inertia of the Pinocchio model, pivot at the gimbal point O, gravity off as in
    TAOS where it is inside K_n) on two hinges (pitch about +y, yaw about -x, the TAOS axes)
@@ -292,50 +293,52 @@ def mujoco_peer(tm, prof, repeat, taos_rec):
                   f"{1e6 * w / n:.2f} us/step")
 
 
-# -- the proposed bristle-damping decay (a demonstration, not a shipped law) -------------------------
+# -- the former bristle-damping decay (a bench-local REFERENCE, not a shipped law) -------------------
 @njit(inline="always")
-def _sigma1_rational(s, p):
-    """sigma_1(s) = sigma_1 v_1 / (v_1 + s) [N m s/rad]: s sigma_1(s) rises monotonically to
-    sigma_1 v_1, so the torque at a frozen bristle state never falls with the slip rate;
-    passive (LuGre's condition s sigma_1(s) <= 4 g(s) h(s)) while sigma_1 v_1 <= 4 T_c and
-    sigma_1 <= 8 T_c / (pi V_d)."""
+def _sigma1_exponential(s, p):
+    """The former decay sigma_1(s) = sigma_1 exp(-(s/v_1)^2) [N m s/rad] (Canudas de Wit et al.
+    1995, eq. 9), kept here only to show why it was replaced: s sigma_1(s) peaks at
+    v_1 / sqrt 2 and falls to 0, so the torque at a frozen bristle state falls with the slip
+    rate and the massless bearing has impasse points (docs/theory/taos3d.md). The shipped
+    law is the rational decay of taos.friction._kernels._sigma1."""
     v1 = p[SLOT_V1]
-    return p[SLOT_SIGMA1] * v1 / (v1 + s)
+    return p[SLOT_SIGMA1] * math.exp(-(s / v1) ** 2)
 
 
 @njit(inline="always")
-def _rational_coeffs(s, p, dt, kappa):
-    return V.bristle_coeffs(s, p, dt, kappa, _sigma1_rational(s, p))
+def _exponential_coeffs(s, p, dt, kappa):
+    return V.bristle_coeffs(s, p, dt, kappa, _sigma1_exponential(s, p))
 
 
 @cfunc(BEARING_SIG, cache=True)
-def rational_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
-    return V.coeff_bearing_step(_rational_coeffs, V.lugre_rho, True, 1.0, p, Kc, d0, d1, z0, z1, dt, s0)
+def exponential_bearing(p, Kc, d0, d1, z0, z1, dt, s0):
+    return V.coeff_bearing_step(_exponential_coeffs, V.lugre_rho, True, 1.0, p, Kc, d0, d1, z0, z1, dt, s0)
 
 
 @cfunc(TORQUE3_SIG, cache=True)
-def rational_torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p):
-    return V.bristle_torque3(w0, w1, z0, z1, dz0, dz1, _sigma1_rational(math.sqrt(w0 * w0 + w1 * w1), p), p)
+def exponential_torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p):
+    return V.bristle_torque3(w0, w1, z0, z1, dz0, dz1, _sigma1_exponential(math.sqrt(w0 * w0 + w1 * w1), p), p)
 
 
 def conv60_variants():
-    """(name, model, packed) for the shipped modified LuGre, the same with constant bristle
-    damping (v_1 = 0) and with the proposed decay sigma_1 v_1 / (v_1 + s)."""
+    """(name, model, packed) for the shipped modified LuGre (rational decay), the same with
+    constant bristle damping (v_1 = 0) and with the former exponential decay (reference)."""
     import dataclasses
     tm = load_taos_model(MODEL, friction=FRICTION)
     law = tm.base.friction
     const = tm.replace(base=tm.base.replace(friction=dataclasses.replace(law, damping_decay_velocity_rad_s=0.0)))
     pk = pack(tm)
-    prop = dataclasses.replace(pk, fid=(rational_bearing, pk.fid[1], rational_torque3))
-    return [("shipped, sigma_1 exp(-(s/v_1)^2)", tm, pk), ("sigma_1 constant (v_1 = 0)", const, pack(const)),
-            ("proposed, sigma_1 v_1/(v_1 + s)", tm, prop)]
+    expo = dataclasses.replace(pk, fid=(exponential_bearing, pk.fid[1], exponential_torque3))
+    return [("shipped, sigma_1 v_1/(v_1 + s)", tm, pk), ("sigma_1 constant (v_1 = 0)", const, pack(const)),
+            ("former (reference), sigma_1 exp(-(s/v_1)^2)", tm, expo)]
 
 
 def decay_impact():
-    """``--decay-impact``: what the proposed decay changes in the planar (simplex) model: engine
-    sine-dwell responses of the hot-fire and ambient files with the proposed decay registered
-    at run time as ``modified-lugre-rational`` (same parameters, planar kernel below) against
-    the shipped law, ratio in dB and deg."""
+    """``--decay-impact``: what replacing the exponential decay by the rational one changed in
+    the planar (simplex) model: engine sine-dwell responses of the hot-fire and ambient files
+    with the shipped law against the former exponential decay (registered at run time as
+    ``modified-lugre-exponential``, same parameters, planar kernel below), ratio in dB and
+    deg; and the shipped law's passivity and monotonicity in both files."""
     from taos.friction import _kernels as K
     from taos.friction import registry
     from taos.friction._laws import ModifiedLuGre
@@ -343,32 +346,34 @@ def decay_impact():
     from taos.model import load_model
     from taos.planar.freqresp import sine_dwell_family
 
-    class RationalDecay(ModifiedLuGre):  # the same fields; only sigma_1(v) differs
-        name = "modified-lugre-rational"
+    class ExponentialDecay(ModifiedLuGre):  # the same fields; only sigma_1(v) differs
+        name = "modified-lugre-exponential"
 
         def _sigma1(self, v):
             v1 = self.damping_decay_velocity_rad_s
-            return self.bristle_damping_Nms_per_rad * v1 / (v1 + np.abs(np.asarray(v, float)))
+            return self.bristle_damping_Nms_per_rad * np.exp(-(np.asarray(v, float) / v1) ** 2)
 
     @cfunc(RATES_SIG)
     def rates(v, z, t_app, p):
         dz = K.lugre_zdot(v, z, p)
-        return dz, p[K.SLOT_SIGMA0] * z + _sigma1_rational(abs(v), p) * dz + p[K.SLOT_SIGMA2] * v
+        return dz, p[K.SLOT_SIGMA0] * z + _sigma1_exponential(abs(v), p) * dz + p[K.SLOT_SIGMA2] * v
 
     e = registry.get(FRICTION)
-    registry.register(FrictionLawEntry(RationalDecay.name, RationalDecay, rates, e.zdot3, rational_torque3,
-                                       rational_bearing), replace_existing=True)
+    registry.register(FrictionLawEntry(ExponentialDecay.name, ExponentialDecay, rates, e.zdot3, exponential_torque3,
+                                       exponential_bearing), replace_existing=True)
     f = np.array([0.5, 1.0, 2.0, 4.0, 5.0, 7.0, 10.0])
     amps = np.radians([0.05, 0.2, 0.8])
     v = np.geomspace(1e-7, 1e2, 4001)  # [rad/s]
     for mf in (MODEL, "models/rs25_ambient.toml"):
         m = load_model(mf)
-        law = m.with_friction(RationalDecay.name).friction
+        law = m.with_friction(FRICTION).friction
         ds1 = np.diff(v * law._sigma1(v))
-        print(f"[decay-impact] {mf}: proposed decay passive (LuGre's documented condition) at every rate "
-              f"1e-7-1e2 rad/s: {bool(law.passive_at(v).all())}; s sigma_1(s) non-decreasing: {bool((ds1 >= 0).all())}")
-        new, old = (sine_dwell_family(m.with_friction(law), f, amps) for law in (RationalDecay.name, FRICTION))
-        print(f"[decay-impact] {mf}, planar engine response, proposed / shipped decay at "
+        print(f"[decay-impact] {mf}: shipped (rational) decay passive (LuGre's condition) at every rate "
+              f"1e-7-1e2 rad/s: {bool(law.passive_at(v).all())}, sufficient-bound ratios "
+              f"{', '.join(f'{r:.3f}' for r in law.passivity_ratios())}; s sigma_1(s) non-decreasing: "
+              f"{bool((ds1 >= 0).all())}")
+        new, old = (sine_dwell_family(m.with_friction(name), f, amps) for name in (FRICTION, ExponentialDecay.name))
+        print(f"[decay-impact] {mf}, planar engine response, shipped (rational) / former (exponential) decay at "
               + " ".join(f"{v:g}" for v in f) + " Hz: dB | deg")
         for a, rn, ro in zip(np.degrees(amps), new, old):
             r = rn.engine / ro.engine
@@ -411,7 +416,7 @@ def main():
     ap.add_argument("--no-conv60", action="store_true", help="skip the 60 s modified-LuGre convergence part")
     ap.add_argument("--only-conv60", action="store_true", help="run the 60 s convergence part alone")
     ap.add_argument("--decay-impact", action="store_true",
-                    help="run only the planar impact of the proposed bristle-damping decay")
+                    help="run only the planar impact of the rational decay against the former exponential")
     args = ap.parse_args()
     up = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
     print(f"machine load (uptime): {up}")
