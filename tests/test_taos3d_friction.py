@@ -103,21 +103,10 @@ def _assert_series_balance(e, p, law, Kc, d, z, dt, w, T, zn, dmag, tc):
         np.testing.assert_allclose(T, tq, rtol=1e-6, atol=1e-6 * tc)
 
 
-def test_bearing_step_keeps_the_branch_it_continues_from(base):
-    """Modified LuGre (Stribeck: the torque falls with the slip speed) makes the backward-Euler
-    bearing equation w dt + Kc T(w) = d multi-valued where Kc |dT/ds| > dt: a slow (sticking)
-    and a fast (sliding) root. Each step continues from the previous slip speed, so a slow
-    sweep of the trial increment d up and back down shows stick-slip hysteresis: up, the
-    bearing stays on the slow branch past the point where the fast one appears; down, on the
-    fast branch past where the slow one reappears. Every result satisfies the series balance."""
-    law = base.with_friction("modified-lugre").friction
+def _sweep(law, Kc, dt, u, z, dmags, tc):
+    """Slip speeds of bearing steps for trial increments d = u dmag, swept up and back down,
+    each step continued from the previous slip speed; every result satisfies the balance."""
     e, p = law.entry, law.pack()
-    Kc = np.array([[5.3e-8, 3e-10], [3e-10, 5.0e-8]])  # the hot-fire model's chain compliance
-    dt = 2e-4
-    tc = law.coulomb_torque_Nm
-    u = np.array([0.6, 0.8])
-    dmags = np.geomspace(1e-5, 1e-3, 300)
-    z = np.zeros(2)
     sweeps = []
     for order in (dmags, dmags[::-1]):
         s0, slips = 0.0, {}
@@ -128,7 +117,32 @@ def test_bearing_step_keeps_the_branch_it_continues_from(base):
                                    np.array([z0, z1]), dmag, tc)
             s0 = slips[dmag] = np.hypot(w0, w1)
         sweeps.append(np.array([slips[m] for m in dmags]))
-    up, down = sweeps
+    return sweeps
+
+
+def test_bearing_step_keeps_the_branch_it_continues_from(base):
+    """A Stribeck law whose static level is twice the Coulomb level (T_s = 2 T_c, v_s
+    0.3 deg/s; the torque falls with the slip speed) with its bristles loaded to the static
+    level makes the backward-Euler bearing equation w dt + Kc T(w) = d multi-valued where
+    Kc |dT/ds| > dt: a slow (sticking) and a fast (sliding) root. Each step continues from
+    the previous slip speed, so a slow sweep of the trial increment d up and back down shows
+    stick-slip hysteresis in one band: up, the bearing stays on the slow branch past the
+    point where the fast one appears; down, on the fast branch past where the slow one
+    reappears. The shipped law (T_s = T_c, rational bristle-damping decay: the torque
+    rises with the slip speed) has one root: up and down sweeps agree."""
+    import dataclasses
+
+    shipped = base.with_friction("modified-lugre").friction
+    tc = shipped.coulomb_torque_Nm
+    Kc = np.array([[5.3e-8, 3e-10], [3e-10, 5.0e-8]])  # the hot-fire model's chain compliance
+    dt = 2e-4
+    u = np.array([0.6, 0.8])
+    up, down = _sweep(shipped, Kc, dt, u, np.zeros(2), np.geomspace(1e-5, 1e-3, 300), tc)
+    np.testing.assert_allclose(up, down, rtol=1e-9, atol=1e-12)
+    law = dataclasses.replace(shipped, static_torque_Nm=2 * tc,
+                              stribeck_velocity_rad_s=3 * shipped.stribeck_velocity_rad_s)
+    dmags = np.geomspace(3e-4, 1.5e-3, 300)
+    up, down = _sweep(law, Kc, dt, u, law.static_torque_Nm / law.bristle_stiffness_Nm_per_rad * u, dmags, tc)
     assert np.all(up <= down * (1 + 1e-9))
     apart = up < 0.2 * down  # slow on the way up, fast on the way down
     print("hysteresis over d =", dmags[apart].min(), "-", dmags[apart].max(), "rad,", apart.sum(), "of", dmags.size)
@@ -162,3 +176,35 @@ def test_bearing_step_solves_the_series_balance(base, name):
                 assert abs(T[0] * w[1] - T[1] * w[0]) < 1e-7 * tc * np.linalg.norm(w)
         elif not law.has_state:  # memoryless: the torque at the slip rate
             np.testing.assert_allclose(T, e.torque3(w0, w1, 0, 0, 0, 0, 0, 0, p), rtol=1e-8, atol=1e-300)
+
+
+@pytest.mark.parametrize("name", ["lugre", "modified-lugre"])
+def test_bearing_torque_rises_with_the_slip_rate_at_a_frozen_bristle_state(base, name):
+    """The incremental condition of the massless bearing (docs/theory/taos3d.md, why the decay
+    is rational): with the shipped rational decay, along any slip direction u the vector
+    kernels' torque component T.u at a frozen bristle state z (|z| <= T_c / sigma_0, any
+    direction relative to u) does not fall as the slip speed s grows, by finite differences
+    over 1e-7-1e3 rad/s from V_d up (h = 1), and equals the closed form (T_s = T_c,
+    sigma_2 = 0 as shipped) sigma_0 z.u + sigma_1 v_1 s / (v_1 + s) (1 - sigma_0 z.u / T_c).
+    So the balance Kc T(w, z) = psi - phi has its root on one rising branch: no impasse,
+    which the former exponential decay (torque peaking at v_1 / sqrt 2 and falling back to
+    sigma_0 z) had. The law is passive (its documented condition) at the same rates."""
+    law = base.with_friction(name).friction
+    e, p = law.entry, law.pack()
+    s0, s1, v1, tc = (law.bristle_stiffness_Nm_per_rad, law.bristle_damping_Nms_per_rad,
+                      law.damping_decay_velocity_rad_s, law.coulomb_torque_Nm)
+    assert law.viscous_damping_Nms_per_rad == 0 and law.static_torque_Nm == tc
+    vd = getattr(law, "vibration_velocity_rad_s", 0.0)
+    s = np.geomspace(max(vd, 1e-7), 1e3, 3001)
+    rng = np.random.default_rng(5)
+    for _ in range(12):
+        a, b = rng.uniform(0, 2 * math.pi, 2)
+        u = np.array([math.cos(a), math.sin(a)])
+        z = rng.uniform(0, 1) * tc / s0 * np.array([math.cos(b), math.sin(b)])
+        T = np.array([e.torque3(*(x * u), *z, *e.zdot3(*(x * u), *z, p), 0.0, 0.0, p) for x in s])
+        Tu = T @ u
+        assert np.all(np.diff(Tu) >= -1e-12 * tc)
+        zu = s0 * (z @ u)
+        np.testing.assert_allclose(Tu, zu + s1 * v1 * s / (v1 + s) * (1 - zu / tc), rtol=1e-12, atol=1e-9 * tc)
+    v = np.geomspace(1e-7, 1e3, 2001)
+    assert law.passive_at(v).all()

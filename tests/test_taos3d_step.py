@@ -1,13 +1,11 @@
 """TAOS 3-D time step: the kernel (allocation-free right-hand side without reference counting,
 the quantised command's mean over each step in every RK4 stage, second-order bearing coupling:
-trapezoidal bearing torque in the RK4 step, BDF2 bearing, the bearing solve continued from
-the previous slip speed) against a converged reference 16x finer than its default step,
-beside the former kernel (bearing torque held over the step, backward-Euler bearing, the
-quantised command sampled at the stages), whose records at 2e-4 s are stored in
-tests/data/taos3d_kernel_2e-4_held.npz (see its ``about`` entry). The default step (4e-4 s)
-must be at least as accurate as the former kernel at 2e-4 s, and the smooth laws must show
-the second-order convergence that allows it; the mean of the command path is checked
-against brute-force quadrature."""
+trapezoidal bearing torque in the RK4 step, BDF2 bearing with its own substeps, the bearing
+solve continued from the previous slip speed) against references 16x finer than its default
+step: the smooth laws must show the second-order convergence that allows the default step;
+modified LuGre (rational bristle-damping decay: a well-posed massless bearing) also against
+an independent uniform-step reference on 4 s and over the whole 60 s run; the mean of the command path is checked against
+brute-force quadrature."""
 
 from __future__ import annotations
 
@@ -20,10 +18,8 @@ from taos.profiles import Sequence, TwoAxis, load_profile
 from taos.taos3d import load_taos_model
 from taos.taos3d.simulate import DEFAULT_DT_S, run_samples
 
-DATA = Path(__file__).parent / "data" / "taos3d_kernel_2e-4_held.npz"
 T_RUN = 4.0
 REF_DT = 2.5e-5  # 16x below the default step
-FORMER_DT_S = 2e-4  # the stored former kernel's step
 REC_S = 0.01  # the stored records' interval [s]
 
 
@@ -48,24 +44,18 @@ def _err(a, ref):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("law", ["modified-lugre", "coulomb-smooth", "coulomb-switching", "dahl"])
-def test_default_step_is_at_least_as_accurate_as_the_former_kernel_at_half_of_it(law):
-    """Error of the default step (4e-4 s) against a 2.5e-5 s reference within 1.05 x the former
-    kernel's error at 2e-4 s (max and rms of theta and x_p), and for the laws whose error the
-    step sets, within 0.1 x. Measured ratios: modified LuGre 0.995-1.000 (its error is one
-    stick-slip event's timing near t = 2.07 s, the same at every step from 2e-4 s up), Coulomb
-    smooth, Coulomb switching and Dahl 0.010-0.031."""
-    old = np.load(DATA)[law]
+def test_default_step_against_a_16x_finer_reference(law):
+    """Error of the default step (4e-4 s) against a 2.5e-5 s reference, first 4 s of the
+    Green Run (+-0.45 deg): within 5 microdegrees for every law (measured: modified LuGre
+    0.6, Coulomb smooth and switching, Dahl 0.7-1.2). The former kernel's stored records
+    (tests/data/taos3d_kernel_2e-4_held.npz, 2e-4 s) predate the servo recalibration and the
+    pressure limit (issue 24.1, 24.2): against this model they are 1.1-1.3e-3 rad off, a
+    different model, so the former-kernel ratios (0.010-0.031 for the smooth laws,
+    benchmarks/RESULTS.md) are history, not re-measured here."""
     tm = load_taos_model("models/rs25_hotfire.toml", friction=law)
-    ref = _run(tm, REF_DT)
-    new = _run(tm, DEFAULT_DT_S)
-    e_old, e_new = _err(old, ref), _err(new, ref)
-    print(law, "former", e_old, "default", e_new, "ratio", e_new / e_old)
-    assert DEFAULT_DT_S == 2 * FORMER_DT_S
-    assert np.all(e_new <= (1.05 if law == "modified-lugre" else 0.1) * e_old)
-    # and small on a +-0.5 deg run: modified LuGre 15 millidegrees (measured 9.4, one stick-slip
-    # event near t = 2.07 s that every step from 5e-5 s up places alike), the others 5
-    # microdegrees (measured 1.0-1.4)
-    assert e_new[0] < np.radians(1.5e-2 if law == "modified-lugre" else 5e-6)
+    e = _err(_run(tm, DEFAULT_DT_S), _run(tm, REF_DT))
+    print(law, "default step: max |d theta|, |d x_p|, rms", e)
+    assert e[0] < np.radians(5e-6)
 
 
 @pytest.mark.slow
@@ -85,25 +75,51 @@ UNIFORM = Path(__file__).parent / "data" / "taos3d_mlugre_uniform_1.5625e-6.npz"
 
 @pytest.mark.slow
 def test_modified_lugre_converges_with_the_step_against_an_independent_fine_reference():
-    """Modified LuGre's massless bearing chatters where its torque falls with the slip rate
-    (decaying bristle damping; taos.taos3d._bearing): the bearing substeps resolve it, so
-    against the former constant-step kernel at a uniform 1.5625e-6 s (stored records, first
-    4 s of the Green Run; its own error there about 1.5e-5 deg, from 3.125e-6 s) the default
-    step is within 1e-3 deg (measured 7.0e-4; the former kernel 1.08e-2 at every step from
-    1e-4 s up) and the error falls with the step (1e-4 s: measured 6.3e-5)."""
+    """Modified LuGre on the first 4 s of the Green Run against an independent solver: the
+    former constant-step kernel (commit abb8363, no bearing substeps) at a uniform
+    1.5625e-6 s with the shipped rational decay, made by
+    tests/data/make_taos3d_uniform_reference.py from that commit's own tree and model files
+    (ideal valve, line load stiffness as that tree gave it: the same here). The default step
+    is within 3e-6 deg (measured 6.2e-7; 7.0e-4 with the former exponential decay against its
+    own reference of this kind) and the error falls with the step (1e-4 s: measured 4.5e-8)."""
     import dataclasses
 
-    ref = np.load(UNIFORM)["records"]
+    data = np.load(UNIFORM)
+    ref = data["records"]
     tm = load_taos_model("models/rs25_hotfire.toml", friction="modified-lugre")
-    # the stored reference (commit abb8363) ran the ideal valve, before the shipped files turned
-    # the square-root valve law on; the bearing's convergence is the point here, so the same valve
     act = dataclasses.replace(tm.base.actuator, pressure_limited=False)
-    tm = tm.replace(base=tm.base.replace(actuator=act))
+    gim = dataclasses.replace(tm.gimbal, line_load_stiffness_N_per_m=float(data["line_load_stiffness_N_per_m"]))
+    tm = tm.replace(base=tm.base.replace(actuator=act), gimbal=gim)
     e4 = _err(_run(tm, DEFAULT_DT_S), ref)
     e1 = _err(_run(tm, 1e-4), ref)
     print("max |d theta| deg at 4e-4, 1e-4 s:", np.degrees(e4[0]), np.degrees(e1[0]))
-    assert e4[0] < np.radians(1e-3)
-    assert e1[0] < 0.5 * e4[0]
+    assert e4[0] < np.radians(3e-6)
+    assert e1[0] < 0.2 * e4[0]
+
+
+@pytest.mark.slow
+def test_shipped_modified_lugre_converges_over_the_60s_green_run():
+    """Issue 24 point 6: the shipped model (hot fire, modified LuGre with the rational
+    bristle-damping decay, square-root valve) over the whole 60 s two-axis Green Run,
+    engine angles against the same kernel at 2.5e-5 s (16x finer; itself within 2.3e-7 deg
+    of a 1.25e-5 s run, benchmarks/bench_taos3d.py part 4): the default step within 1e-4 deg
+    (the acceptance is 1e-3; measured 2.0e-5), and the error falls at second order, at least
+    3x per halving (measured 1.97e-5 / 5.0e-6 / 1.1e-6 deg at 4e-4 / 2e-4 / 1e-4 s; the
+    reference run in the test: about 15 s at machine load 5). With the former exponential decay the same runs gave 6.0e-3 / 7.7e-3 /
+    7.7e-3 deg: no step-converged solution (docs/theory/taos3d.md)."""
+    tm = load_taos_model("models/rs25_hotfire.toml", friction="modified-lugre")
+    assert tm.base.actuator.pressure_limited
+
+    def run(dt):
+        n = int(round(60.0 / dt))
+        cmd = np.ascontiguousarray(np.asarray(_greenrun()(np.arange(n + 1) * dt)).T)
+        return run_samples(tm, cmd, dt, int(round(REC_S / dt)))[:, 0:2]
+
+    ref = run(REF_DT)
+    e4, e2, e1 = (np.degrees(np.abs(run(dt) - ref).max()) for dt in (DEFAULT_DT_S, 2e-4, 1e-4))
+    print("60 s, shipped modified LuGre: max |d theta| deg at 4e-4, 2e-4, 1e-4 s:", e4, e2, e1)
+    assert e4 < 1e-4
+    assert e2 < e4 / 3 and e1 < e2 / 3
 
 
 @pytest.mark.parametrize("rounding", [False, True])

@@ -122,10 +122,13 @@ def lugre_zdot(v, z, p):
 
 @njit(cache=True, inline="always")
 def _sigma1(v, p):
-    """sigma_1(v) = sigma_1 exp(-(v/v_1)^2), constant when v_1 = 0 (Canudas 1995, eq. 9)."""
+    """Bristle damping sigma_1(v) = sigma_1 v_1 / (v_1 + |v|) [N m s/rad], constant when
+    v_1 = 0: |v| sigma_1(v) rises monotonically to sigma_1 v_1, so the torque at a frozen
+    bristle state never falls with the rate (this project's decay law, in place of the
+    exponential of Canudas de Wit et al. 1995: :class:`taos.friction.LuGre`)."""
     v1 = p[SLOT_V1]
     if v1 > 0.0:
-        return p[SLOT_SIGMA1] * math.exp(-(v / v1) ** 2)
+        return p[SLOT_SIGMA1] * v1 / (v1 + abs(v))
     return p[SLOT_SIGMA1]
 
 

@@ -292,16 +292,35 @@ class Dahl(FrictionLaw):
 
 @dataclass(frozen=True)
 class LuGre(FrictionLaw):
-    """LuGre friction (Canudas de Wit et al. 1995).
+    """LuGre friction (Canudas de Wit et al. 1995), with a rational bristle-damping decay.
 
     dz/dt = v - sigma_0 |v| z / g(v),  g(v) = T_c + (T_s - T_c) exp(-|v/v_s|^delta),
-    T_f = sigma_0 z + sigma_1(v) dz/dt + sigma_2 v,  sigma_1(v) = sigma_1 exp(-(v/v_1)^2)
+    T_f = sigma_0 z + sigma_1(v) dz/dt + sigma_2 v,  sigma_1(v) = sigma_1 v_1 / (v_1 + |v|)
     (constant if v_1 = 0).
 
     Steady state g(v) sgn(v) + sigma_2 v. Passivity (Barabanov & Ortega 2000; from the
     storage sigma_0 z^2/2): the power balance is a quadratic form in (z, v) that is
-    non-negative when |v| sigma_1(v)^2 <= 4 g(v) (sigma_1(v) + sigma_2); a decaying sigma_1
-    (v_1 > 0) keeps it for all v. :meth:`passive_at` evaluates the condition.
+    non-negative when |v| sigma_1(v)^2 <= 4 g(v) (sigma_1(v) + sigma_2); :meth:`passive_at`
+    evaluates it. With the rational decay |v| sigma_1(v) < sigma_1 v_1, so it holds at every
+    rate while sigma_1 v_1 <= 4 min g (and, for the modified law, where h(v) >= (2/pi) |v| / V_d
+    below V_d, while sigma_1 <= 8 min G / (pi V_d)); :meth:`passivity_ratios` gives both
+    ratios (at most 1: passive). Constant sigma_1 (v_1 = 0) is not passive above
+    4 g / sigma_1 unless sigma_2 covers it.
+
+    Incremental condition: in series with a compliance and a (nearly) massless part (the
+    3-D model's gimbal bearing, :mod:`taos.friction._vector`) the torque at a frozen bristle
+    state must not fall with the rate, dT_f/dv >= 0; above V_d that is
+    (1 - sigma_0 z sgn(v) / g) d(|v| sigma_1(v))/d|v| + sigma_2 >= 0, so |v| sigma_1(v) must
+    not decrease. The decay exp(-(v/v_1)^2) of Canudas de Wit et al. (1995, eq. 9) fails it
+    above v_1 / sqrt 2 (|v| sigma_1(v) peaks there and falls to 0): the bearing's equations
+    then have impasse points (the slip jumps, with no step-converged solution over a Green
+    Run; docs/theory/taos3d.md). The rational decay keeps the purpose of the exponential
+    (sigma_1(v) -> 0 in sliding, so the law is passive at every rate) while
+    d(|v| sigma_1(v))/d|v| = sigma_1 v_1^2 / (v_1 + |v|)^2 > 0: it replaces it in this
+    project, for ``lugre`` and ``modified-lugre`` alike (one definition,
+    :func:`taos.friction._kernels._sigma1`; the parameters sigma_1 and v_1 keep their names
+    and meaning: sigma_1(0) = sigma_1, and v_1 the rate where the damping has decayed to
+    sigma_1 / 2, 1/e with the exponential).
     """
 
     name: ClassVar[str] = "lugre"
@@ -327,20 +346,34 @@ class LuGre(FrictionLaw):
         return np.ones_like(np.asarray(v, float))
 
     def _sigma1(self, v):
+        """sigma_1(v) = sigma_1 v_1 / (v_1 + |v|) [N m s/rad] (the kernels' ``_sigma1``)."""
+        v = np.abs(np.asarray(v, float))
         v1 = self.damping_decay_velocity_rad_s
         s1 = self.bristle_damping_Nms_per_rad
-        return s1 * np.exp(-(np.asarray(v, float) / v1) ** 2) if v1 > 0 else s1 + 0 * np.asarray(v, float)
+        return s1 * v1 / (v1 + v) if v1 > 0 else s1 + 0 * v
 
     def steady_state(self, v):
         v = np.asarray(v, float)
         return self._g(v) * self._h(v) * np.sign(v) + self.viscous_damping_Nms_per_rad * v
 
     def passive_at(self, v) -> np.ndarray:
-        """True where the passivity condition |v| sigma_1^2 <= 4 g (sigma_1 + sigma_2) holds."""
+        """True where the passivity condition |v| sigma_1(v)^2 <= 4 g(v) (sigma_1(v) + sigma_2)
+        holds, at rates ``v`` [rad/s]."""
         v = np.asarray(v, float)
         s1 = self._sigma1(v)
         g = self._g(v) * self._h(v)
         return np.abs(v) * s1 ** 2 <= 4.0 * g * (s1 + self.viscous_damping_Nms_per_rad) + 1e-300
+
+    def passivity_ratios(self) -> tuple[float, float]:
+        """(sigma_1 v_1 / (4 g_min), sigma_1 pi V_d / (8 g_min)), g_min = min(T_s, T_c) the
+        Stribeck curve's lowest level: both at most 1 make the law passive at every rate
+        (sufficient, sigma_2 ignored; class docstring). The first is infinite for a constant
+        sigma_1 > 0 (v_1 = 0); the second is 0 without vibration (V_d = 0, plain LuGre)."""
+        gmin = min(self.static_torque_Nm, self.coulomb_torque_Nm)
+        s1, v1 = self.bristle_damping_Nms_per_rad, self.damping_decay_velocity_rad_s
+        vd = getattr(self, "vibration_velocity_rad_s", 0.0)
+        first = s1 * v1 / (4.0 * gmin) if v1 > 0 else (math.inf if s1 > 0 else 0.0)
+        return first, s1 * math.pi * vd / (8.0 * gmin)
 
     def validate(self, source, section="friction"):
         if not self.bristle_stiffness_Nm_per_rad > 0:
@@ -366,7 +399,8 @@ class ModifiedLuGre(LuGre):
     (bristle relaxation rate sigma_0 pi V_d / (2 T_s) there, finite). With V_d = 0 the law is
     exactly LuGre (h = 1); the packed kernels are identical. Basis: the averaging argument of
     DESIGN.md and the paper's companion work on vibration-reduced stiction (ref. 2 of the
-    seed paper). Passivity as for LuGre with g including h.
+    seed paper). Passivity as for LuGre with g including h (below V_d the bound
+    sigma_1 <= 8 min G / (pi V_d) of :meth:`LuGre.passivity_ratios`).
     """
 
     name: ClassVar[str] = "modified-lugre"

@@ -28,6 +28,16 @@ by one backward-Euler step, solved exactly (:func:`coeff_bearing_step` for every
 torque is T = a(|w|) w + b(|w|) z_n, :func:`switching_bearing_step` for the stick-slip law).
 The 3-D model's normal-load scaling of the torque levels is
 :meth:`taos.friction.FrictionLaw.scaled`.
+
+Well-posedness of that series connection needs the torque at a frozen bristle state not to
+fall with the slip rate, dT_u/ds >= 0 (beyond the law's passivity): for LuGre above V_d,
+(1 - sigma_0 z.u / g) d(s sigma_1(s))/ds + sigma_2 >= 0. The rational decay of sigma_1
+(:func:`._kernels._sigma1`, sigma_1 v_1 / (v_1 + s)) meets it at every slip rate; the
+exponential decay of Canudas de Wit et al. (1995) broke it above v_1 / sqrt 2, where the
+torque peaked and fell back to sigma_0 z, and the bearing equation had impasse points (the
+slip jumped; docs/theory/taos3d.md, :class:`taos.friction.LuGre`).
+:func:`bristle_coeffs` and :func:`bristle_torque3` take the damping's value, so a reference
+decay law reuses them (benchmarks/bench_taos3d.py keeps the exponential that way).
 """
 
 from __future__ import annotations
@@ -114,12 +124,18 @@ def smooth_torque3(w0, w1, p):
 
 
 @njit(cache=True, inline="always")
-def lugre_torque3(w0, w1, z0, z1, dz0, dz1, p):
-    s = math.sqrt(w0 * w0 + w1 * w1)
-    s1 = _sigma1(s, p)
+def bristle_torque3(w0, w1, z0, z1, dz0, dz1, s1, p):
+    """T = sigma_0 z + s1 z' + sigma_2 w with the bristle damping's value ``s1`` [N m s/rad]
+    at the slip speed (the LuGre torque for any decay law of sigma_1)."""
     s0 = p[SLOT_SIGMA0]
     s2 = p[SLOT_SIGMA2]
     return s0 * z0 + s1 * dz0 + s2 * w0, s0 * z1 + s1 * dz1 + s2 * w1
+
+
+@njit(cache=True, inline="always")
+def lugre_torque3(w0, w1, z0, z1, dz0, dz1, p):
+    s = math.sqrt(w0 * w0 + w1 * w1)
+    return bristle_torque3(w0, w1, z0, z1, dz0, dz1, _sigma1(s, p), p)
 
 
 # -- implicit-step coefficients: T = a w + b z_n, z_new = (z_n + dt kappa w) / (1 + dt kappa rho) ------
@@ -138,13 +154,19 @@ def dahl_coeffs(s, p, dt, kappa):
 
 
 @njit(cache=True, inline="always")
-def lugre_coeffs(s, p, dt, kappa):
+def bristle_coeffs(s, p, dt, kappa, s1):
+    """(a, b) of the LuGre torque over an implicit step at slip speed ``s`` with the bristle
+    damping's value ``s1`` [N m s/rad] there (any decay law of sigma_1)."""
     rho = lugre_rho(s, p)
     hk = dt * kappa
     den = 1.0 + hk * rho
-    s1 = _sigma1(s, p)
     s0 = p[SLOT_SIGMA0]
     return (s0 * hk + s1) / den + p[SLOT_SIGMA2], (s0 - s1 * rho) / den
+
+
+@njit(cache=True, inline="always")
+def lugre_coeffs(s, p, dt, kappa):
+    return bristle_coeffs(s, p, dt, kappa, _sigma1(s, p))
 
 
 # -- the bearing step ------------------------------------------------------------------------------

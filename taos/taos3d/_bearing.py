@@ -31,21 +31,21 @@ switching, Dahl, whose torque never falls with the slip rate at fixed z) keep th
 What the control resolves is the law's own fast
 dynamics: with massless gimbal halves the slip rate is algebraic (the chain compliance Kc in
 series with the friction element), and a law whose torque falls with the slip rate at
-fixed z (modified LuGre's bristle damping sigma_1(s) s decays above v_1 / sqrt 2) has an
-unstable fast mode there, rate (1 + Kc sigma_0) / (Kc |dT/dw|): the massless bearing's
-relaxation oscillation (stick-slip chatter, jumps of the slip rate where a branch of the
-implicit equation folds). A fixed body step either smooths it away (h > Kc |dT/dw|: the
-implicit equation single-valued) or places its jumps at the step's grid; the substeps place
-them to the tolerance.
+fixed z (a Stribeck law with T_s > T_c; modified LuGre's vibration factor just below V_d when
+the bristles oppose the slip) has an unstable fast mode there, rate
+(1 + Kc sigma_0) / (Kc |dT/dw|): the massless bearing's relaxation oscillation (stick-slip
+chatter, jumps of the slip rate where a branch of the implicit equation folds). A fixed body
+step either smooths it away (h > Kc |dT/dw|: the implicit equation single-valued) or places
+its jumps at the step's grid; the substeps place them to the tolerance.
 
-Measured (two-axis Green Run, hot fire; benchmarks/RESULTS.md, tests/test_taos3d_step.py): on
-the first 4 s, against the former kernel at a uniform 1.5625e-6 s, the engine angle error of
-modified LuGre is 6.0e-4 / 3.7e-4 / 6.3e-5 deg at 4e-4 / 2e-4 / 1e-4 s (former kernel
-1.08e-2 deg at all three: it smoothed the chatter out). Over 60 s the fine references
-themselves differ by 4-7e-3 deg (chatter events near t = 13.6 and 32.5 s whose jump timing
-the finest steps do not settle), so 60 s figures below that level are not meaningful.
-Cost: the 60 s run at 4e-4 s takes about 2.5x the former kernel's time (the chatter is
-frequent in the 0.8 deg segments).
+The shipped LuGre laws keep the torque rising with the slip rate above V_d (the rational
+bristle-damping decay, :class:`taos.friction.LuGre`), so the bearing equation has no impasse
+points. Measured (two-axis Green Run, hot fire, modified LuGre; benchmarks/RESULTS.md,
+tests/test_taos3d_step.py): over the whole 60 s the engine angle is within 2.0e-5 / 5.1e-6 /
+1.1e-6 deg of a 1.25e-5 s run at 4e-4 / 2e-4 / 1e-4 s (second order). With the former
+exponential decay the torque peaked at v_1 / sqrt 2 and fell back to sigma_0 z with no rising
+branch, the slip jumped in one substep at impasse points, and no step converged (6-8e-3 deg
+at every step; docs/theory/taos3d.md, why the bristle damping decays rationally).
 
 The engine sees the bearing torque's mean over the step (trapezoid over the substeps), as the
 velocity kick of :func:`taos.taos3d.dynamics.step`.

@@ -45,12 +45,12 @@ Time stepping (second order in the bearing coupling):
 
 Against a fine reference on the 60 s two-axis Green Run (first 4 s) the smooth laws' error
 at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler bearing) at
-2e-4 s. Modified LuGre's massless bearing has an unstable fast mode where its torque falls
-with the slip rate at fixed z (the bristle damping sigma_1(s) s decays above v_1 / sqrt 2):
-the fine-step solution chatters there (relaxation oscillation of the slip rate), which a
-fixed 4e-4 s (or anything down to 2.5e-5 s) implicit step damped away (error 1.1e-2 deg at
-every step); the bearing substeps resolve it: 6.0e-4 deg at 4e-4 s, falling with the step
-(tests/test_taos3d_step.py, benchmarks/RESULTS.md). The stiff bearing time constant
+2e-4 s. Where a law's torque falls with the slip rate at fixed z the massless bearing has an
+unstable fast mode (a relaxation oscillation of the slip rate), which a fixed implicit step
+damps away; the bearing substeps resolve it. The shipped LuGre laws' torque rises with the
+slip rate (rational bristle-damping decay), and modified LuGre's 60 s engine angle converges
+at second order: 2.0e-5 deg at 4e-4 s against a 1.25e-5 s run (tests/test_taos3d_step.py,
+benchmarks/RESULTS.md; :mod:`taos.taos3d._bearing`, docs/theory/taos3d.md). The stiff bearing time constant
 never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
 the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
 omega dt < 2.8 for RK4); accuracy sets the default 4e-4 s. A quantised command is piecewise
