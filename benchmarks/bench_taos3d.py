@@ -12,7 +12,7 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
    shared: both are printed).
 2. Accuracy of the step: 4 s of the same run (modified LuGre, and Coulomb smooth, whose error
    is not masked by stick-slip timing) against a 2.5e-5 s reference, at the default step and
-   at 2e-4 s (the former kernel's stored records, tests/data/taos3d_kernel_2e-4_held.npz,
+   at 2e-4 s (the former kernel's stored records, removed from tests/data (git history),
    predate the servo recalibration and the pressure limit of issue 24: no longer the same
    model, not compared). Then sine dwells (``taos_freqresp_family``, pitch, 0.5-20 Hz, 0.05 and
    0.4 deg) at the default step and 2e-4 s against 6.25e-6 s, and the 1.25e-5 s run against

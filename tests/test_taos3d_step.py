@@ -48,7 +48,7 @@ def test_default_step_against_a_16x_finer_reference(law):
     """Error of the default step (4e-4 s) against a 2.5e-5 s reference, first 4 s of the
     Green Run (+-0.45 deg): within 5 microdegrees for every law (measured: modified LuGre
     0.6, Coulomb smooth and switching, Dahl 0.7-1.2). The former kernel's stored records
-    (tests/data/taos3d_kernel_2e-4_held.npz, 2e-4 s) predate the servo recalibration and the
+    (2e-4 s, removed; in git history before this file's rational-decay change) predate the servo recalibration and the
     pressure limit (issue 24.1, 24.2): against this model they are 1.1-1.3e-3 rad off, a
     different model, so the former-kernel ratios (0.010-0.031 for the smooth laws,
     benchmarks/RESULTS.md) are history, not re-measured here."""

@@ -56,7 +56,7 @@ MEANINGS: dict[str, str] = {
     "friction.stribeck_exponent": "Stribeck shape exponent delta",
     "friction.bristle_stiffness": "bristle (pre-sliding) stiffness sigma_0",
     "friction.bristle_damping": "bristle damping sigma_1",
-    "friction.damping_decay_velocity": "rate above which the bristle damping decays, v_1",
+    "friction.damping_decay_velocity": "bristle-damping decay rate v_1: sigma_1(v) = sigma_1 v_1/(v_1 + |v|), half at v_1",
     "friction.viscous_damping": "viscous friction sigma_2",
     "friction.vibration_velocity": "vibration rate amplitude V_d of the modified LuGre law",
     "friction.stick_velocity": "stick band of the switching Coulomb law",
