@@ -28,6 +28,7 @@ EXPECT = {
     "plot_masv_coupling.py": ["strongest engine-to-engine", "below the direct response"],
     "plot_control_interop.py": ["python-control: gain margin", "taos.loop_margins: phase margin"],
     "plot_custom_friction_law.py": ["(viscous-coulomb-example)", "with c = 2e5 N m s/rad"],
+    "plot_fmu_in_fmpy.py": ["FMPy validation problems: []", "max engine-angle difference 0 deg"],
 }
 
 
