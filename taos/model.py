@@ -28,7 +28,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
-import tomllib
 import types
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -341,17 +340,14 @@ def parse_avionics(doc: Mapping, src: str) -> Avionics:
 
 
 def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
-    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it cannot
-    be read (``what`` says what was expected, e.g. "a readable model file") or is not TOML."""
-    src = str(path)
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as e:
-        raise InputError(src, "(file)", what, got=e.strerror) from None
-    try:
-        return raw, tomllib.loads(raw.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
-        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it is not
+    a readable regular file of at most :data:`taos.errors.MAX_TOML_BYTES` (``what`` says what was
+    expected, e.g. "a readable model file"), is not TOML, or nests deeper than
+    :data:`taos.errors.MAX_TOML_DEPTH`. A FIFO or device never blocks or floods the run."""
+    from .errors import parse_toml, read_input_bytes
+
+    raw = read_input_bytes(path, what)
+    return raw, parse_toml(raw, str(path))
 
 
 #: ``[friction]`` key naming the shared friction parameter set of one piece of hardware

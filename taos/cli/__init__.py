@@ -3,15 +3,49 @@
 Each subcommand lives in a small module with ``add_parser(subparsers)`` and ``run(args)``;
 register new ones in :data:`COMMANDS`. Bad input exits with status 2 and one line naming
 the file, the field and what was expected; an unstable simulation exits with status 3.
+
+Ctrl-C and SIGTERM during start-up (importing the command modules, before
+:func:`taos.errors.run_cli` takes over) end the process at once with one line and status 130 /
+143: nothing has been written yet. The handlers are installed when this module is imported,
+the first thing the ``taos`` console script and ``python -m taos`` do.
 """
 
 from __future__ import annotations
 
-import argparse
-import importlib
+import os
+import signal
 import sys
+import threading
 
-from taos.errors import run_cli as run
+
+def _startup_signal(signum, frame):  # pragma: no cover - exercised in a subprocess
+    what = "interrupted (Ctrl-C)" if signum == signal.SIGINT else f"terminated (signal {signum})"
+    os.write(2, f"taos: {what} during start-up; nothing written\n".encode())
+    os._exit(128 + signum)
+
+
+def install_startup_signals() -> None:
+    """Ctrl-C / SIGTERM -> one line and exit 130 / 143 until the run's own handling starts (only
+    in the main thread of a process started as a command line, never when imported as a library
+    by a program that has its own handlers)."""
+    if threading.current_thread() is threading.main_thread():
+        for s in (signal.SIGINT, signal.SIGTERM):
+            if signal.getsignal(s) in (signal.default_int_handler, signal.SIG_DFL):
+                signal.signal(s, _startup_signal)
+
+
+def _is_console() -> bool:
+    argv0 = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    return argv0 in ("taos", "masv", "__main__.py") or sys.argv[:1] == ["-m"]
+
+
+if _is_console():
+    install_startup_signals()
+
+import argparse  # noqa: E402
+import importlib  # noqa: E402
+
+from taos.errors import run_cli as run  # noqa: E402
 
 #: subcommand modules, in help order
 COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.export",
@@ -27,7 +61,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run(build_parser(), argv)
+    """The ``taos`` console script: build the parser and run (:func:`taos.errors.run_cli`); a
+    Ctrl-C while the command modules load still ends with one line and status 130."""
+    try:
+        parser = build_parser()
+    except KeyboardInterrupt:
+        print("taos: interrupted (Ctrl-C) during start-up; nothing written", file=sys.stderr)
+        return 130
+    return run(parser, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover
