@@ -28,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
+import os
 import types
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -488,18 +489,22 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
 def _input_files(p: Path, raw: bytes, doc: Mapping) -> dict[str, tuple[str, str]]:
     """role -> (path, SHA-256) of the model file and the shared files it names (parameter sets,
     the 3-D ``[gimbal] stiffness_file`` when it exists; a missing one is the 3-D loader's error)."""
+    from .errors import check_input_file
+    from .results import file_sha256
+
     files = {"model": (str(p), hashlib.sha256(raw).hexdigest())}
     for sec in ("actuator", "friction"):
         ref = doc.get(sec, {}).get(PARAMETER_SET_KEY) if isinstance(doc.get(sec), Mapping) else None
         if isinstance(ref, str) and ref:
             q = resolve_parameter_set(ref, p)
-            files[f"{sec}_parameter_set"] = (str(q), hashlib.sha256(q.read_bytes()).hexdigest())
+            files[f"{sec}_parameter_set"] = (str(q), file_sha256(q))
     gim = doc.get("gimbal")
     ref = gim.get("stiffness_file") if isinstance(gim, Mapping) else None
-    if isinstance(ref, str) and ref:
+    if isinstance(ref, str) and ref:   # read only, relative to the model file; a regular file of bounded size
         q = (p.parent / ref).resolve()
-        if q.is_file():
-            files["stiffness_file"] = (str(q), hashlib.sha256(q.read_bytes()).hexdigest())
+        if os.path.lexists(q):
+            check_input_file(q, "a stiffness matrix file (.npz or .csv)", field="gimbal.stiffness_file")
+            files["stiffness_file"] = (str(q), file_sha256(q))
     return files
 
 
@@ -541,8 +546,9 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}
     files = _input_files(p, raw, doc)
-    from .bounds import check_model_plausible
+    from .bounds import check_model_bounds, check_model_plausible
 
+    check_model_bounds(src, engine, actuator, structure, avionics, ftab, extra)
     check_model_plausible(src, engine, actuator, structure)
     return TvcModel(name=str(doc.get("name", p.stem)), engine=engine, actuator=actuator,
                     structure=structure, friction=law, avionics=avionics, source=src,

@@ -177,6 +177,9 @@ def _value(table: Mapping, key: str, unit: str, check: str, src: str, section: s
             raise InputError(src, fld, expected, got=f"{v!r} (no unit)")
         q = Q_(float(v), "dimensionless")
     else:
+        from taos.units import check_value_text
+
+        check_value_text(v, src, fld, expected)
         try:
             q = Q_(v)
         except Exception:
