@@ -252,3 +252,42 @@ def check_model_bounds(src: str, engine, actuator, structure, avionics, friction
             if arm is not None and abs(arm - R) > MOMENT_ARM_TOLERANCE * R:
                 raise InputError(src, "actuator.moment_arm", f"the lever arm of the [geometry] {axis} attachment "
                                  f"points ({arm:.4g} m) within {100 * MOMENT_ARM_TOLERANCE:g} %", got=f"{R:.4g} m")
+
+
+# -- the Python API's arguments, checked as the command line checks them --------------------
+
+AXES = ("pitch", "yaw")
+
+
+def check_axis(axis, field: str = "axis", source: str = "argument") -> str:
+    """``axis`` is 'pitch' or 'yaw' (InputError naming the argument otherwise)."""
+    if axis not in AXES:
+        raise InputError(source, field, "'pitch' or 'yaw'", got=repr(axis)[:40])
+    return axis
+
+
+def check_grid(values, field: str, unit: str, lo: float = 0.0, hi: float = math.inf,
+               source: str = "argument") -> np.ndarray:
+    """A non-empty 1-D grid of finite values in (``lo``, ``hi``] (frequencies [Hz], amplitudes
+    [rad]) as a float array; InputError naming ``field`` for an empty grid, a NaN, a zero or
+    negative value: the API never answers them with NaN or a silent result."""
+    try:
+        a = np.atleast_1d(np.asarray(values, float)).ravel()
+    except (TypeError, ValueError):
+        raise InputError(source, field, f"numbers in {unit}", got=repr(values)[:60]) from None
+    if a.size == 0:
+        raise InputError(source, field, f"at least one value in {unit}", got="an empty grid")
+    bad = np.flatnonzero(~(np.isfinite(a) & (a > lo) & (a <= hi)))
+    if bad.size:
+        raise InputError(source, field, f"finite values above {lo:g} {unit}" + ("" if hi == math.inf else
+                         f" and at most {hi:g} {unit}"), got=f"{a[bad[0]]:g} {unit}")
+    return a
+
+
+def check_response_args(freq_hz, amplitudes_rad=None, axis: str = "pitch") -> None:
+    """The arguments of the frequency-response and describing-function API: frequencies in
+    :data:`RESPONSE_FREQ_HZ`, amplitudes positive and within 90 deg, a known axis."""
+    check_axis(axis)
+    check_grid(freq_hz, "freq_hz", "Hz", 0.0, RESPONSE_FREQ_HZ[1])
+    if amplitudes_rad is not None:
+        check_grid(amplitudes_rad, "amplitudes_rad", "rad", 0.0, math.pi / 2)

@@ -252,10 +252,15 @@ def from_si(value: float, si_unit: str, unit: str) -> float:
 
 
 def parse_float_list(text: str, option: str, source: str = "command line") -> list[float]:
-    """'0.1,0.5,1' -> [0.1, 0.5, 1.0] (a command-line option's list of numbers); refuses empty,
+    """'0.1,0.5,1' -> [0.1, 0.5, 1.0] (a command-line option's list of numbers); refuses an empty
+    list or item (a double or trailing comma),
     non-numeric, non-positive or non-finite items (:class:`~taos.errors.InputError` naming ``option``)."""
+    if not isinstance(text, str) or not text.strip() or len(text) > 10000:
+        raise InputError(source, option, "a comma-separated list of numbers like 0.1,0.5,1", got=repr(text)[:40])
+    if any(not s.strip() for s in text.split(",")):
+        raise InputError(source, option, "numbers separated by single commas (no empty item)", got=repr(text)[:60])
     try:
-        vals = [float(s) for s in text.split(",") if s.strip()]
+        vals = [float(s) for s in text.split(",")]
     except ValueError:
         raise InputError(source, option, "a comma-separated list of numbers like 0.1,0.5,1",
                          got=repr(text)) from None
