@@ -284,6 +284,11 @@ def parse_actuator(doc: Mapping, src: str) -> Actuator:
                 "relief_flow_coefficient"}
     kw = {_ACTUATOR_SI[k]: _need(s, k, kind, src, "actuator", **{chk: True})
           for k, (kind, chk) in _ACTUATOR_FIELDS.items() if k not in optional or k in s}
+    from .bounds import MODEL_BOUNDS, check_bound
+
+    for key, si_name in _ACTUATOR_SI.items():   # the bounds first: a cross-field check names the right field
+        if si_name in kw and f"actuator.{key}" in MODEL_BOUNDS and not (key in optional and kw[si_name] == 0.0):
+            check_bound(kw[si_name], f"actuator.{key}", src)
     if kw.get("pressure_feedback_gain_m_per_s_Pa", 0.0) > 0 and not kw.get(
             "pressure_feedback_time_constant_s", 0.0) > 0:
         raise InputError(src, "actuator.pressure_feedback_time_constant",

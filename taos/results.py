@@ -319,7 +319,7 @@ def check_output_file(path: str | Path, field: str = "(output)", suffixes: tuple
         return p
     try:
         st = os.lstat(p)
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):
         st = None
     except OSError as e:
         raise _output_error(path, e, field) from None

@@ -368,6 +368,9 @@ def load_test_data(path: str | Path, *, resample: bool = True) -> TestData:
     src = str(path)
     if not p.exists():
         raise InputError(src, "(file)", "an existing data file", got="no such file")
+    from taos.errors import check_input_file
+
+    check_input_file(p, "a readable data file (.csv or .h5)")
     if p.suffix.lower() in (".h5", ".hdf5"):
         meta, sig, labels = _read_hdf5(p, src)
     elif p.suffix.lower() in (".csv", ".txt"):
