@@ -13,25 +13,18 @@ the first thing the ``taos`` console script and ``python -m taos`` do.
 from __future__ import annotations
 
 import os
-import signal
 import sys
 import threading
 
 
-def _startup_signal(signum, frame):  # pragma: no cover - exercised in a subprocess
-    what = "interrupted (Ctrl-C)" if signum == signal.SIGINT else f"terminated (signal {signum})"
-    os.write(2, f"taos: {what} during start-up; nothing written\n".encode())
-    os._exit(128 + signum)
-
-
 def install_startup_signals() -> None:
-    """Ctrl-C / SIGTERM -> one line and exit 130 / 143 until the run's own handling starts (only
-    in the main thread of a process started as a command line, never when imported as a library
-    by a program that has its own handlers)."""
+    """Ctrl-C / SIGTERM -> one line and exit 130 / 143 until the run's own handling starts
+    (:func:`taos._startup_signals`; already installed when the package was imported by a
+    command line)."""
+    import taos
+
     if threading.current_thread() is threading.main_thread():
-        for s in (signal.SIGINT, signal.SIGTERM):
-            if signal.getsignal(s) in (signal.default_int_handler, signal.SIG_DFL):
-                signal.signal(s, _startup_signal)
+        taos._startup_signals()
 
 
 def _is_console() -> bool:
