@@ -9,7 +9,10 @@ was expected. The CLI prints ``str(err)`` and exits with status 2
 from __future__ import annotations
 
 import difflib
-from typing import Iterable, Mapping
+import os
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Callable, Iterable, Mapping
 
 
 class InputError(ValueError):
@@ -136,8 +139,6 @@ def check_input_file(path, what: str, max_bytes: int = MAX_DATA_BYTES, field: st
         raise InputError(str(path), field, what + " (a regular file)", got=kind)
     if st.st_size > max_bytes:
         raise InputError(str(path), field, f"{what} of at most {max_bytes} bytes", got=f"{st.st_size} bytes")
-    from .results import note_input
-
     note_input(path)
     return st.st_size
 
@@ -188,52 +189,57 @@ def parse_toml(raw: bytes, src: str, max_depth: int = MAX_TOML_DEPTH) -> dict:
     return doc
 
 
+# -- the run's inputs and the replace policy of its outputs (taos.results) ---------------
+
+#: ``--force``: replace an existing regular file this program did not write (set by the CLI)
+_FORCE: ContextVar[bool] = ContextVar("taos_force_replace", default=False)
+#: (device, inode) and resolved path of every input read in this CLI run (None: not recorded)
+_INPUTS: ContextVar[set | None] = ContextVar("taos_inputs", default=None)
+
+
+@contextmanager
+def output_policy(force: bool = False, record_inputs: bool = True):
+    """Within the block, outputs may replace foreign regular files (``force``, the CLI's
+    ``--force``) and, with ``record_inputs``, every input file read (:func:`note_input`) is
+    remembered so that no output replaces it, ``--force`` or not."""
+    t1 = _FORCE.set(bool(force))
+    t2 = _INPUTS.set(set() if record_inputs else None)
+    try:
+        yield
+    finally:
+        _FORCE.reset(t1)
+        _INPUTS.reset(t2)
+
+
+def _identity(path) -> tuple | None:
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return (st.st_dev, st.st_ino)
+
+
+def note_input(path) -> None:
+    """Remember ``path`` as an input of this run (no output may replace it)."""
+    seen = _INPUTS.get()
+    ident = _identity(path)
+    if seen is not None and ident is not None:
+        seen.add(ident)
+
+
+def check_not_input(path, field: str, inputs=()) -> None:
+    """Refuse an output place that is, or links to, one of ``inputs`` or an input read so far."""
+    ident = _identity(path)
+    if ident is None:
+        return
+    known = set(_INPUTS.get() or ()) | {i for i in map(_identity, inputs) if i is not None}
+    if ident in known:
+        raise InputError(str(path), field, "an output place that is not one of the run's inputs "
+                         "(an output never replaces an input)", got="an input file")
+
+
+
 # -- the exit-status contract of the command lines (taos and masv) --------------------------
-
-#: options that name an output place (file or folder); every other path argument is an input
-OUTPUT_OPTIONS = ("json", "out", "plot", "html", "df_out", "out_model", "plot_df", "plot_time", "plot_map")
-#: options that name an output file (``--out`` is a file or a folder, checked by its command)
-_OUTPUT_FILE_OPTIONS = {"json": (), "html": (".html", ".htm"), "df_out": (), "out_model": (),
-                        "plot": (".png", ".svg"), "plot_df": (".png", ".svg"), "plot_time": (".png", ".svg"),
-                        "plot_map": (".png", ".svg")}
-
-
-def _input_paths(args) -> list[str]:
-    """Every argument value (positional or option, lists included) other than an output option
-    that names an existing path: the run's inputs as the user gave them."""
-    import os
-
-    out = []
-    for k, v in vars(args).items():
-        if k in OUTPUT_OPTIONS or k == "func":
-            continue
-        for x in (v if isinstance(v, (list, tuple)) else [v]):
-            if isinstance(x, str) and x and len(x) < 4096 and "\0" not in x and os.path.exists(x):
-                out.append(x)
-    return out
-
-
-def check_arguments(args) -> None:
-    """Checks every command shares, before any work: a seed is a 32-bit unsigned whole number;
-    an output option is not empty, is not one of the inputs (nor a link to one) and names a place
-    :func:`taos.results.check_output_file` accepts."""
-    from .results import check_not_input, check_output_file
-
-    seed = getattr(args, "seed", None)
-    if isinstance(seed, int) and not 0 <= seed < 2 ** 32:
-        raise InputError("command line", "--seed", "a whole number from 0 to 4294967295", got=str(seed))
-    inputs = _input_paths(args)
-    for k in OUTPUT_OPTIONS:
-        v = getattr(args, k, None)
-        if v is None or v == "-":
-            continue
-        opt = "--" + k.replace("_", "-")
-        if not isinstance(v, str) or not v.strip():
-            raise InputError("command line", opt, "a file or folder name", got=repr(v))
-        check_not_input(v, opt, inputs)
-        if k in _OUTPUT_FILE_OPTIONS:
-            check_output_file(v, opt, _OUTPUT_FILE_OPTIONS[k])
-
 
 class _Signals:
     """SIGINT/SIGTERM handling of one command-line run: the handler records the signal before it
@@ -252,13 +258,15 @@ class _Signals:
         raise Interrupted(signum)
 
 
-def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None) -> int:
+def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
+            check: Callable[[object], None] | None = None) -> int:
     """Parse and dispatch; every failure ends with one line on standard error (no traceback
     unless ``--debug``): bad input -> exit 2, an unstable run or one that left its envelope ->
     exit 3, Ctrl-C -> exit 130, SIGTERM -> exit 143, anything unexpected -> exit 1.
 
     ``--force`` (any command) lets an output replace an existing regular file this program did
-    not write (:mod:`taos.results`); nothing ever replaces an input."""
+    not write (:mod:`taos.results`); nothing ever replaces an input. ``check(args)`` runs
+    before the command (``taos``: :func:`taos.results.check_arguments`)."""
     import contextlib
     import io
     import os
@@ -266,8 +274,6 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None) -> int:
     import sys
     import threading
     import traceback
-
-    from .results import output_policy
 
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv or bool(os.environ.get("TAOS_DEBUG"))
@@ -292,7 +298,8 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None) -> int:
     rc = 1
     try:
         with output_policy(force=force):
-            check_arguments(args)
+            if check is not None:
+                check(args)
             rc = int(args.func(args) or 0)
     except InputError as e:
         if debug:

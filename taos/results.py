@@ -37,7 +37,6 @@ import stat
 import subprocess
 import tempfile
 from contextlib import contextmanager
-from contextvars import ContextVar
 from functools import cache
 from importlib import metadata
 from pathlib import Path
@@ -46,7 +45,7 @@ from typing import TYPE_CHECKING, Callable, Mapping
 if TYPE_CHECKING:  # h5py is imported where a file is written (start-up of the CLI)
     import h5py
 
-from .errors import InputError
+from .errors import _FORCE, InputError, check_not_input, note_input, output_policy  # noqa: F401
 
 MARK = ".taos-output.json"
 MAX_MARK_BYTES = 16 * 2 ** 20
@@ -155,52 +154,7 @@ def input_provenance(path, kind: str, prov: dict | None = None) -> dict:
 
 # -- output safety: the folder mark, the replace policy, temporaries -------------------------
 
-#: ``--force``: replace an existing regular file this program did not write (set by the CLI)
-_FORCE: ContextVar[bool] = ContextVar("taos_force_replace", default=False)
-#: (device, inode) and resolved path of every input read in this CLI run (None: not recorded)
-_INPUTS: ContextVar[set | None] = ContextVar("taos_inputs", default=None)
 _NAME_MAX = 255
-
-
-@contextmanager
-def output_policy(force: bool = False, record_inputs: bool = True):
-    """Within the block, outputs may replace foreign regular files (``force``, the CLI's
-    ``--force``) and, with ``record_inputs``, every input file read (:func:`note_input`) is
-    remembered so that no output replaces it, ``--force`` or not."""
-    t1 = _FORCE.set(bool(force))
-    t2 = _INPUTS.set(set() if record_inputs else None)
-    try:
-        yield
-    finally:
-        _FORCE.reset(t1)
-        _INPUTS.reset(t2)
-
-
-def _identity(path: str | Path) -> tuple | None:
-    try:
-        st = os.stat(path)
-    except (OSError, ValueError):
-        return None
-    return (st.st_dev, st.st_ino)
-
-
-def note_input(path: str | Path) -> None:
-    """Remember ``path`` as an input of this run (no output may replace it)."""
-    seen = _INPUTS.get()
-    ident = _identity(path)
-    if seen is not None and ident is not None:
-        seen.add(ident)
-
-
-def check_not_input(path: str | Path, field: str, inputs=()) -> None:
-    """Refuse an output place that is, or links to, one of ``inputs`` or an input read so far."""
-    ident = _identity(path)
-    if ident is None:
-        return
-    known = set(_INPUTS.get() or ()) | {i for i in map(_identity, inputs) if i is not None}
-    if ident in known:
-        raise InputError(str(path), field, "an output place that is not one of the run's inputs "
-                         "(an output never replaces an input)", got="an input file")
 
 
 def _read_mark_doc(folder: Path) -> dict:
@@ -520,3 +474,44 @@ def toml_set(doc, section: str, key: str, value, comment: str | None = None) -> 
             ws = max(2, column - len(item.as_string()))
         item.trivia.comment_ws = " " * ws
     table[key] = item
+
+
+#: options that name an output place (file or folder); every other path argument is an input
+OUTPUT_OPTIONS = ("json", "out", "plot", "html", "df_out", "out_model", "plot_df", "plot_time", "plot_map")
+#: options that name an output file (``--out`` is a file or a folder, checked by its command)
+_OUTPUT_FILE_OPTIONS = {"json": (), "html": (".html", ".htm"), "df_out": (), "out_model": (),
+                        "plot": (".png", ".svg"), "plot_df": (".png", ".svg"), "plot_time": (".png", ".svg"),
+                        "plot_map": (".png", ".svg")}
+
+
+def _input_paths(args) -> list[str]:
+    """Every argument value (positional or option, lists included) other than an output option
+    that names an existing path: the run's inputs as the user gave them."""
+    out = []
+    for k, v in vars(args).items():
+        if k in OUTPUT_OPTIONS or k == "func":
+            continue
+        for x in (v if isinstance(v, (list, tuple)) else [v]):
+            if isinstance(x, str) and x and len(x) < 4096 and "\0" not in x and os.path.exists(x):
+                out.append(x)
+    return out
+
+
+def check_arguments(args) -> None:
+    """Checks every ``taos`` command shares, before any work (:func:`taos.errors.run_cli`'s
+    ``check``): a seed is a 32-bit unsigned whole number; an output option is not empty, is not
+    one of the inputs (nor a link to one) and names a place :func:`check_output_file` accepts."""
+    seed = getattr(args, "seed", None)
+    if isinstance(seed, int) and not 0 <= seed < 2 ** 32:
+        raise InputError("command line", "--seed", "a whole number from 0 to 4294967295", got=str(seed))
+    inputs = _input_paths(args)
+    for k in OUTPUT_OPTIONS:
+        v = getattr(args, k, None)
+        if v is None or v == "-":
+            continue
+        opt = "--" + k.replace("_", "-")
+        if not isinstance(v, str) or not v.strip():
+            raise InputError("command line", opt, "a file or folder name", got=repr(v))
+        check_not_input(v, opt, inputs)
+        if k in _OUTPUT_FILE_OPTIONS:
+            check_output_file(v, opt, _OUTPUT_FILE_OPTIONS[k])

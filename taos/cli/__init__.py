@@ -61,7 +61,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("taos: interrupted (Ctrl-C) during start-up; nothing written", file=sys.stderr)
         return 130
-    return run(parser, argv)
+    from taos.results import check_arguments
+
+    return run(parser, argv, check=check_arguments)
 
 
 if __name__ == "__main__":  # pragma: no cover
