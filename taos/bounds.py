@@ -185,9 +185,38 @@ MAX_STROKE_M = 0.5
 MOMENT_ARM_TOLERANCE = 0.1
 
 
+#: flight-file fields (``[vehicle]``, ``[fcs]``), as :data:`MODEL_BOUNDS`: launch vehicles from a
+#: sounding rocket to a super-heavy stack; flight-control gains of a stable attitude loop
+FLIGHT_BOUNDS: dict[str, tuple[float, float, str, str]] = {
+    "vehicle.mass": (1e2, 1e8, "kg", "a sounding rocket to 30 times a Saturn V (2.9e6 kg)"),
+    "vehicle.pitch_inertia": (1.0, 1e12, "kg*m**2", "SLS core stage 4.5e8 kg m^2"),
+    "vehicle.yaw_inertia": (1.0, 1e12, "kg*m**2", "SLS core stage 4.5e8 kg m^2"),
+    "vehicle.thrust_per_engine": (1.0, 1e8, "N", "F-1 6.8 MN"),
+    "vehicle.gimbal_arm": (0.1, 300.0, "m", "c.g. to gimbal of a 110 m stack is under 60 m"),
+    "vehicle.engine_mass": (0.0, 1e5, "kg", "as engine.mass of a model file"),
+    "vehicle.engine_cg_offset": (0.0, 20.0, "m", "an engine is at most ~6 m long"),
+    "vehicle.engine_inertia": (0.0, 1e7, "kg*m**2", "as engine.inertia_pitch"),
+    "vehicle.aero_instability": (0.0, 100.0, "1/s**2", "a divergence rate of 10 rad/s is no flyable vehicle"),
+    "vehicle.bending_frequency": (0.0, 1e3, "Hz", "first bending modes are 1-10 Hz"),
+    "vehicle.bending_damping_ratio": (1e-5, 10.0, "1", "structures are 0.005-0.05"),
+    "vehicle.bending_gain": (0.0, 1e3, "1", "a modal slope ratio"),
+    "fcs.attitude_gain": (1e-3, 100.0, "rad/rad", "1-3 deg/deg typical"),
+    "fcs.integral_gain": (0.0, 100.0, "1/s", "below the attitude bandwidth"),
+    "fcs.rate_gain": (0.0, 100.0, "s", "0.5-5 s typical"),
+    "fcs.lag_time_constant": (0.0, 10.0, "s", "command lags are 0.01-0.5 s"),
+    "fcs.notch_frequency": (0.0, 1e3, "Hz", "at the bending mode, 1-10 Hz"),
+    "fcs.notch_zeta_num": (0.0, 10.0, "1", "a damping ratio"),
+    "fcs.notch_zeta_den": (1e-5, 10.0, "1", "a damping ratio"),
+    "fcs.delay": (0.0, 2.0, "s", "sensor and computer delays are tens of ms"),
+}
+#: most engines of one flight file (N1: 30)
+MAX_ENGINES = 64
+
+
 def check_bound(value: float, field: str, src: str) -> float:
-    """``value`` (SI) within :data:`MODEL_BOUNDS` ``[field]``, else one line with the bounds."""
-    lo, hi, unit, why = MODEL_BOUNDS[field]
+    """``value`` (SI) within :data:`MODEL_BOUNDS` or :data:`FLIGHT_BOUNDS` ``[field]``, else one
+    line with the bounds."""
+    lo, hi, unit, why = MODEL_BOUNDS[field] if field in MODEL_BOUNDS else FLIGHT_BOUNDS[field]
     if not (math.isfinite(value) and lo <= value <= hi):
         raise InputError(src, field, f"a value from {lo:.4g} to {hi:.4g} {unit} ({why})", got=f"{value:.4g} {unit}")
     return value

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from taos.bounds import MODEL_BOUNDS
+from taos.bounds import FLIGHT_BOUNDS, MODEL_BOUNDS
 
 from .test_bad_inputs import DATA, model_text
 
@@ -60,6 +60,15 @@ def model_copy(work: Path, name: str = "m.toml", edit: Callable | None = None) -
     if edit is not None:
         edit(doc)
     return write(work, name, tomlkit.dumps(doc))
+
+
+def flight_copy(work: Path, edit: Callable) -> Path:
+    """The shipped flight file (its TVC model path made absolute), edited through tomlkit."""
+    import tomlkit
+
+    doc = tomlkit.parse(FLIGHT.read_text().replace('"../rs25_flight.toml"', f'"{MODELS}/rs25_flight.toml"'))
+    edit(doc)
+    return write(work, "f.toml", tomlkit.dumps(doc))
 
 
 def setting(section: str, key: str, value) -> Callable:
@@ -239,6 +248,8 @@ def _text(si: float, unit: str) -> str | float:
     """A model-file value of ``si`` (SI) in ``unit`` (angles in deg; a plain number for '1')."""
     if unit == "1":
         return si
+    if unit == "rad/rad":
+        return f"{si:.6g} deg/deg"
     if unit == "rad":
         return f"{math.degrees(si):.6g} deg"
     return f"{si:.6g} {unit}"
@@ -252,6 +263,17 @@ def _bound_cases():
         for label, v in (("below", below), ("above", hi * 100 if hi > 0 else 1.0)):
             cases.append(Case("bounds", f"{fld} {label} its bound", lambda w, s=sec, k=key, v=v, u=unit: [
                 "info", model_copy(w, edit=setting(s, k, _text(v, u)))], expect=(fld,)))
+
+    for fld, (lo, hi, unit, _why) in FLIGHT_BOUNDS.items():
+        sec, key = fld.split(".")
+        below = lo / 100 if lo > 0 else -1.0
+        for label, v in (("below", below), ("above", hi * 100)):
+            cases.append(Case("bounds", f"flight {fld} {label} its bound", lambda w, s=sec, k=key, v=v, u=unit: [
+                "lco", MODELS / "rs25_flight.toml", "--flight", flight_copy(w, setting(s, k, _text(v, u))),
+                "--no-time-domain"], expect=(fld,)))
+    cases.append(Case("bounds", "flight with 1000 engines", lambda w: [
+        "lco", MODELS / "rs25_flight.toml", "--flight", flight_copy(w, setting("vehicle", "engine_count", 1000)),
+        "--no-time-domain"], expect=("vehicle.engine_count",)))
 
     def no_geometry(doc):
         del doc["geometry"]

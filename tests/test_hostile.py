@@ -81,3 +81,12 @@ def test_hostile_input(case: Case, tmp_path, capsys, monkeypatch):
     else:
         new_or_changed = {k for k in changed if k in before}
         assert new_or_changed <= set(case.changes), f"user files changed: {sorted(new_or_changed - set(case.changes))}"
+
+
+def test_the_bounds_page_lists_every_bound():
+    """docs/reference/bounds.md stays true: every bounded field is in its tables."""
+    from taos.bounds import FLIGHT_BOUNDS, MODEL_BOUNDS
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "reference" / "bounds.md").read_text()
+    missing = [f for f in [*MODEL_BOUNDS, *FLIGHT_BOUNDS] if f"`{f}`" not in text]
+    assert not missing, missing

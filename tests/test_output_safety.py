@@ -214,14 +214,14 @@ def test_info_shows_the_unstable_mode(tmp_path, capsys):
 
 
 def test_leaving_the_envelope_stops_with_exit_3_naming_time_state_and_cause(tmp_path, capsys):
-    """A supply pressure far too low for the load (stall force A P_s tiny): the load force
+    """A supply pressure far too low for the load (20 psi: stall force A P_s tiny, yet within the documented 1 bar lower bound): the load force
     leaves the envelope; the run stops with exit 3 and writes nothing."""
     t = inline_actuator_set(AMBIENT.read_text(), AMBIENT).replace('stiffness_file = "../fem_data/', f'stiffness_file = "{ROOT}/fem_data/')
-    t = re.sub(r'(?m)^supply_pressure\s*=.*$', 'supply_pressure = "5 psi"', t)
-    # the valve law off (with it on, a 5 psi supply makes the stall limit a stiff mode that the
+    t = re.sub(r'(?m)^supply_pressure\s*=.*$', 'supply_pressure = "20 psi"', t)
+    # the valve law off (with it on, a 20 psi supply makes the stall limit a stiff mode that the
     # step check refuses before the run: exit 2); the envelope check catches the load force
     t = re.sub(r'(?m)^pressure_limited\s*=.*$', 'pressure_limited = false', t)
-    t = re.sub(r'(?m)^relief_pressure\s*=.*$', 'relief_pressure = "5 psi"', t)  # cracks at P_s
+    t = re.sub(r'(?m)^relief_pressure\s*=.*$', 'relief_pressure = "20 psi"', t)  # cracks at P_s
     model = tmp_path / "weak.toml"
     model.write_text(t)
     out = tmp_path / "run.h5"

@@ -46,7 +46,11 @@ COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lc
 
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="taos", description="TVC gimbal/actuator simulation (simplex and TAOS)")
+    ap = argparse.ArgumentParser(prog="taos", description="TVC gimbal/actuator simulation (simplex and TAOS)",
+                                 epilog="Every command also takes --force (an output may replace an existing "
+                                 "file taos did not write; never an input, a device or a folder) and --debug "
+                                 "(tracebacks). Exit status: 0 done, 2 bad input, 3 unstable or out of its "
+                                 "envelope, 130 Ctrl-C, 143 SIGTERM, 1 internal error.")
     sub = ap.add_subparsers(dest="command", required=True)
     for name in COMMANDS:
         importlib.import_module(name).add_parsers(sub)
