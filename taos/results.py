@@ -167,7 +167,7 @@ def _read_mark_doc(folder: Path) -> dict:
         if not stat.S_ISREG(os.lstat(p).st_mode) or os.path.getsize(p) > MAX_MARK_BYTES:
             raise ValueError
         d = json.loads(p.read_text(encoding="utf-8"))
-        if not isinstance(d, dict) or d.get("written_by") != "taos":
+        if not isinstance(d, dict) or not isinstance(d.get("files"), list) or d.get("written_by", "taos") != "taos":
             raise ValueError
         return {"written_by": "taos", "files": [str(x) for x in d.get("files", [])],
                 "pending": [str(x) for x in d.get("pending", [])]}
@@ -264,13 +264,13 @@ def check_output_file(path: str | Path, field: str = "(output)", suffixes: tuple
     symbolic link) that this program did not write (its folder's mark does not list it),
     unless ``--force``."""
     p = Path(path)
+    if _is_dev_null(p):   # the user plainly means: make it and throw it away
+        return p
     if suffixes and p.suffix.lower() not in suffixes:
         raise InputError(str(path), field, "a file name ending in " + " or ".join(suffixes), got=repr(p.suffix))
     if len(str(p)) > 4000 or any(len(part.encode()) > _NAME_MAX - 60 for part in p.parts):
         raise InputError(str(path)[:80] + "...", field, f"a file name of at most {_NAME_MAX - 60} bytes "
                          "per folder level", got=f"{max(len(x.encode()) for x in p.parts)} bytes")
-    if _is_dev_null(p):
-        return p
     try:
         st = os.lstat(p)
     except (FileNotFoundError, NotADirectoryError):

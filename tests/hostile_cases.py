@@ -207,6 +207,14 @@ def _output_cases():
         Case("outputs", "info --json /dev/null discards", lambda w: ["info", AMBIENT, "--json", os.devnull], rc=0),
         Case("outputs", "freqresp --json /dev/null discards",
              lambda w: ["freqresp", AMBIENT, "--freq-hz", "1", "--linear", "--json", os.devnull], rc=0),
+        Case("outputs", "freqresp --plot /dev/null: no format to make, refused",   # the suffix chooses PNG or SVG
+             lambda w: ["freqresp", AMBIENT, "--freq-hz", "1", "--linear", "--plot", os.devnull], expect=(".png",)),
+        Case("outputs", "simulate --out /dev/null discards",
+             lambda w: ["simulate", AMBIENT, "--profile", PROFILE, "--out", os.devnull], rc=0),
+        Case("outputs", "a rerun replaces its own output",
+             lambda w: [write(w, ".taos-output.json", '{"written_by": "taos", "files": ["mine.json"]}') and
+                        write(w, "mine.json", "old") and "info", AMBIENT, "--json", w / "mine.json"], rc=0,
+             changes=("mine.json", ".taos-output.json")),
         Case("outputs", "info --json over a user file with --force",
              lambda w: ["info", AMBIENT, "--json", write(w, "user.json", "mine"), "--force"], rc=0,
              changes=("user.json", ".taos-output.json")),
