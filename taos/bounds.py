@@ -4,7 +4,12 @@ Every check raises :class:`~taos.errors.InputError` (exit 2: one line naming the
 limit) or, for a model that is unstable or a run that leaves its envelope,
 :class:`~taos.errors.UnstableModel` / :class:`~taos.errors.EnvelopeExceeded` (exit 3).
 
-Limits (SI inside; shown here in the units of the messages):
+The physical bounds of every model-file and flight-file value, each with its reason, are the
+tables :data:`MODEL_BOUNDS` and :data:`FLIGHT_BOUNDS` (checked when a file is loaded, with the
+cross-field checks of :func:`check_model_bounds`); the Python API's grids and axes are checked
+by :func:`check_response_args`. All are listed in docs/reference/bounds.md.
+
+Limits of a run (SI inside; shown here in the units of the messages):
 
 =============================  ==================================  ==========================================
 quantity                       limit                               why

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Callable
 
 from taos.bounds import FLIGHT_BOUNDS, MODEL_BOUNDS
+from taos.errors import MAX_DATA_BYTES, MAX_TOML_BYTES
 
 from .test_bad_inputs import DATA, model_text
 
@@ -362,7 +363,8 @@ def _hostile_files():
         ("a socket", lambda w, n: sock(w, n), ("socket",)),
         ("/dev/zero", lambda w, n: Path("/dev/zero"), ("regular file",)),
         ("/dev/null", lambda w, n: Path(os.devnull), ("regular file",)),
-        ("a 5 GiB sparse file", lambda w, n: sparse(w, n, 5 * 2 ** 30), ("bytes",)),
+        ("a file beyond the size cap", lambda w, n: sparse(w, n, (MAX_DATA_BYTES if n.endswith(".csv")
+                                                                 else MAX_TOML_BYTES) + 1), ("bytes",)),
         ("binary junk", lambda w, n: write(w, n, bytes(range(256)) * 4), ()),
         ("arrays nested 3000 deep", lambda w, n: write(w, n, deep_arrays), ()),
         ("inline tables nested 3000 deep", lambda w, n: write(w, n, deep_tables), ()),

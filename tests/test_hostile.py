@@ -21,13 +21,20 @@ SHIPPED = [AMBIENT, PROFILE, DATA, FLIGHT, MASV, ASCENT, MODELS / "rs25_flight.t
            MODELS / "actuators" / "tvc_actuator.toml", MODELS / "friction" / "rs25_gimbal.toml"]
 
 
+#: files larger than this (only the sparse oversized inputs of the ``files`` group) are compared
+#: by size and modification time rather than hashed: reading gigabytes of zeros would only cost time
+BIG = 64 * 2 ** 20
+
+
 def fingerprint(folder: Path) -> dict:
-    """Path -> SHA-256 of every regular file under ``folder`` (links and special files by kind),
-    and of the shipped inputs the cases read."""
+    """Path -> SHA-256 of every regular file under ``folder`` (links and special files by kind;
+    files above :data:`BIG` by size and modification time), and of the shipped inputs."""
     out = {}
     for p in sorted(folder.rglob("*")):
         st = os.lstat(p)
-        if stat.S_ISREG(st.st_mode):
+        if stat.S_ISREG(st.st_mode) and st.st_size > BIG:   # the sparse "oversized input" files
+            out[str(p.relative_to(folder))] = f"{st.st_size} bytes, modified {st.st_mtime_ns}"
+        elif stat.S_ISREG(st.st_mode):
             with open(p, "rb") as f:
                 out[str(p.relative_to(folder))] = hashlib.sha256(f.read()).hexdigest()
         elif stat.S_ISLNK(st.st_mode):
