@@ -210,7 +210,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     from taos.errors import run_cli as run
-    return run(build_parser(), argv)
+    from taos.results import check_arguments
+
+    return run(build_parser(), argv, check=check_arguments)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -28,6 +28,40 @@ def table(rows: list[dict]) -> str:
     return "\n".join(out)
 
 
+def hostile_section() -> str:
+    """The hostile-input suite's count by contract group (tests/hostile_cases.py and
+    tests/test_hostile_fuzz.py; docs/reference/bounds.md lists what each group holds)."""
+    from collections import Counter
+
+    sys.path.insert(0, str(ROOT))
+    from tests import test_hostile_fuzz as fz
+    from tests.hostile_cases import CASES
+
+    groups = Counter(c.group for c in CASES)
+    tests = [getattr(fz, n) for n in dir(fz) if n.startswith("test_")]
+    fuzz = [t for t in tests if getattr(t, "is_hypothesis_test", False)]
+    import math
+
+    other = sum(math.prod(len(m.args[1]) for m in getattr(t, "pytestmark", []) if m.name == "parametrize")
+                for t in tests if not getattr(t, "is_hypothesis_test", False))
+    rows = "\n".join(f"| {g} | {n} |" for g, n in sorted(groups.items()))
+    return f"""
+## Hostile-input suite
+
+`tests/test_hostile.py` (the table `tests/hostile_cases.py`) and `tests/test_hostile_fuzz.py`,
+grouped by the contract each group holds ({{doc}}`reference/bounds`): {len(CASES)} table cases,
+each checking the exit status, a one-line message naming the field or option, and that no file
+of the user's changed (SHA-256 before and after); {other} API, JSON, exit-status and signal cases;
+{len(fuzz)} hypothesis properties of {fz.FUZZ.max_examples} examples each ({len(fuzz) * fz.FUZZ.max_examples}
+examples). In all {len(CASES) + other} cases plus the fuzzing.
+
+| group | cases |
+|---|---|
+{rows}
+| API, JSON, exit status, signals | {other} |
+"""
+
+
 def main() -> int:
     with tempfile.TemporaryDirectory() as d:
         log = Path(d) / "verification.jsonl"
@@ -50,7 +84,7 @@ models or two computations), the tolerance it is held to and the error measured 
 {len(rows)} cases, {sum(r['passed'] for r in rows)} within tolerance.
 
 {table(rows)}
-"""
+{hostile_section()}"""
     out = ROOT / "docs" / "verification.md"
     out.parent.mkdir(exist_ok=True)
     out.write_text(text)

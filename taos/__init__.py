@@ -37,7 +37,33 @@ only what it needs.
 
 from __future__ import annotations
 
-import importlib
+import sys as _sys
+
+
+def _startup_signals() -> None:
+    """Ctrl-C / SIGTERM while a ``taos`` or ``masv`` command starts (imports, before
+    :func:`taos.errors.run_cli` takes over): one line and exit 130 / 143, nothing written yet.
+    Installed here, the first code of the package to run, and only for a command line (``taos``,
+    ``masv``, ``python -m taos``), never for a program importing the library."""
+    import os
+    import signal
+
+    prog = os.path.basename(_sys.argv[0]) if _sys.argv and _sys.argv[0] not in ("-m", "") else "taos"
+
+    def stop(signum, frame):  # pragma: no cover - exercised in subprocesses (tests/test_hostile_fuzz.py)
+        what = "interrupted (Ctrl-C)" if signum == signal.SIGINT else f"terminated (signal {signum})"
+        os.write(2, f"{prog}: {what} during start-up; nothing written\n".encode())
+        os._exit(128 + signum)
+
+    for s in (signal.SIGINT, signal.SIGTERM):
+        if signal.getsignal(s) in (signal.default_int_handler, signal.SIG_DFL):
+            signal.signal(s, stop)
+
+
+if _sys.argv[:1] == ["-m"] or (_sys.argv[:1] and _sys.argv[0].rsplit("/", 1)[-1] in ("taos", "masv")):
+    _startup_signals()
+
+import importlib  # noqa: E402
 
 __version__ = "0.1.0"
 

@@ -4,7 +4,12 @@ Every check raises :class:`~taos.errors.InputError` (exit 2: one line naming the
 limit) or, for a model that is unstable or a run that leaves its envelope,
 :class:`~taos.errors.UnstableModel` / :class:`~taos.errors.EnvelopeExceeded` (exit 3).
 
-Limits (SI inside; shown here in the units of the messages):
+The physical bounds of every model-file and flight-file value, each with its reason, are the
+tables :data:`MODEL_BOUNDS` and :data:`FLIGHT_BOUNDS` (checked when a file is loaded, with the
+cross-field checks of :func:`check_model_bounds`); the Python API's grids and axes are checked
+by :func:`check_response_args`. All are listed in docs/reference/bounds.md.
+
+Limits of a run (SI inside; shown here in the units of the messages):
 
 =============================  ==================================  ==========================================
 quantity                       limit                               why
@@ -132,3 +137,191 @@ def check_cycles(cycles: int, source: str, field: str) -> int:
     if cycles > MAX_CYCLES:
         raise InputError(source, field, f"at most {MAX_CYCLES} cycles", got=str(cycles))
     return cycles
+
+
+# -- physical bounds of every model-file value (docs/reference/bounds.md) --------------------
+
+#: field -> (lowest, highest) in SI, SI unit, why. A value outside is refused when the model file
+#: is loaded, before any work (one line naming the field, the value and the bounds). The bounds
+#: are orders of magnitude around launch-vehicle TVC hardware, not tolerances: they refuse a
+#: mistyped unit or exponent ("1e-300 lbf/in", "400 deg", "1000 m"), never a real design.
+MODEL_BOUNDS: dict[str, tuple[float, float, str, str]] = {
+    "engine.mass": (1.0, 1e5, "kg", "a thruster to ten F-1 engines (8.4 t each)"),
+    "engine.inertia_pitch": (1e-2, 1e7, "kg*m**2", "RS-25 12400 kg m^2; 1e7 is a whole stage"),
+    "engine.inertia_yaw": (1e-2, 1e7, "kg*m**2", "RS-25 12400 kg m^2; 1e7 is a whole stage"),
+    "engine.rotational_stiffness": (0.0, 1e10, "N*m/rad", "feedlines and gravity: 5e5 N m/rad for RS-25"),
+    "engine.thrust": (0.0, 1e8, "N", "F-1 6.8 MN; 1e8 N is fifteen of them"),
+    "engine.gimbal_range": (1e-3 * DEG, 30.0 * DEG, "rad", "TVC gimbals swing 5-15 deg; the planar "
+                            "small-angle model means nothing beyond 30 deg"),
+    "engine.hard_stop_stiffness": (1e3, 1e13, "N*m/rad", "a stop must be stiffer than the load path"),
+    "engine.hard_stop_damping_ratio": (0.0, 10.0, "1", "a damping ratio beyond 10 is no contact model"),
+    "actuator.moment_arm": (0.01, 5.0, "m", "lever arms are 0.1-1.5 m (RS-25 0.8 m); 5 m is longer than "
+                            "the engine"),
+    "actuator.piston_area": (1e-5, 0.1, "m**2", "0.016-155 in^2; RS-25 actuator 15 in^2"),
+    "actuator.supply_pressure": (1e5, 1e8, "Pa", "1 bar to 14500 psi; flight hydraulics 3000-8000 psi"),
+    "actuator.oil_bulk_modulus": (1e7, 1e10, "Pa", "aerated oil 10 MPa to stiffer than any oil; "
+                                  "mineral oil 1.4-1.7 GPa"),
+    "actuator.trapped_volume": (1e-7, 1.0, "m**3", "0.1 cm^3 to 1 m^3; RS-25 actuator 100 in^3"),
+    "actuator.piston_mass": (1e-2, 1e4, "kg", "10 g to 10 t; RS-25 actuator 45 kg"),
+    "actuator.piston_damping": (0.0, 1e9, "N*s/m", "1e4 N s/m typical"),
+    "actuator.loop_gain": (1e-2, 1e4, "1/s", "position-loop gains are 10-100 1/s"),
+    "actuator.valve_natural_frequency": (1.0, 1e4, "Hz", "servovalves are 50-500 Hz"),
+    "actuator.valve_damping_ratio": (1e-3, 10.0, "1", "servovalves 0.5-1"),
+    "actuator.flow_pressure_coefficient": (0.0, 1e-6, "m**3/s/Pa", "K_c is 1e-13-1e-10 m^3/(s Pa)"),
+    "actuator.leakage_coefficient": (0.0, 1e-6, "m**3/s/Pa", "as K_c"),
+    "actuator.pressure_feedback_gain": (0.0, 1e-5, "m/s/Pa", "1e-8 m/(s Pa) typical: 0.2 m/s at supply"),
+    "actuator.pressure_feedback_time_constant": (0.0, 100.0, "s", "washout of 0.01-1 s"),
+    "actuator.max_rate": (1e-4, 10.0, "m/s", "TVC piston rates are 0.1-0.5 m/s"),
+    "actuator.relief_flow_coefficient": (0.0, 1e-4, "m**3/s/Pa", "a relief valve passes at most the pump flow"),
+    "structure.load_stiffness": (1e4, 1e11, "N/m", "57 lbf/in to 5.7e8 lbf/in; RS-25 load path "
+                                 "1.15e5-2.05e5 lbf/in"),
+    "structure.load_damping_ratio": (0.0, 10.0, "1", "structures are 0.005-0.05"),
+    "friction.coulomb_torque": (0.0, 1e7, "N*m", "RS-25 hot fire 1.3e4 N m; 1e7 N m would hold a stage"),
+    "friction.static_torque": (0.0, 1e7, "N*m", "as the Coulomb torque"),
+    "avionics.command_range": (1e-3 * DEG, 90.0 * DEG, "rad", "the command word spans the gimbal range "
+                               "(RS-25 +-21 deg full scale)"),
+}
+#: longest piston travel at the hard stops, R tan(theta_max) [m]: TVC actuator strokes are
+#: +-5 to +-15 cm; stops beyond half a metre of piston travel lie outside any actuator's stroke
+MAX_STROKE_M = 0.5
+#: agreement of ``actuator.moment_arm`` with the lever arm the ``[geometry]`` attachment points
+#: give (distance from the gimbal point to the actuator line): a relative difference of at most
+#: this (the planar and 3-D models would otherwise describe different engines)
+MOMENT_ARM_TOLERANCE = 0.1
+
+
+#: flight-file fields (``[vehicle]``, ``[fcs]``), as :data:`MODEL_BOUNDS`: launch vehicles from a
+#: sounding rocket to a super-heavy stack; flight-control gains of a stable attitude loop
+FLIGHT_BOUNDS: dict[str, tuple[float, float, str, str]] = {
+    "vehicle.mass": (1e2, 1e8, "kg", "a sounding rocket to 30 times a Saturn V (2.9e6 kg)"),
+    "vehicle.pitch_inertia": (1.0, 1e12, "kg*m**2", "SLS core stage 4.5e8 kg m^2"),
+    "vehicle.yaw_inertia": (1.0, 1e12, "kg*m**2", "SLS core stage 4.5e8 kg m^2"),
+    "vehicle.thrust_per_engine": (1.0, 1e8, "N", "F-1 6.8 MN"),
+    "vehicle.gimbal_arm": (0.1, 300.0, "m", "c.g. to gimbal of a 110 m stack is under 60 m"),
+    "vehicle.engine_mass": (0.0, 1e5, "kg", "as engine.mass of a model file"),
+    "vehicle.engine_cg_offset": (0.0, 20.0, "m", "an engine is at most ~6 m long"),
+    "vehicle.engine_inertia": (0.0, 1e7, "kg*m**2", "as engine.inertia_pitch"),
+    "vehicle.aero_instability": (0.0, 100.0, "1/s**2", "a divergence rate of 10 rad/s is no flyable vehicle"),
+    "vehicle.bending_frequency": (0.0, 1e3, "Hz", "first bending modes are 1-10 Hz"),
+    "vehicle.bending_damping_ratio": (1e-5, 10.0, "1", "structures are 0.005-0.05"),
+    "vehicle.bending_gain": (0.0, 1e3, "1", "a modal slope ratio"),
+    "fcs.attitude_gain": (1e-3, 100.0, "rad/rad", "1-3 deg/deg typical"),
+    "fcs.integral_gain": (0.0, 100.0, "1/s", "below the attitude bandwidth"),
+    "fcs.rate_gain": (0.0, 100.0, "s", "0.5-5 s typical"),
+    "fcs.lag_time_constant": (0.0, 10.0, "s", "command lags are 0.01-0.5 s"),
+    "fcs.notch_frequency": (0.0, 1e3, "Hz", "at the bending mode, 1-10 Hz"),
+    "fcs.notch_zeta_num": (0.0, 10.0, "1", "a damping ratio"),
+    "fcs.notch_zeta_den": (1e-5, 10.0, "1", "a damping ratio"),
+    "fcs.delay": (0.0, 2.0, "s", "sensor and computer delays are tens of ms"),
+}
+#: most engines of one flight file (N1: 30)
+MAX_ENGINES = 64
+
+
+def check_bound(value: float, field: str, src: str) -> float:
+    """``value`` (SI) within :data:`MODEL_BOUNDS` or :data:`FLIGHT_BOUNDS` ``[field]``, else one
+    line with the bounds."""
+    lo, hi, unit, why = MODEL_BOUNDS[field] if field in MODEL_BOUNDS else FLIGHT_BOUNDS[field]
+    if not (math.isfinite(value) and lo <= value <= hi):
+        raise InputError(src, field, f"a value from {lo:.4g} to {hi:.4g} {unit} ({why})", got=f"{value:.4g} {unit}")
+    return value
+
+
+def _lever_arm(geometry: dict, axis: str, src: str) -> float | None:
+    """Distance [m] from the gimbal point (origin) to the line through the axis' structure and
+    engine attachment points of ``[geometry]``, or None when they are not given."""
+    from .units import to_si
+
+    pts = []
+    for key in (f"{axis}_structure_attach", f"{axis}_engine_attach"):
+        v = geometry.get(key)
+        if not isinstance(v, list) or len(v) != 3:
+            return None
+        pts.append(np.array([to_si(c, "length", source=src, field=f"geometry.{key}[{i}]") for i, c in enumerate(v)]))
+    d = pts[0] - pts[1]
+    n = float(np.linalg.norm(d))
+    if not n > 0:
+        raise InputError(src, f"geometry.{axis}_engine_attach", "an attachment point apart from the structure's",
+                         got="the same point")
+    return float(np.linalg.norm(np.cross(pts[1], d / n)))
+
+
+def check_model_bounds(src: str, engine, actuator, structure, avionics, friction_table, extra) -> None:
+    """Every value of a loaded model within :data:`MODEL_BOUNDS`, and the cross-field checks:
+    static torque at least the Coulomb torque (breakaway needs at least the sliding torque), the
+    hard stops inside the stroke (:data:`MAX_STROKE_M`), the moment arm against the
+    ``[geometry]`` lever arms (:data:`MOMENT_ARM_TOLERANCE`)."""
+    from .units import to_si
+
+    objs = {"engine": engine, "actuator": actuator, "structure": structure}
+    for field, _ in MODEL_BOUNDS.items():
+        sec, key = field.split(".")
+        if sec in objs:
+            obj = objs[sec]
+            attr = next((a for a in vars(obj) if a == key or a.startswith(key + "_")), None)
+            value = getattr(obj, attr) if attr is not None else None
+            optional_zero = key in ("gimbal_range", "hard_stop_stiffness", "max_rate", "relief_flow_coefficient")
+            if value is None or (optional_zero and value == 0.0):
+                continue
+            check_bound(float(value), field, src)
+        elif sec == "friction" and key in friction_table:
+            check_bound(to_si(friction_table[key], "torque", source=src, field=field), field, src)
+    check_bound(avionics.command_range_rad, "avionics.command_range", src)
+    if "static_torque" in friction_table and "coulomb_torque" in friction_table:
+        ts = to_si(friction_table["static_torque"], "torque", source=src, field="friction.static_torque")
+        tc = to_si(friction_table["coulomb_torque"], "torque", source=src, field="friction.coulomb_torque")
+        if ts < tc * (1 - 1e-12):
+            raise InputError(src, "friction.static_torque", f"at least the Coulomb torque {tc:.6g} N*m (breakaway "
+                             "takes at least the sliding torque)", got=f"{ts:.6g} N*m")
+    if engine.gimbal_range_rad > 0:
+        travel = actuator.moment_arm_m * math.tan(engine.gimbal_range_rad)
+        if travel > MAX_STROKE_M:
+            raise InputError(src, "engine.gimbal_range", f"hard stops inside the actuator stroke: piston travel "
+                             f"R tan(theta_max) at most {MAX_STROKE_M:g} m", got=f"{travel:.3g} m")
+    geometry = extra.get("geometry")
+    if isinstance(geometry, dict):
+        for axis in ("pitch", "yaw"):
+            arm = _lever_arm(geometry, axis, src)
+            R = actuator.moment_arm_m
+            if arm is not None and abs(arm - R) > MOMENT_ARM_TOLERANCE * R:
+                raise InputError(src, "actuator.moment_arm", f"the lever arm of the [geometry] {axis} attachment "
+                                 f"points ({arm:.4g} m) within {100 * MOMENT_ARM_TOLERANCE:g} %", got=f"{R:.4g} m")
+
+
+# -- the Python API's arguments, checked as the command line checks them --------------------
+
+AXES = ("pitch", "yaw")
+
+
+def check_axis(axis, field: str = "axis", source: str = "argument") -> str:
+    """``axis`` is 'pitch' or 'yaw' (InputError naming the argument otherwise)."""
+    if axis not in AXES:
+        raise InputError(source, field, "'pitch' or 'yaw'", got=repr(axis)[:40])
+    return axis
+
+
+def check_grid(values, field: str, unit: str, lo: float = 0.0, hi: float = math.inf,
+               source: str = "argument") -> np.ndarray:
+    """A non-empty 1-D grid of finite values in (``lo``, ``hi``] (frequencies [Hz], amplitudes
+    [rad]) as a float array; InputError naming ``field`` for an empty grid, a NaN, a zero or
+    negative value: the API never answers them with NaN or a silent result."""
+    try:
+        a = np.atleast_1d(np.asarray(values, float)).ravel()
+    except (TypeError, ValueError):
+        raise InputError(source, field, f"numbers in {unit}", got=repr(values)[:60]) from None
+    if a.size == 0:
+        raise InputError(source, field, f"at least one value in {unit}", got="an empty grid")
+    bad = np.flatnonzero(~(np.isfinite(a) & (a > lo) & (a <= hi)))
+    if bad.size:
+        raise InputError(source, field, f"finite values above {lo:g} {unit}" + ("" if hi == math.inf else
+                         f" and at most {hi:g} {unit}"), got=f"{a[bad[0]]:g} {unit}")
+    return a
+
+
+def check_response_args(freq_hz, amplitudes_rad=None, axis: str = "pitch") -> None:
+    """The arguments of the frequency-response and describing-function API: frequencies in
+    :data:`RESPONSE_FREQ_HZ`, amplitudes positive and within 90 deg, a known axis."""
+    check_axis(axis)
+    check_grid(freq_hz, "freq_hz", "Hz", 0.0, RESPONSE_FREQ_HZ[1])
+    if amplitudes_rad is not None:
+        check_grid(amplitudes_rad, "amplitudes_rad", "rad", 0.0, math.pi / 2)

@@ -9,7 +9,10 @@ was expected. The CLI prints ``str(err)`` and exits with status 2
 from __future__ import annotations
 
 import difflib
-from typing import Iterable, Mapping
+import os
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Callable, Iterable, Mapping
 
 
 class InputError(ValueError):
@@ -109,12 +112,161 @@ def check_keys(table: Mapping, allowed: Iterable[str], source: str, section: str
         raise InputError(source, field, "one of " + ", ".join(allowed), got="an unknown key")
 
 
+# -- reading input files: regular files only, size bounded, TOML depth bounded ---------------
+
+#: largest TOML input (model, profile, flight, ascent, campaign, parameter set, sidecar) [bytes]
+MAX_TOML_BYTES = 8 * 2 ** 20
+#: largest data record, matrix or archive read [bytes]
+MAX_DATA_BYTES = 4 * 2 ** 30
+#: deepest nesting of tables and arrays in a TOML input (the shipped files use 3)
+MAX_TOML_DEPTH = 16
+
+
+def check_input_file(path, what: str, max_bytes: int = MAX_DATA_BYTES, field: str = "(file)") -> int:
+    """Refuse, without opening it, an input that is not a regular file (a folder, a device such
+    as ``/dev/zero``, a FIFO that would block, a socket) or is larger than ``max_bytes``; returns
+    its size. ``what`` says what was expected, e.g. "a readable model file"."""
+    import os
+    import stat
+
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError) as e:
+        raise InputError(str(path), field, what, got=getattr(e, "strerror", None) or "an unusable path") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
+                else "a device or socket")
+        raise InputError(str(path), field, what + " (a regular file)", got=kind)
+    if st.st_size > max_bytes:
+        raise InputError(str(path), field, f"{what} of at most {max_bytes} bytes", got=f"{st.st_size} bytes")
+    note_input(path)
+    return st.st_size
+
+
+def read_input_bytes(path, what: str, max_bytes: int = MAX_TOML_BYTES, field: str = "(file)") -> bytes:
+    """The bytes of a regular input file of at most ``max_bytes`` (:func:`check_input_file`),
+    opened without blocking (a FIFO swapped in after the check does not hang the run)."""
+    import os
+    import stat
+
+    check_input_file(path, what, max_bytes, field)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as e:
+        raise InputError(str(path), field, what, got=e.strerror) from None
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise InputError(str(path), field, what + " (a regular file)", got="not a regular file")
+        raw = f.read(max_bytes + 1)
+    if len(raw) > max_bytes:
+        raise InputError(str(path), field, f"{what} of at most {max_bytes} bytes", got="more")
+    return raw
+
+
+def _depth(obj, limit: int, level: int = 0) -> int:
+    if level > limit:
+        return level
+    if isinstance(obj, dict):
+        return max([_depth(v, limit, level + 1) for v in obj.values()] or [level])
+    if isinstance(obj, list):
+        return max([_depth(v, limit, level + 1) for v in obj] or [level])
+    return level
+
+
+def parse_toml(raw: bytes, src: str, max_depth: int = MAX_TOML_DEPTH) -> dict:
+    """A TOML document's table; InputError (one line) when it is not UTF-8 TOML or nests
+    tables and arrays deeper than ``max_depth`` (deep nesting would exhaust the stack)."""
+    import tomllib
+
+    try:
+        doc = tomllib.loads(raw.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0] if str(e) else "") from None
+    except RecursionError:
+        raise InputError(src, "(file)", f"TOML nested at most {max_depth} levels deep", got="deeper") from None
+    if _depth(doc, max_depth) > max_depth:
+        raise InputError(src, "(file)", f"TOML nested at most {max_depth} levels deep", got="deeper")
+    return doc
+
+
+# -- the run's inputs and the replace policy of its outputs (taos.results) ---------------
+
+#: ``--force``: replace an existing regular file this program did not write (set by the CLI)
+_FORCE: ContextVar[bool] = ContextVar("taos_force_replace", default=False)
+#: (device, inode) and resolved path of every input read in this CLI run (None: not recorded)
+_INPUTS: ContextVar[set | None] = ContextVar("taos_inputs", default=None)
+
+
+@contextmanager
+def output_policy(force: bool = False, record_inputs: bool = True):
+    """Within the block, outputs may replace foreign regular files (``force``, the CLI's
+    ``--force``) and, with ``record_inputs``, every input file read (:func:`note_input`) is
+    remembered so that no output replaces it, ``--force`` or not."""
+    t1 = _FORCE.set(bool(force))
+    t2 = _INPUTS.set(set() if record_inputs else None)
+    try:
+        yield
+    finally:
+        _FORCE.reset(t1)
+        _INPUTS.reset(t2)
+
+
+def _identity(path) -> tuple | None:
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return (st.st_dev, st.st_ino)
+
+
+def note_input(path) -> None:
+    """Remember ``path`` as an input of this run (no output may replace it)."""
+    seen = _INPUTS.get()
+    ident = _identity(path)
+    if seen is not None and ident is not None:
+        seen.add(ident)
+
+
+def check_not_input(path, field: str, inputs=()) -> None:
+    """Refuse an output place that is, or links to, one of ``inputs`` or an input read so far."""
+    ident = _identity(path)
+    if ident is None:
+        return
+    known = set(_INPUTS.get() or ()) | {i for i in map(_identity, inputs) if i is not None}
+    if ident in known:
+        raise InputError(str(path), field, "an output place that is not one of the run's inputs "
+                         "(an output never replaces an input)", got="an input file")
+
+
+
 # -- the exit-status contract of the command lines (taos and masv) --------------------------
 
-def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None) -> int:
+class _Signals:
+    """SIGINT/SIGTERM handling of one command-line run: the handler records the signal before it
+    raises, so a run whose exception was swallowed somewhere (a library's cleanup) still ends
+    with 130/143, never 0."""
+
+    def __init__(self):
+        self.received: int | None = None
+
+    def __call__(self, signum, frame):
+        import signal
+
+        self.received = signum
+        if signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise Interrupted(signum)
+
+
+def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
+            check: Callable[[object], None] | None = None) -> int:
     """Parse and dispatch; every failure ends with one line on standard error (no traceback
     unless ``--debug``): bad input -> exit 2, an unstable run or one that left its envelope ->
-    exit 3, Ctrl-C -> exit 130, SIGTERM -> exit 143, anything unexpected -> exit 1."""
+    exit 3, Ctrl-C -> exit 130, SIGTERM -> exit 143, anything unexpected -> exit 1.
+
+    ``--force`` (any command) lets an output replace an existing regular file this program did
+    not write (:mod:`taos.results`); nothing ever replaces an input. ``check(args)`` runs
+    before the command (``taos``: :func:`taos.results.check_arguments`)."""
     import contextlib
     import io
     import os
@@ -125,7 +277,8 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None) -> int:
 
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv or bool(os.environ.get("TAOS_DEBUG"))
-    argv = [a for a in argv if a != "--debug"]
+    force = "--force" in argv
+    argv = [a for a in argv if a not in ("--debug", "--force")]
     buf = io.StringIO()
     try:
         with contextlib.redirect_stderr(buf):
@@ -135,40 +288,59 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None) -> int:
         if lines:
             print(lines[-1], file=sys.stderr)
         return int(e.code or 0) if not isinstance(e.code, str) else 2
-    old = None
+    except KeyboardInterrupt:
+        print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
+        return 130
+    handler, old = _Signals(), {}
     if threading.current_thread() is threading.main_thread():
-        def _term(signum, frame):
-            raise Interrupted(signum)
-        old = signal.signal(signal.SIGTERM, _term)
+        for s in (signal.SIGTERM, signal.SIGINT):
+            old[s] = signal.signal(s, handler)
+    rc = 1
     try:
-        return int(args.func(args) or 0)
+        with output_policy(force=force):
+            if check is not None:
+                check(args)
+            rc = int(args.func(args) or 0)
     except InputError as e:
         if debug:
             traceback.print_exc()
         print(f"{parser.prog}: {e}", file=sys.stderr)
-        return 2
+        rc = 2
     except SimulationUnstable as e:
         if debug:
             traceback.print_exc()
         print(f"{parser.prog}: {e}", file=sys.stderr)
-        return 3
+        rc = 3
     except KeyboardInterrupt:
-        print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
-        return 130
+        handler.received = signal.SIGINT
     except Interrupted as e:
-        print(f"{parser.prog}: terminated (signal {e.signum}); no partial output written", file=sys.stderr)
-        return 128 + e.signum
+        handler.received = e.signum
     except MemoryError:
         print(f"{parser.prog}: out of memory: the job is larger than this machine can hold "
               "(shorten the run or coarsen the step)", file=sys.stderr)
-        return 2
+        rc = 2
+    except OSError as e:   # a file or folder the user named that the system refuses
+        if debug:
+            traceback.print_exc()
+        where = e.filename if e.filename is not None else "(file system)"
+        print(f"{parser.prog}: {where}: expected a place this program can read or write, got "
+              f"{e.strerror or type(e).__name__}", file=sys.stderr)
+        rc = 2
     except Exception as e:  # a bug: still one line unless --debug
         if debug:
             traceback.print_exc()
         msg = " ".join(str(e).split())[:300]
         print(f"{parser.prog}: internal error: {type(e).__name__}: {msg} (rerun with --debug for the traceback)",
               file=sys.stderr)
-        return 1
+        rc = 1
     finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
+        for s, h in old.items():
+            signal.signal(s, h)
+    if handler.received == signal.SIGINT:
+        print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
+        return 130
+    if handler.received is not None:
+        print(f"{parser.prog}: terminated (signal {handler.received}); no partial output written",
+              file=sys.stderr)
+        return 128 + handler.received
+    return rc

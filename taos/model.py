@@ -28,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
-import tomllib
+import os
 import types
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -284,6 +284,11 @@ def parse_actuator(doc: Mapping, src: str) -> Actuator:
                 "relief_flow_coefficient"}
     kw = {_ACTUATOR_SI[k]: _need(s, k, kind, src, "actuator", **{chk: True})
           for k, (kind, chk) in _ACTUATOR_FIELDS.items() if k not in optional or k in s}
+    from .bounds import MODEL_BOUNDS, check_bound
+
+    for key, si_name in _ACTUATOR_SI.items():   # the bounds first: a cross-field check names the right field
+        if si_name in kw and f"actuator.{key}" in MODEL_BOUNDS and not (key in optional and kw[si_name] == 0.0):
+            check_bound(kw[si_name], f"actuator.{key}", src)
     if kw.get("pressure_feedback_gain_m_per_s_Pa", 0.0) > 0 and not kw.get(
             "pressure_feedback_time_constant_s", 0.0) > 0:
         raise InputError(src, "actuator.pressure_feedback_time_constant",
@@ -341,17 +346,14 @@ def parse_avionics(doc: Mapping, src: str) -> Avionics:
 
 
 def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
-    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it cannot
-    be read (``what`` says what was expected, e.g. "a readable model file") or is not TOML."""
-    src = str(path)
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as e:
-        raise InputError(src, "(file)", what, got=e.strerror) from None
-    try:
-        return raw, tomllib.loads(raw.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
-        raise InputError(src, "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it is not
+    a readable regular file of at most :data:`taos.errors.MAX_TOML_BYTES` (``what`` says what was
+    expected, e.g. "a readable model file"), is not TOML, or nests deeper than
+    :data:`taos.errors.MAX_TOML_DEPTH`. A FIFO or device never blocks or floods the run."""
+    from .errors import parse_toml, read_input_bytes
+
+    raw = read_input_bytes(path, what)
+    return raw, parse_toml(raw, str(path))
 
 
 #: ``[friction]`` key naming the shared friction parameter set of one piece of hardware
@@ -492,18 +494,22 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
 def _input_files(p: Path, raw: bytes, doc: Mapping) -> dict[str, tuple[str, str]]:
     """role -> (path, SHA-256) of the model file and the shared files it names (parameter sets,
     the 3-D ``[gimbal] stiffness_file`` when it exists; a missing one is the 3-D loader's error)."""
+    from .errors import check_input_file
+    from .results import file_sha256
+
     files = {"model": (str(p), hashlib.sha256(raw).hexdigest())}
     for sec in ("actuator", "friction"):
         ref = doc.get(sec, {}).get(PARAMETER_SET_KEY) if isinstance(doc.get(sec), Mapping) else None
         if isinstance(ref, str) and ref:
             q = resolve_parameter_set(ref, p)
-            files[f"{sec}_parameter_set"] = (str(q), hashlib.sha256(q.read_bytes()).hexdigest())
+            files[f"{sec}_parameter_set"] = (str(q), file_sha256(q))
     gim = doc.get("gimbal")
     ref = gim.get("stiffness_file") if isinstance(gim, Mapping) else None
-    if isinstance(ref, str) and ref:
+    if isinstance(ref, str) and ref:   # read only, relative to the model file; a regular file of bounded size
         q = (p.parent / ref).resolve()
-        if q.is_file():
-            files["stiffness_file"] = (str(q), hashlib.sha256(q.read_bytes()).hexdigest())
+        if os.path.lexists(q):
+            check_input_file(q, "a stiffness matrix file (.npz or .csv)", field="gimbal.stiffness_file")
+            files["stiffness_file"] = (str(q), file_sha256(q))
     return files
 
 
@@ -545,8 +551,9 @@ def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}
     files = _input_files(p, raw, doc)
-    from .bounds import check_model_plausible
+    from .bounds import check_model_bounds, check_model_plausible
 
+    check_model_bounds(src, engine, actuator, structure, avionics, ftab, extra)
     check_model_plausible(src, engine, actuator, structure)
     return TvcModel(name=str(doc.get("name", p.stem)), engine=engine, actuator=actuator,
                     structure=structure, friction=law, avionics=avionics, source=src,

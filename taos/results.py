@@ -1,27 +1,42 @@
 """Result files: written atomically, never over a file the program did not write, with provenance.
 
+The rule (docs/reference/outputs.md, "What an output may replace"):
+
+* An output never replaces an input of the run (the same file, or a link to it: compared by
+  device and inode), ``--force`` or not.
+* An output never replaces a device, FIFO, socket or folder; ``/dev/null`` is taken as the user
+  means it: the output is made and thrown away.
+* An existing regular file (or symbolic link) is replaced only when this program wrote it: every
+  folder it writes in holds its mark ``.taos-output.json`` listing the files it wrote there
+  (under an exclusive lock of the folder, so concurrent runs see each other's files). Any other
+  file is refused (exit 2) before any work unless the user says ``--force``.
 * :func:`atomic_write` writes one file through a temporary file beside it
-  (``.NAME.PID.taos.tmp``) renamed into place; a failure or a signal leaves the previous file
-  intact and removes the temporary file; one left by a killed run (SIGKILL) is removed by the
-  next run writing in that folder (:func:`clean_stale_temps`).
-* :func:`write_output_folder` fills an output folder with the program's own files only: it
-  records them in ``.taos-output.json`` (its mark) and replaces a file only if the mark lists
-  it; foreign files are left alone, and a foreign file in the way of an output is refused
-  (exit 2) before anything is written.
+  (``.NAME.PID.TOKEN.taos.tmp``, TOKEN 128 random bits) renamed into place; the mark lists the
+  temporary before it is made, so the temporaries of a killed run (SIGKILL) are removed by the
+  next run writing in that folder (:func:`clean_stale_temps`) and nothing else ever is.
+* :func:`write_output_folder` fills an output folder with the program's own files only, all
+  complete or none replaced; foreign files are left alone.
 * :func:`base_provenance` (package version, git revision) and :func:`file_sha256` complete the
   provenance that every output carries.
 
 An output place that cannot be written (a folder where a file is expected or the reverse, no
-permission) is bad input: :class:`~taos.errors.InputError`, exit 2.
+permission, a name too long) is bad input: :class:`~taos.errors.InputError`, exit 2.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import math
 import os
 import re
+import secrets
+import shutil
+import stat
 import subprocess
+import tempfile
+from contextlib import contextmanager
 from functools import cache
 from importlib import metadata
 from pathlib import Path
@@ -30,10 +45,11 @@ from typing import TYPE_CHECKING, Callable, Mapping
 if TYPE_CHECKING:  # h5py is imported where a file is written (start-up of the CLI)
     import h5py
 
-from .errors import InputError
+from .errors import _FORCE, InputError, check_not_input, note_input, output_policy  # noqa: F401
 
 MARK = ".taos-output.json"
-_TMP_RE = re.compile(r"^\..+\.(\d+)\.taos\.tmp$")  # only this program's own temporaries
+MAX_MARK_BYTES = 16 * 2 ** 20
+_TMP_RE = re.compile(r"^\..+\.(\d+)\.[0-9a-f]{32}\.taos\.tmp$")  # .NAME.PID.TOKEN.taos.tmp
 
 
 def package_version() -> str:
@@ -136,57 +152,141 @@ def input_provenance(path, kind: str, prov: dict | None = None) -> dict:
     return out
 
 
+# -- output safety: the folder mark, the replace policy, temporaries -------------------------
+
+_NAME_MAX = 255
+
+
+def _read_mark_doc(folder: Path) -> dict:
+    """The folder's mark (``{"written_by": "taos", "files": [...], "pending": [...]}``); an empty
+    one when there is none; InputError when a file of that name is not this program's mark."""
+    p = folder / MARK
+    if not os.path.lexists(p):
+        return {"written_by": "taos", "files": [], "pending": []}
+    try:
+        if not stat.S_ISREG(os.lstat(p).st_mode) or os.path.getsize(p) > MAX_MARK_BYTES:
+            raise ValueError
+        d = json.loads(p.read_text(encoding="utf-8"))
+        if not isinstance(d, dict) or not isinstance(d.get("files"), list) or d.get("written_by", "taos") != "taos":
+            raise ValueError
+        return {"written_by": "taos", "files": [str(x) for x in d.get("files", [])],
+                "pending": [str(x) for x in d.get("pending", [])]}
+    except (OSError, ValueError, TypeError, AttributeError):
+        raise InputError(str(p), "(output)", f"this program's own mark {MARK} (it keeps its list of "
+                         "written files there)", got="a file it did not write") from None
+
+
+def _read_mark(folder: Path) -> set[str]:
+    try:
+        return set(_read_mark_doc(folder)["files"])
+    except InputError:
+        return set()
+
+
+@contextmanager
+def _locked_mark(folder: Path):
+    """The folder's mark, read and rewritten under an exclusive lock of the folder (concurrent
+    writers of one folder each see the other's files)."""
+    import fcntl
+
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        mark = _read_mark_doc(folder)
+        before = json.dumps(mark, sort_keys=True)
+        yield mark
+        if json.dumps(mark, sort_keys=True) != before:
+            mark["files"], mark["pending"] = sorted(set(mark["files"])), sorted(set(mark["pending"]))
+            (folder / MARK).write_text(json.dumps(mark, indent=1) + "\n", encoding="utf-8")
+    finally:
+        os.close(fd)
+
+
 def _pid_alive(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except PermissionError:
+    except (PermissionError, OverflowError):
         return True
     return True
 
 
-def clean_stale_temps(folder: str | Path) -> list[Path]:
-    """Remove temporary files and folders left in ``folder`` by killed runs (their process is
-    gone); returns what was removed."""
-    import shutil
-
+def _clean_pending(folder: Path, mark: dict) -> list[Path]:
     removed = []
-    try:
-        entries = list(Path(folder).iterdir())
-    except OSError:
-        return removed
-    for p in entries:
-        m = _TMP_RE.match(p.name)
-        if not m:
+    for name in list(mark["pending"]):
+        m = _TMP_RE.match(name)
+        if m is None or (int(m.group(1)) != os.getpid() and _pid_alive(int(m.group(1)))):
             continue
-        pid = int(m.group(1))
-        if _pid_alive(pid) and pid != os.getpid():
+        if int(m.group(1)) == os.getpid():
             continue
-        if pid == os.getpid():
-            continue
+        p = folder / name
         try:
-            shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
-            removed.append(p)
+            if os.path.lexists(p):
+                shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
+                removed.append(p)
         except OSError:
-            pass
+            continue
+        mark["pending"].remove(name)
     return removed
+
+
+def clean_stale_temps(folder: str | Path) -> list[Path]:
+    """Remove the temporaries of killed runs in ``folder``: only those this program listed in
+    the folder's mark before creating them, and only when their process is gone."""
+    folder = Path(folder)
+    if not (folder / MARK).is_file():
+        return []
+    try:
+        with _locked_mark(folder) as mark:
+            return _clean_pending(folder, mark)
+    except (OSError, InputError):
+        return []
 
 
 def _output_error(path, e: OSError, field: str = "(output)"):
     return InputError(str(path), field, "a place this program can write", got=e.strerror or str(e))
 
 
-def check_output_file(path: str | Path, field: str = "(output)", suffixes: tuple[str, ...] = ()) -> Path:
-    """Refuse an output file place that is an existing folder or whose parent is not a folder
-    (and, with ``suffixes``, a name not ending in one of them)."""
+def _is_dev_null(path: Path) -> bool:
+    try:
+        return os.path.samefile(path, os.devnull)
+    except OSError:
+        return False
+
+
+def check_output_file(path: str | Path, field: str = "(output)", suffixes: tuple[str, ...] = (),
+                      inputs=()) -> Path:
+    """Refuse, before any work, an output file place that cannot take this program's output:
+    a name ending in none of ``suffixes``; a name too long for the file system; an existing
+    folder, device, FIFO or socket (``/dev/null`` is allowed: the output is discarded); a path
+    under a regular file; one of ``inputs`` or an input read so far; an existing file (or
+    symbolic link) that this program did not write (its folder's mark does not list it),
+    unless ``--force``."""
     p = Path(path)
+    if _is_dev_null(p):   # the user plainly means: make it and throw it away
+        return p
     if suffixes and p.suffix.lower() not in suffixes:
         raise InputError(str(path), field, "a file name ending in " + " or ".join(suffixes), got=repr(p.suffix))
-    if p.is_dir():
-        raise InputError(str(path), field, "a file name (not a folder)", got="an existing folder")
+    if len(str(p)) > 4000 or any(len(part.encode()) > _NAME_MAX - 60 for part in p.parts):
+        raise InputError(str(path)[:80] + "...", field, f"a file name of at most {_NAME_MAX - 60} bytes "
+                         "per folder level", got=f"{max(len(x.encode()) for x in p.parts)} bytes")
+    try:
+        st = os.lstat(p)
+    except (FileNotFoundError, NotADirectoryError):
+        st = None
+    except OSError as e:
+        raise _output_error(path, e, field) from None
+    if st is not None:
+        if stat.S_ISDIR(st.st_mode):
+            raise InputError(str(path), field, "a file name (not a folder)", got="an existing folder")
+        if not (stat.S_ISREG(st.st_mode) or stat.S_ISLNK(st.st_mode)):
+            raise InputError(str(path), field, "a regular file place (or /dev/null)",
+                             got="a device, FIFO or socket (never replaced)")
+        check_not_input(p, field, inputs)
+        if p.name not in _read_mark(p.parent) and not _FORCE.get():
+            raise InputError(str(path), field, "a new file, or one this program wrote (it never replaces a "
+                             "file it did not write; --force replaces it)", got="an existing file it did not write")
     parent = p.parent
     for q in [parent, *parent.parents]:
         if q.exists():
@@ -197,7 +297,7 @@ def check_output_file(path: str | Path, field: str = "(output)", suffixes: tuple
 
 
 def _tmp_name(path: Path) -> Path:
-    return path.parent / f".{path.name}.{os.getpid()}.taos.tmp"
+    return path.parent / f".{path.name[:80]}.{os.getpid()}.{secrets.token_hex(16)}.taos.tmp"
 
 
 def _mode() -> int:
@@ -206,52 +306,67 @@ def _mode() -> int:
     return 0o666 & ~umask
 
 
-def atomic_write(path: str | Path, write: Callable[[Path], None]) -> None:
+def _discard(write: Callable[[Path], None], name: str) -> None:
+    """``/dev/null`` as output: make the output in a private folder and throw it away."""
+    with tempfile.TemporaryDirectory(prefix="taos-devnull-") as d:
+        write(Path(d) / name)
+
+
+def atomic_write(path: str | Path, write: Callable[[Path], None], field: str = "(output)") -> None:
     """Call ``write(tmp)`` on a temporary path beside ``path`` and rename it into place only
-    if it succeeds, so a failed or interrupted run leaves the previous file and no partial one."""
-    path = check_output_file(path)
+    if it succeeds, so a failed or interrupted run leaves the previous file and no partial one.
+
+    The place is checked by :func:`check_output_file` (never an input, a device or a file this
+    program did not write); the file's folder mark lists the temporary before it is made (so
+    that only this program's own temporaries are ever cleaned) and the file once written."""
+    path = check_output_file(path, field)
+    if _is_dev_null(path):
+        return _discard(write, "output" + path.suffix)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        with _locked_mark(path.parent) as mark:
+            _clean_pending(path.parent, mark)
+            tmp = _tmp_name(path)
+            mark["pending"].append(tmp.name)
     except OSError as e:
-        raise _output_error(path, e) from None
-    clean_stale_temps(path.parent)
-    tmp = _tmp_name(path)
+        raise _output_error(path, e, field) from None
     try:
         try:
             write(tmp)
             os.chmod(tmp, _mode())  # the usual mode (h5py and mkstemp differ)
-            os.replace(tmp, path)
+            with _locked_mark(path.parent) as mark:
+                check_output_file(path, field)  # again: another writer may have come in between
+                os.replace(tmp, path)
+                mark["files"].append(path.name)
+                mark["pending"].remove(tmp.name)
         except OSError as e:
-            raise _output_error(path, e) from None
+            raise _output_error(path, e, field) from None
     except BaseException:
         if os.path.lexists(tmp):
             os.unlink(tmp)
+        with contextlib.suppress(OSError, InputError, ValueError), _locked_mark(path.parent) as mark:
+            mark["pending"].remove(tmp.name)
         raise
-
-
-def _read_mark(folder: Path) -> set[str]:
-    try:
-        return set(json.loads((folder / MARK).read_text()).get("files", []))
-    except (OSError, ValueError, AttributeError):
-        return set()
 
 
 def check_output_folder(out: str | Path, names, field: str = "--out") -> Path:
     """Refuse, before any work, an output folder that is a regular file, sits under one, or
-    holds a file of one of ``names`` that this program did not write."""
+    holds a file of one of ``names`` that this program did not write (``--force`` lets it
+    replace a foreign regular file), or a device, FIFO, socket or folder in place of one."""
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise InputError(str(out), field, "an output folder (or a new name)", got="an existing regular file")
     check_output_file(out / "x", field)
     if out.is_dir():
-        owned = _read_mark(out)
+        owned = _read_mark_doc(out)["files"]
         for name in names:
             p = out / name
-            if os.path.lexists(p) and name not in owned:
-                raise InputError(str(p), field, "a folder whose files of that name this program wrote "
-                                 "(it never replaces a file it did not write)", got="a file it did not write")
-            if p.is_dir():
+            if p.is_dir() and not p.is_symlink():
                 raise InputError(str(p), field, "a file place", got="an existing folder")
+            if os.path.lexists(p) and name not in owned:
+                check_output_file(p, field)
+            elif os.path.lexists(p):
+                check_not_input(p, field)
         if not os.access(out, os.W_OK | os.X_OK):
             raise InputError(str(out), field, "a folder this program can write", got="no permission")
     return out
@@ -261,47 +376,74 @@ def write_output_folder(out: str | Path, files: Mapping[str, Callable[[Path], No
                         field: str = "--out") -> Path:
     """Write ``files`` (name -> ``write(tmp_path)``) into folder ``out``.
 
-    Refuses (InputError, before writing anything) an ``out`` that is a regular file, and a
-    file of the same name as an output that this program did not write. Every output is first
-    written to a temporary file in ``out``; only when all are complete are they renamed into
-    place (the previous result stays whole until then). Foreign files are never touched."""
+    Refuses (InputError, before writing anything) what :func:`check_output_folder` refuses.
+    Every output is first written to a temporary file in ``out`` (listed in the mark first);
+    only when all are complete are they renamed into place (the previous result stays whole
+    until then). Foreign files are never touched."""
     out = check_output_folder(out, list(files), field)
     try:
         out.mkdir(parents=True, exist_ok=True)
+        with _locked_mark(out) as mark:
+            _clean_pending(out, mark)
+            tmps = {name: _tmp_name(out / name) for name in files}
+            mark["pending"] += [t.name for t in tmps.values()]
     except OSError as e:
         raise _output_error(out, e, field) from None
-    owned = _read_mark(out)
-    clean_stale_temps(out)
-    tmps: dict[str, Path] = {}
     mode = _mode()
     try:
         try:
             for name, write in files.items():
-                tmps[name] = _tmp_name(out / name)
                 write(tmps[name])
                 os.chmod(tmps[name], mode)
-            mark = _tmp_name(out / MARK)
-            tmps[MARK] = mark
-            mark.write_text(json.dumps({"written_by": "taos", "files": sorted(owned | set(files))}, indent=1) + "\n")
-            for name, tmp in tmps.items():
-                os.replace(tmp, out / name)
+            with _locked_mark(out) as mark:
+                check_output_folder(out, list(files), field)
+                for name, tmp in tmps.items():
+                    os.replace(tmp, out / name)
+                    mark["pending"].remove(tmp.name)
+                mark["files"] += list(files)
         except OSError as e:
             raise _output_error(out, e, field) from None
     except BaseException:
         for tmp in tmps.values():
             if os.path.lexists(tmp):
                 os.unlink(tmp)
+        with contextlib.suppress(OSError, InputError, ValueError), _locked_mark(out) as mark:
+            mark["pending"] = [n for n in mark["pending"] if n not in {t.name for t in tmps.values()}]
         raise
     return out
 
 
+def _first_non_finite(obj, where: str = "") -> str | None:
+    """Dotted key of the first NaN or infinite number in a JSON payload, or None."""
+    if isinstance(obj, float):
+        return where or "(value)" if not math.isfinite(obj) else None
+    if isinstance(obj, Mapping):
+        items = ((f"{where}.{k}" if where else str(k), v) for k, v in obj.items())
+    elif isinstance(obj, (list, tuple)):
+        items = ((f"{where}[{i}]", v) for i, v in enumerate(obj))
+    else:
+        return None
+    for w, v in items:
+        hit = _first_non_finite(v, w)
+        if hit is not None:
+            return hit
+    return None
+
+
 def write_json(path: str, payload: dict) -> None:
-    """JSON to ``path`` ('-' is standard output), atomically for files."""
-    text = json.dumps(payload, indent=2, allow_nan=False)
+    """JSON to ``path`` ('-' is standard output), atomically for files. A NaN or infinite
+    value is refused (InputError naming its key: the inputs led to a non-finite figure) and
+    nothing is written."""
+    try:
+        text = json.dumps(payload, indent=2, allow_nan=False)
+    except ValueError:
+        key = _first_non_finite(payload) or "(value)"
+        raise InputError(str(path), key, "finite numbers in the output (the inputs led to a NaN or "
+                         "infinite figure; nothing was written)", got="a non-finite value") from None
     if path == "-":
         print(text)
         return
-    atomic_write(path, lambda p: p.write_text(text + "\n"))
+    atomic_write(path, lambda p: p.write_text(text + "\n"), field="--json")
 
 
 def write_provenance(h5: h5py.File, provenance: dict) -> None:
@@ -332,3 +474,44 @@ def toml_set(doc, section: str, key: str, value, comment: str | None = None) -> 
             ws = max(2, column - len(item.as_string()))
         item.trivia.comment_ws = " " * ws
     table[key] = item
+
+
+#: options that name an output place (file or folder); every other path argument is an input
+OUTPUT_OPTIONS = ("json", "out", "plot", "html", "df_out", "out_model", "plot_df", "plot_time", "plot_map")
+#: options that name an output file (``--out`` is a file or a folder, checked by its command)
+_OUTPUT_FILE_OPTIONS = {"json": (), "html": (".html", ".htm"), "df_out": (), "out_model": (),
+                        "plot": (".png", ".svg"), "plot_df": (".png", ".svg"), "plot_time": (".png", ".svg"),
+                        "plot_map": (".png", ".svg")}
+
+
+def _input_paths(args) -> list[str]:
+    """Every argument value (positional or option, lists included) other than an output option
+    that names an existing path: the run's inputs as the user gave them."""
+    out = []
+    for k, v in vars(args).items():
+        if k in OUTPUT_OPTIONS or k == "func":
+            continue
+        for x in (v if isinstance(v, (list, tuple)) else [v]):
+            if isinstance(x, str) and x and len(x) < 4096 and "\0" not in x and os.path.exists(x):
+                out.append(x)
+    return out
+
+
+def check_arguments(args) -> None:
+    """Checks every ``taos`` command shares, before any work (:func:`taos.errors.run_cli`'s
+    ``check``): a seed is a 32-bit unsigned whole number; an output option is not empty, is not
+    one of the inputs (nor a link to one) and names a place :func:`check_output_file` accepts."""
+    seed = getattr(args, "seed", None)
+    if isinstance(seed, int) and not 0 <= seed < 2 ** 32:
+        raise InputError("command line", "--seed", "a whole number from 0 to 4294967295", got=str(seed))
+    inputs = _input_paths(args)
+    for k in OUTPUT_OPTIONS:
+        v = getattr(args, k, None)
+        if v is None or v == "-":
+            continue
+        opt = "--" + k.replace("_", "-")
+        if not isinstance(v, str) or not v.strip():
+            raise InputError("command line", opt, "a file or folder name", got=repr(v))
+        check_not_input(v, opt, inputs)
+        if k in _OUTPUT_FILE_OPTIONS:
+            check_output_file(v, opt, _OUTPUT_FILE_OPTIONS[k])

@@ -55,6 +55,36 @@ def _Q(*args):
 
 _NUMBER_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s+([A-Za-z][^\s].*?|[A-Za-z]|1\s*/\s*[A-Za-z].*?)\s*$")
 
+#: longest value text accepted ("115000 lbf/in" is 13 characters)
+MAX_VALUE_TEXT = 64
+_NAME = r"[A-Za-z_][A-Za-z0-9_]*"
+_POW = r"(?:\s*(?:\*\*|\^)\s*[-+]?\d{1,2})?"
+#: the unit grammar: names joined by * and /, each with at most one small whole-number power
+#: (``in*lbf``, ``kg*m**2``, ``m**3/s/Pa``, ``1/s``); no numbers elsewhere, no parentheses, no
+#: chained powers: the text is parsed, never evaluated as an expression (``9**9**9`` would not end)
+UNIT_GRAMMAR = re.compile(rf"^(?:1\s*/\s*)?{_NAME}{_POW}(?:\s*[*/]\s*{_NAME}{_POW})*$")
+_VALUE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d{1,3})?)\s*(.*?)\s*$")
+
+
+def check_value_text(value: str, source: str, field: str, expected: str) -> str:
+    """Refuse value text that is not a plain decimal number followed by an optional unit of
+    :data:`UNIT_GRAMMAR`, or longer than :data:`MAX_VALUE_TEXT`; returns the unit text ('' for
+    none). Run before pint sees a value, so that no text is ever evaluated as an expression."""
+    v = _VALUE.match(value) if isinstance(value, str) and len(value) <= MAX_VALUE_TEXT else None
+    if v is None or (v.group(2) and not UNIT_GRAMMAR.match(v.group(2))):
+        raise InputError(source, field, expected, got=repr(value)[:MAX_VALUE_TEXT + 2])
+    return v.group(2)
+
+
+def check_unit_text(unit: str, source: str, field: str, expected: str = "a unit like 'deg' or 'lbf/in'") -> str:
+    """Refuse unit text outside :data:`UNIT_GRAMMAR` (or longer than :data:`MAX_VALUE_TEXT`)
+    before pint sees it; returns it stripped."""
+    if not isinstance(unit, str) or len(unit) > MAX_VALUE_TEXT or not UNIT_GRAMMAR.match(unit.strip()):
+        got = repr(unit)[:MAX_VALUE_TEXT + 2] if isinstance(unit, str) else repr(unit)[:40]
+        raise InputError(source, field, expected + " (unit names joined by * and /, each with at most a "
+                         "two-digit power)", got=got)
+    return unit.strip()
+
 
 @functools.cache
 def _cache_file() -> Path | None:
@@ -174,6 +204,9 @@ def to_si(value: object, kind: str, *, source: str, field: str, positive: bool =
     expected = f"a {kind.replace('_', ' ')} with its unit, like {example}"
     if isinstance(value, bool):
         raise InputError(source, field, expected, got=repr(value))
+    if isinstance(value, str):   # parsed here, never evaluated: a number and a unit of the grammar
+        if not check_value_text(value, source, field, expected) and kind != "dimensionless":
+            raise InputError(source, field, expected, got=f"{value!r} (no unit)")
     m = _NUMBER_UNIT.match(value) if isinstance(value, str) else None
     ab = _affine(m.group(2), kind) if m else None
     if kind == "dimensionless" and isinstance(value, (int, float)):
@@ -219,10 +252,15 @@ def from_si(value: float, si_unit: str, unit: str) -> float:
 
 
 def parse_float_list(text: str, option: str, source: str = "command line") -> list[float]:
-    """'0.1,0.5,1' -> [0.1, 0.5, 1.0] (a command-line option's list of numbers); refuses empty,
+    """'0.1,0.5,1' -> [0.1, 0.5, 1.0] (a command-line option's list of numbers); refuses an empty
+    list or item (a double or trailing comma),
     non-numeric, non-positive or non-finite items (:class:`~taos.errors.InputError` naming ``option``)."""
+    if not isinstance(text, str) or not text.strip() or len(text) > 10000:
+        raise InputError(source, option, "a comma-separated list of numbers like 0.1,0.5,1", got=repr(text)[:40])
+    if any(not s.strip() for s in text.split(",")):
+        raise InputError(source, option, "numbers separated by single commas (no empty item)", got=repr(text)[:60])
     try:
-        vals = [float(s) for s in text.split(",") if s.strip()]
+        vals = [float(s) for s in text.split(",")]
     except ValueError:
         raise InputError(source, option, "a comma-separated list of numbers like 0.1,0.5,1",
                          got=repr(text)) from None

@@ -152,7 +152,8 @@ def test_ascent_cli_writes_runs_and_refuses_foreign_names(tmp_path):
     out = tmp_path / "asc"
     assert main(["ascent", "ascent", "--friction", "dahl", "--start", "120", "--end", "150", "--dt", "1e-3",
                  "--out", str(out), "--json", str(tmp_path / "s.json")]) == 0
-    assert {p.name for p in out.iterdir()} == {"ascent_dahl.h5", "ascent.png", "summary.json"}
+    # (and taos's mark .taos-output.json, the list of the files it wrote there: docs/reference/bounds.md)
+    assert {p.name for p in out.iterdir()} == {"ascent_dahl.h5", "ascent.png", "summary.json", ".taos-output.json"}
     import h5py
     with h5py.File(out / "ascent_dahl.h5") as f:
         assert f.attrs["ascent_sha256"] and f["yaw/engine_rad"].shape == f["t_s"].shape

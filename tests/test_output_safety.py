@@ -175,12 +175,15 @@ def test_killed_during_write_keeps_previous_result_and_leaves_no_temporary(comma
     proc.kill()
     proc.wait(60)
     assert temporaries(folder), "SIGKILL should leave the temporary file for the next run"
-    assert {k: v for k, v in _snapshot(folder).items() if not k.endswith(".tmp")} == before
+    # (the mark lists the temporary as pending: that is how the next run knows it is its own)
+    mine = lambda snap: {k: v for k, v in snap.items() if not k.endswith(".tmp") and k != ".taos-output.json"}  # noqa: E731
+    assert mine(_snapshot(folder)) == mine(before)
     # ... and the next run in that place removes the stale temporary file
     again = subprocess.run([sys.executable, "-m", "taos", *map(str, args)], cwd=tmp_path, env=env(),
                            capture_output=True, text=True, timeout=600)
     assert again.returncode == 0, again.stderr
     assert not temporaries(folder)
+    assert '"pending": []' in (folder / ".taos-output.json").read_text()
 
 
 # -- divergence -------------------------------------------------------------------------------
@@ -211,14 +214,14 @@ def test_info_shows_the_unstable_mode(tmp_path, capsys):
 
 
 def test_leaving_the_envelope_stops_with_exit_3_naming_time_state_and_cause(tmp_path, capsys):
-    """A supply pressure far too low for the load (stall force A P_s tiny): the load force
+    """A supply pressure far too low for the load (20 psi: stall force A P_s tiny, yet within the documented 1 bar lower bound): the load force
     leaves the envelope; the run stops with exit 3 and writes nothing."""
     t = inline_actuator_set(AMBIENT.read_text(), AMBIENT).replace('stiffness_file = "../fem_data/', f'stiffness_file = "{ROOT}/fem_data/')
-    t = re.sub(r'(?m)^supply_pressure\s*=.*$', 'supply_pressure = "5 psi"', t)
-    # the valve law off (with it on, a 5 psi supply makes the stall limit a stiff mode that the
+    t = re.sub(r'(?m)^supply_pressure\s*=.*$', 'supply_pressure = "20 psi"', t)
+    # the valve law off (with it on, a 20 psi supply makes the stall limit a stiff mode that the
     # step check refuses before the run: exit 2); the envelope check catches the load force
     t = re.sub(r'(?m)^pressure_limited\s*=.*$', 'pressure_limited = false', t)
-    t = re.sub(r'(?m)^relief_pressure\s*=.*$', 'relief_pressure = "5 psi"', t)  # cracks at P_s
+    t = re.sub(r'(?m)^relief_pressure\s*=.*$', 'relief_pressure = "20 psi"', t)  # cracks at P_s
     model = tmp_path / "weak.toml"
     model.write_text(t)
     out = tmp_path / "run.h5"
@@ -307,17 +310,25 @@ def test_viewer_server_ends_when_its_parent_is_killed(tmp_path):
 
 
 def test_stale_temporaries_of_dead_runs_are_removed_and_nothing_else(tmp_path):
-    from taos.results import atomic_write
+    """Only a temporary this program listed in the folder's mark before making it is ever
+    removed: a user's file with the same pattern, or the old pattern, is kept."""
+    import json
+
+    from taos.results import MARK, atomic_write
 
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
-    stale = tmp_path / f".run.h5.{dead.pid}.taos.tmp"
+    stale = tmp_path / f".run.h5.{dead.pid}.{'ab' * 16}.taos.tmp"     # a killed run's, listed
     stale.write_text("half")
-    mine = tmp_path / ".notes.123.tmp"      # looks temporary, but not this program's
+    lookalike = tmp_path / f".old.h5.{dead.pid}.{'cd' * 16}.taos.tmp"  # same pattern, not listed
+    lookalike.write_text("user")
+    mine = tmp_path / f".notes.{dead.pid}.taos.tmp"      # looks temporary, but not this program's
     mine.write_text("keep")
+    (tmp_path / MARK).write_text(json.dumps({"written_by": "taos", "files": [], "pending": [stale.name]}))
     atomic_write(tmp_path / "run.json", lambda p: p.write_text("{}"))
-    assert not stale.exists() and mine.read_text() == "keep"
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".notes.123.tmp", "run.json"]
+    assert not stale.exists() and mine.read_text() == "keep" and lookalike.read_text() == "user"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([MARK, mine.name, lookalike.name, "run.json"])
+    assert json.loads((tmp_path / MARK).read_text())["pending"] == []
 
 
 def test_debug_shows_the_traceback_and_an_internal_error_is_still_one_line(tmp_path, capsys, monkeypatch):

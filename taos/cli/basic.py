@@ -81,6 +81,20 @@ def cmd_info(args) -> int:
     return 0
 
 
+def _check_freqresp_flags(args) -> None:
+    """Refuse flags that contradict each other (one would be silently ignored), naming one."""
+    if args.linear and args.amplitude_deg is not None:
+        raise InputError("command line", "--amplitude-deg", "no amplitude with --linear (the linear response "
+                         "has none)", got=repr(args.amplitude_deg))
+    if args.steady is not None and args.amplitude_deg is None:
+        raise InputError("command line", "--steady", "--amplitude-deg too (--steady chooses how a sine dwell "
+                         "settles; the linear response has no dwell)", got=args.steady)
+    if args.cross and args.engine != "taos":
+        raise InputError("command line", "--cross", "--engine taos (the planar engine has no cross-axis "
+                         "response)", got=f"--engine {args.engine}")
+    args.steady = args.steady or "settle"
+
+
 def cmd_freqresp(args) -> int:
     import numpy as np
 
@@ -90,6 +104,7 @@ def cmd_freqresp(args) -> int:
     from taos.planar import envelope as run_checks
     from taos.results import check_output_file
 
+    _check_freqresp_flags(args)
     freqs = parse_float_list(args.freq_hz, "--freq-hz")
     limits.check_response_frequencies(freqs)
     for opt, suf in (("json", ()), ("plot", (".png", ".svg"))):
@@ -215,9 +230,9 @@ def add_parsers(sub) -> None:
     p.add_argument("--freq-hz", required=True, help="comma-separated frequencies, e.g. 0.1,0.5,1,2,5")
     p.add_argument("--amplitude-deg", help="command amplitude(s) for the sine-dwell (nonlinear) response; a "
                    "comma-separated list gives the whole N(A, w) map in one call (JSON: amplitude x frequency rows)")
-    p.add_argument("--steady", choices=("settle", "shoot"), default="settle",
-                   help="how each dwell reaches its periodic orbit: settle (integrate from rest through the "
-                   "settling time, default) or shoot (periodic steady state by shooting, simplex engine)")
+    p.add_argument("--steady", choices=("settle", "shoot"), default=None,
+                   help="with --amplitude-deg: how each dwell reaches its periodic orbit: settle (integrate from "
+                   "rest through the settling time, default) or shoot (periodic steady state by shooting, simplex engine)")
     p.add_argument("--linear", action="store_true", help="exact linear response (no friction, unity avionics)")
     p.add_argument("--axis", choices=AXES, default="pitch")
     p.add_argument("--engine", choices=ENGINES, default="simplex",

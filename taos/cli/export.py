@@ -13,6 +13,10 @@ def cmd_export(args) -> int:
     from taos.interop.files import export_csv, export_mat
     from taos.model import load_model
 
+    from taos.results import check_output_file
+
+    if (args.format or ("mat" if str(args.out).lower().endswith(".mat") else "csv")) == "mat":
+        check_output_file(args.out, "--out", (".mat",))   # before any work
     model = load_model(args.model, friction=getattr(args, "friction", None))
     freqs = (parse_float_list(args.freq_hz, "--freq-hz") if args.freq_hz
              else np.logspace(-1, np.log10(30.0), 200).tolist())

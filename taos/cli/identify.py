@@ -17,6 +17,9 @@ def _estimate(path, args):
     from taos.identify.data import load_test_data
     from taos.identify.estimation import estimate
 
+    if getattr(args, "nperseg", None) is not None and args.method == "dwell":
+        raise InputError("command line", "--nperseg", "--method h1 or auto (a sine-dwell correlation has no "
+                         "segments)", got="--method dwell")
     data = load_test_data(path)
     axes = None if args.axis in (None, "both") else (args.axis,)
     if axes and axes[0] not in data.axes:
@@ -132,7 +135,10 @@ def cmd_fit(args) -> int:
     if not 0.0 <= args.min_coherence <= 1.0:
         raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
     model = load_model(args.model, friction=args.friction)
-    free = [s.strip() for s in args.free.split(",") if s.strip()]
+    free = [s.strip() for s in args.free.split(",")]
+    if not all(free):
+        raise InputError("command line", "--free", "parameter names separated by single commas, like "
+                         "load_stiffness,coulomb_torque", got=repr(args.free))
     start = _parse_start(args.start, model)
     bounds = _parse_bounds(args.bounds)
     responses, labels = [], []
@@ -224,8 +230,8 @@ def cmd_compare(args) -> int:
     if args.data:
         _, da = _estimate(args.data[0], args)
         _, db = _estimate(args.data[1], args)
-    labels = tuple(args.labels.split(",")) if args.labels else None
-    if labels is not None and len(labels) != 2:
+    labels = tuple(x.strip() for x in args.labels.split(",")) if args.labels is not None else None
+    if labels is not None and (len(labels) != 2 or not all(labels)):
         raise InputError("command line", "--labels", "two labels like ambient,'hot fire'", got=args.labels)
     cmp = compare_models(ma, mb, da, db, labels)
     out = write_comparison(cmp, args.out, json_path=args.json)

@@ -41,6 +41,11 @@ def cmd_lco(args) -> int:
         raise InputError("command line", "--signoff", "--requirements FILE with it", got="no --requirements")
     if args.sweep:
         return _sweep(args, flight, model, amps, freqs)
+    if args.plot_map:
+        raise InputError("command line", "--plot-map", "--sweep too (the map is of a sweep)", got=args.plot_map)
+    if args.plot_time and args.no_time_domain:
+        raise InputError("command line", "--plot-time", "a time-domain run (not with --no-time-domain)",
+                         got=args.plot_time)
     rep = analyse_lco(flight, model, axis=args.axis, duration_s=args.duration, avionics=args.avionics,
                       amplitudes_rad=amps, freq_hz=freqs,
                       window_s=min(120.0, 0.5 * args.duration), time_domain=not args.no_time_domain,
@@ -81,6 +86,12 @@ def cmd_lco(args) -> int:
 def _sweep(args, flight, model, amps, freqs) -> int:
     """``taos lco --sweep NAME=V1,V2 [--sweep NAME2=...]``: the verdict map (prediction only)."""
     from taos.flight.lco_map import lco_map, parse_sweep
+    for opt in ("plot", "plot_df", "plot_time", "df_out"):   # the sweep is prediction only: these would be ignored
+        if getattr(args, opt):
+            raise InputError("command line", "--" + opt.replace("_", "-"), "not with --sweep (a verdict map; its "
+                             "plot is --plot-map)", got=getattr(args, opt))
+    if len(args.sweep) > 2:
+        raise InputError("command line", "--sweep", "one or two sweeps", got=f"{len(args.sweep)}")
     axes = [parse_sweep(s) for s in args.sweep]
     if args.axis:
         flight = dataclasses.replace(flight, axis=args.axis)

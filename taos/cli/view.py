@@ -19,6 +19,9 @@ def _positive(value: float, option: str) -> float:
 def cmd_view(args) -> int:
     from taos.viewer import load_run, serve, write_html
 
+    if args.paused_at is not None and not args.html:
+        raise InputError("command line", "--paused-at", "--html too (the live viewer has its own time slider)",
+                         got=repr(args.paused_at))
     if args.html:
         from taos.results import check_output_file
         check_output_file(args.html, "--html")

@@ -20,6 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
+import re
+
 import numpy as np
 
 from ..errors import InputError
@@ -86,10 +88,16 @@ class GimbalStiffness:
 
 
 def _read_csv(path: Path) -> np.ndarray:
+    from ..errors import check_input_file
+
+    check_input_file(path, "a stiffness matrix file (.npz or .csv)")
     try:
         return np.loadtxt(path, delimiter=",", comments="#", ndmin=2)
-    except ValueError as exc:
-        raise InputError(str(path), "matrix", "comma-separated numbers", got=str(exc).splitlines()[0]) from None
+    except (ValueError, UnicodeDecodeError) as exc:
+        # the reason, never the file's text: a stiffness_file may point at any file of the user's
+        row = re.search(r"at row (\d+)", str(exc))
+        raise InputError(str(path), "matrix", "comma-separated numbers",
+                         got="text that is not numbers" + (f" (row {row.group(1)})" if row else "")) from None
 
 
 def read_npz(path: str | Path, field: str = "(file)") -> dict[str, np.ndarray]:
@@ -98,6 +106,9 @@ def read_npz(path: str | Path, field: str = "(file)") -> dict[str, np.ndarray]:
     import zipfile
 
     src = str(path)
+    from ..errors import check_input_file
+
+    check_input_file(path, "a NumPy .npz archive", field=field)
     try:
         with np.load(path, allow_pickle=False) as z:
             if not hasattr(z, "files"):

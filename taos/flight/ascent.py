@@ -197,6 +197,9 @@ def _column(t: Mapping, key: str, si_unit: str, src: str) -> np.ndarray:
     if (not isinstance(vals, list) or not vals or len(vals) > MAX_TABLE_ROWS
             or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals)):
         raise InputError(src, f"{fld}.values", f"a list of 1 to {MAX_TABLE_ROWS} numbers", got=repr(vals)[:80])
+    from taos.units import check_unit_text
+
+    check_unit_text(col["unit"], src, f"{fld}.unit", f"a unit convertible to {si_unit}")
     try:
         factor = Q_(1.0, str(col["unit"])).to(si_unit).magnitude
     except Exception:
@@ -247,6 +250,9 @@ def _aero(doc: Mapping, src: str) -> Aero:
     a = _table(doc, "aero", src)
     _keys(a, {"reference_area", "normal_force_slope", "center_of_pressure_ahead"}, src, "aero")
     slope = a.get("normal_force_slope")
+    if isinstance(slope, str):
+        from taos.units import check_value_text
+        check_value_text(slope, src, "aero.normal_force_slope", "a non-negative slope with its unit, like '4 1/rad'")
     try:
         s = float(Q_(slope).to("1/rad").magnitude) if isinstance(slope, str) else None
     except Exception:

@@ -177,6 +177,9 @@ def _value(table: Mapping, key: str, unit: str, check: str, src: str, section: s
             raise InputError(src, fld, expected, got=f"{v!r} (no unit)")
         q = Q_(float(v), "dimensionless")
     else:
+        from taos.units import check_value_text
+
+        check_value_text(v, src, fld, expected)
         try:
             q = Q_(v)
         except Exception:
@@ -205,6 +208,9 @@ def _parse(table: Mapping, keys: dict, src: str, section: str) -> dict:
                 continue
             raise InputError(src, f"{section}.{k}", f"a value in {unit}", got="nothing (key missing)")
         out[fld] = _value(table, k, unit, check, src, section)
+        from taos.bounds import FLIGHT_BOUNDS, check_bound
+        if f"{section}.{k}" in FLIGHT_BOUNDS:   # the documented physical bounds (docs/reference/bounds.md)
+            check_bound(out[fld], f"{section}.{k}", src)
     return out
 
 
@@ -219,8 +225,10 @@ def load_flight(path: str | Path) -> FlightModel:
     vt = doc.get("vehicle")
     vkw = _parse(vt, _VEHICLE_KEYS, src, "vehicle")
     n = vt.get("engine_count")
-    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
-        raise InputError(src, "vehicle.engine_count", "a positive whole number of engines", got=repr(n))
+    from taos.bounds import MAX_ENGINES
+    if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_ENGINES:
+        raise InputError(src, "vehicle.engine_count", f"a whole number of engines from 1 to {MAX_ENGINES}",
+                         got=repr(n))
     ft = doc.get("fcs")
     fkw = _parse(ft, _FCS_KEYS, src, "fcs")
     order = ft.get("pade_order", 2)

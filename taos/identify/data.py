@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import io
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -70,6 +69,19 @@ SIGNALS = {
 HYDRAULIC = (("load_pressure", "load_pressure_Pa", "psi"), ("spool", "spool_flow_m_s", "in/s"))
 MIN_SAMPLES = 16
 IRREGULAR_TOL = 1e-3
+#: sample rate of a record [Hz]: test-stand DAQs record 100 Hz to 100 kHz; a rate outside
+#: 1 Hz .. 1 MHz is a time column in the wrong unit (ms read as s, or the reverse)
+SAMPLE_RATE_HZ = (1.0, 1e6)
+#: largest magnitude of a signal, by unit kind (SI), and why: beyond it the column is in the
+#: wrong unit or corrupt, and any response estimated from it would be absurd
+SIGNAL_LIMITS = {
+    "angle": (math.radians(45.0), "45 deg: no TVC gimbal swings further (RS-25: 10.5 deg)"),
+    "length": (1.0, "1 m: a piston stroke is centimetres (RS-25 actuator: +-5 in)"),
+    "pressure": (1e9, "1 GPa (145000 psi): hydraulic supplies are 3000-5000 psi"),
+    "velocity": (100.0, "100 m/s: servo-actuator piston rates are below 1 m/s"),
+}
+#: longest record [s]: three times the longest documented run (taos.bounds.MAX_DURATION_S)
+MAX_RECORD_S = 3e4
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,6 +164,9 @@ def _toml_value(v) -> str:
 def unit_factor(unit: str, signal: str, source: str, column: str) -> float:
     """SI factor of ``unit`` for ``signal`` (e.g. 'deg' for an angle -> pi/180)."""
     kind, si, example = SIGNALS[signal]
+    from taos.units import check_unit_text
+
+    check_unit_text(unit, source, column, f"a {kind} unit like {example}")
     try:
         q = Q_(1.0, unit)
         ok = q.dimensionality == Q_(1.0, si).dimensionality
@@ -195,6 +210,9 @@ def _check_meta(meta: dict, src: str, sidecar: bool) -> None:
 def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
     """Returns (metadata, {signal: array SI}, {signal: column label}). Streams the numbers
     (``numpy.loadtxt`` on the open file), so memory stays near the size of the array itself."""
+    from taos.errors import check_input_file
+
+    check_input_file(path, "a readable CSV text file")
     try:
         f = open(path, encoding="utf-8")
     except OSError as e:
@@ -214,19 +232,23 @@ def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
         if header_line is None:
             raise InputError(src, "(header)", "a header row of column names like 'time [s],pitch_command [deg],...'",
                              got="no rows")
-        try:
-            meta = tomllib.loads("\n".join(meta_lines))
-        except tomllib.TOMLDecodeError as e:
-            raise InputError(src, "(# metadata)", "TOML 'key = value' comment lines", got=str(e).splitlines()[0]) from None
+        from taos.errors import parse_toml
+
+        meta = parse_toml("\n".join(meta_lines).encode("utf-8"), src)
         _check_meta(meta, src, sidecar=False)
         header = [h.strip() for h in header_line.split(",")]
+        dup = next((h for i, h in enumerate(header) if h in header[:i]), None)
+        if dup is not None:
+            raise InputError(src, dup, "each column name once in the header", got="a repeated column name")
+        if any(not h for h in header):
+            raise InputError(src, "(header)", "a name for every column", got=f"an empty name in column "
+                             f"{header.index('') + 1}")
         sidecar = path.with_suffix(".toml")
         mapping: dict[str, tuple[str, str]] = {}
         if sidecar.exists():
-            try:
-                side = tomllib.loads(sidecar.read_text())
-            except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
-                raise InputError(str(sidecar), "(file)", "valid TOML", got=str(e).splitlines()[0]) from None
+            from taos.errors import parse_toml, read_input_bytes
+
+            side = parse_toml(read_input_bytes(sidecar, "a readable sidecar TOML file"), str(sidecar))
             _check_meta(side, str(sidecar), sidecar=True)
             cols = side.pop("columns", {})
             if not isinstance(cols, dict):
@@ -284,6 +306,9 @@ def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
 def _read_hdf5(path: Path, src: str) -> tuple[dict, dict, dict]:
     import h5py
 
+    from taos.errors import check_input_file
+
+    check_input_file(path, "a readable HDF5 file")
     try:
         h5 = h5py.File(path, "r")
     except OSError as e:
@@ -343,6 +368,9 @@ def load_test_data(path: str | Path, *, resample: bool = True) -> TestData:
     src = str(path)
     if not p.exists():
         raise InputError(src, "(file)", "an existing data file", got="no such file")
+    from taos.errors import check_input_file
+
+    check_input_file(p, "a readable data file (.csv or .h5)")
     if p.suffix.lower() in (".h5", ".hdf5"):
         meta, sig, labels = _read_hdf5(p, src)
     elif p.suffix.lower() in (".csv", ".txt"):
@@ -364,6 +392,7 @@ def load_test_data(path: str | Path, *, resample: bool = True) -> TestData:
         i = bad[0]
         raise InputError(src, labels["time"], "strictly increasing time",
                          got=f"{t[i + 1]:.9g} s after {t[i]:.9g} s at sample {i + 1}")
+    _check_record_sanity(src, t, sig, labels)
     axes = tuple(ax for ax in AXES if f"{ax}_command" in sig)
     if not axes:
         raise InputError(src, "pitch_command", "a pitch_command or yaw_command column", got="none")
@@ -409,6 +438,27 @@ def load_test_data(path: str | Path, *, resample: bool = True) -> TestData:
                     synthetic=bool(meta.get("synthetic", False)), resampled=resampled,
                     metadata={k: v for k, v in meta.items()
                               if k not in ("condition", "synthetic", "engine_angle_reference")})
+
+
+def _check_record_sanity(src: str, t, sig: dict, labels: dict) -> None:
+    """The record's sample rate within :data:`SAMPLE_RATE_HZ`, its length within
+    :data:`MAX_RECORD_S`, and every signal within :data:`SIGNAL_LIMITS` (time strictly
+    increasing is checked before)."""
+    rate = (t.size - 1) / (t[-1] - t[0])
+    lo, hi = SAMPLE_RATE_HZ
+    if not lo <= rate <= hi:
+        raise InputError(src, labels["time"], f"a sample rate from {lo:g} to {hi:g} Hz (a time column in "
+                         "seconds as its unit says)", got=f"{rate:.4g} Hz")
+    if t[-1] - t[0] > MAX_RECORD_S:
+        raise InputError(src, labels["time"], f"a record of at most {MAX_RECORD_S:g} s", got=f"{t[-1] - t[0]:.4g} s")
+    for name, x in sig.items():
+        kind = SIGNALS[name][0]
+        if kind in SIGNAL_LIMITS and x.size:
+            lim, why = SIGNAL_LIMITS[kind]
+            i = int(np.argmax(np.abs(x)))
+            if abs(x[i]) > lim:
+                raise InputError(src, labels[name], f"magnitudes of at most {lim:g} {SIGNALS[name][1]} ({why})",
+                                 got=f"{x[i]:.4g} {SIGNALS[name][1]} at sample {i}")
 
 
 def from_time_history(th, *, engine_offset_rad=None, condition: str = "", source: str = "<simulation>",

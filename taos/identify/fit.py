@@ -415,6 +415,24 @@ def _toml_value(p, v_si: float):
     return f"{from_si(v_si, _si_unit(p.kind), p.unit):.6g} {p.unit}"
 
 
+def _keep_static_above_coulomb(result: FitResult, doc, todo: dict, note_stamp: str) -> None:
+    """A fitted Coulomb torque T_c scales the file's static torque T_s with it (T_s / T_c kept:
+    both levels are proportional to the bearing normal load), so the fitted file keeps
+    T_s >= T_c, which loading a model requires (docs/reference/bounds.md)."""
+    from taos.units import to_si
+
+    ftab = doc.get("friction", {})
+    if "coulomb_torque" not in result.names or "static_torque" not in ftab:
+        return
+    p = PARAMETERS["coulomb_torque"]
+    tc_new = result.values[result.names.index("coulomb_torque")]
+    tc_old = result.initial.friction.coulomb_torque_Nm
+    ts_old = to_si(str(ftab["static_torque"]), "torque", source=result.initial.source, field="friction.static_torque")
+    ts_new = max(ts_old * tc_new / tc_old if tc_old > 0 else ts_old, tc_new)
+    todo[("friction", "static_torque")] = (_toml_value(p, ts_new), f"# scaled with the fitted coulomb_torque by "
+                                           f"taos fit ({note_stamp}): T_s/T_c kept")
+
+
 def fitted_model_text(result: FitResult, data_label: str = "") -> str:
     """The model file of ``result.initial`` with the fitted values replaced and commented
     (edited with tomlkit: every other line and comment stays as it was)."""
@@ -442,6 +460,7 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
                 todo[(p.section, "crossover_command")] = (["0 deg"], "# added by taos fit")
         else:
             todo[(p.section, p.toml_key)] = (_toml_value(p, result.values[i]), note)
+    _keep_static_above_coulomb(result, doc, todo, note_stamp=stamp)
     file_law = str(result.initial.friction_table.get("model", result.initial.friction.name))
     if result.initial.friction.name != file_law:
         todo[("friction", "model")] = (result.initial.friction.name,

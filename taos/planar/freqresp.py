@@ -145,6 +145,9 @@ class FrequencyResponse:
 
 def linear_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, axis: str = "pitch") -> FrequencyResponse:
     """Exact response of the linear simplex block (no friction, unity avionics)."""
+    from taos.bounds import check_response_args
+
+    check_response_args(freq_hz, None, axis)
     ss = simplex_state_space(model, axis)
     h = ss.freqresp(freq_hz, "command_rad", ["x_p_m", "theta_rad"])
     R = model.actuator.moment_arm_m
@@ -266,6 +269,9 @@ def sine_dwell_grid(model: TvcModel, amplitudes_rad: np.typing.ArrayLike, freq_h
     """Sine-dwell responses over a grid of amplitudes x frequencies in one parallel call
     (:func:`sine_dwell_points`, whose settings it takes). Returns (piston, engine) complex
     arrays of shape (n_amp, n_freq)."""
+    from taos.bounds import check_response_args
+
+    check_response_args(freq_hz, amplitudes_rad, axis)
     amps = np.atleast_1d(np.asarray(amplitudes_rad, float))
     f = np.atleast_1d(np.asarray(freq_hz, float))
     A, F = np.meshgrid(amps, f, indexing="ij")
@@ -281,6 +287,9 @@ def sine_dwell_family(model: TvcModel, freq_hz, amplitudes_rad, axis: str = "pit
     describing-function map N(A, w) of the ``taos freqresp --amplitude-deg A1,A2,...`` call.
     Each row equals the single-amplitude call bit for bit. With ``method="shoot"`` the
     provenance carries the largest shooting residual and whether every dwell converged."""
+    from taos.bounds import check_response_args
+
+    check_response_args(freq_hz, amplitudes_rad, axis)
     amps = np.atleast_1d(np.asarray(amplitudes_rad, float))
     f = np.atleast_1d(np.asarray(freq_hz, float))
     A, F = np.meshgrid(amps, f, indexing="ij")

@@ -293,8 +293,16 @@ def start_loopback_server(timeout_s: float = 20.0):
     env["TAOS_VIEWER_PARENT"] = str(os.getpid())  # the server ends when this process ends
     proc = subprocess.Popen([sys.executable, "-u", "-m", "taos.viewer._server"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, env=env, start_new_session=True)
+    import select
+    import time
+
     zmq_url = web_url = None
+    deadline = time.monotonic() + timeout_s   # every wait bounded: a server that never answers is an error
     while zmq_url is None or web_url is None:
+        if not select.select([proc.stdout], [], [], max(0.0, deadline - time.monotonic()))[0]:
+            proc.kill()
+            proc.wait(5)
+            raise RuntimeError(f"meshcat server did not start within {timeout_s:g} s")
         line = proc.stdout.readline().decode("utf-8").strip()
         if not line and proc.poll() is not None:
             err = proc.stderr.read().decode("utf-8", "replace").strip().splitlines()
