@@ -250,7 +250,7 @@ def test_cli_builds_and_refuses_bad_input_without_writing(tmp_path):
     assert keep.read_bytes() == b"not mine"
     again = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu")   # its own FMU: replaced
     assert again.returncode == 0, again.stderr
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.fmu", "bad.toml", "keep.fmu"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".taos-output.json", "a.fmu", "bad.toml", "keep.fmu"]
 
 
 def test_a_tampered_model_copy_is_refused_at_instantiation(simplex_fmu, tmp_path):
