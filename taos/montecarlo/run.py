@@ -6,11 +6,11 @@ its frequency, and whether it is sustained (growth over the window > 0.8) above 
 avionics LSB (0.004 deg). Peaks of engine angle, engine rate and attitude error are taken over
 the whole segment.
 
-Physical sanity: the engine is held inside its gimbal range by hard stops, so a run whose engine
-peak or oscillation amplitude exceeds the range (``model.engine.gimbal_range_rad``, with a 10 %
-allowance for the contact's compliance) has left the model's envelope: it is stored as
-**diverged**, apart from the runs that failed (non-finite state, refused value) and never counted
-as a limit cycle.
+Physical sanity: the engine is held inside its gimbal range (``model.engine.gimbal_range_rad``)
+by hard stops, so a run whose engine reaches them (peak or oscillation amplitude at or above
+``STOP_FRACTION`` of the range) has left the small-amplitude regime a limit-cycle verdict is
+about: it is stored as **diverged**, apart from the runs that failed (non-finite state, refused
+value), and never counted as a limit cycle. A model without hard stops has no such bound.
 
 :class:`FlightRuns` is the engine's run kind (:class:`taos.montecarlo.engine.RunKind`): it
 carries the parsed campaign, ascent and TVC model (no file is opened by a worker) and the content
@@ -35,7 +35,7 @@ from taos.montecarlo.store import STATUS
 RECORD_INTERVAL_S = 0.02
 #: measured cost of one RK4 step of the flight plant, for sizing batches [s] (benchmarks/RESULTS.md)
 STEP_COST_S = 2.5e-6
-STOP_ALLOWANCE = 1.10
+STOP_FRACTION = 0.98
 SCALARS = ("amplitude_deg", "engine_amplitude_deg", "frequency_hz", "growth", "peak_engine_deg",
            "peak_engine_rate_deg_s", "peak_attitude_deg")
 FLAGS = ("lco",)
@@ -73,9 +73,10 @@ class FlightRuns:
 
     @property
     def gimbal_range_deg(self) -> float:
-        """The sanity bound on engine angles [deg] (inf when the model has no hard stops)."""
+        """The sanity bound on engine angles [deg]: ``STOP_FRACTION`` of the gimbal range (inf when
+        the model has no hard stops)."""
         r = self.model.engine.gimbal_range_rad
-        return math.degrees(r) * STOP_ALLOWANCE if r > 0 else math.inf
+        return math.degrees(r) * STOP_FRACTION if r > 0 else math.inf
 
     def run_batch(self, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray) -> dict:
         n, m = len(seeds), len(self.trace_t_s)
@@ -111,9 +112,9 @@ class FlightRuns:
         out["trace"][i, :mm] = tr[:mm]
         bound = self.gimbal_range_deg
         worst = max(vals["peak_engine_deg"], vals["engine_amplitude_deg"])
-        if not math.isfinite(worst) or not math.isfinite(vals["amplitude_deg"]) or worst > bound:
+        if not math.isfinite(worst) or not math.isfinite(vals["amplitude_deg"]) or worst >= bound:
             out["status"][i] = STATUS["diverged"]
-            out["error"][i] = f"engine {worst:.4g} deg beyond the gimbal range bound {bound:.4g} deg"
+            out["error"][i] = f"engine reached its hard stops ({worst:.4g} deg, bound {bound:.4g} deg)"
             return
         out["status"][i] = STATUS["ok"]
         out["lco"][i] = bool(osc.lco)
