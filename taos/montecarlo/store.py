@@ -77,15 +77,15 @@ def write_batch(path: Path, start: int, out: Mapping[str, np.ndarray], group: st
                                                                                     zarr_format=2)
 
 
-def open_store(path: Path, group: str | None = None):
+def open_store(path: Path, group: str | None = None, consolidated: bool | None = None):
     """The store (or its ``group``) as a lazy :class:`xarray.Dataset`."""
     import xarray as xr
-    return xr.open_zarr(path, group=group, zarr_format=2)
+    return xr.open_zarr(path, group=group, zarr_format=2, consolidated=consolidated)
 
 
 def status(path: Path, group: str | None = None) -> np.ndarray | None:
     """Every run's status code, or None when the store cannot be read."""
     try:
-        return np.asarray(open_store(path, group)["status"].values, np.int8)
+        return np.asarray(open_store(path, group, consolidated=False)["status"].values, np.int8)
     except (OSError, KeyError, ValueError):
         return None
