@@ -10,7 +10,10 @@ Physical sanity: the engine is held inside its gimbal range (``model.engine.gimb
 by hard stops, so a run whose engine reaches them (peak or oscillation amplitude at or above
 ``STOP_FRACTION`` of the range) has left the small-amplitude regime a limit-cycle verdict is
 about: it is stored as **diverged**, apart from the runs that failed (non-finite state, refused
-value), and never counted as a limit cycle. A model without hard stops has no such bound.
+value), and never counted as a limit cycle. A model without hard stops has no such bound. The
+measured oscillation must be physical too: the fundamental of a signal bounded by its peak P is
+at most 4P/pi (a square wave's), at a positive frequency; a run whose measurement breaks that
+(a fit of a window without an oscillation) is stored as failed, with the reason.
 
 :class:`FlightRuns` is the engine's run kind (:class:`taos.montecarlo.engine.RunKind`): it
 carries the parsed campaign, ascent and TVC model (no file is opened by a worker) and the content
@@ -36,6 +39,8 @@ RECORD_INTERVAL_S = 0.02
 #: measured cost of one RK4 step of the flight plant, for sizing batches [s] (benchmarks/RESULTS.md)
 STEP_COST_S = 2.5e-6
 STOP_FRACTION = 0.98
+#: the largest fundamental of a signal bounded by its peak: a square wave's, 4/pi (1 % margin)
+FUNDAMENTAL_BOUND = 4 / math.pi * 1.01
 SCALARS = ("amplitude_deg", "engine_amplitude_deg", "frequency_hz", "growth", "peak_engine_deg",
            "peak_engine_rate_deg_s", "peak_attitude_deg")
 FLAGS = ("lco",)
@@ -111,10 +116,17 @@ class FlightRuns:
         mm = min(len(tr), out["trace"].shape[1])
         out["trace"][i, :mm] = tr[:mm]
         bound = self.gimbal_range_deg
-        worst = max(vals["peak_engine_deg"], vals["engine_amplitude_deg"])
-        if not math.isfinite(worst) or not math.isfinite(vals["amplitude_deg"]) or worst >= bound:
+        worst = vals["peak_engine_deg"]
+        if not math.isfinite(worst) or worst >= bound:
             out["status"][i] = STATUS["diverged"]
             out["error"][i] = f"engine reached its hard stops ({worst:.4g} deg, bound {bound:.4g} deg)"
+            return
+        peak_cmd = deg(float(np.max(np.abs(h.signal("command_rad", c.axis)))))
+        if not (vals["engine_amplitude_deg"] <= FUNDAMENTAL_BOUND * worst
+                and vals["amplitude_deg"] <= FUNDAMENTAL_BOUND * peak_cmd and vals["frequency_hz"] > 0):
+            out["status"][i] = STATUS["failed"]
+            out["error"][i] = (f"oscillation measurement not physical: fundamental {vals['engine_amplitude_deg']:.4g} "
+                               f"deg at {vals['frequency_hz']:.3g} Hz from an engine peaking at {worst:.4g} deg")
             return
         out["status"][i] = STATUS["ok"]
         out["lco"][i] = bool(osc.lco)
