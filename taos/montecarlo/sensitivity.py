@@ -61,10 +61,6 @@ def design(method: str, prob: dict, n: int, seed: int) -> np.ndarray:
     return morris.sample(prob, n, num_levels=MORRIS_LEVELS, seed=seed)
 
 
-def design_runs(method: str, k: int, n: int) -> int:
-    return n * (k + 2) if method == "sobol" else n * (k + 1)
-
-
 def indices(method: str, prob: dict, x: np.ndarray, y: np.ndarray, seed: int, confidence: float = 0.95) -> list[dict]:
     """Per factor: Sobol' ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` (half-widths of the
     ``confidence`` bootstrap interval) or Morris ``mu_star``, ``mu_star_conf``, ``sigma``;
@@ -87,13 +83,23 @@ def indices(method: str, prob: dict, x: np.ndarray, y: np.ndarray, seed: int, co
         return rows
 
 
+def holm(pvalues) -> np.ndarray:
+    """Holm's step-down adjusted p-values (family-wise error)."""
+    p = np.asarray(pvalues, float)
+    order = np.argsort(p)
+    adj = np.empty_like(p)
+    run = 0.0
+    for rank, i in enumerate(order):
+        run = max(run, min(1.0, (len(p) - rank) * p[i]))
+        adj[i] = run
+    return adj
+
+
 def logistic_regression(names: Sequence[str], x: np.ndarray, yes: np.ndarray, max_iter: int = 50,
                         alpha: float = 0.05) -> dict | None:
     """Logistic regression of ``yes`` (bool per run) on the columns of ``x`` (module docstring);
     None when it cannot be fitted (one outcome only, or fewer runs than 10 per factor)."""
     from scipy.stats import norm
-
-    from taos.montecarlo.stats import holm
     yes = np.asarray(yes, bool)
     x = np.asarray(x, float)
     keep = [j for j in range(x.shape[1]) if np.ptp(x[:, j]) > 0] if x.size else []

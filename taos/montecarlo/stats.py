@@ -27,7 +27,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from taos.montecarlo.sensitivity import holm, logistic_regression
 from taos.montecarlo.store import STATUS
+
+__all__ = ["wilson_interval", "quantile_interval", "percentiles", "holm", "spearman", "envelope", "CampaignResult",
+           "summarise"]
 
 PERCENTILES = (5, 50, 95)
 
@@ -66,18 +70,6 @@ def percentiles(values, confidence: float = 0.95) -> dict | None:
         r = quantile_interval(v.size, p / 100, confidence)
         out[f"p{p}_ci"] = None if r is None else [float(v[r[0] - 1]), float(v[r[1] - 1])]
     return out
-
-
-def holm(pvalues) -> np.ndarray:
-    """Holm's step-down adjusted p-values (family-wise error)."""
-    p = np.asarray(pvalues, float)
-    order = np.argsort(p)
-    adj = np.empty_like(p)
-    run = 0.0
-    for rank, i in enumerate(order):
-        run = max(run, min(1.0, (len(p) - rank) * p[i]))
-        adj[i] = run
-    return adj
 
 
 def spearman(names, factors: np.ndarray, y: np.ndarray, alpha: float = 0.05) -> list[dict]:
@@ -142,7 +134,6 @@ class CampaignResult:
 def summarise(campaign_name: str, case: str, ds, nominal, confidence: float = 0.95) -> CampaignResult:
     """Statistics (module docstring) of the stored runs ``ds`` and the ``nominal`` run (both
     :class:`xarray.Dataset` in the store layout)."""
-    from taos.montecarlo.sensitivity import logistic_regression
     st = np.asarray(ds["status"].values, np.int8)
     ok = st == STATUS["ok"]
     n_fail, n_div = int((st == STATUS["failed"]).sum()), int((st == STATUS["diverged"]).sum())
