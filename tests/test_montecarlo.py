@@ -188,9 +188,11 @@ def test_dead_scheduler_address_one_line_nothing_written(tmp_path, capsys):
     assert not out.exists()
 
 
-def test_silent_server_times_out_nothing_written(tmp_path, capsys):
-    """A server that accepts and never answers (not a Dask scheduler): refused within the
-    timeout (3 s, plus start-up), with nothing written."""
+@pytest.mark.parametrize("reply, expected", [(b"", "3 s"), (b"\xff" * 64, "not as a Dask scheduler")])
+def test_a_server_that_is_not_dask_refused_in_time_nothing_written(tmp_path, capsys, reply, expected):
+    """A server that accepts and never answers, or answers with bytes that are not the Dask
+    protocol: refused within the timeout (3 s, plus start-up) with the right reason (never "out
+    of memory"), nothing written."""
     srv = socket.socket()
     srv.bind(("127.0.0.1", 0))
     srv.listen(8)
@@ -201,7 +203,10 @@ def test_silent_server_times_out_nothing_written(tmp_path, capsys):
         srv.settimeout(0.2)
         while not stop.is_set():
             try:
-                held.append(srv.accept()[0])
+                c = srv.accept()[0]
+                held.append(c)
+                if reply:
+                    c.sendall(reply)
             except OSError:
                 pass
     th = threading.Thread(target=accept, daemon=True)
@@ -220,8 +225,14 @@ def test_silent_server_times_out_nothing_written(tmp_path, capsys):
         srv.close()
     assert rc == 2 and el < 15, el
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "--scheduler" in err[0] and "3 s" in err[0]
+    assert len(err) == 1 and "--scheduler" in err[0] and expected in err[0] and "memory" not in err[0].lower(), err
     assert not out.exists()
+
+
+def test_scheduler_port_out_of_range_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["montecarlo", str(SHORT), "--runs", "2", "--scheduler", "tcp://127.0.0.1:99999", "--out", str(out)]) == 2
+    assert "port 1 to 65535" in capsys.readouterr().err and not out.exists()
 
 
 BAD = [

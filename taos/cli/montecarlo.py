@@ -93,8 +93,10 @@ def cmd_montecarlo(args) -> int:
 
     if args.scheduler and args.workers is not None:
         raise InputError("command line", "--scheduler", "either --workers or --scheduler, not both")
-    if args.scheduler and not _SCHEDULER.match(args.scheduler):
-        raise InputError("command line", "--scheduler", "an address like tcp://127.0.0.1:8786", got=repr(args.scheduler))
+    m = _SCHEDULER.match(args.scheduler) if args.scheduler else None
+    if args.scheduler and (not m or (m.group(2) and not 1 <= int(m.group(2)[1:]) <= 65535)):
+        raise InputError("command line", "--scheduler", "an address like tcp://127.0.0.1:8786 (port 1 to 65535)",
+                         got=repr(args.scheduler))
     if args.workers is not None and args.workers < 1:
         raise InputError("command line", "--workers", "1 or more workers", got=str(args.workers))
     c = load_campaign(args.campaign)

@@ -140,8 +140,12 @@ def connect(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIME
     th.join(timeout_s + 2.0)
     if "client" not in box:
         e = box.get("error")
-        why = f"{type(e).__name__}: {str(e).splitlines()[0][:120]}" if e is not None and str(e) else (
-            type(e).__name__ if e is not None else f"no answer in {timeout_s:g} s")
+        if e is None:
+            why = f"no answer in {timeout_s:g} s"
+        elif isinstance(e, (OSError, TimeoutError)):
+            why = str(e).splitlines()[0][:120] if str(e) else type(e).__name__
+        else:  # it answered, but what it sent is not the Dask protocol (e.g. a length of exabytes)
+            why = "something answered there, but not as a Dask scheduler"
         raise InputError("command line", "--scheduler", f"the address of a running Dask scheduler answering within "
                          f"{timeout_s:g} s", got=f"{scheduler} ({why})")
     return box["client"], None
