@@ -125,13 +125,14 @@ def big(n: int, root: Path) -> dict:
     spath = out / "campaign.zarr"
     ds = store.open_store(spath)
     b = summary["timing"]["batch"]
-    keys = ("status", "error", "cpu", "trace", "lco",
+    keys = ("status", "error", "cpu", "inputs_sha256", "trace", "lco",
             "amplitude_deg", "engine_amplitude_deg", "frequency_hz", "growth", "peak_engine_deg", "peak_engine_rate_deg_s",
             "peak_attitude_deg")
     cost = []
     for start in (0, (n // b - 1) * b):  # rewrite the first and the last full batch with what it holds
         batch = {k: ds[k].values[start:start + b] for k in keys}
-        batch["error"], batch["cpu"] = list(batch["error"]), list(batch["cpu"])
+        for k in ("error", "cpu", "inputs_sha256"):
+            batch[k] = list(batch[k])
         t = time.perf_counter()
         store.write_batch(spath, start, batch)
         cost.append(time.perf_counter() - t)

@@ -142,6 +142,7 @@ def test_failed_and_diverged_runs_are_counted_and_stored_in_their_rows(failing):
     assert np.isnan(tr[st == 2]).all() and np.isfinite(tr[st == 1]).all()
     assert all("unstable" in e for e in ds["error"].values[st == 2])
     assert all("hard stops" in e for e in ds["error"].values[st == 3])
+    assert set(ds["inputs_sha256"].values) == {json.loads((out / "campaign.json").read_text())["inputs_sha256"]}
     assert not ds["lco"].values[st != 1].any()
     assert np.isnan(ds["amplitude_deg"].values[st == 2]).all()
     seeds = [run_factors(load_campaign(FAILING), i)[0] for i in range(12)]

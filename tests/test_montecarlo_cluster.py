@@ -39,7 +39,7 @@ def _hook(event, args):
 sys.addaudithook(_hook)
 '''
 STORED = ("status", "seed", "factor", "trace", "amplitude_deg", "frequency_hz", "growth", "lco", "peak_engine_deg",
-          "cpu", "error")
+          "cpu", "error", "inputs_sha256")
 
 
 def same_store(a: Path, b: Path) -> None:

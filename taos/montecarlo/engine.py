@@ -106,6 +106,7 @@ def run_task(kind: RunKind, names: tuple[str, ...], factors: np.ndarray, seeds: 
     """One batch as a Dask task (module level, so workers import it)."""
     out = kind.run_batch(names, factors, seeds)
     out["cpu"] = [cpu_target()] * len(seeds)
+    out["inputs_sha256"] = [kind.inputs_sha256] * len(seeds)
     return out
 
 

@@ -130,10 +130,3 @@ class FlightRuns:
             return
         out["status"][i] = STATUS["ok"]
         out["lco"][i] = bool(osc.lco)
-
-
-def run_one(kinds: FlightRuns, factors: dict, seed: int) -> dict:
-    """One run (factors by name) in this process: the stored variables of its row."""
-    names = tuple(factors)
-    out = kinds.run_batch(names, np.array([[factors[k] for k in names]]), np.array([seed]))
-    return {k: v[0] for k, v in out.items()}

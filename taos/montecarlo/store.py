@@ -10,6 +10,7 @@ Layout (``OUT/campaign.zarr``, Zarr format 2, readable with ``xarray.open_zarr``
     status     (run)  int8         0 not run yet, 1 ok, 2 failed, 3 diverged (attrs: ``flag_meanings``)
     error      (run)  str          why a run failed or diverged ("" when ok)
     cpu        (run)  str          the CPU / compile target the run's kernels ran with
+    inputs_sha256 (run) str        the content hash of the inputs the worker flew the run with
     <scalar>   (run)  float        the run kind's scalar outputs (NaN when not ok)
     <flag>     (run)  bool         the run kind's yes/no outputs
     trace      (run, time)         the run kind's trace (NaN when not ok)
@@ -51,6 +52,7 @@ def create(path: Path, *, labels: np.ndarray, names: tuple[str, ...], factors: n
                    {"flag_values": list(STATUS.values()), "flag_meanings": " ".join(STATUS)}),
         "error": (("run",), _lazy((n,), f"<U{TEXT_WIDTH}", ch, "")),
         "cpu": (("run",), _lazy((n,), "<U64", ch, "")),
+        "inputs_sha256": (("run",), _lazy((n,), "<U64", ch, "")),
         "trace": (("run", "time"), _lazy((n, m), float, (ch[0], max(m, 1)), np.nan)),
     }
     for s in scalars:
@@ -70,8 +72,9 @@ def write_batch(path: Path, start: int, out: Mapping[str, np.ndarray], group: st
     body = {k: ((("run", "time") if k == "trace" else ("run",)), np.asarray(v)) for k, v in out.items() if k != "status"}
     if "error" in body:
         body["error"] = (("run",), np.asarray([e[:TEXT_WIDTH] for e in out["error"]], f"<U{TEXT_WIDTH}"))
-    if "cpu" in body:
-        body["cpu"] = (("run",), np.asarray(out["cpu"], "<U64"))
+    for k in ("cpu", "inputs_sha256"):
+        if k in body:
+            body[k] = (("run",), np.asarray(out[k], "<U64"))
     xr.Dataset(body).to_zarr(path, group=group, region=region, zarr_format=2)
     xr.Dataset({"status": (("run",), np.asarray(out["status"], np.int8))}).to_zarr(path, group=group, region=region,
                                                                                     zarr_format=2)
