@@ -34,6 +34,8 @@ __all__ = ["wilson_interval", "quantile_interval", "percentiles", "holm", "spear
            "summarise"]
 
 PERCENTILES = (5, 50, 95)
+#: runs listed in the summary's ``failures`` (all of them are in the store)
+MAX_LISTED = 1000
 
 
 def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
@@ -144,7 +146,9 @@ def summarise(campaign_name: str, case: str, ds, nominal, confidence: float = 0.
                                                        "peak_engine_rate_deg_s", "peak_attitude_deg")}
     names = [str(x) for x in ds["parameter"].values]
     fac = np.asarray(ds["factor"].values, float)
-    errors = np.asarray(ds["error"].values)
+    bad = np.flatnonzero((st == STATUS["failed"]) | (st == STATUS["diverged"]))[:MAX_LISTED]
+    errors = np.asarray(ds["error"].isel(run=bad).values) if len(bad) else np.zeros(0, str)
+    seeds = np.asarray(ds["seed"].isel(run=bad).values) if len(bad) else np.zeros(0, np.int64)
     nom = {v: (nominal[v].values[0].item() if v in nominal else None) for v in
            ("status", "lco", "amplitude_deg", "engine_amplitude_deg", "frequency_hz", "peak_engine_deg")}
     nom = {kk: (None if isinstance(v, float) and not math.isfinite(v) else v) for kk, v in nom.items()}
@@ -166,8 +170,7 @@ def summarise(campaign_name: str, case: str, ds, nominal, confidence: float = 0.
         "sensitivity_of_amplitude": spearman(names, fac[ok], amp[ok]),
         "lco_logistic_regression": logistic_regression(names, fac[ok], lco[ok]),
         "failures": [{"index": int(i), "status": "failed" if st[i] == STATUS["failed"] else "diverged",
-                      "seed": int(ds["seed"].values[i]), "error": str(errors[i])}
-                     for i in np.flatnonzero((st == STATUS["failed"]) | (st == STATUS["diverged"]))[:1000]],
+                      "seed": int(sd), "error": str(e)} for i, sd, e in zip(bad, seeds, errors)],
         "envelope_t_s": np.asarray(ds["time"].values).tolist(),
         "envelope": envelope(ds["trace"], ok),
     }
