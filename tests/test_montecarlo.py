@@ -269,3 +269,29 @@ def test_percentile_intervals_in_the_summary(failing):
     amp = s["amplitude_deg_lco_runs"]
     assert amp["n"] == 5 and amp["p50_ci"] is None  # 5 runs: no 95 % interval of the median exists
     assert not math.isnan(amp["p50"])
+
+
+def test_flight_sensitivity_designs_run_through_the_campaign_engine(tmp_path):
+    """Morris (2 trajectories: 2 (k + 1) runs) and Sobol' (N = 2: N (k + 2) runs) designs of the
+    short flight campaign, in this process: every run stored, indices for every factor, every
+    run with the campaign's turbulence seed; the Sobol' design rows follow the dispersions'
+    ranges."""
+    c = load_campaign(SHORT)
+    k = len(c.dispersions)
+    for method, n, rows, key in (("morris", 2, 2 * (k + 1), "mu_star"), ("sobol", 2, 2 * (k + 2), "ST")):
+        out = tmp_path / method
+        run_campaign(c, out, runs=n, workers=0, design=method)
+        summary = json.loads((out / "summary.json").read_text())
+        s = summary["sensitivity"]
+        assert s["method"] == method and s["runs"] == rows
+        ds = open_store(out / "campaign.zarr")
+        assert ds.sizes["run"] == rows and set(ds["seed"].values) == {c.seed}
+        if s["indices"] is not None:
+            assert {r["parameter"] for r in s["indices"]} == {d.name for d in c.dispersions}
+            assert all(math.isfinite(r[key]) for r in s["indices"])
+        else:
+            assert "failed or diverged" in s["error"]
+        for j, d in enumerate(c.dispersions):
+            col = ds["factor"].values[:, j]
+            lo = d.low if math.isfinite(d.low) else 0.0
+            assert col.min() >= lo - 1e-12 and (not math.isfinite(d.high) or col.max() <= d.high + 1e-12)
