@@ -123,11 +123,13 @@ def isolated(tmp_path_factory):
             return "opened"
         except PermissionError:
             return "denied"
-    with Client(addr, timeout="10s") as c:
-        seen = c.run(_try_open, str(ROOT / "models" / "rs25_flight.toml"))
-        assert set(seen.values()) == {"denied"}, seen
-    yield addr, proj
-    stop_cluster([*workers, sched])
+    try:
+        with Client(addr, timeout="10s") as c:
+            seen = c.run(_try_open, str(ROOT / "models" / "rs25_flight.toml"))
+            assert set(seen.values()) == {"denied"}, seen
+        yield addr, proj
+    finally:
+        stop_cluster([*workers, sched])
 
 
 def test_local_cluster_store_is_bit_identical_to_in_process(reference, tmp_path):
