@@ -139,7 +139,8 @@ def test_local_cluster_store_is_bit_identical_to_in_process(reference, tmp_path)
     import xarray as xr
     out = tmp_path / "local"
     assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--out", str(out), "--no-progress"]) == 0
-    assert {p.name for p in out.iterdir()} == {"campaign.json", "campaign.zarr", "summary.json", "montecarlo.png"}
+    assert {p.name for p in out.iterdir()} == {"campaign.json", "campaign.zarr", "summary.json", "montecarlo.png",
+                                               ".taos-output.json"}   # taos's mark of the files it wrote
     same_store(out, reference)
     assert stats(out) == stats(reference)
     ds = xr.open_zarr(out / "campaign.zarr")
