@@ -93,31 +93,49 @@ def cmd_montecarlo(args) -> int:
 
     if args.scheduler and args.workers is not None:
         raise InputError("command line", "--scheduler", "either --workers or --scheduler, not both")
-    if args.scheduler and not _SCHEDULER.match(args.scheduler):
-        raise InputError("command line", "--scheduler", "an address like tcp://127.0.0.1:8786", got=repr(args.scheduler))
+    m = _SCHEDULER.match(args.scheduler) if args.scheduler else None
+    if args.scheduler and (not m or (m.group(2) and not 1 <= int(m.group(2)[1:]) <= 65535)):
+        raise InputError("command line", "--scheduler", "an address like tcp://127.0.0.1:8786 (port 1 to 65535)",
+                         got=repr(args.scheduler))
+    if args.workers is not None and args.workers < 1:
+        raise InputError("command line", "--workers", "1 or more workers", got=str(args.workers))
     c = load_campaign(args.campaign)
     res = run_campaign(c, args.out, runs=args.runs, case=args.case, friction=args.friction, workers=args.workers,
-                       scheduler=args.scheduler, resume=args.resume, progress=not args.no_progress)
+                       scheduler=args.scheduler, resume=args.resume, progress=not args.no_progress,
+                       design=args.sensitivity or "montecarlo", batch=args.batch,
+                       connect_timeout_s=args.connect_timeout)
     from taos.plotting import save
     from taos.plotting.ascent import plot_campaign
     save(plot_campaign(res), Path(args.out) / "montecarlo.png")
-    s = res.summary
+    summary = json.loads((Path(args.out) / "summary.json").read_text())
     if args.json:
-        summary = json.loads((Path(args.out) / "summary.json").read_text())
         write_json(args.json, summary)
-    else:
-        f = s["lco_fraction"]
-        amp = s["amplitude_deg_lco_runs"]
-        print(f"{c.name}, case {s['case']}: limit cycle in {f['lco_runs']} of {s['runs_ok']} runs "
-              f"({100 * f['value']:.1f} %, 95 % CI {100 * f['ci_low']:.1f}-{100 * f['ci_high']:.1f} %)"
-              + (f"; command amplitude median {amp['p50']:.3f} deg (5-95 %: {amp['p5']:.3f}-{amp['p95']:.3f})"
-                 if amp else ""))
-        if s["runs_failed"]:
-            print(f"{s['runs_failed']} runs failed (seeds and reasons in summary.json)")
-        if s["sensitivity_of_amplitude"]:
-            top = s["sensitivity_of_amplitude"][0]
-            print(f"strongest driver of the amplitude: {top['parameter']} (Spearman {top['spearman_rho']:+.2f})")
-        print(f"campaign written to {args.out}")
+        return 0
+    s = res.summary
+    f = s["lco_fraction"]
+    amp = s["amplitude_deg_lco_runs"]
+    frac = "" if f["value"] is None else (f" ({100 * f['value']:.1f} %, 95 % CI {100 * f['ci_low']:.1f}-"
+                                          f"{100 * f['ci_high']:.1f} %)")
+    print(f"{c.name}, case {s['case']}: limit cycle in {f['lco_runs']} of {s['runs_ok']} completed runs{frac}"
+          + (f"; command amplitude median {amp['p50']:.3f} deg (5-95 %: {amp['p5']:.3f}-{amp['p95']:.3f})"
+             if amp else ""))
+    if s["runs_failed"] or s["runs_diverged"]:
+        print(f"of {s['runs']} runs, {s['runs_failed']} failed and {s['runs_diverged']} diverged: the fraction over "
+              f"all runs lies between {100 * f['all_runs_low']:.1f} and {100 * f['all_runs_high']:.1f} % "
+              "(seeds and reasons in summary.json and the store)")
+    sens = summary.get("sensitivity")
+    if sens and sens.get("indices"):
+        top = sens["indices"][0]
+        val = (f"ST {top['ST']:.2f} +- {top['ST_conf']:.2f}, S1 {top['S1']:.2f} +- {top['S1_conf']:.2f}"
+               if sens["method"] == "sobol" else f"mu* {top['mu_star']:.3g} +- {top['mu_star_conf']:.2g} deg")
+        print(f"{sens['method']}: strongest driver of the amplitude: {top['parameter']} ({val})")
+    elif sens:
+        print(f"{sens['method']}: no indices ({sens['error']})")
+    elif s["sensitivity_of_amplitude"]:
+        top = s["sensitivity_of_amplitude"][0]
+        print(f"strongest driver of the amplitude: {top['parameter']} (Spearman {top['spearman_rho']:+.2f}, "
+              f"Holm p {top['p_holm']:.2g})")
+    print(f"campaign written to {args.out}")
     return 0
 
 
@@ -147,7 +165,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--progress", action="store_true", help="show a progress bar")
     p.set_defaults(func=cmd_ascent)
 
-    p = sub.add_parser("montecarlo", help="dispersed campaign of the flight LCO on Dask (resumable)")
+    p = sub.add_parser("montecarlo", help="dispersed campaign or global sensitivity of the flight LCO on Dask (resumable)")
     p.add_argument("campaign", help="campaign file or shipped name, e.g. post_separation (models/montecarlo/)")
     p.add_argument("--runs", type=_positive_int, required=True, help="number of dispersed runs")
     p.add_argument("--case", help="named case of the campaign (default: its default_case)")
@@ -157,6 +175,12 @@ def add_parsers(sub) -> None:
     p.add_argument("--out", required=True, help="campaign folder (runs are stored as they arrive)")
     p.add_argument("--resume", action="store_true", help="continue the campaign stored in --out")
     p.add_argument("--json", metavar="PATH", help="write the summary here ('-' for standard output)")
+    p.add_argument("--sensitivity", choices=("sobol", "morris"),
+                   help="a global sensitivity design instead of the dispersed runs: sobol (Saltelli, --runs N "
+                        "base samples, a power of two: N (k + 2) runs) or morris (--runs N trajectories)")
+    p.add_argument("--batch", type=_positive_int, help="runs per Dask task (default: about 10 s of work, 50-1000)")
+    p.add_argument("--connect-timeout", type=float, default=20.0,
+                   help="seconds to wait for --scheduler to answer (default 20)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_montecarlo)
 

@@ -1,17 +1,25 @@
-"""Monte Carlo dispersions of the flight LCO verdict, run on Dask.
+"""Monte Carlo dispersions and global sensitivity of the flight LCO, run on Dask.
 
 * :mod:`taos.montecarlo.campaign` - campaign files: dispersions, cases, seeds;
-* :mod:`taos.montecarlo.run` - one run: disperse, fly the segment, measure the limit cycle;
-* :mod:`taos.montecarlo.stats` - LCO fraction with its confidence interval, percentiles,
-  envelopes and the parameters that drive the amplitude;
-* :mod:`taos.montecarlo.executor` - the campaign on a Dask LocalCluster or scheduler, stored as
-  the runs arrive (resumable).
+* :mod:`taos.montecarlo.run` - flight runs: disperse, fly the segment, measure the limit cycle;
+* :mod:`taos.montecarlo.engine` - a design (parameter sets) and a run kind, run in batches on
+  Dask with the inputs sent by value, stored as they arrive (resumable);
+* :mod:`taos.montecarlo.store` - the result store (xarray on Zarr, a ``run`` dimension);
+* :mod:`taos.montecarlo.inputs` - the content hash of every input file a load reads;
+* :mod:`taos.montecarlo.stats` - LCO fraction with its interval, percentiles with order-statistic
+  intervals, envelopes, Spearman with Holm's correction;
+* :mod:`taos.montecarlo.sensitivity` - Sobol' and Morris indices (SALib), logistic regression;
+* :mod:`taos.montecarlo.analytic` - analytic run kinds (Ishigami) and the engine on any design;
+* :mod:`taos.montecarlo.executor` - a flight campaign end to end.
 """
 
+from taos.montecarlo.analytic import Ishigami, run_design
 from taos.montecarlo.campaign import Campaign, Dispersion, load_campaign
+from taos.montecarlo.engine import Design, RunKind
 from taos.montecarlo.executor import run_campaign
-from taos.montecarlo.run import RunResult, run_one
+from taos.montecarlo.run import FlightRuns
 from taos.montecarlo.stats import CampaignResult, summarise, wilson_interval
+from taos.montecarlo.store import open_store
 
-__all__ = ["Campaign", "Dispersion", "load_campaign", "run_campaign", "RunResult", "run_one", "CampaignResult",
-           "summarise", "wilson_interval"]
+__all__ = ["Campaign", "Dispersion", "load_campaign", "run_campaign", "FlightRuns", "CampaignResult",
+           "summarise", "wilson_interval", "Design", "RunKind", "Ishigami", "run_design", "open_store"]

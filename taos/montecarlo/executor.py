@@ -1,197 +1,205 @@
-"""Running a campaign on Dask: a LocalCluster by default, or an existing scheduler.
+"""A flight campaign, end to end: load the inputs once, run the design on the engine, store,
+summarise.
 
-Every run is the pure function :func:`taos.montecarlo.run.run_one` of (campaign file, case,
-friction law, run index), executed as a Dask task; its result is written to
-``OUT/runs/run_NNNNNN.json`` (atomically) the moment it arrives, so an interrupted campaign
-resumes where it stopped (``resume=True`` skips the stored runs). A worker that dies loses no
-run: Dask re-runs its tasks elsewhere (up to ``RETRIES`` times), and a run that fails in itself
-is stored with its seed, factors and reason. The statistics are computed from the stored runs
-sorted by index, so the same seeds give the same statistics on any executor.
+The client loads and checks every input (campaign, ascent, flight, TVC model and the files they
+name) once, records the content hash of all of them (:mod:`taos.montecarlo.inputs`) and sends
+the parsed inputs to the workers (:mod:`taos.montecarlo.engine`): no worker opens a project file.
+The hash is in the manifest, the store and the summary; ``--resume`` refuses a campaign whose
+inputs changed in any way.
+
+Designs: ``montecarlo`` (run i draws its factors and seed from SeedSequence([seed, i])), or a
+global sensitivity design (``sobol``, ``morris``: :mod:`taos.montecarlo.sensitivity`, every run
+with the campaign's seed for the turbulence, so the output is a function of the factors alone).
 
 Output folder (only these names are written; anything else in it is left alone)::
 
-    campaign.json     manifest: campaign file and hash, case, runs, seed, friction law
-    runs/             one JSON per run (and nominal.json)
-    summary.json      statistics (:mod:`taos.montecarlo.stats`) + provenance + timing
-    campaign.h5       every run: scalars, factors, traces, envelopes, provenance
+    campaign.json     manifest: inputs and their hash, case, design, runs, seed, batch size
+    campaign.zarr     the store (:mod:`taos.montecarlo.store`); group "nominal": the nominal run
+    summary.json      statistics (:mod:`taos.montecarlo.stats`), sensitivity, provenance, timing
     montecarlo.png    figure-9-style plot (drawn by the ``taos montecarlo`` command)
+
+Nothing is written before the inputs are checked and the executor (LocalCluster or scheduler)
+answers.
 """
 
 from __future__ import annotations
 
 import json
-import logging
+import shutil
 import time
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from taos.errors import InputError
-from taos.montecarlo.campaign import Campaign, base_models, check_case, load_campaign
-from taos.montecarlo.run import RunResult, run_one
+from taos.montecarlo import engine, sensitivity, store
+from taos.montecarlo.campaign import Campaign, base_models, check_case, run_factors
+from taos.montecarlo.engine import Design, Part
+from taos.montecarlo.inputs import digest, recording
+from taos.montecarlo.run import FlightRuns
 from taos.montecarlo.stats import CampaignResult, summarise
-from taos.results import atomic_write, package_version, write_provenance
+from taos.results import atomic_write, package_version
 
-FORMAT = "taos-montecarlo-1"
+FORMAT = "taos-montecarlo-2"
 MANIFEST = "campaign.json"
-OUTPUT_NAMES = (MANIFEST, "runs", "summary.json", "campaign.h5", "montecarlo.png")
-RETRIES = 3
-MAX_RUNS = 100_000
+STORE = "campaign.zarr"
+OUTPUT_NAMES = (MANIFEST, STORE, "summary.json", "montecarlo.png")
+MAX_RUNS = 200_000
 MAX_WORKERS = 64
+DESIGNS = ("montecarlo",) + sensitivity.METHODS
+SENSITIVITY_OUTPUT = "amplitude_deg"
 
 
-@lru_cache(maxsize=4)
-def _loaded(path: str, sha256: str, friction: str | None):
-    """Campaign and base models, once per worker process and campaign."""
-    c = load_campaign(path)
-    if c.sha256 != sha256:
-        raise InputError(path, "(file)", "the campaign file unchanged while the campaign runs", got="a changed file")
-    return c, base_models(c, friction)
+def flight_runs(c: Campaign, case: str, friction: str | None) -> tuple[FlightRuns, list[dict]]:
+    """The campaign's run kind with its inputs loaded once here, and the table of input files."""
+    with recording() as files:
+        ascent, model = base_models(c, friction)
+    settings = json.dumps({"format": FORMAT, "campaign_sha256": c.sha256, "case": case, "friction": friction})
+    sha, table = digest(files | {c.source}, settings)
+    return FlightRuns(campaign=c, case=case, ascent=ascent, model=model, inputs_sha256=sha), table
 
 
-def run_task(path: str, sha256: str, case: str, friction: str | None, index: int) -> dict:
-    """One run as a Dask task (module-level, so workers import it): returns the run's JSON dict."""
-    c, base = _loaded(path, sha256, friction)
-    return run_one(c, case, index, base=base).to_dict()
+def montecarlo_design(c: Campaign, runs: int) -> Design:
+    """Runs 0..runs-1: factors and seeds from SeedSequence([campaign seed, index])."""
+    names = tuple(d.name for d in c.dispersions)
+    seeds, rows = np.empty(runs, np.int64), np.empty((runs, len(names)))
+    for i in range(runs):
+        s, f = run_factors(c, i)
+        seeds[i], rows[i] = s, [f[k] for k in names]
+    return Design(names, rows, seeds)
 
 
-def _run_path(runs_dir: Path, index: int) -> Path:
-    return runs_dir / ("nominal.json" if index < 0 else f"run_{index:06d}.json")
+def nominal_design(c: Campaign) -> Design:
+    names = tuple(d.name for d in c.dispersions)
+    return Design(names, np.ones((1, len(names))), np.array([c.seed]))
 
 
-def _read_run(p: Path) -> RunResult | None:
-    try:
-        return RunResult.from_dict(json.loads(p.read_text()))
-    except (OSError, ValueError, TypeError, KeyError):
-        return None  # missing or unreadable: run it (again)
+def sensitivity_design(c: Campaign, method: str, n: int) -> Design:
+    if not c.dispersions:
+        raise InputError(c.source, "dispersions", "at least one dispersion for a sensitivity analysis", got="none")
+    if method == "sobol" and (n < 2 or n & (n - 1)):
+        raise InputError("command line", "--runs", "a power of two (the Sobol' base sample N; N (k + 2) runs)",
+                         got=str(n))
+    x = sensitivity.design(method, sensitivity.problem(c.dispersions), n, seed=c.seed % 2 ** 32)
+    return Design(tuple(d.name for d in c.dispersions), x, np.full(len(x), c.seed))
 
 
-def _prepare_out(out: Path, manifest: dict, resume: bool) -> None:
+def _check_out(out: Path, manifest: dict, resume: bool) -> dict | None:
+    """The stored manifest when resuming (None for a new campaign); refuses, before any write,
+    a folder that is a file, a campaign without --resume and a resume with other inputs."""
     if out.exists() and not out.is_dir():
         raise InputError("command line", "--out", "a folder for the campaign (or a new path)", got=f"{out} (a file)")
     mpath = out / MANIFEST
-    if mpath.exists():
-        try:
-            old = json.loads(mpath.read_text())
-        except (OSError, ValueError):
-            raise InputError(str(mpath), "(file)", "a campaign manifest written by taos montecarlo",
-                             got="an unreadable file") from None
-        if not resume:
-            raise InputError("command line", "--out", "a folder without a campaign in it (or --resume to continue it)",
-                             got=str(out))
-        same = ("format", "campaign_sha256", "case", "seed", "friction")
-        diff = [k for k in same if old.get(k) != manifest[k]]
-        if diff:
-            raise InputError(str(mpath), diff[0], f"the same {diff[0]} to resume this campaign",
-                             got=f"{manifest[diff[0]]!r} (stored: {old.get(diff[0])!r})")
-    else:
+    if not mpath.exists():
         clash = [n for n in OUTPUT_NAMES if (out / n).exists()]
         if clash:
             raise InputError("command line", "--out", "a folder whose campaign file names are free "
                              "(files taos did not write are never replaced)", got=f"{out / clash[0]} exists")
-
-
-def _client(workers: int | None, scheduler: str | None):
-    from dask.distributed import Client, LocalCluster
-    if scheduler:
-        try:
-            return Client(scheduler, timeout="20s"), None
-        except (OSError, TimeoutError) as e:
-            raise InputError("command line", "--scheduler", "the address of a running Dask scheduler",
-                             got=f"{scheduler} ({type(e).__name__})") from None
-    cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+        return None
+    try:
+        old = json.loads(mpath.read_text())
+    except (OSError, ValueError):
+        raise InputError(str(mpath), "(file)", "a campaign manifest written by taos montecarlo",
+                         got="an unreadable file") from None
+    if not resume:
+        raise InputError("command line", "--out", "a folder without a campaign in it (or --resume to continue it)",
+                         got=str(out))
+    for k in ("format", "inputs_sha256", "case", "seed", "friction", "design", "runs", "design_sha256"):
+        if old.get(k) != manifest[k]:
+            what = "inputs (a file changed)" if k == "inputs_sha256" else k
+            raise InputError(str(mpath), k, f"the same {what} to resume this campaign",
+                             got=f"{manifest[k]!r} (stored: {old.get(k)!r})")
+    return old
 
 
 def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | None = None, friction: str | None = None,
                  workers: int | None = None, scheduler: str | None = None, resume: bool = False,
-                 progress: bool = False) -> CampaignResult:
-    """Run ``runs`` dispersed runs of case ``case`` (and the nominal) of campaign ``c`` into
-    ``out_dir`` (module docstring); returns the statistics. ``workers`` size of the default
-    LocalCluster (one thread each); ``scheduler`` an existing Dask scheduler instead."""
+                 progress: bool = False, design: str = "montecarlo", batch: int | None = None,
+                 connect_timeout_s: float = engine.CONNECT_TIMEOUT_S) -> CampaignResult:
+    """Run ``runs`` dispersed runs (or, for ``design`` "sobol"/"morris", the sensitivity design
+    of ``runs`` base samples / trajectories) of case ``case`` and the nominal into ``out_dir``
+    (module docstring); returns the statistics. ``workers``: size of the default LocalCluster (one
+    thread each; 0: in this process); ``scheduler``: an existing Dask scheduler instead;
+    ``batch``: runs per task (default from the run cost)."""
+    if design not in DESIGNS:
+        raise InputError("command line", "--sensitivity", "one of " + ", ".join(sensitivity.METHODS), got=repr(design))
     if not 1 <= runs <= MAX_RUNS:
         raise InputError("command line", "--runs", f"a number of runs from 1 to {MAX_RUNS}", got=str(runs))
-    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+    if workers is not None and not 0 <= workers <= MAX_WORKERS:
         raise InputError("command line", "--workers", f"1 to {MAX_WORKERS} workers", got=str(workers))
+    if batch is not None and not 1 <= batch <= engine.MAX_BATCH:
+        raise InputError("command line", "--batch", f"1 to {engine.MAX_BATCH} runs per task", got=str(batch))
+    if not 0.1 <= connect_timeout_s <= 600:
+        raise InputError("command line", "--connect-timeout", "0.1 to 600 s", got=str(connect_timeout_s))
     case = check_case(c, case)
     friction = friction or c.friction
-    ascent, model = base_models(c, friction)  # checks files (and the law) before any work starts
+    kind, table = flight_runs(c, case, friction)  # every input checked before any work starts
+    d = montecarlo_design(c, runs) if design == "montecarlo" else sensitivity_design(c, design, runs)
+    if d.n > MAX_RUNS:
+        raise InputError("command line", "--runs", f"a design of at most {MAX_RUNS} runs", got=f"{d.n} runs")
     out = Path(out_dir)
-    manifest = {"format": FORMAT, "campaign_file": c.source, "campaign_sha256": c.sha256, "case": case,
-                "runs": runs, "seed": c.seed, "friction": friction}
-    _prepare_out(out, manifest, resume)
-    runs_dir = out / "runs"
-    runs_dir.mkdir(parents=True, exist_ok=True)
-    atomic_write(out / MANIFEST, lambda p: p.write_text(json.dumps(manifest, indent=2) + "\n"))
-    results: dict[int, RunResult] = {}
-    for i in [-1, *range(runs)]:
-        r = _read_run(_run_path(runs_dir, i)) if resume else None
-        if r is not None and r.index == i:
-            results[i] = r
-    pending = [i for i in [-1, *range(runs)] if i not in results]
+    manifest = {"format": FORMAT, "campaign_file": c.source, "inputs_sha256": kind.inputs_sha256,
+                "input_files": table, "case": case, "seed": c.seed, "friction": friction, "design": design,
+                "runs": runs, "design_runs": d.n, "design_sha256": d.sha256()}
+    old = _check_out(out, manifest, resume)
+    parts = [Part("nominal", nominal_design(c)), Part(None, d)]
+    spath = out / STORE
     t0 = time.perf_counter()
-    n_workers = None
-    if pending:
-        from dask.distributed import as_completed
-        client, cluster = _client(workers, scheduler)
-        bar = None
-        try:
-            n_workers = len(client.scheduler_info().get("workers", {}))
-            if progress:
-                from tqdm import tqdm
-                bar = tqdm(total=runs + 1, initial=runs + 1 - len(pending), desc="montecarlo", unit="run")
-            futs = client.map(run_task, [c.source] * len(pending), [c.sha256] * len(pending), [case] * len(pending),
-                              [friction] * len(pending), pending, pure=False, retries=RETRIES)
-            for fut in as_completed(futs):
-                d = fut.result()
-                r = RunResult.from_dict(d)
-                atomic_write(_run_path(runs_dir, r.index), lambda p, d=d: p.write_text(json.dumps(d) + "\n"))
-                results[r.index] = r
-                if bar is not None:
-                    bar.update(1)
-        finally:
-            if bar is not None:
-                bar.close()
+    client, cluster = engine.connect(2 if workers is None else workers, scheduler, connect_timeout_s)
+    try:
+        n_workers = len(client.scheduler_info().get("workers", {})) if client is not None else 0
+        if old is not None and store.status(spath) is not None and store.status(spath, "nominal") is not None:
+            manifest["batch"] = int(old["batch"])
+        else:
+            manifest["batch"] = batch or engine.batch_size(d.n, kind.run_cost_s, max(n_workers, 1))
+            out.mkdir(parents=True, exist_ok=True)
+            if spath.exists():  # a store this campaign began (its manifest is ours) but could not finish creating
+                shutil.rmtree(spath)
+            attrs = {"format": FORMAT, "inputs_sha256": kind.inputs_sha256, "campaign": c.name, "case": case,
+                     "design": design, "seed": c.seed, "friction_model": kind.model.friction.name,
+                     "sanity_bound_engine_deg": kind.gimbal_range_deg}
+            atomic_write(out / MANIFEST, lambda q: q.write_text(json.dumps(manifest, indent=1) + "\n"))
+            for p in sorted(parts, key=lambda q: q.group is not None):  # the root group first
+                store.create(spath, labels=np.arange(p.design.n), names=p.design.names, factors=p.design.factors,
+                             seeds=p.design.seeds, scalars=kind.scalars, flags=kind.flags, trace_t_s=kind.trace_t_s,
+                             batch=manifest["batch"], attrs=attrs, group=p.group)
+        executed = engine.execute(spath, kind, parts, manifest["batch"], client, progress=progress)
+    finally:
+        if client is not None:
             client.close()
-            if cluster is not None:
-                cluster.close()
+        if cluster is not None:
+            cluster.close()
     wall = time.perf_counter() - t0
-    res = summarise(c.name, case, [results[i] for i in range(runs)], results[-1], c.start_s, c.trace_interval_s)
-    prov = {"campaign_file": c.source, "campaign_sha256": c.sha256, "ascent_file": ascent.source,
-            "ascent_sha256": ascent.sha256, "model_file": model.source, "model_sha256": model.sha256,
-            "package_version": package_version(), "seed": c.seed, "case": case, "friction_model": model.friction.name,
-            "solver": {"method": "rk4-fixed-step", "dt_s": c.dt_s}, "segment_s": [c.start_s, c.start_s + c.duration_s]}
-    timing = {"wall_s": wall, "runs_executed": len(pending), "workers": n_workers,
-              "runs_per_s_per_worker": (len(pending) / wall / n_workers) if pending and n_workers else None,
-              "executor": scheduler or "LocalCluster"}
-    _write_outputs(res, out, prov, timing)
+    ds, nom = store.open_store(spath), store.open_store(spath, "nominal")
+    flown = {str(v) for g in (ds, nom) for v in np.unique(g["inputs_sha256"].values)}
+    if flown != {kind.inputs_sha256}:
+        raise RuntimeError(f"the store holds runs flown with other inputs: {sorted(flown)}")
+    res = summarise(c.name, case, ds, nom)
+    sens = None
+    if design != "montecarlo":
+        sens = _sensitivity(c, design, ds)
+    prov = {"campaign_file": c.source, "campaign_sha256": c.sha256, "inputs_sha256": kind.inputs_sha256,
+            "input_files": table, "ascent_sha256": kind.ascent.sha256, "model_sha256": kind.model.sha256,
+            "package_version": package_version(), "seed": c.seed, "case": case, "design": design,
+            "friction_model": kind.model.friction.name, "solver": {"method": "rk4-fixed-step", "dt_s": c.dt_s},
+            "segment_s": [c.start_s, c.start_s + c.duration_s],
+            "cpu_targets": sorted({str(v) for v in np.unique(ds["cpu"].values)} - {""})}
+    timing = {"wall_s": wall, "runs_executed": executed, "workers": n_workers or None, "batch": manifest["batch"],
+              "runs_per_s_per_worker": (executed / wall / n_workers) if executed and n_workers else None,
+              "executor": scheduler or ("in-process" if workers == 0 else "LocalCluster")}
+    payload = {"statistics": res.summary, "sensitivity": sens, "provenance": prov, "timing": timing}
+    text = json.dumps(payload, indent=1, allow_nan=False) + "\n"
+    atomic_write(out / "summary.json", lambda q: q.write_text(text))
     return res
 
 
-def _write_outputs(res: CampaignResult, out: Path, prov: dict, timing: dict) -> None:
-    payload = {"statistics": res.summary, "provenance": prov, "timing": timing}
-    atomic_write(out / "summary.json", lambda p: p.write_text(json.dumps(payload, indent=1, allow_nan=False) + "\n"))
-
-    def h5(tmp):
-        import h5py
-        ok = [r for r in res.runs]
-        names = sorted(res.runs[0].factors) if res.runs else []
-        with h5py.File(tmp, "w") as f:
-            write_provenance(f, prov)
-            f.create_dataset("index", data=np.array([r.index for r in ok]))
-            f.create_dataset("seed", data=np.array([r.seed for r in ok], dtype=np.int64))
-            for k in ("ok", "lco"):
-                f.create_dataset(k, data=np.array([getattr(r, k) for r in ok], bool))
-            for k in ("amplitude_deg", "engine_amplitude_deg", "frequency_hz", "growth", "peak_engine_deg",
-                      "peak_engine_rate_deg_s", "peak_attitude_deg"):
-                f.create_dataset(k, data=np.array([getattr(r, k) for r in ok], float))
-            fac = f.create_dataset("factors", data=np.array([[r.factors[n] for n in names] for r in ok], float)
-                                   .reshape(len(ok), len(names)))
-            fac.attrs["names"] = ",".join(names)
-            f.create_dataset("trace_t_s", data=res.trace_t_s)
-            f.create_dataset("traces_rad", data=res.traces_rad, compression="gzip")
-            f.create_dataset("nominal_trace_rad", data=res.nominal_trace_rad)
-            f.attrs["statistics"] = json.dumps(res.summary)
-    atomic_write(out / "campaign.h5", h5)
+def _sensitivity(c: Campaign, method: str, ds) -> dict:
+    st = np.asarray(ds["status"].values)
+    y = np.asarray(ds[SENSITIVITY_OUTPUT].values, float)
+    base = {"method": method, "output": SENSITIVITY_OUTPUT, "runs": int(len(y)), "confidence": 0.95}
+    bad = int(np.sum(st != store.STATUS["ok"]))
+    if bad:
+        return base | {"indices": None, "error": f"{bad} runs failed or diverged: the estimators need every run"}
+    prob = sensitivity.problem(c.dispersions)
+    return base | {"indices": sensitivity.indices(method, prob, np.asarray(ds["factor"].values), y,
+                                                  seed=c.seed % 2 ** 32)}

@@ -1,14 +1,23 @@
 """Campaign statistics: how often the TVC limit-cycles, how large, and what drives it.
 
-* LCO fraction k/n with the Wilson score interval (E. B. Wilson, "Probable inference, the law of
-  succession, and statistical inference", JASA 22 (1927) 209-212), 95 % by default;
-* percentiles (5, 50, 95) of the command oscillation amplitude and frequency (LCO runs), and of
-  the peak engine angle, engine rate and attitude error (all runs);
-* envelopes: the 5/50/95 % bands of the FCS command trace over time;
-* sensitivity: Spearman rank correlation of each dispersed factor with the command oscillation
-  amplitude, strongest first (scipy.stats.spearmanr).
+Every run is counted: ``runs = ok + failed + diverged`` (a run that failed or left the physical
+envelope is reported apart, with its reason in the store, never dropped).
 
-Statistics depend only on the runs (sorted by index), never on the executor or timing.
+* LCO fraction k/n over the completed runs with the Wilson score interval (E. B. Wilson,
+  "Probable inference, the law of succession, and statistical inference", JASA 22 (1927)
+  209-212), 95 % by default, and the range k/N .. (k + failed + diverged)/N over all N runs
+  (what the fraction would be whichever way the runs without a verdict went);
+* percentiles (5, 50, 95) with distribution-free intervals from order statistics: the interval
+  [x_(l), x_(u)] covers the q-quantile with probability P(l <= B <= u - 1), B ~ Bin(n, q)
+  (W. J. Conover, Practical Nonparametric Statistics, 3rd ed., 1999, sec. 3.2); ``None`` when
+  n is too small for the confidence asked;
+* envelopes: the 5/50/95 % bands of the FCS command trace over time;
+* the amplitude's Spearman rank correlation with each factor (quick view) with Holm's step-down
+  correction for testing every factor (S. Holm, Scand. J. Statist. 6 (1979) 65-70);
+* the LCO yes/no outcome: logistic regression on the standardised factors
+  (:func:`taos.montecarlo.sensitivity.logistic_regression`).
+
+Statistics depend only on the stored runs, in run order, never on the executor or timing.
 """
 
 from __future__ import annotations
@@ -18,9 +27,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from taos.montecarlo.run import RunResult
+from taos.montecarlo.sensitivity import holm, logistic_regression
+from taos.montecarlo.store import STATUS
+
+__all__ = ["wilson_interval", "quantile_interval", "percentiles", "holm", "spearman", "envelope", "CampaignResult",
+           "summarise"]
 
 PERCENTILES = (5, 50, 95)
+#: runs listed in the summary's ``failures`` (all of them are in the store)
+MAX_LISTED = 1000
 
 
 def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
@@ -35,72 +50,130 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
     return max(0.0, c - h), min(1.0, c + h)
 
 
-def _pct(values) -> dict | None:
-    v = np.asarray([x for x in values if math.isfinite(x)], float)
+def quantile_interval(n: int, q: float, confidence: float = 0.95) -> tuple[int, int] | None:
+    """1-based ranks (l, u) of the order statistics bracketing the q-quantile of n samples with
+    probability >= ``confidence`` (module docstring), or None when n is too small."""
+    from scipy.stats import binom
+    a = (1 - confidence) / 2
+    lo, hi = int(binom.ppf(a, n, q)), int(binom.ppf(1 - a, n, q)) + 1
+    if lo < 1 or hi > n:
+        return None
+    return lo, hi
+
+
+def percentiles(values, confidence: float = 0.95) -> dict | None:
+    """``{"n", "p5", "p5_ci", ...}`` of the finite ``values`` (None when there are none)."""
+    v = np.sort(np.asarray(values, float)[np.isfinite(values)])
     if v.size == 0:
         return None
-    return {f"p{p}": float(np.percentile(v, p)) for p in PERCENTILES}
+    out: dict = {"n": int(v.size)}
+    for p in PERCENTILES:
+        out[f"p{p}"] = float(np.percentile(v, p))
+        r = quantile_interval(v.size, p / 100, confidence)
+        out[f"p{p}_ci"] = None if r is None else [float(v[r[0] - 1]), float(v[r[1] - 1])]
+    return out
+
+
+def spearman(names, factors: np.ndarray, y: np.ndarray, alpha: float = 0.05) -> list[dict]:
+    """Spearman's rho of each factor column with ``y``, strongest first, Holm-adjusted."""
+    from scipy.stats import spearmanr
+    rows = []
+    if len(y) < 4 or np.ptp(y) == 0:
+        return rows
+    for j, name in enumerate(names):
+        x = factors[:, j]
+        if np.ptp(x) == 0:
+            continue
+        rho, pval = spearmanr(x, y)
+        rows.append({"parameter": name, "spearman_rho": float(rho), "p_value": float(pval)})
+    for r, a in zip(rows, holm([r["p_value"] for r in rows])):
+        r["p_holm"] = float(a)
+        r["significant"] = bool(a < alpha)
+    rows.sort(key=lambda s: -abs(s["spearman_rho"]))
+    return rows
+
+
+def envelope(traces, ok: np.ndarray, block_bytes: int = 64 << 20) -> dict:
+    """5/50/95 % bands [deg] over the ok runs of ``traces`` (an array or a lazy (run, time)
+    xarray variable), computed a block of time columns at a time."""
+    m = traces.shape[1]
+    n_ok = int(ok.sum())
+    env = {f"p{p}_deg": np.full(m, np.nan) for p in PERCENTILES}
+    if n_ok == 0 or m == 0:
+        return {k: v.tolist() for k, v in env.items()}
+    step = max(1, block_bytes // (8 * max(len(ok), 1)))
+    for j in range(0, m, step):
+        blk = np.asarray(traces[:, j:j + step])[ok]
+        for p in PERCENTILES:
+            env[f"p{p}_deg"][j:j + step] = np.degrees(np.percentile(blk, p, axis=0))
+    return {k: v.tolist() for k, v in env.items()}
 
 
 @dataclass(frozen=True, eq=False)
 class CampaignResult:
-    """A finished campaign: the runs (by index), the nominal run, traces and the summary."""
+    """A finished campaign: per-run arrays in run order (``status`` codes of
+    :data:`taos.montecarlo.store.STATUS`), the envelopes and the summary (JSON-ready)."""
 
     campaign_name: str
     case: str
-    runs: tuple[RunResult, ...]
-    nominal: RunResult
+    status: np.ndarray
+    lco: np.ndarray
+    amplitude_deg: np.ndarray
     trace_t_s: np.ndarray
-    traces_rad: np.ndarray
+    traces_rad: object  # (run, time): an array or a lazy xarray variable
     nominal_trace_rad: np.ndarray
     summary: dict
 
     @property
     def n_runs(self) -> int:
-        return len(self.runs)
+        return len(self.status)
+
+    @property
+    def ok(self) -> np.ndarray:
+        return self.status == STATUS["ok"]
 
 
-def summarise(campaign_name: str, case: str, runs, nominal: RunResult, start_s: float, trace_interval_s: float,
-              confidence: float = 0.95) -> CampaignResult:
-    """Statistics of ``runs`` (module docstring) as a :class:`CampaignResult`."""
-    runs = tuple(sorted(runs, key=lambda r: r.index))
-    ok = [r for r in runs if r.ok]
-    k = sum(1 for r in ok if r.lco)
-    lo, hi = wilson_interval(k, len(ok), confidence)
-    traces = np.array([r.trace_rad for r in ok], float) if ok else np.zeros((0, len(nominal.trace_rad)))
-    t = start_s + trace_interval_s * np.arange(len(nominal.trace_rad))
-    env = {}
-    if len(ok):
-        for p in PERCENTILES:
-            env[f"p{p}_deg"] = np.degrees(np.percentile(traces, p, axis=0)).tolist()
-    sens = []
-    amp = np.array([r.amplitude_deg for r in ok])
-    if len(ok) > 2:
-        from scipy.stats import spearmanr
-        for name in sorted(ok[0].factors):
-            x = np.array([r.factors[name] for r in ok])
-            if np.ptp(x) == 0 or np.ptp(amp) == 0:
-                continue
-            rho, pval = spearmanr(x, amp)
-            sens.append({"parameter": name, "spearman_rho": float(rho), "p_value": float(pval)})
-        sens.sort(key=lambda s: -abs(s["spearman_rho"]))
-    lco_runs = [r for r in ok if r.lco]
+def summarise(campaign_name: str, case: str, ds, nominal, confidence: float = 0.95) -> CampaignResult:
+    """Statistics (module docstring) of the stored runs ``ds`` and the ``nominal`` run (both
+    :class:`xarray.Dataset` in the store layout)."""
+    st = np.asarray(ds["status"].values, np.int8)
+    ok = st == STATUS["ok"]
+    n_fail, n_div = int((st == STATUS["failed"]).sum()), int((st == STATUS["diverged"]).sum())
+    lco = np.asarray(ds["lco"].values, bool) & ok
+    k, n_ok, n = int(lco.sum()), int(ok.sum()), len(st)
+    lo, hi = wilson_interval(k, n_ok, confidence)
+    sc = {v: np.asarray(ds[v].values, float) for v in ("amplitude_deg", "frequency_hz", "peak_engine_deg",
+                                                       "peak_engine_rate_deg_s", "peak_attitude_deg")}
+    names = [str(x) for x in ds["parameter"].values]
+    fac = np.asarray(ds["factor"].values, float)
+    bad = np.flatnonzero((st == STATUS["failed"]) | (st == STATUS["diverged"]))[:MAX_LISTED]
+    errors = np.asarray(ds["error"].isel(run=bad).values) if len(bad) else np.zeros(0, str)
+    seeds = np.asarray(ds["seed"].isel(run=bad).values) if len(bad) else np.zeros(0, np.int64)
+    nom = {v: (nominal[v].values[0].item() if v in nominal else None) for v in
+           ("status", "lco", "amplitude_deg", "engine_amplitude_deg", "frequency_hz", "peak_engine_deg")}
+    nom = {kk: (None if isinstance(v, float) and not math.isfinite(v) else v) for kk, v in nom.items()}
+    amp = sc["amplitude_deg"]
     summary = {
-        "campaign": campaign_name, "case": case, "runs": len(runs), "runs_ok": len(ok),
-        "runs_failed": len(runs) - len(ok),
-        "lco_fraction": {"value": k / len(ok) if ok else 0.0, "lco_runs": k, "ci_low": lo, "ci_high": hi,
-                         "confidence": confidence, "method": "Wilson score"},
-        "nominal": nominal.to_dict() | {"trace_rad": None},
-        "amplitude_deg_lco_runs": _pct([r.amplitude_deg for r in lco_runs]),
-        "frequency_hz_lco_runs": _pct([r.frequency_hz for r in lco_runs]),
-        "amplitude_deg_all_runs": _pct([r.amplitude_deg for r in ok]),
-        "peak_engine_deg": _pct([r.peak_engine_deg for r in ok]),
-        "peak_engine_rate_deg_s": _pct([r.peak_engine_rate_deg_s for r in ok]),
-        "peak_attitude_deg": _pct([r.peak_attitude_deg for r in ok]),
-        "sensitivity_of_amplitude": sens,
-        "failures": [{"index": r.index, "seed": r.seed, "factors": r.factors, "error": r.error}
-                     for r in runs if not r.ok],
-        "envelope_t_s": t.tolist(), "envelope": env,
+        "campaign": campaign_name, "case": case, "runs": n, "runs_ok": n_ok, "runs_failed": n_fail,
+        "runs_diverged": n_div, "runs_not_run": int((st == STATUS["pending"]).sum()),
+        "lco_fraction": {"value": k / n_ok if n_ok else None, "lco_runs": k, "ci_low": lo, "ci_high": hi,
+                         "confidence": confidence, "method": "Wilson score, over the completed runs",
+                         "all_runs_low": k / n if n else None,
+                         "all_runs_high": (k + n_fail + n_div) / n if n else None},
+        "nominal": nom,
+        "amplitude_deg_lco_runs": percentiles(amp[lco], confidence),
+        "frequency_hz_lco_runs": percentiles(sc["frequency_hz"][lco], confidence),
+        "amplitude_deg_all_runs": percentiles(amp[ok], confidence),
+        "peak_engine_deg": percentiles(sc["peak_engine_deg"][ok], confidence),
+        "peak_engine_rate_deg_s": percentiles(sc["peak_engine_rate_deg_s"][ok], confidence),
+        "peak_attitude_deg": percentiles(sc["peak_attitude_deg"][ok], confidence),
+        "sensitivity_of_amplitude": spearman(names, fac[ok], amp[ok]),
+        "lco_logistic_regression": logistic_regression(names, fac[ok], lco[ok]),
+        "failures": [{"index": int(i), "status": "failed" if st[i] == STATUS["failed"] else "diverged",
+                      "seed": int(sd), "error": str(e)} for i, sd, e in zip(bad, seeds, errors)],
+        "envelope_t_s": np.asarray(ds["time"].values).tolist(),
+        "envelope": envelope(ds["trace"], ok),
     }
-    return CampaignResult(campaign_name=campaign_name, case=case, runs=runs, nominal=nominal, trace_t_s=t,
-                          traces_rad=traces, nominal_trace_rad=np.asarray(nominal.trace_rad, float), summary=summary)
+    return CampaignResult(campaign_name=campaign_name, case=case, status=st, lco=lco, amplitude_deg=amp,
+                          trace_t_s=np.asarray(ds["time"].values), traces_rad=ds["trace"],
+                          nominal_trace_rad=np.asarray(nominal["trace"].values[0]), summary=summary)

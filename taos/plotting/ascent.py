@@ -47,14 +47,17 @@ def plot_campaign(result, max_runs: int = 400):
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 4.5), gridspec_kw={"width_ratios": [2, 1]})
     t = result.trace_t_s
     # normalised by the nominal run's command oscillation amplitude (its peak if it has none)
-    nom = result.nominal
-    ref = np.radians(nom.amplitude_deg) if nom.ok and nom.amplitude_deg > 0 else np.max(np.abs(result.nominal_trace_rad))
+    nom = result.summary["nominal"]
+    ref = (np.radians(nom["amplitude_deg"]) if nom.get("status") == 1 and (nom.get("amplitude_deg") or 0) > 0
+           else np.max(np.abs(result.nominal_trace_rad)))
     ref = max(float(ref), 1e-12)
-    traces = result.traces_rad[: max_runs]
+    ok = result.ok
+    traces = np.asarray(result.traces_rad[: max_runs])[ok[: max_runs]]
     for y in traces:
         a1.plot(t, y / ref, color="0.7", lw=0.4)
-    if len(result.traces_rad):
-        lo, hi = np.percentile(result.traces_rad / ref, [5, 95], axis=0)
+    env = result.summary["envelope"]
+    if ok.any():
+        lo, hi = np.radians(env["p5_deg"]) / ref, np.radians(env["p95_deg"]) / ref
         a1.fill_between(t, lo, hi, color="tab:blue", alpha=0.25, label="5-95 % of runs")
     a1.plot(t, result.nominal_trace_rad / ref, color="k", lw=1.2, label="nominal")
     a1.set_xlabel("flight time [s]")
@@ -62,14 +65,14 @@ def plot_campaign(result, max_runs: int = 400):
     a1.set_title(f"{result.campaign_name}: case {result.case}, {result.n_runs} runs")
     a1.grid(True, alpha=0.3)
     a1.legend(fontsize=8)
-    amp = np.array([r.amplitude_deg for r in result.runs if r.ok])
-    lco = np.array([r.lco for r in result.runs if r.ok], bool)
+    amp = result.amplitude_deg[ok]
+    lco = result.lco[ok]
     if amp.size:
         bins = np.linspace(0, max(float(amp.max()), 1e-3) * 1.05, 30)
         a2.hist(amp[~lco], bins=bins, color="0.6", label="no LCO")
         a2.hist(amp[lco], bins=bins, color="tab:red", alpha=0.8, label="LCO")
     f = result.summary["lco_fraction"]
-    a2.set_title(f"LCO in {100 * f['value']:.1f} % of runs (95 % CI {100 * f['ci_low']:.1f}-{100 * f['ci_high']:.1f} %)",
+    a2.set_title(f"LCO in {100 * (f['value'] or 0):.1f} % of completed runs (95 % CI {100 * f['ci_low']:.1f}-{100 * f['ci_high']:.1f} %)",
                  fontsize=9)
     a2.set_xlabel("command oscillation amplitude [deg]")
     a2.set_ylabel("runs")

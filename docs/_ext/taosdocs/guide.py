@@ -98,6 +98,10 @@ STEPS: tuple[Step, ...] = (
          outputs=("out/compare/table.txt", "out/compare/comparison.json", "out/compare/bode_overlay.png",
                   "out/compare/piston_side_by_side.png"),
          figures=("out/compare/bode_overlay.png", "out/compare/piston_side_by_side.png"), show_stdout=40),
+    # -- Monte Carlo -------------------------------------------------------------------------
+    Step("montecarlo", "taos montecarlo post_separation --runs 4 --workers 1 --out out/mc --no-progress",
+         outputs=("out/mc/summary.json", "out/mc/campaign.zarr", "out/mc/montecarlo.png"),
+         figures=("out/mc/montecarlo.png",), show_stdout=5),
     # -- MASV --------------------------------------------------------------------------------
     Step("masv_modes", "masv modes core_stage", show_stdout=30),
     Step("masv_freqresp", "masv freqresp core_stage --freq-hz 0.5,1,2,3,5,7,10,14 --plot out/masv_grid.png "

@@ -1,0 +1,133 @@
+"""Global sensitivity of a campaign output, and what drives the LCO yes/no outcome.
+
+* **Sobol' indices** (I. M. Sobol', Math. Comput. Simul. 55 (2001) 271-280): first-order
+  ``S1_i = V[E(Y|X_i)]/V(Y)`` and total ``ST_i = E[V(Y|X_~i)]/V(Y)``, estimated on a Saltelli
+  design (A. Saltelli et al., Comput. Phys. Commun. 181 (2010) 259-270) of ``N (k + 2)`` runs
+  (scrambled Sobol' sequence; ``N`` a power of two), with bootstrap confidence intervals, by SALib
+  (J. Herman, W. Usher, JOSS 2 (2017) 97; ``SALib.sample.sobol``, ``SALib.analyze.sobol``).
+* **Morris elementary effects** (M. D. Morris, Technometrics 33 (1991) 161-174) with the
+  ``mu*`` of F. Campolongo et al. (Environ. Model. Softw. 22 (2007) 1509-1518): a cheap screen,
+  ``N (k + 1)`` runs (``SALib.sample.morris``, ``SALib.analyze.morris``).
+* **Logistic regression** of a yes/no outcome on the standardised factors,
+  ``P(yes) = 1/(1 + exp(-(b0 + sum b_j z_j)))``, fitted by iteratively reweighted least squares
+  (maximum likelihood; D. W. Hosmer, S. Lemeshow, Applied Logistic Regression, 2nd ed., 2000,
+  ch. 1-2), Wald standard errors from the Fisher information, odds ratio per standard deviation
+  of each factor and Holm-adjusted p-values.
+
+The factors' distributions are those of the campaign's dispersions: ``uniform`` as is, ``normal``
+as a normal truncated at [low, high] (mean +- 6 std where unbounded, floored at 0). The design
+rows are run through the same engine as a Monte Carlo campaign.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Sequence
+
+import numpy as np
+
+METHODS = ("sobol", "morris")
+MORRIS_LEVELS = 4
+
+
+def problem(dispersions: Sequence) -> dict:
+    """The SALib problem of ``dispersions`` (:class:`taos.montecarlo.campaign.Dispersion`)."""
+    names, bounds, dists = [], [], []
+    for d in dispersions:
+        names.append(d.name)
+        if d.distribution == "uniform":
+            dists.append("unif")
+            bounds.append([d.low, d.high])
+        else:
+            lo = d.low if math.isfinite(d.low) else max(0.0, d.mean - 6 * d.std)
+            hi = d.high if math.isfinite(d.high) else d.mean + 6 * d.std
+            if d.std == 0:
+                dists.append("unif")
+                bounds.append([d.mean, d.mean + 1e-12])
+            else:
+                dists.append("truncnorm")
+                bounds.append([lo, hi, d.mean, d.std])
+    return {"num_vars": len(names), "names": names, "bounds": bounds, "dists": dists}
+
+
+def design(method: str, prob: dict, n: int, seed: int) -> np.ndarray:
+    """The design rows (runs, k) of ``method`` with ``n`` base samples (Sobol': a power of
+    two, n (k + 2) rows) or trajectories (Morris: n (k + 1) rows)."""
+    if method == "sobol":
+        from SALib.sample import sobol
+        return sobol.sample(prob, n, calc_second_order=False, seed=seed)
+    from SALib.sample import morris
+    return morris.sample(prob, n, num_levels=MORRIS_LEVELS, seed=seed)
+
+
+def indices(method: str, prob: dict, x: np.ndarray, y: np.ndarray, seed: int, confidence: float = 0.95) -> list[dict]:
+    """Per factor: Sobol' ``S1``, ``S1_conf``, ``ST``, ``ST_conf`` (half-widths of the
+    ``confidence`` bootstrap interval) or Morris ``mu_star``, ``mu_star_conf``, ``sigma``;
+    strongest (ST or mu*) first."""
+    y = np.asarray(y, float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        if method == "sobol":
+            from SALib.analyze import sobol
+            r = sobol.analyze(prob, y, calc_second_order=False, conf_level=confidence, seed=seed)
+            rows = [{"parameter": nm, "S1": float(r["S1"][i]), "S1_conf": float(r["S1_conf"][i]),
+                     "ST": float(r["ST"][i]), "ST_conf": float(r["ST_conf"][i])} for i, nm in enumerate(prob["names"])]
+            rows.sort(key=lambda d: -d["ST"])
+            return rows
+        from SALib.analyze import morris
+        r = morris.analyze(prob, np.asarray(x, float), y, conf_level=confidence, num_levels=MORRIS_LEVELS, seed=seed)
+        rows = [{"parameter": nm, "mu_star": float(r["mu_star"][i]), "mu_star_conf": float(r["mu_star_conf"][i]),
+                 "sigma": float(r["sigma"][i])} for i, nm in enumerate(prob["names"])]
+        rows.sort(key=lambda d: -d["mu_star"])
+        return rows
+
+
+def holm(pvalues) -> np.ndarray:
+    """Holm's step-down adjusted p-values (family-wise error)."""
+    p = np.asarray(pvalues, float)
+    order = np.argsort(p)
+    adj = np.empty_like(p)
+    run = 0.0
+    for rank, i in enumerate(order):
+        run = max(run, min(1.0, (len(p) - rank) * p[i]))
+        adj[i] = run
+    return adj
+
+
+def logistic_regression(names: Sequence[str], x: np.ndarray, yes: np.ndarray, max_iter: int = 50,
+                        alpha: float = 0.05) -> dict | None:
+    """Logistic regression of ``yes`` (bool per run) on the columns of ``x`` (module docstring);
+    None when it cannot be fitted (one outcome only, or fewer runs than 10 per factor)."""
+    from scipy.stats import norm
+    yes = np.asarray(yes, bool)
+    x = np.asarray(x, float)
+    keep = [j for j in range(x.shape[1]) if np.ptp(x[:, j]) > 0] if x.size else []
+    n = len(yes)
+    if not keep or yes.all() or not yes.any() or n < 10 * len(keep):
+        return None
+    mu, sd = x[:, keep].mean(axis=0), x[:, keep].std(axis=0)
+    z = np.column_stack([np.ones(n), (x[:, keep] - mu) / sd])
+    b = np.zeros(z.shape[1])
+    converged = False
+    for _ in range(max_iter):
+        p = 1 / (1 + np.exp(-np.clip(z @ b, -700, 700)))
+        w = np.maximum(p * (1 - p), 1e-12)
+        info = z.T @ (z * w[:, None])
+        step = np.linalg.solve(info, z.T @ (yes - p))
+        b += step
+        if np.max(np.abs(step)) < 1e-10:
+            converged = True
+            break
+    p = 1 / (1 + np.exp(-np.clip(z @ b, -700, 700)))
+    info = z.T @ (z * np.maximum(p * (1 - p), 1e-12)[:, None])
+    se = np.sqrt(np.diag(np.linalg.inv(info)))
+    pv = 2 * norm.sf(np.abs(b / se))
+    adj = holm(pv[1:])
+    rows = [{"parameter": names[j], "coefficient_per_std": float(b[i + 1]), "std_error": float(se[i + 1]),
+             "odds_ratio_per_std": float(np.exp(b[i + 1])), "p_value": float(pv[i + 1]), "p_holm": float(adj[i]),
+             "significant": bool(adj[i] < alpha), "factor_mean": float(mu[i]), "factor_std": float(sd[i])}
+            for i, j in enumerate(keep)]
+    rows.sort(key=lambda r: -abs(r["coefficient_per_std"]))
+    return {"runs": n, "converged": converged, "intercept": float(b[0]), "coefficients": rows,
+            "method": "maximum likelihood (IRLS), Wald intervals, Holm-adjusted p"}

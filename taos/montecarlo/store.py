@@ -1,0 +1,94 @@
+"""The campaign store: xarray on Zarr, one row per run, written batch by batch.
+
+Layout (``OUT/campaign.zarr``, Zarr format 2, readable with ``xarray.open_zarr``)::
+
+    run        (run)               run index (0 .. n-1), the dimension every per-run variable has
+    parameter  (parameter)         names of the dispersed factors
+    time       (time)              trace sample times [s]
+    factor     (run, parameter)    the run's factors (design row)
+    seed       (run)               the run's random seed
+    status     (run)  int8         0 not run yet, 1 ok, 2 failed, 3 diverged (attrs: ``flag_meanings``)
+    error      (run)  str          why a run failed or diverged ("" when ok)
+    cpu        (run)  str          the CPU / compile target the run's kernels ran with
+    inputs_sha256 (run) str        the content hash of the inputs the worker flew the run with
+    <scalar>   (run)  float        the run kind's scalar outputs (NaN when not ok)
+    <flag>     (run)  bool         the run kind's yes/no outputs
+    trace      (run, time)         the run kind's trace (NaN when not ok)
+
+A second group (``group="nominal"``) holds the nominal run(s) in the same layout. The arrays are
+chunked along ``run`` by the batch size, so a batch is whole chunks: writing it costs the same at
+the first and the 100,000th run, and ``status`` is written last, so a batch cut short by a kill
+reads as not run and is run again on resume. A failed run keeps its row: traces stay aligned with
+run indices.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+STATUS = {"pending": 0, "ok": 1, "failed": 2, "diverged": 3}
+TEXT_WIDTH = 160
+
+
+def _lazy(shape, dtype, chunks, fill):
+    import dask.array as da
+    return da.full(shape, fill, dtype=dtype, chunks=chunks)
+
+
+def create(path: Path, *, labels: np.ndarray, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray,
+           scalars: tuple[str, ...], flags: tuple[str, ...], trace_t_s: np.ndarray, batch: int, attrs: Mapping,
+           group: str | None = None) -> None:
+    """Write the store's metadata and the design (factors, seeds); every output unset."""
+    import xarray as xr
+    n, m = len(labels), len(trace_t_s)
+    ch = (min(batch, n),)
+    data = {
+        "factor": (("run", "parameter"), np.asarray(factors, float).reshape(n, len(names))),
+        "seed": (("run",), np.asarray(seeds, np.int64)),
+        "status": (("run",), _lazy((n,), np.int8, ch, 0),
+                   {"flag_values": list(STATUS.values()), "flag_meanings": " ".join(STATUS)}),
+        "error": (("run",), _lazy((n,), f"<U{TEXT_WIDTH}", ch, "")),
+        "cpu": (("run",), _lazy((n,), "<U64", ch, "")),
+        "inputs_sha256": (("run",), _lazy((n,), "<U64", ch, "")),
+        "trace": (("run", "time"), _lazy((n, m), float, (ch[0], max(m, 1)), np.nan)),
+    }
+    for s in scalars:
+        data[s] = (("run",), _lazy((n,), float, ch, np.nan))
+    for f in flags:
+        data[f] = (("run",), _lazy((n,), bool, ch, False))
+    ds = xr.Dataset(data, coords={"run": np.asarray(labels, np.int64), "parameter": list(names),
+                                  "time": np.asarray(trace_t_s, float)}, attrs=dict(attrs))
+    ds.to_zarr(path, group=group, compute=False, mode="w-" if group is None else "a", zarr_format=2)
+
+
+def write_batch(path: Path, start: int, out: Mapping[str, np.ndarray], group: str | None = None) -> None:
+    """Store a batch's outputs at rows ``start``.. (``out``: the variables above, ``status`` last)."""
+    import xarray as xr
+    n = len(out["status"])
+    region = {"run": slice(start, start + n)}
+    body = {k: ((("run", "time") if k == "trace" else ("run",)), np.asarray(v)) for k, v in out.items() if k != "status"}
+    if "error" in body:
+        body["error"] = (("run",), np.asarray([e[:TEXT_WIDTH] for e in out["error"]], f"<U{TEXT_WIDTH}"))
+    for k in ("cpu", "inputs_sha256"):
+        if k in body:
+            body[k] = (("run",), np.asarray(out[k], "<U64"))
+    xr.Dataset(body).to_zarr(path, group=group, region=region, zarr_format=2)
+    xr.Dataset({"status": (("run",), np.asarray(out["status"], np.int8))}).to_zarr(path, group=group, region=region,
+                                                                                    zarr_format=2)
+
+
+def open_store(path: Path, group: str | None = None, consolidated: bool | None = None):
+    """The store (or its ``group``) as a lazy :class:`xarray.Dataset`."""
+    import xarray as xr
+    return xr.open_zarr(path, group=group, zarr_format=2, consolidated=consolidated)
+
+
+def status(path: Path, group: str | None = None) -> np.ndarray | None:
+    """Every run's status code, or None when the store cannot be read."""
+    try:
+        return np.asarray(open_store(path, group, consolidated=False)["status"].values, np.int8)
+    except (OSError, KeyError, ValueError):
+        return None

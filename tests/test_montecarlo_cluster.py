@@ -1,0 +1,243 @@
+"""Monte Carlo campaigns on real Dask clusters: bit-identical stores across executors, worker
+counts and batch sizes; workers that cannot see the project files; a persistent cluster after an
+input edit; worker and client kills with resume."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from taos.cli import main
+from taos.montecarlo import Design, Ishigami, load_campaign, open_store, run_campaign, run_design
+from taos.montecarlo import sensitivity as sens
+from taos.montecarlo import store
+
+from tests.test_montecarlo import ROOT, SHORT, copy_inputs, stats
+
+pytestmark = pytest.mark.slow
+RUNS = 20
+BIN = Path(sys.executable).parent
+#: a worker preload: an audit hook refusing to open anything under the folders in TAOS_TEST_DENY
+DENY = '''
+import os, sys
+_deny = [p for p in os.environ.get("TAOS_TEST_DENY", "").split(os.pathsep) if p]
+def _hook(event, args):
+    if event == "open" and isinstance(args[0], (str, bytes, os.PathLike)):
+        p = os.path.abspath(os.fsdecode(args[0]))
+        if any(p == d or p.startswith(d + os.sep) for d in _deny):
+            raise PermissionError(f"isolated worker: {p} is not visible here")
+sys.addaudithook(_hook)
+'''
+STORED = ("status", "seed", "factor", "trace", "amplitude_deg", "frequency_hz", "growth", "lco", "peak_engine_deg",
+          "cpu", "error", "inputs_sha256")
+
+
+def same_store(a: Path, b: Path) -> None:
+    """Every stored variable of two campaigns bit-identical (NaN where NaN)."""
+    for group in (None, "nominal"):
+        x, y = open_store(a / "campaign.zarr", group), open_store(b / "campaign.zarr", group)
+        for v in STORED:
+            assert np.array_equal(x[v].values, y[v].values, equal_nan=x[v].dtype.kind == "f"), (group, v)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start_cluster(tmp: Path, deny: list[Path], n: int = 2):
+    """A scheduler and ``n`` one-thread workers as separate processes on loopback; the workers
+    run in ``tmp/cwd`` and cannot open anything under ``deny``."""
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    cwd = tmp / "cwd"
+    cwd.mkdir(exist_ok=True)
+    (tmp / "deny_preload.py").write_text(DENY)
+    env = dict(os.environ, TAOS_TEST_DENY=os.pathsep.join(str(d.resolve()) for d in deny))
+    sched = subprocess.Popen([str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port),
+                              "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    workers = [subprocess.Popen([str(BIN / "dask"), "worker", addr, "--nthreads", "1", "--nworkers", "1",
+                                 "--no-dashboard", "--no-nanny", "--host", "127.0.0.1",
+                                 "--preload", str(tmp / "deny_preload.py")],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=cwd)
+               for _ in range(n)]
+    from dask.distributed import Client
+    deadline = time.time() + 90
+    while True:
+        try:
+            with Client(addr, timeout="5s") as c:
+                c.wait_for_workers(n, timeout=30)
+            break
+        except Exception:
+            if time.time() > deadline:
+                stop_cluster([sched, *workers])
+                raise
+            time.sleep(0.5)
+    return addr, sched, workers
+
+
+def stop_cluster(procs) -> None:
+    for p in procs:
+        if p.poll() is None:
+            p.send_signal(signal.SIGTERM)
+    for p in procs:
+        try:
+            p.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The short campaign in this process (no Dask), 7 runs per batch."""
+    out = tmp_path_factory.mktemp("mcref") / "ref"
+    run_campaign(load_campaign(SHORT), out, runs=RUNS, workers=0, batch=7)
+    return out
+
+
+@pytest.fixture(scope="module")
+def isolated(tmp_path_factory):
+    """A loopback cluster whose workers cannot open the project's model, flight, FEM or test
+    data files, nor anything under ``proj`` (where the tests copy inputs)."""
+    tmp = tmp_path_factory.mktemp("iso")
+    proj = tmp / "proj"
+    proj.mkdir()
+    addr, sched, workers = start_cluster(tmp, [ROOT / "models", ROOT / "fem_data", ROOT / "tests" / "data", proj])
+    from dask.distributed import Client
+
+    def _try_open(path: str) -> str:  # nested: sent by value to the workers (they cannot import tests)
+        try:
+            open(path, "rb").close()
+            return "opened"
+        except PermissionError:
+            return "denied"
+    try:
+        with Client(addr, timeout="10s") as c:
+            seen = c.run(_try_open, str(ROOT / "models" / "rs25_flight.toml"))
+            assert set(seen.values()) == {"denied"}, seen
+        yield addr, proj
+    finally:
+        stop_cluster([*workers, sched])
+
+
+def test_local_cluster_store_is_bit_identical_to_in_process(reference, tmp_path):
+    """Default executor (LocalCluster, 2 workers, batch from the run cost) against the
+    in-process engine with 7 runs per batch: the same store, bit for bit, and the same
+    statistics; the store reads with xarray.open_zarr."""
+    import xarray as xr
+    out = tmp_path / "local"
+    assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--out", str(out), "--no-progress"]) == 0
+    assert {p.name for p in out.iterdir()} == {"campaign.json", "campaign.zarr", "summary.json", "montecarlo.png",
+                                               ".taos-output.json"}   # taos's mark of the files it wrote
+    same_store(out, reference)
+    assert stats(out) == stats(reference)
+    ds = xr.open_zarr(out / "campaign.zarr")
+    assert ds.sizes["run"] == RUNS and (ds["status"].values > 0).all()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["provenance"]["inputs_sha256"] == ds.attrs["inputs_sha256"]
+    assert summary["timing"]["batch"] == json.loads((out / "campaign.json").read_text())["batch"]
+
+
+def test_workers_that_cannot_see_the_files_give_identical_results(isolated, reference, tmp_path):
+    """Workers in another folder that may not open a single project file: the campaign (3 runs
+    per batch) stores exactly what the in-process run stores, and Ishigami runs there too."""
+    addr, _ = isolated
+    out = tmp_path / "iso"
+    assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--batch", "3", "--out", str(out),
+                 "--no-progress"]) == 0
+    same_store(out, reference)
+    assert stats(out) == stats(reference)
+    kind, x = Ishigami(), sens.design("sobol", Ishigami.problem(), 64, seed=1)
+    d = Design(("x1", "x2", "x3"), x, np.zeros(len(x), np.int64))
+    a = run_design(kind, d, tmp_path / "a.zarr", scheduler=addr, batch=50)
+    b = run_design(kind, d, tmp_path / "b.zarr", workers=0, batch=64)
+    assert np.array_equal(a["y"].values, b["y"].values)
+
+
+def test_persistent_cluster_flies_the_edited_input(isolated, tmp_path):
+    """The same cluster after the ascent file is edited (a stronger separation kick): the new
+    campaign has a new inputs hash and stores what the in-process engine stores for the edited
+    input, not the old one."""
+    addr, proj = isolated
+    camp = copy_inputs(proj / "edit")
+    before = tmp_path / "before"
+    assert main(["montecarlo", str(camp), "--runs", "4", "--scheduler", addr, "--batch", "2", "--out", str(before),
+                 "--no-progress"]) == 0
+    asc = proj / "edit" / "models" / "flight" / "ascent.toml"
+    asc.write_text(asc.read_text().replace('separation_rate_kick = "0.1 deg/s"', 'separation_rate_kick = "0.4 deg/s"'))
+    after, ref = tmp_path / "after", tmp_path / "ref"
+    assert main(["montecarlo", str(camp), "--runs", "4", "--scheduler", addr, "--batch", "2", "--out", str(after),
+                 "--no-progress"]) == 0
+    run_campaign(load_campaign(camp), ref, runs=4, workers=0)
+    h = [json.loads((o / "campaign.json").read_text())["inputs_sha256"] for o in (before, after, ref)]
+    assert h[0] != h[1] == h[2]
+    same_store(after, ref)
+    assert stats(after) == stats(ref) != stats(before)
+
+
+def _stored(out: Path) -> int:
+    st = store.status(out / "campaign.zarr") if (out / "campaign.json").exists() else None
+    return 0 if st is None else int((st > 0).sum())
+
+
+def test_killing_a_worker_loses_no_run(reference, tmp_path):
+    """A worker killed mid-campaign: Dask re-runs its batches on the other one; the campaign
+    ends with every run and the same store."""
+    addr, sched, workers = start_cluster(tmp_path, [])
+    out = tmp_path / "kill"
+    rc = {}
+    try:
+        th = threading.Thread(target=lambda: rc.setdefault("rc", main(
+            ["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--batch", "2", "--out", str(out),
+             "--no-progress"])))
+        th.start()
+        deadline = time.time() + 180
+        while _stored(out) < 4 and time.time() < deadline:
+            time.sleep(0.05)
+        workers[0].kill()
+        th.join(timeout=300)
+    finally:
+        stop_cluster([*workers, sched])
+    assert rc.get("rc") == 0
+    same_store(out, reference)
+    assert stats(out) == stats(reference)
+
+
+def test_killed_client_resumes_to_the_same_store(reference, tmp_path):
+    """The client (the taos process) killed with SIGKILL mid-campaign: --resume on the same
+    folder runs only what is missing and ends with the same store and statistics."""
+    addr, sched, workers = start_cluster(tmp_path, [])
+    out = tmp_path / "resume"
+    try:
+        p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
+                              "--batch", "2", "--out", str(out), "--no-progress"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.time() + 180
+        while _stored(out) < 5 and time.time() < deadline and p.poll() is None:
+            time.sleep(0.05)
+        p.kill()
+        p.wait()
+        done = _stored(out)
+        assert 0 < done < RUNS + 1
+        assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
+                     "--no-progress"]) == 2  # without --resume: refused
+        assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
+                     "--resume", "--no-progress"]) == 0
+    finally:
+        stop_cluster([*workers, sched])
+    same_store(out, reference)
+    assert stats(out) == stats(reference)
+    executed = json.loads((out / "summary.json").read_text())["timing"]["runs_executed"]
+    assert executed < RUNS + 1
