@@ -3,7 +3,7 @@ Green Run of one's own model
 ============================
 
 Start from a shipped model file, change what differs on your hardware (here a softer load
-path and a higher gimbal friction level), and run the Green Run analysis on it: the verdict in
+path and a higher gimbal friction level, its breakaway level with it), and run the Green Run analysis on it: the verdict in
 words, the figures of merit, and the Bode plot with the spec mask. A short two-axis profile
 keeps it quick; ``taos.greenrun(model, out="DIR")`` (or ``taos greenrun FILE --out DIR``)
 writes the full interactive report.
@@ -26,6 +26,7 @@ from taos.shipped import models_dir
 doc = tomlkit.parse((models_dir() / "rs25_hotfire.toml").read_text())
 doc["structure"]["load_stiffness"] = "180000 lbf/in"      # our load path, softer than 205000
 doc["friction"]["coulomb_torque"] = "130000 in*lbf"       # our bearing, more friction
+doc["friction"]["static_torque"] = "130000 in*lbf"        # breakaway at least the sliding torque
 doc["name"] = "my engine (hot fire, softer load path, more friction)"
 with tempfile.TemporaryDirectory() as folder:
     path = Path(folder) / "my_engine.toml"
