@@ -281,3 +281,13 @@ def test_unregister_removes_a_run_time_law_and_keeps_builtins(flight):
         friction.unregister("lugre")
     with pytest.raises(InputError):  # a built-in id cannot be taken over
         friction.register(dataclasses.replace(friction.get("lugre")), replace_existing=True)
+
+
+@pytest.mark.parametrize("bad", [{"a": 1}, 3, ["dahl"]])
+def test_a_law_name_that_is_not_a_string_is_bad_input(bad):
+    """``[friction] model = {a = 1}`` (a table, a number, a list where a law id belongs) is one
+    InputError naming friction.model, not an internal TypeError (found by the model-file fuzzing)."""
+    from taos.friction import registry
+
+    with pytest.raises(InputError, match="friction.model"):
+        registry.params_of(bad, "m.toml")

@@ -276,10 +276,13 @@ def param_classes() -> dict[str, type]:
 def params_of(law_id: str, source: str = "friction registry", field: str = "friction.model") -> type:
     """The parameter class of ``law_id`` (no kernel is loaded; a plug-in law's package is
     imported); an unknown id raises :class:`InputError` naming the known ids."""
+    if not isinstance(law_id, str):   # a TOML table or number where a name belongs
+        raise InputError(source, field, "a friction law id (a string), one of " + ", ".join(ids()),
+                         got=repr(law_id)[:60])
     classes = param_classes()
     if law_id in classes:
         return classes[law_id]
-    plugin = _plugin_entry(law_id) if isinstance(law_id, str) else None
+    plugin = _plugin_entry(law_id)
     if plugin is not None:
         return plugin.params
     raise InputError(source, field, "a friction law id, one of " + ", ".join(ids()), got=repr(law_id))
