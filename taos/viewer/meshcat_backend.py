@@ -291,8 +291,10 @@ def start_loopback_server(timeout_s: float = 20.0):
     root = str(Path(__file__).resolve().parents[2])
     env["PYTHONPATH"] = root + os.pathsep + env.get("PYTHONPATH", "")
     env["TAOS_VIEWER_PARENT"] = str(os.getpid())  # the server ends when this process ends
+    # bufsize=0: stdout unbuffered, so a line the server wrote is never held in a Python buffer
+    # while select() below waits on the pipe for more (both URLs often arrive in one write)
     proc = subprocess.Popen([sys.executable, "-u", "-m", "taos.viewer._server"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, env=env, start_new_session=True)
+                            stderr=subprocess.PIPE, env=env, start_new_session=True, bufsize=0)
     import select
     import time
 
