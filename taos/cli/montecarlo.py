@@ -32,7 +32,7 @@ def cmd_ascent(args) -> int:
 
     ascent = load_ascent(args.ascent)
     laws = [s.strip() for s in args.friction.split(",")] if args.friction is not None else [None]
-    if not all(laws):
+    if args.friction is not None and not all(laws):
         raise InputError("command line", "--friction", "friction law names separated by single commas, like "
                          "dahl,lugre", got=repr(args.friction))
     if len(laws) > 6:
