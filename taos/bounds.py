@@ -4,10 +4,12 @@ Every check raises :class:`~taos.errors.InputError` (exit 2: one line naming the
 limit) or, for a model that is unstable or a run that leaves its envelope,
 :class:`~taos.errors.UnstableModel` / :class:`~taos.errors.EnvelopeExceeded` (exit 3).
 
-The physical bounds of every model-file and flight-file value, each with its reason, are the
-tables :data:`MODEL_BOUNDS` and :data:`FLIGHT_BOUNDS` (checked when a file is loaded, with the
-cross-field checks of :func:`check_model_bounds`); the Python API's grids and axes are checked
-by :func:`check_response_args`. All are listed in docs/reference/bounds.md.
+The physical bounds of every model, flight, campaign, ascent and profile-file value, each with
+its reason, are the tables :data:`MODEL_BOUNDS`, :data:`FLIGHT_BOUNDS`, :data:`CAMPAIGN_BOUNDS`,
+:data:`ASCENT_BOUNDS` and :data:`PROFILE_BOUNDS` (checked when a file is loaded, with the
+cross-field checks of :func:`check_model_bounds`, :func:`check_campaign_bounds` and
+:func:`check_ascent_bounds`); the Python API's grids and axes are checked by
+:func:`check_response_args`. All are listed in docs/reference/bounds.md.
 
 Limits of a run (SI inside; shown here in the units of the messages):
 
