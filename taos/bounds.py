@@ -363,12 +363,11 @@ CAMPAIGN_BOUNDS: dict[str, tuple[float, float, str, str]] = {
 }
 
 
-def check_campaign_bounds(c) -> None:
+def check_campaign_bounds(c, model_fields: dict[str, str]) -> None:
     """A loaded :class:`~taos.montecarlo.campaign.Campaign` within :data:`CAMPAIGN_BOUNDS`; a
     normal dispersion's mean inside its [low, high] (else the clipping piles the runs on a
-    bound); every case override within the model bound of its field (:data:`MODEL_BOUNDS`)."""
-    from taos.identify.surrogate import PARAMETERS
-
+    bound); every case override within the model bound (:data:`MODEL_BOUNDS`) of its model-file
+    field (``model_fields``: parameter name -> "section.key")."""
     src, T = c.source, CAMPAIGN_BOUNDS
     for key, value in (("seed", c.seed), ("start", c.start_s), ("duration", c.duration_s), ("dt", c.dt_s),
                        ("analysis_window", c.analysis_window_s), ("trace_interval", c.trace_interval_s),
@@ -386,9 +385,8 @@ def check_campaign_bounds(c) -> None:
                              "clipping would pile the runs on a bound)", got=f"{d.mean:g}")
     for case, over in c.cases.items():
         for name, v in over.items():
-            p = PARAMETERS[name]
-            if f"{p.section}.{p.toml_key}" in MODEL_BOUNDS:
-                _check_in(MODEL_BOUNDS, f"{p.section}.{p.toml_key}", v, src, f"cases.{case}.{name}")
+            if model_fields.get(name) in MODEL_BOUNDS:
+                _check_in(MODEL_BOUNDS, model_fields[name], v, src, f"cases.{case}.{name}")
 
 
 #: ascent-file fields (``models/flight/ascent.toml``, :mod:`taos.flight.ascent`), as

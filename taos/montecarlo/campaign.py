@@ -243,7 +243,7 @@ def load_campaign(path: str | Path) -> Campaign:
                  dispersions=disp, update_interval_s=upd, ptis=ptis,
                  avionics=avionics)
     from taos.bounds import check_campaign_bounds
-    check_campaign_bounds(c)   # the documented bounds (docs/reference/bounds.md), before any work
+    check_campaign_bounds(c, {k: f"{q.section}.{q.toml_key}" for k, q in PARAMETERS.items()})   # before any work
     return c
 
 

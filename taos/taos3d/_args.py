@@ -8,25 +8,39 @@ import math
 
 import numpy as np
 
-from ..bounds import MAX_DURATION_S, RESPONSE_FREQ_HZ, check_axis, check_grid
+from ..bounds import MAX_DURATION_S, MAX_JOB_BYTES, MAX_STEPS, RESPONSE_FREQ_HZ, check_axis, check_grid
 from ..errors import InputError
 
 SRC = "argument"
 #: largest dwell amplitude of the API [rad], as :func:`taos.bounds.check_response_args`
 MAX_AMPLITUDE_RAD = math.pi / 2
+#: integration steps of one dwell grid, the command line's budget (taos.planar.envelope.check_dwell)
+MAX_DWELL_STEPS = 5e7
 
 
 def check_step(dt_s, field: str, duration_s: float | None = None) -> float:
     """A finite positive step [s] (and, with ``duration_s``, a job within the step and memory
-    limits of :func:`taos.planar.envelope.check_run_step`)."""
-    from ..planar.envelope import check_run_step
-
+    limits :data:`taos.bounds.MAX_STEPS`, :data:`~taos.bounds.MAX_JOB_BYTES`, estimated as the
+    command line does)."""
     try:
         dt = float(dt_s)
     except (TypeError, ValueError):
         raise InputError(SRC, field, "a positive step in seconds", got=repr(dt_s)[:40]) from None
-    check_run_step(dt, None, duration_s=duration_s, n_axes=2, source=SRC, field=field)
+    if not (math.isfinite(dt) and dt > 0):
+        raise InputError(SRC, field, "a positive step in seconds", got=repr(dt_s)[:40])
+    if duration_s is not None:
+        n = duration_s / dt
+        if n > MAX_STEPS or n * 8 * 12 > MAX_JOB_BYTES:   # time, two commands and their copies, float64
+            raise InputError(SRC, field, f"at most {MAX_STEPS:.0e} steps within {MAX_JOB_BYTES / 2 ** 30:g} GiB for "
+                             f"the {duration_s:g} s run", got=f"{dt:g} s")
     return dt
+
+
+def check_dwell_steps(total: int) -> None:
+    """The integration steps of a whole dwell grid within :data:`MAX_DWELL_STEPS`."""
+    if total > MAX_DWELL_STEPS:
+        raise InputError(SRC, "freq_hz", f"sine-dwell frequencies needing at most {MAX_DWELL_STEPS:.0e} integration "
+                         "steps (settling, then the measured cycles, per amplitude)", got=f"{total:.3g} steps")
 
 
 def check_count(value, field: str, lowest: int) -> int:
@@ -41,8 +55,6 @@ def check_dwell_args(tm, freq_hz, amplitudes_rad, axis: str, amp_field: str, dt_
     """(frequencies, amplitudes or None) of a frequency-response call, checked: a known axis, a
     non-empty grid of frequencies in (0, 1e4] Hz and of amplitudes in (0, 90] deg, a positive
     step, whole cycle counts, a job within the dwell step budget."""
-    from ..planar.envelope import check_dwell
-
     check_axis(axis)
     f = check_grid(freq_hz, "freq_hz", "Hz", 0.0, RESPONSE_FREQ_HZ[1], source=SRC)
     if amplitudes_rad is None:
@@ -55,8 +67,6 @@ def check_dwell_args(tm, freq_hz, amplitudes_rad, axis: str, amp_field: str, dt_
     if settle_s is not None and not (isinstance(settle_s, (int, float)) and 0 <= settle_s <= MAX_DURATION_S):
         raise InputError(SRC, "settle_s", f"None or a settling time from 0 to {MAX_DURATION_S:g} s",
                          got=repr(settle_s)[:40])
-    check_dwell(tm.base, f, dt_s=dt, axis=axis, source=SRC,
-                field="freq_hz", min_steps_per_cycle=min_steps_per_cycle, n_amplitudes=a.size)
     return f, a
 
 

@@ -296,6 +296,7 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     dts = 1.0 / (fmeas * npc)
     nset = (np.maximum(settle_cycles, np.ceil(ts * fmeas)) * npc).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
+    _args.check_dwell_steps(int(np.sum(nset + nmeas)))   # before any work, as the command line's budget
     perm = deal_by_cost(nset + nmeas)   # results put back in input order below
     amps, freqs = np.ascontiguousarray(np.asarray(amps, float)[perm]), np.ascontiguousarray(np.asarray(freqs, float)[perm])
     fmeas, dts, nset, nmeas = fmeas[perm], dts[perm], nset[perm], nmeas[perm]
