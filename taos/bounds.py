@@ -287,8 +287,9 @@ def check_model_bounds(src: str, engine, actuator, structure, avionics, friction
             arm = _lever_arm(geometry, axis, src)
             R = actuator.moment_arm_m
             if arm is not None and abs(arm - R) > MOMENT_ARM_TOLERANCE * R:
-                raise InputError(src, "actuator.moment_arm", f"the lever arm of the [geometry] {axis} attachment "
-                                 f"points ({arm:.4g} m) within {100 * MOMENT_ARM_TOLERANCE:g} %", got=f"{R:.4g} m")
+                raise InputError(src, f"geometry.{axis}_engine_attach", f"attach points giving a moment arm of "
+                                 f"{R:.4g} m (actuator.moment_arm) within {100 * MOMENT_ARM_TOLERANCE:g} %",
+                                 got=f"{arm:.4g} m")
 
 
 # -- the Python API's arguments, checked as the command line checks them --------------------
