@@ -4,10 +4,12 @@ Every check raises :class:`~taos.errors.InputError` (exit 2: one line naming the
 limit) or, for a model that is unstable or a run that leaves its envelope,
 :class:`~taos.errors.UnstableModel` / :class:`~taos.errors.EnvelopeExceeded` (exit 3).
 
-The physical bounds of every model-file and flight-file value, each with its reason, are the
-tables :data:`MODEL_BOUNDS` and :data:`FLIGHT_BOUNDS` (checked when a file is loaded, with the
-cross-field checks of :func:`check_model_bounds`); the Python API's grids and axes are checked
-by :func:`check_response_args`. All are listed in docs/reference/bounds.md.
+The physical bounds of every model, flight, campaign, ascent and profile-file value, each with
+its reason, are the tables :data:`MODEL_BOUNDS`, :data:`FLIGHT_BOUNDS`, :data:`CAMPAIGN_BOUNDS`,
+:data:`ASCENT_BOUNDS` and :data:`PROFILE_BOUNDS` (checked when a file is loaded, with the
+cross-field checks of :func:`check_model_bounds`, :func:`check_campaign_bounds` and
+:func:`check_ascent_bounds`); the Python API's grids and axes are checked by
+:func:`check_response_args`. All are listed in docs/reference/bounds.md.
 
 Limits of a run (SI inside; shown here in the units of the messages):
 
@@ -40,6 +42,7 @@ number of fit starts           1 .. 64
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -284,9 +287,9 @@ def check_model_bounds(src: str, engine, actuator, structure, avionics, friction
             arm = _lever_arm(geometry, axis, src)
             R = actuator.moment_arm_m
             if arm is not None and abs(arm - R) > MOMENT_ARM_TOLERANCE * R:
-                raise InputError(src, "actuator.moment_arm", f"[geometry] {axis} attachment points "
-                                 f"(geometry.{axis}_engine_attach, geometry.{axis}_structure_attach) whose moment "
-                                 f"arm ({arm:.4g} m) is within {100 * MOMENT_ARM_TOLERANCE:g} % of it", got=f"{R:.4g} m")
+                raise InputError(src, f"geometry.{axis}_engine_attach", f"attach points giving a moment arm of "
+                                 f"{R:.4g} m (actuator.moment_arm) within {100 * MOMENT_ARM_TOLERANCE:g} %",
+                                 got=f"{arm:.4g} m")
 
 
 # -- the Python API's arguments, checked as the command line checks them --------------------
@@ -326,3 +329,167 @@ def check_response_args(freq_hz, amplitudes_rad=None, axis: str = "pitch") -> No
     check_grid(freq_hz, "freq_hz", "Hz", 0.0, RESPONSE_FREQ_HZ[1])
     if amplitudes_rad is not None:
         check_grid(amplitudes_rad, "amplitudes_rad", "rad", 0.0, math.pi / 2)
+
+
+# -- campaign, ascent and profile files (docs/reference/bounds.md) ----------------------------
+
+def _check_in(table: dict, key: str, value: float, src: str, field: str | None = None) -> float:
+    """``value`` (SI) within ``table[key]`` (lowest, highest, SI unit, why), else one line naming
+    ``field`` (default ``key``), the value and the bounds."""
+    lo, hi, unit, why = table[key]
+    if not (math.isfinite(value) and lo <= value <= hi):
+        raise InputError(src, field or key, f"a value from {lo:.4g} to {hi:.4g} {unit} ({why})",
+                         got=f"{value:.4g} {unit}")
+    return value
+
+
+#: campaign-file fields (``models/montecarlo/*.toml``, :mod:`taos.montecarlo.campaign`), as
+#: :data:`MODEL_BOUNDS`; ``dispersions.*`` are factors on the case's nominal value. The run count,
+#: batch size and workers are command-line values (``taos.montecarlo.executor``: 1 to 200,000
+#: runs, 1 to 1000 runs per task, 0 to 64 workers).
+CAMPAIGN_BOUNDS: dict[str, tuple[float, float, str, str]] = {
+    "seed": (0.0, 2.0 ** 63 - 1, "1", "an entropy word of NumPy's SeedSequence, kept a signed 64-bit integer"),
+    "start": (0.0, 2000.0, "s", "a time of the ascent (ascent files are at most 2000 s)"),
+    "duration": (10.0, 2000.0, "s", "at least the shortest analysis window; at most an ascent"),
+    "dt": (1e-5, 2e-3, "s", "the oil column needs an RK4 step of at most 2 ms; below 0.01 ms a run takes hours"),
+    "analysis_window": (10.0, 2000.0, "s", "a 0.1 Hz limit cycle needs a whole cycle; at most the duration"),
+    "trace_interval": (1e-5, 200.0, "s", "from dt to a tenth of the duration"),
+    "update_interval": (0.01, 10.0, "s", "vehicle properties change by < 1.5 % in 5 s after separation"),
+    "dispersions.mean": (0.01, 100.0, "1", "a factor on the nominal value: dispersions are percent-level, a "
+                         "stress campaign pushes a gain to 16 times; 100 times nominal is another vehicle"),
+    "dispersions.std": (0.0, 1.0, "1", "preflight 3-sigma spreads are 5-45 %; one sigma of 100 % is no dispersion"),
+    "dispersions.low": (0.0, 100.0, "1", "factors stay non-negative; as mean"),
+    "dispersions.high": (0.0, 100.0, "1", "as mean"),
+    "cases": (1.0, 64.0, "", "named variants of one campaign, run one at a time"),
+}
+
+
+def check_campaign_bounds(c, model_fields: dict[str, str]) -> None:
+    """A loaded :class:`~taos.montecarlo.campaign.Campaign` within :data:`CAMPAIGN_BOUNDS`; a
+    normal dispersion's mean inside its [low, high] (else the clipping piles the runs on a
+    bound); every case override within the model bound (:data:`MODEL_BOUNDS`) of its model-file
+    field (``model_fields``: parameter name -> "section.key")."""
+    src, T = c.source, CAMPAIGN_BOUNDS
+    for key, value in (("seed", c.seed), ("start", c.start_s), ("duration", c.duration_s), ("dt", c.dt_s),
+                       ("analysis_window", c.analysis_window_s), ("trace_interval", c.trace_interval_s),
+                       ("update_interval", c.update_interval_s), ("cases", len(c.cases))):
+        if value is not None:
+            _check_in(T, key, float(value), src)
+    for d in c.dispersions:
+        fld = f"dispersions.{d.name}"
+        vals = {"low": d.low, "high": d.high} | ({"mean": d.mean, "std": d.std} if d.distribution == "normal" else {})
+        for k, v in vals.items():
+            if math.isfinite(v) or k in ("mean", "std"):      # an infinite low/high is "not given"
+                _check_in(T, f"dispersions.{k}", v, src, f"{fld}.{k}")
+        if d.distribution == "normal" and not d.low <= d.mean <= d.high:
+            raise InputError(src, f"{fld}.mean", f"a mean inside [low, high] = [{d.low:g}, {d.high:g}] (the "
+                             "clipping would pile the runs on a bound)", got=f"{d.mean:g}")
+    for case, over in c.cases.items():
+        for name, v in over.items():
+            if model_fields.get(name) in MODEL_BOUNDS:
+                _check_in(MODEL_BOUNDS, model_fields[name], v, src, f"cases.{case}.{name}")
+
+
+#: ascent-file fields (``models/flight/ascent.toml``, :mod:`taos.flight.ascent`), as
+#: :data:`MODEL_BOUNDS`; ``trajectory.*`` bound every value of the column, ``pti.*`` every
+#: ``[[pti]]``. Signed quantities have a negative lowest value.
+ASCENT_BOUNDS: dict[str, tuple[float, float, str, str]] = {
+    "update_interval": (0.01, 10.0, "s", "a zero-order hold of the vehicle properties: 10 ms to 10 s"),
+    "trajectory.time": (0.0, 2000.0, "s", "an ascent to orbit lasts 8-10 min"),
+    "trajectory.mass": (1e2, 1e8, "kg", "as vehicle.mass of a flight file"),
+    "trajectory.inertia": (1.0, 1e12, "kg*m**2", "as vehicle.pitch_inertia"),
+    "trajectory.gimbal_arm": (0.1, 300.0, "m", "as vehicle.gimbal_arm"),
+    "trajectory.core_thrust_per_engine": (0.0, 1e8, "N", "as vehicle.thrust_per_engine (0: engine off)"),
+    "trajectory.booster_thrust": (0.0, 1e8, "N", "per booster: an SLS five-segment booster 16 MN"),
+    "trajectory.dynamic_pressure": (0.0, 1e6, "Pa", "max-q is 30-40 kPa; 1 MPa is Mach 3.7 at sea level"),
+    "trajectory.velocity": (1.0, 1.2e4, "m/s", "the wind angle of attack w/V means nothing below 1 m/s; "
+                            "escape velocity is 11.2 km/s"),
+    "trajectory.wind_speed": (0.0, 200.0, "m/s", "jet-stream cores reach 100 m/s"),
+    "boosters.separation_time": (0.0, 2000.0, "s", "a time of the ascent"),
+    "boosters.gimbal_arm": (0.1, 300.0, "m", "as vehicle.gimbal_arm"),
+    "boosters.actuator_time_constant": (1e-3, 10.0, "s", "booster TVC servos are 0.02-0.2 s"),
+    "boosters.separation_rate_kick": (-0.2, 0.2, "rad/s", "separation disturbances are a fraction of a deg/s; "
+                                      "11 deg/s would tumble the stack"),
+    "aero.reference_area": (0.0, 1000.0, "m**2", "SLS 55 m^2 (8.4 m); 1000 m^2 is a 36 m diameter"),
+    "aero.normal_force_slope": (0.0, 50.0, "1/rad", "C_N_alpha of slender launch vehicles is 2-10 1/rad"),
+    "aero.center_of_pressure_ahead": (-300.0, 300.0, "m", "within the stack (SLS 98 m)"),
+    "wind.azimuth": (-2 * math.pi, 2 * math.pi, "rad", "a direction: one turn either way"),
+    "wind.gust_time": (0.0, 2000.0, "s", "a time of the ascent"),
+    "wind.gust_amplitude": (-100.0, 100.0, "m/s", "design discrete gusts are 9-30 m/s"),
+    "wind.gust_duration": (0.01, 1000.0, "s", "1-cosine gusts last 1-20 s"),
+    "wind.turbulence_intensity": (0.0, 50.0, "m/s", "severe turbulence has an RMS of 3-7 m/s"),
+    "wind.turbulence_time_constant": (0.1, 1000.0, "s", "Dryden correlation times are 0.5-10 s; the turbulence "
+                                      "is drawn every tau/20, so 0.1 s bounds it to 4e5 points over 2000 s"),
+    "pti.start": (0.0, 2000.0, "s", "a time of the ascent"),
+    "pti.duration": (0.01, 2000.0, "s", "flight PTIs last 10-30 s"),
+    "pti.amplitude": (1e-4 * DEG, 5.0 * DEG, "rad", "PTIs are 0.1-0.5 deg; below 1e-4 deg (1/40 of a command LSB) "
+                      "no test input; 5 deg is half the gimbal range"),
+    "pti.low_frequency": (1e-3, 50.0, "Hz", "flight PTIs span 0.1-10 Hz; the multisine has 4 lines an octave, "
+                          "so 1e-3 Hz bounds it to 63 lines"),
+    "pti.high_frequency": (1e-3, 50.0, "Hz", "as low_frequency, and above it"),
+}
+
+
+def check_pti_bounds(p, src: str, sec: str) -> None:
+    """One ``[[pti]]`` (:class:`~taos.flight.ascent.Pti`, named ``sec``) within :data:`ASCENT_BOUNDS`."""
+    for key, v in (("start", p.start_s), ("duration", p.duration_s), ("amplitude", p.amplitude_rad),
+                   ("low_frequency", p.low_frequency_hz), ("high_frequency", p.high_frequency_hz)):
+        _check_in(ASCENT_BOUNDS, f"pti.{key}", v, src, f"{sec}.{key}")
+
+
+def check_ascent_bounds(a) -> None:
+    """A loaded :class:`~taos.flight.ascent.Ascent` within :data:`ASCENT_BOUNDS`, and the gust
+    and every PTI inside the trajectory (else they are silently never flown)."""
+    src, T = a.source, ASCENT_BOUNDS
+    _check_in(T, "update_interval", a.update_interval_s, src)
+    tr = a.trajectory
+    for col in ("time", "mass", "inertia", "gimbal_arm", "core_thrust_per_engine", "booster_thrust",
+                "dynamic_pressure", "velocity", "wind_speed"):
+        arr = next(getattr(tr, f.name) for f in dataclasses.fields(tr) if f.name.startswith(col + "_"))
+        lo, hi = T[f"trajectory.{col}"][:2]
+        bad = np.flatnonzero(~((arr >= lo) & (arr <= hi)))
+        if bad.size:
+            _check_in(T, f"trajectory.{col}", float(arr[bad[0]]), src, f"trajectory.{col}.values")
+    b, ae, w = a.boosters, a.aero, a.wind
+    for key, v in (("boosters.separation_time", b.separation_time_s), ("boosters.gimbal_arm", b.gimbal_arm_m),
+                   ("boosters.actuator_time_constant", b.actuator_time_constant_s),
+                   ("boosters.separation_rate_kick", b.separation_rate_kick_rad_s),
+                   ("aero.reference_area", ae.reference_area_m2), ("aero.normal_force_slope", ae.normal_force_slope_per_rad),
+                   ("aero.center_of_pressure_ahead", ae.center_of_pressure_ahead_m), ("wind.azimuth", w.azimuth_rad),
+                   ("wind.gust_time", w.gust_time_s), ("wind.gust_amplitude", w.gust_amplitude_m_s),
+                   ("wind.gust_duration", w.gust_duration_s), ("wind.turbulence_intensity", w.turbulence_intensity_m_s),
+                   ("wind.turbulence_time_constant", w.turbulence_time_constant_s)):
+        _check_in(T, key, v, src)
+    end = a.end_time_s
+    if w.gust_time_s > end:
+        raise InputError(src, "wind.gust_time", f"a time within the trajectory (to {end:g} s)", got=f"{w.gust_time_s:g} s")
+    for p in a.ptis:
+        if p.end_s > end + 1e-9:
+            raise InputError(src, "pti", f"every PTI within the trajectory (to {end:g} s)",
+                             got=f"a PTI from {p.start_s:g} s to {p.end_s:g} s")
+
+
+#: profile-file values (``models/profiles/*.toml``, :mod:`taos.profiles`), by key in any
+#: profile table. Angles against the RS-25 gimbal range; frequencies, durations and cycles as
+#: the run limits above (:data:`COMMAND_FREQ_HZ`, :data:`MAX_DURATION_S`, :data:`MAX_CYCLES`).
+PROFILE_BOUNDS: dict[str, tuple[float, float, str, str]] = {
+    "amplitude": (1e-6 * DEG, GIMBAL_RANGE_RAD, "rad", "a sine, sweep, multisine or circle must move (a millionth "
+                  "of a degree) and stay within the gimbal range +-10.5 deg"),
+    "step amplitude": (-GIMBAL_RANGE_RAD, GIMBAL_RANGE_RAD, "rad", "within the gimbal range"),
+    "levels": (-GIMBAL_RANGE_RAD, GIMBAL_RANGE_RAD, "rad", "within the gimbal range"),
+    "rate": (1e-3 * DEG, 1000.0 * DEG, "rad/s", "TVC slew rates are 5-30 deg/s: a faster ramp is a step, a slower "
+             "one crosses the range in more than 1e4 s"),
+    "frequency": (*COMMAND_FREQ_HZ, "Hz", "test and flight content is 0.1-30 Hz"),
+    "cycles": (1.0, float(MAX_CYCLES), "", "a whole number of cycles"),
+    "start": (0.0, MAX_DURATION_S, "s", "the run length limit"),
+    "hold": (0.0, MAX_DURATION_S, "s", "the run length limit"),
+    "duration": (0.0, MAX_DURATION_S, "s", "above zero, and the run length limit"),
+    "number of levels": (1.0, 1000.0, "", "a multi-ramp has a handful of levels"),
+    "number of frequencies": (1.0, 200.0, "", "the multisine is summed line by line at every sample"),
+    "number of segments": (1.0, 1000.0, "", "a test sequence has tens of segments"),
+}
+
+
+def check_profile_value(key: str, value: float, src: str, field: str) -> float:
+    """``value`` (SI, or a count) within :data:`PROFILE_BOUNDS` ``[key]``."""
+    return _check_in(PROFILE_BOUNDS, key, float(value), src, field)

@@ -250,12 +250,22 @@ TYPE_KEYS = {
 _TOP = {"name", "description"}
 
 
-def _angle(tab, key, src, sec):
-    from .bounds import check_command_angle
+def _angle(tab, key, src, sec, moving=True):
+    """An angle within the gimbal range; ``moving`` (a sine, sweep, multisine, circle): above zero
+    (:data:`taos.bounds.PROFILE_BOUNDS`)."""
+    from .bounds import check_command_angle, check_profile_value
 
     if key not in tab:
         raise InputError(src, f"{sec}.{key}", "an angle with its unit, like '0.4 deg'", got="nothing (key missing)")
-    return check_command_angle(to_si(tab[key], "angle", source=src, field=f"{sec}.{key}"), src, f"{sec}.{key}")
+    v = check_command_angle(to_si(tab[key], "angle", source=src, field=f"{sec}.{key}"), src, f"{sec}.{key}")
+    return check_profile_value("amplitude", v, src, f"{sec}.{key}") if moving else v
+
+
+def _count(items: list, what: str, src: str, field: str) -> list:
+    from .bounds import check_profile_value
+
+    check_profile_value(f"number of {what}", len(items), src, field)
+    return items
 
 
 def _pos(tab, key, kind, src, sec, example):
@@ -269,6 +279,12 @@ def _pos(tab, key, kind, src, sec, example):
     elif kind == "time":
         check_duration(v, src, f"{sec}.{key}")
     return v
+
+
+def _ramp_rate(tab, src, sec):
+    from .bounds import check_profile_value
+
+    return check_profile_value("rate", _pos(tab, "rate", "angular_velocity", src, sec, "'0.5 deg/s'"), src, f"{sec}.rate")
 
 
 def _time(tab, key, default, src, sec, **chk):
@@ -302,7 +318,7 @@ def profile_from_table(tab: dict, src: str, sec: str):
     """One single-axis profile from a TOML table."""
     kind = _table(tab, src, sec)
     if kind == "step":
-        return Step(_angle(tab, "amplitude", src, sec), _time(tab, "start", "0.5 s", src, sec, nonnegative=True),
+        return Step(_angle(tab, "amplitude", src, sec, moving=False), _time(tab, "start", "0.5 s", src, sec, nonnegative=True),
                     _time(tab, "hold", "2 s", src, sec, positive=True))
     if kind == "multi_ramp":
         from .bounds import check_command_angle
@@ -310,9 +326,10 @@ def profile_from_table(tab: dict, src: str, sec: str):
         levels = tab.get("levels")
         if not isinstance(levels, list) or not levels:
             raise InputError(src, f"{sec}.levels", "a list of angles like ['0.2 deg', '-0.2 deg']", got=repr(levels))
+        _count(levels, "levels", src, f"{sec}.levels")
         return MultiRamp(tuple(check_command_angle(to_si(v, "angle", source=src, field=f"{sec}.levels[{i}]"), src,
                                                    f"{sec}.levels[{i}]") for i, v in enumerate(levels)),
-                         _pos(tab, "rate", "angular_velocity", src, sec, "'0.5 deg/s'"),
+                         _ramp_rate(tab, src, sec),
                          _time(tab, "hold", "1 s", src, sec, nonnegative=True))
     if kind == "sine_dwell":
         return SineDwell(_angle(tab, "amplitude", src, sec), _pos(tab, "frequency", "frequency", src, sec, "'1 Hz'"),
@@ -321,24 +338,31 @@ def profile_from_table(tab: dict, src: str, sec: str):
         log = tab.get("logarithmic", True)
         if not isinstance(log, bool):
             raise InputError(src, f"{sec}.logarithmic", "true or false", got=repr(log))
-        return SineSweep(_angle(tab, "amplitude", src, sec), _pos(tab, "start_frequency", "frequency", src, sec, "'0.1 Hz'"),
-                         _pos(tab, "end_frequency", "frequency", src, sec, "'10 Hz'"),
-                         _pos(tab, "duration", "time", src, sec, "'60 s'"), log)
+        f0, f1 = (_pos(tab, k, "frequency", src, sec, e) for k, e in (("start_frequency", "'0.1 Hz'"),
+                                                                       ("end_frequency", "'10 Hz'")))
+        if log and f0 == f1:   # k = ln(f1/f0)/T = 0: the logarithmic phase divides by it
+            raise InputError(src, f"{sec}.end_frequency", "a frequency other than start_frequency for a logarithmic "
+                             "sweep (a constant frequency is a sine_dwell)", got=f"{f1:g} Hz")
+        return SineSweep(_angle(tab, "amplitude", src, sec), f0, f1, _pos(tab, "duration", "time", src, sec, "'60 s'"),
+                         log)
     if kind == "multisine":
         from .bounds import check_command_frequency
 
         fr = tab.get("frequencies")
         if not isinstance(fr, list) or not fr:
             raise InputError(src, f"{sec}.frequencies", "a list of frequencies like ['0.5 Hz', '1 Hz']", got=repr(fr))
-        return Multisine(_angle(tab, "amplitude", src, sec),
-                         tuple(check_command_frequency(to_si(v, "frequency", source=src, field=f"{sec}.frequencies[{i}]",
-                                                             positive=True), src, f"{sec}.frequencies[{i}]")
-                               for i, v in enumerate(fr)),
-                         _pos(tab, "duration", "time", src, sec, "'20 s'"))
+        _count(fr, "frequencies", src, f"{sec}.frequencies")
+        freqs = tuple(check_command_frequency(to_si(v, "frequency", source=src, field=f"{sec}.frequencies[{i}]",
+                                                    positive=True), src, f"{sec}.frequencies[{i}]")
+                      for i, v in enumerate(fr))
+        if len(set(freqs)) != len(freqs):   # Schroeder's phases are for distinct lines
+            raise InputError(src, f"{sec}.frequencies", "distinct frequencies", got="a frequency given twice")
+        return Multisine(_angle(tab, "amplitude", src, sec), freqs, _pos(tab, "duration", "time", src, sec, "'20 s'"))
     if kind == "sequence":
         segs = tab.get("segments")
         if not isinstance(segs, list) or not segs:
             raise InputError(src, f"{sec}.segments", "a list of profile tables ([[...segments]])", got=repr(segs)[:60])
+        _count(segs, "segments", src, f"{sec}.segments")
         return Sequence(tuple(profile_from_table(s, src, f"{sec}.segments[{i}]") for i, s in enumerate(segs)))
     raise InputError(src, f"{sec}.type", "one of step, multi_ramp, sine_dwell, sine_sweep, multisine, sequence",
                      got=repr(kind))

@@ -543,6 +543,12 @@ FLAG_CASES = [
     ("view --html with a .png name", lambda w: ["view", w / "r.h5", "--html", w / "v.png"], "--html"),
     ("an unknown --friction", lambda w: ["info", AMBIENT, "--friction", "sticky"], "sticky"),
     ("--axis roll", _fr("--freq-hz", "1", "--axis", "roll"), "--axis"),
+    ("ascent --friction with a double comma", lambda w: ["ascent", ASCENT, "--out", w / "a", "--friction",
+                                                         "dahl,,lugre"], "--friction"),
+    ("ascent --friction with a trailing comma", lambda w: ["ascent", ASCENT, "--out", w / "a", "--friction", "dahl,"],
+     "--friction"),
+    ("ascent --friction a lone comma", lambda w: ["ascent", ASCENT, "--out", w / "a", "--friction", ","], "--friction"),
+    ("empty ascent --friction", lambda w: ["ascent", ASCENT, "--out", w / "a", "--friction", ""], "--friction"),
 ]
 
 
@@ -553,5 +559,7 @@ def _flag_cases():
     ]
 
 
-CASES: list[Case] = (_output_cases() + _bound_cases() + _unit_cases() + _file_cases() + _data_cases()
-                     + _flag_cases())
+from .hostile_file_bounds import file_bound_cases  # noqa: E402 - it uses the helpers above
+
+CASES: list[Case] = (_output_cases() + _bound_cases() + file_bound_cases() + _unit_cases() + _file_cases()
+                     + _data_cases() + _flag_cases())

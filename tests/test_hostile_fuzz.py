@@ -66,6 +66,82 @@ def test_api_refuses_what_the_cli_refuses(model, call, field):
     assert "\n" not in str(exc.value)
 
 
+@pytest.fixture(scope="module")
+def tm():
+    from taos.taos3d import load_taos_model
+    return load_taos_model(AMBIENT)
+
+
+def _t3(name, *args, **kw):
+    """A call of the public 3-D API ``taos.taos3d.NAME`` (``run_samples`` from its module)."""
+    def call(tm):
+        import taos.taos3d as t3
+        from taos.taos3d.simulate import run_samples
+        return (run_samples if name == "run_samples" else getattr(t3, name))(tm, *args, **kw)
+    return call
+
+
+def _step():
+    from taos.profiles import Step
+    return Step(math.radians(0.1))
+
+
+TAOS3D_CASES = [
+    ("freqresp: empty grid", _t3("taos_freqresp", [], None), "freq_hz"),
+    ("freqresp: negative frequency", _t3("taos_freqresp", [1.0, -2.0], None), "freq_hz"),
+    ("freqresp: zero frequency", _t3("taos_freqresp", [0.0], None), "freq_hz"),
+    ("freqresp: NaN frequency", _t3("taos_freqresp", [math.nan], None), "freq_hz"),
+    ("freqresp: 1e12 Hz", _t3("taos_freqresp", [1e12], None), "freq_hz"),
+    ("freqresp: text frequency", _t3("taos_freqresp", ["one"], None), "freq_hz"),
+    ("freqresp: unknown axis", _t3("taos_freqresp", [1.0], None, "roll"), "axis"),
+    ("freqresp: zero amplitude", _t3("taos_freqresp", [1.0], 0.0), "amplitude_rad"),
+    ("freqresp: negative amplitude", _t3("taos_freqresp", [1.0], -0.01), "amplitude_rad"),
+    ("freqresp: NaN amplitude", _t3("taos_freqresp", [1.0], math.nan), "amplitude_rad"),
+    ("freqresp: 2 rad amplitude", _t3("taos_freqresp", [1.0], 2.0), "amplitude_rad"),
+    ("freqresp: zero step", _t3("taos_freqresp", [1.0], 0.01, dt_max_s=0.0), "dt_max_s"),
+    ("freqresp: NaN step", _t3("taos_freqresp", [1.0], 0.01, dt_max_s=math.nan), "dt_max_s"),
+    ("freqresp: no measured cycle", _t3("taos_freqresp", [1.0], 0.01, measure_cycles=0), "measure_cycles"),
+    ("family: empty amplitudes", _t3("taos_freqresp_family", [1.0], []), "amplitudes_rad"),
+    ("family: no amplitudes", _t3("taos_freqresp_family", [1.0], None), "amplitudes_rad"),
+    ("family: a zero amplitude", _t3("taos_freqresp_family", [1.0], [0.01, 0.0]), "amplitudes_rad"),
+    ("family: empty frequencies", _t3("taos_freqresp_family", [], [0.01]), "freq_hz"),
+    ("family: negative frequency", _t3("taos_freqresp_family", [-1.0], [0.01]), "freq_hz"),
+    ("family: unknown axis", _t3("taos_freqresp_family", [1.0], [0.01], "roll"), "axis"),
+    ("family: negative step", _t3("taos_freqresp_family", [1.0], [0.01], dt_max_s=-1e-4), "dt_max_s"),
+    ("family: a 1e-6 Hz dwell beyond the step budget", _t3("taos_freqresp_family", [1e-6], [0.01]), "freq_hz"),
+    ("two-axis: zero measured amplitude", _t3("two_axis_dwell", [[0.0, 0.01]], [[1.0, 2.0]]), "amplitude_rad"),
+    ("two-axis: zero measured frequency", _t3("two_axis_dwell", [[0.01, 0.01]], [[0.0, 2.0]]), "freq_hz"),
+    ("two-axis: NaN amplitude", _t3("two_axis_dwell", [[0.01, math.nan]], [[1.0, 2.0]]), "amplitude_rad"),
+    ("two-axis: negative frequency", _t3("two_axis_dwell", [[0.01, 0.01]], [[1.0, -2.0]]), "freq_hz"),
+    ("two-axis: unknown axis", _t3("two_axis_dwell", [[0.01, 0.01]], [[1.0, 2.0]], measure_axis="roll"),
+     "measure_axis"),
+    ("two-axis: empty rows", _t3("two_axis_dwell", np.zeros((0, 2)), np.zeros((0, 2))), "amplitude_rad"),
+    ("two-axis: three columns", _t3("two_axis_dwell", [[0.01, 0.01, 0.01]], [[1.0, 2.0, 3.0]]), "amplitude_rad"),
+    ("two-axis: rows that differ", _t3("two_axis_dwell", [[0.01, 0.01]] * 2, [[1.0, 2.0]] * 3), "freq_hz"),
+    ("two-axis: zero step", _t3("two_axis_dwell", [[0.01, 0.01]], [[1.0, 2.0]], dt_max_s=0.0), "dt_max_s"),
+    ("simulate: zero step", lambda tm: _t3("simulate_taos", _step(), dt_s=0.0)(tm), "dt_s"),
+    ("simulate: NaN step", lambda tm: _t3("simulate_taos", _step(), dt_s=math.nan)(tm), "dt_s"),
+    ("simulate: a step of 1e-12 s (2e8 steps)", lambda tm: _t3("simulate_taos", _step(), dt_s=1e-12)(tm), "dt_s"),
+    ("simulate: zero record interval", lambda tm: _t3("simulate_taos", _step(), record_every=0)(tm), "record_every"),
+    ("simulate: negative duration", lambda tm: _t3("simulate_taos", _step(), duration_s=-1.0)(tm), "duration_s"),
+    ("simulate: infinite duration", lambda tm: _t3("simulate_taos", _step(), duration_s=math.inf)(tm), "duration_s"),
+    ("run_samples: zero step", _t3("run_samples", np.zeros((10, 2)), 0.0), "dt_s"),
+    ("run_samples: three columns", _t3("run_samples", np.zeros((10, 3)), 1e-4), "cmd"),
+    ("run_samples: one row", _t3("run_samples", np.zeros((1, 2)), 1e-4), "cmd"),
+    ("run_samples: NaN command", _t3("run_samples", np.full((10, 2), math.nan), 1e-4), "cmd"),
+    ("run_samples: zero record interval", _t3("run_samples", np.zeros((10, 2)), 1e-4, 0), "record_every"),
+]
+
+
+@pytest.mark.parametrize("call,field", [(c, f) for _, c, f in TAOS3D_CASES], ids=[n for n, _, _ in TAOS3D_CASES])
+def test_the_3d_api_refuses_what_the_cli_refuses(tm, call, field):
+    """taos.taos3d validates its arguments as the CLI does: InputError naming the argument, one line."""
+    with pytest.raises(InputError) as exc:
+        call(tm)
+    assert exc.value.field == field
+    assert "\n" not in str(exc.value)
+
+
 def test_a_non_finite_figure_never_reaches_a_json_file(tmp_path):
     from taos.results import write_json
 
@@ -141,12 +217,15 @@ def test_a_signal_at_any_moment_is_one_line_and_its_status(signum, delay, tmp_pa
     package's first line runs, the interpreter's own start-up, 20-150 ms on a loaded machine, is
     Python's: a signal then is the interpreter's default.)"""
     out = tmp_path / "fr.json"
-    proc = subprocess.Popen([sys.executable, "-m", "taos", "freqresp", str(AMBIENT), "--freq-hz", "1,2,3,5",
-                             "--amplitude-deg", "0.2,0.4", "--json", str(out)], cwd=tmp_path, env=_env(),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # about 9 s of dwells with the kernels compiled (2 s would end inside the 2 s and 4 s delays: a
+    # signal then arrives during the interpreter's own shutdown, after the output is written)
+    proc = subprocess.Popen([sys.executable, "-m", "taos", "freqresp", str(AMBIENT), "--freq-hz",
+                             "0.01,0.02,0.05,1,2,3,5", "--amplitude-deg", "0.1,0.2,0.4", "--json", str(out)],
+                            cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     _wait_for_handlers(proc)
     time.sleep(delay)
-    if proc.poll() is not None:
+    if proc.poll() is not None or out.exists():
+        proc.wait(120)
         pytest.skip("the run ended before the signal")
     proc.send_signal(signum)
     rc = proc.wait(120)

@@ -31,7 +31,10 @@ def cmd_ascent(args) -> int:
     from taos.units import to_si
 
     ascent = load_ascent(args.ascent)
-    laws = [s.strip() for s in args.friction.split(",") if s.strip()] if args.friction else [None]
+    laws = [s.strip() for s in args.friction.split(",")] if args.friction is not None else [None]
+    if args.friction is not None and not all(laws):
+        raise InputError("command line", "--friction", "friction law names separated by single commas, like "
+                         "dahl,lugre", got=repr(args.friction))
     if len(laws) > 6:
         raise InputError("command line", "--friction", "at most six friction laws", got=args.friction)
     tvc = args.model or ascent.tvc_model

@@ -306,6 +306,8 @@ def _ptis(doc: Mapping, src: str) -> tuple[Pti, ...]:
                        duration_s=_need(p, "duration", "time", src, sec, positive=True), amplitude_rad=amp,
                        low_frequency_hz=lo, high_frequency_hz=hi,
                        axes=("pitch", "yaw") if axis == "both" else (axis,)))
+        from taos.bounds import check_pti_bounds
+        check_pti_bounds(out[-1], src, sec)
     return tuple(sorted(out, key=lambda q: q.start_s))
 
 
@@ -330,9 +332,12 @@ def load_ascent(path: str | Path) -> Ascent:
     dt_up = to_si(doc.get("update_interval", "1 s"), "time", source=src, field="update_interval", positive=True)
     if not 0.01 <= dt_up <= 10.0:
         raise InputError(src, "update_interval", "an interval from 0.01 s to 10 s", got=repr(doc.get("update_interval")))
-    return Ascent(name=str(doc.get("name", p.stem)), trajectory=_trajectory(doc, src), boosters=_boosters(doc, src),
-                  aero=_aero(doc, src), wind=_wind(doc, src), ptis=_ptis(doc, src), flight=flight,
-                  update_interval_s=dt_up, tvc_model=tvc, source=src, sha256=hashlib.sha256(raw).hexdigest())
+    from taos.bounds import check_ascent_bounds
+    a = Ascent(name=str(doc.get("name", p.stem)), trajectory=_trajectory(doc, src), boosters=_boosters(doc, src),
+               aero=_aero(doc, src), wind=_wind(doc, src), ptis=_ptis(doc, src), flight=flight,
+               update_interval_s=dt_up, tvc_model=tvc, source=src, sha256=hashlib.sha256(raw).hexdigest())
+    check_ascent_bounds(a)   # the documented bounds (docs/reference/bounds.md), before any work
+    return a
 
 
 # -- derived quantities ----------------------------------------------------------------------

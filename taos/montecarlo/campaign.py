@@ -235,13 +235,16 @@ def load_campaign(path: str | Path) -> Campaign:
     ptis = doc.get("ptis", True)
     if not isinstance(ptis, bool):
         raise InputError(src, "ptis", "true or false", got=repr(ptis))
-    return Campaign(name=str(doc.get("name", p.stem)), source=src, sha256=hashlib.sha256(raw).hexdigest(),
-                    ascent_file=str((p.parent / asc).resolve()),
-                    tvc_model_file=str((p.parent / tvc).resolve()) if tvc else "",
-                    friction=fr, seed=seed, start_s=start, duration_s=dur, dt_s=dt, axis=axis,
-                    analysis_window_s=win, trace_interval_s=trace, default_case=str(default), cases=cases,
-                    dispersions=disp, update_interval_s=upd, ptis=ptis,
-                    avionics=avionics)
+    c = Campaign(name=str(doc.get("name", p.stem)), source=src, sha256=hashlib.sha256(raw).hexdigest(),
+                 ascent_file=str((p.parent / asc).resolve()),
+                 tvc_model_file=str((p.parent / tvc).resolve()) if tvc else "",
+                 friction=fr, seed=seed, start_s=start, duration_s=dur, dt_s=dt, axis=axis,
+                 analysis_window_s=win, trace_interval_s=trace, default_case=str(default), cases=cases,
+                 dispersions=disp, update_interval_s=upd, ptis=ptis,
+                 avionics=avionics)
+    from taos.bounds import check_campaign_bounds
+    check_campaign_bounds(c, {k: f"{q.section}.{q.toml_key}" for k, q in PARAMETERS.items()})   # before any work
+    return c
 
 
 def check_case(c: Campaign, case: str | None) -> str:

@@ -24,6 +24,7 @@ from ..planar.freqresp import FrequencyResponse, deal_by_cost, settle_time_s
 from ..linear import StateSpace
 from ..profiles import Profile, is_two_axis
 from ..planar.simulate import SolverSettings, TimeHistory, provenance
+from . import _args
 from . import dynamics as _dy
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
 
@@ -120,8 +121,8 @@ def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int =
                 pk: Packed | None = None) -> np.ndarray:
     """Integrate the two-axis command samples ``cmd`` (n + 1, 2) [rad] every ``dt_s`` [s]
     from rest; returns the records (n_rec, len(dynamics.REC))."""
+    cmd = np.ascontiguousarray(_args.check_samples(cmd, dt_s, record_every), dtype=np.float64)
     pk = pack(tm) if pk is None else pk
-    cmd = np.ascontiguousarray(cmd, dtype=np.float64)
     nrec = (cmd.shape[0] - 1) // record_every + 1
     out = np.empty((nrec, len(_dy.REC)))
     status = _dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(_dy.N_BEARING), cmd, dt_s,
@@ -136,6 +137,7 @@ def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S
     """Run ``profile`` (a single-axis profile drives pitch; two-axis drives both) through the
     TAOS model from rest; ``dt_s`` integration step [s]; ``duration_s`` default the profile's
     duration plus 1 s."""
+    _args.check_simulate_args(profile, dt_s, record_every, duration_s)
     T = (profile.duration_s + 1.0) if duration_s is None else duration_s
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
@@ -235,8 +237,11 @@ def taos_freqresp(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitude_rad: fl
     """Command -> piston (x_p / (R theta_c)) and command -> engine (theta / theta_c) of the
     TAOS model, commanding ``axis``; ``cross=True`` reports the other axis' outputs (the
     kinematic and friction cross-coupling). ``amplitude_rad`` None: exact linear response
-    (friction off, unity avionics); else sine dwell from rest with friction and avionics."""
-    f = np.atleast_1d(np.asarray(freq_hz, float))
+    (friction off, unity avionics); else sine dwell from rest with friction and avionics.
+    Raises :class:`~taos.errors.InputError` for an empty grid, a frequency outside (0, 1e4] Hz,
+    an amplitude outside (0, 90] deg, an unknown axis or a non-positive step."""
+    f, _ = _args.check_dwell_args(tm, freq_hz, amplitude_rad, axis, "amplitude_rad", dt_max_s, settle_cycles,
+                                  measure_cycles, settle_s, min_steps_per_cycle)
     i = AXES.index(axis)
     o = 1 - i if cross else i
     R = tm.base.actuator.moment_arm_m
@@ -257,9 +262,14 @@ def taos_freqresp_family(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitudes
                          settle_s: float | None = None, min_steps_per_cycle: int = 64) -> list[FrequencyResponse]:
     """Sine-dwell responses of the TAOS model at every command amplitude [rad] x frequency
     [Hz], all dwells in one parallel call (as :func:`taos_freqresp`, whose single-amplitude
-    result is the family's row bit for bit: each dwell is independent)."""
-    f = np.atleast_1d(np.asarray(freq_hz, float))
-    a = np.atleast_1d(np.asarray(amplitudes_rad, float))
+    result is the family's row bit for bit: each dwell is independent). Arguments checked as
+    :func:`taos_freqresp`'s."""
+    if amplitudes_rad is None:
+        from ..errors import InputError
+        raise InputError("argument", "amplitudes_rad", "dwell amplitudes in rad (taos_freqresp gives the linear "
+                         "response)", got="None")
+    f, a = _args.check_dwell_args(tm, freq_hz, amplitudes_rad, axis, "amplitudes_rad", dt_max_s, settle_cycles,
+                                  measure_cycles, settle_s, min_steps_per_cycle)
     i = AXES.index(axis)
     o = 1 - i if cross else i
     R = tm.base.actuator.moment_arm_m
@@ -286,6 +296,7 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     dts = 1.0 / (fmeas * npc)
     nset = (np.maximum(settle_cycles, np.ceil(ts * fmeas)) * npc).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
+    _args.check_dwell_steps(int(np.sum(nset + nmeas)))   # before any work, as the command line's budget
     perm = deal_by_cost(nset + nmeas)   # results put back in input order below
     amps, freqs = np.ascontiguousarray(np.asarray(amps, float)[perm]), np.ascontiguousarray(np.asarray(freqs, float)[perm])
     fmeas, dts, nset, nmeas = fmeas[perm], dts[perm], nset[perm], nmeas[perm]
@@ -305,9 +316,12 @@ def two_axis_dwell(tm: TaosModel, amplitude_rad, freq_hz, *, measure_axis: str =
                    settle_s: float | None = None, min_steps_per_cycle: int = 64):
     """Pitch and yaw sines at once (rows of ``amplitude_rad``/``freq_hz`` (n, 2) [rad, Hz]);
     returns (piston, engine) complex gains of ``measure_axis`` at its own frequency (n,).
-    Whole measured cycles of both sines need commensurate frequencies."""
-    amps = np.atleast_2d(np.asarray(amplitude_rad, float))
-    freqs = np.atleast_2d(np.asarray(freq_hz, float))
+    Whole measured cycles of both sines need commensurate frequencies. Raises
+    :class:`~taos.errors.InputError` for rows not (n, 2), a non-finite, negative or too large
+    value, a zero amplitude or frequency on the measured axis, an unknown axis, a bad step."""
+    amps, freqs = _args.check_two_axis(amplitude_rad, freq_hz, measure_axis)
+    _args.check_dwell_args(tm, freqs[:, AXES.index(measure_axis)], amps[:, AXES.index(measure_axis)], measure_axis,
+                           "amplitude_rad", dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle)
     i = AXES.index(measure_axis)
     res = _dwell(tm, amps, freqs, freqs[:, i], dt_max_s, settle_cycles, measure_cycles, settle_s,
                  min_steps_per_cycle)
