@@ -14,29 +14,11 @@ import numpy as np
 import pytest
 
 from tests.conftest import MODELS, run_cli
+from tests.test_report import SHORT_PROFILE as PROFILE
 from tests.test_viewer import CHROMIUM_FLAGS, chromium
 
 pytestmark = pytest.mark.slow
 
-PROFILE = """name = "short two-axis"
-[pitch]
-type = "sequence"
-[[pitch.segments]]
-type = "sine_dwell"
-amplitude = "0.4 deg"
-frequency = "2 Hz"
-cycles = 6
-[[pitch.segments]]
-type = "sine_dwell"
-amplitude = "0.8 deg"
-frequency = "1 Hz"
-cycles = 10
-[yaw]
-type = "sine_dwell"
-amplitude = "0.4 deg"
-frequency = "3 Hz"
-cycles = 8
-"""
 
 #: moves the mouse over point ``POINT`` of the linear piston-gain curve of the pitch Bode plot
 #: (a real ``mousemove`` on the plot's drag layer, at the point's pixel position) and writes what
