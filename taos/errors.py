@@ -249,6 +249,21 @@ class _Signals:
     def __init__(self):
         self.received: int | None = None
 
+    def unraisable(self, previous):
+        """A ``sys.unraisablehook`` for the run: the interrupt this handler raised inside a
+        callback that cannot pass it on (llvmlite's ctypes object-cache callback while numba
+        loads a kernel) is not printed as "Exception ignored ..." but delivered again, from
+        another thread, so that it lands in ordinary code of the main thread and ends the run."""
+        import os
+        import threading
+
+        def hook(u):
+            if isinstance(u.exc_value, (KeyboardInterrupt, Interrupted)) and self.received is not None:
+                threading.Timer(0.0, os.kill, (os.getpid(), self.received)).start()
+                return
+            previous(u)
+        return hook
+
     def __call__(self, signum, frame):
         import signal
 
@@ -292,9 +307,11 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
         print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
         return 130
     handler, old = _Signals(), {}
+    old_unraisable = sys.unraisablehook
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGINT):
             old[s] = signal.signal(s, handler)
+        sys.unraisablehook = handler.unraisable(old_unraisable)
     rc = 1
     try:
         with output_policy(force=force):
@@ -336,6 +353,7 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+        sys.unraisablehook = old_unraisable
     if handler.received == signal.SIGINT:
         print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
         return 130
