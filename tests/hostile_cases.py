@@ -20,7 +20,8 @@ from typing import Callable
 from taos.bounds import FLIGHT_BOUNDS, MODEL_BOUNDS
 from taos.errors import MAX_DATA_BYTES, MAX_TOML_BYTES
 
-from .test_bad_inputs import DATA, model_text
+from .test_bad_inputs import DATA, model_text, set_cell
+from .test_bad_inputs import _first_data_row as _first_row
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
@@ -108,10 +109,6 @@ def folder(work: Path, name: str) -> Path:
 def csv_with(work: Path, edit: Callable[[list[str]], list[str]], name: str = "d.csv") -> Path:
     lines = DATA.read_text().splitlines()[:3000]
     return write(work, name, "\n".join(edit(lines)) + "\n")
-
-
-def _first_row(lines):
-    return next(i for i, ln in enumerate(lines) if ln and not ln.startswith("#")) + 1
 
 
 # -- 1. outputs never replace what the user owns --------------------------------------------------
@@ -413,16 +410,6 @@ def _file_cases():
 
 # -- 5. data records: sample rate, columns, time, magnitudes --------------------------------------
 
-def _cell(row: int, col: int, value: str):
-    def edit(lines):
-        k = _first_row(lines) + row
-        cells = lines[k].split(",")
-        cells[col] = value
-        lines[k] = ",".join(cells)
-        return lines
-    return edit
-
-
 def _header(fn):
     def edit(lines):
         k = _first_row(lines) - 1
@@ -448,16 +435,16 @@ DATA_EDITS = [
     ("no time column", _header(lambda h: ["clock [s]"] + h[1:]), ("time",)),
     ("no pitch piston column", _header(lambda h: [x.replace("pitch_piston", "pitch_pistn") for x in h]),
      ("pitch_piston",)),
-    ("time going backwards", _cell(50, 0, "0.0"), ("time",)),
-    ("a repeated time stamp", lambda ls: _cell(51, 0, ls[_first_row(ls) + 50].split(",")[0])(ls), ("time",)),
+    ("time going backwards", set_cell(50, 0, "0.0"), ("time",)),
+    ("a repeated time stamp", lambda ls: set_cell(51, 0, ls[_first_row(ls) + 50].split(",")[0])(ls), ("time",)),
     ("a 1e12 Hz sample rate (ps read as s)", _times(1e-9), ("sample rate",)),
     ("a 0.01 Hz sample rate", _times(1e4), ("sample rate",)),
-    ("a command of 100 deg", _cell(10, 1, "100"), ("pitch_command",)),
-    ("a piston at 5 m", lambda ls: _cell(10, next(i for i, h in enumerate(ls[_first_row(ls) - 1].split(","))
+    ("a command of 100 deg", set_cell(10, 1, "100"), ("pitch_command",)),
+    ("a piston at 5 m", lambda ls: set_cell(10, next(i for i, h in enumerate(ls[_first_row(ls) - 1].split(","))
                                                 if "pitch_piston" in h), "200")(ls), ("pitch_piston",)),
-    ("a NaN cell", _cell(10, 1, "nan"), ("finite",)),
-    ("an inf cell", _cell(10, 1, "inf"), ("finite",)),
-    ("a text cell", _cell(10, 1, "abc"), ("rows",)),
+    ("a NaN cell", set_cell(10, 1, "nan"), ("finite",)),
+    ("an inf cell", set_cell(10, 1, "inf"), ("finite",)),
+    ("a text cell", set_cell(10, 1, "abc"), ("rows",)),
     ("a short row", lambda ls: ls[:_first_row(ls) + 5] + [ls[_first_row(ls) + 5].rsplit(",", 1)[0]] + ls[_first_row(ls) + 6:],
      ("rows",)),
     ("a power tower unit", _header(lambda h: [x.replace("[deg]", "[9**9**9 deg]") for x in h]), ("command",)),
