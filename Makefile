@@ -47,7 +47,7 @@ browser:
 # (pytest-xdist; the tests share no output folder or port): the whole suite took 5 min on 2 cores
 # (other work on the machine, load ~3) against 18 min in one process (load ~4-5).
 test: $(WARM) browser docs
-	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 tests; rc=$$?; \
+	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --durations=25 tests; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
 
 # The fast loop while developing: every test except those marked slow (the end-to-end runs: the
