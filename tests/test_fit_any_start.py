@@ -38,11 +38,11 @@ def test_the_record_states_its_truth_and_its_maker():
 def fits(tmp_path_factory):
     out = {}
     for name in ("rs25_ambient", "rs25_hotfire"):
-        js = tmp_path_factory.mktemp(name) / "fit.json"
+        d = tmp_path_factory.mktemp(name)
         p = run_cli("fit", RECORD, "--model", MODELS / f"{name}.toml", "--free", "load_stiffness,coulomb_torque",
-                    "--json", js)
+                    "--json", d / "fit.json", "--out-model", d / "fitted.toml")
         assert p.returncode == 0, p.stderr
-        out[name] = json.loads(js.read_text())
+        out[name] = {**json.loads((d / "fit.json").read_text()), "fitted_model": d / "fitted.toml"}
     return out
 
 
@@ -149,3 +149,20 @@ def test_start_outside_the_physical_bounds_is_one_clear_line(tmp_path):
     p = run_cli("fit", RECORD, "--model", bad, "--free", "load_stiffness,coulomb_torque")
     assert p.returncode == 2, p.stderr
     assert "friction.coulomb_torque" in p.stderr and "stall torque" in p.stderr and "Traceback" not in p.stderr
+
+
+@pytest.mark.slow
+def test_fitted_model_file_carries_the_scaled_law(fits):
+    """The ambient start's fitted file: T_c at the fitted level, its static torque (a key of the
+    model file) scaled with it, the bristle stiffness (from the shared set, through its
+    reference_torque) at the hardware's pre-sliding angle: the same law the fit used."""
+    from taos.model import load_model
+
+    amb = load_model(MODELS / "rs25_ambient.toml")
+    back = load_model(fits["rs25_ambient"]["fitted_model"])
+    tc = fits["rs25_ambient"]["parameters"]["coulomb_torque"]["value_si"]
+    assert back.friction.coulomb_torque_Nm == pytest.approx(tc, rel=1e-5)
+    assert back.friction.static_torque_Nm == pytest.approx(tc, rel=1e-5)
+    angle = amb.friction.coulomb_torque_Nm / amb.friction.bristle_stiffness_Nm_per_rad
+    assert back.friction.coulomb_torque_Nm / back.friction.bristle_stiffness_Nm_per_rad == pytest.approx(angle,
+                                                                                                         rel=1e-5)

@@ -453,22 +453,29 @@ def _toml_value(p, v_si: float):
     return f"{from_si(v_si, _si_unit(p.kind), p.unit):.6g} {p.unit}"
 
 
-def _keep_static_above_coulomb(result: FitResult, doc, todo: dict, note_stamp: str) -> None:
-    """A fitted Coulomb torque T_c scales the file's static torque T_s with it (T_s / T_c kept:
-    both levels are proportional to the bearing normal load), so the fitted file keeps
-    T_s >= T_c, which loading a model requires (docs/reference/bounds.md)."""
-    from taos.units import to_si
+def _keep_law_shape(result: FitResult, doc, todo: dict, note_stamp: str) -> None:
+    """A fitted Coulomb torque T_c is the friction level: the fit scaled every held torque-like
+    parameter of the law with it (:func:`taos.identify.surrogate.apply_values`), so the fitted
+    file scales those written in its own ``[friction]`` table too (the static torque T_s
+    above all, so T_s >= T_c, which loading a model requires: docs/reference/bounds.md); those
+    of a shared parameter set follow the file's ``coulomb_torque`` through its
+    ``reference_torque``."""
+    import dataclasses as _dc
+
+    from taos.units import DIMENSIONS
 
     ftab = doc.get("friction", {})
-    if "coulomb_torque" not in result.names or "static_torque" not in ftab:
+    if "coulomb_torque" not in result.names:
         return
-    p = PARAMETERS["coulomb_torque"]
-    tc_new = result.values[result.names.index("coulomb_torque")]
-    tc_old = result.initial.friction.coulomb_torque_Nm
-    ts_old = to_si(str(ftab["static_torque"]), "torque", source=result.initial.source, field="friction.static_torque")
-    ts_new = max(ts_old * tc_new / tc_old if tc_old > 0 else ts_old, tc_new)
-    todo[("friction", "static_torque")] = (_toml_value(p, ts_new), f"# scaled with the fitted coulomb_torque by "
-                                           f"taos fit ({note_stamp}): T_s/T_c kept")
+    law = result.model.friction
+    for f in _dc.fields(law):
+        key = f.metadata.get("key")
+        if not f.metadata.get("torque_like") or key == "coulomb_torque" or key in result.names or key not in ftab:
+            continue
+        unit = "in*lbf" if f.metadata["kind"] == "torque" else DIMENSIONS[f.metadata["kind"]][1]
+        v = from_si(getattr(law, f.name), DIMENSIONS[f.metadata["kind"]][1], unit)
+        todo[("friction", key)] = (f"{v:.6g} {unit}", f"# scaled with the fitted coulomb_torque by taos fit "
+                                                      f"({note_stamp}): the law's shape kept")
 
 
 def fitted_model_text(result: FitResult, data_label: str = "") -> str:
@@ -498,7 +505,7 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
                 todo[(p.section, "crossover_command")] = (["0 deg"], "# added by taos fit")
         else:
             todo[(p.section, p.toml_key)] = (_toml_value(p, result.values[i]), note)
-    _keep_static_above_coulomb(result, doc, todo, note_stamp=stamp)
+    _keep_law_shape(result, doc, todo, note_stamp=stamp)
     file_law = str(result.initial.friction_table.get("model", result.initial.friction.name))
     if result.initial.friction.name != file_law:
         todo[("friction", "model")] = (result.initial.friction.name,
@@ -522,6 +529,11 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
     return head + tomlkit.dumps(doc)
 
 
+def _law_values(law) -> dict:
+    import dataclasses as _dc
+    return {f.name: float(getattr(law, f.name)) for f in _dc.fields(law)}
+
+
 def write_fitted_model(result: FitResult, path, data_label: str = "") -> None:
     """Write the fitted model file (TOML with units, fitted values commented), atomically,
     after checking that it loads back to the fitted values."""
@@ -534,4 +546,8 @@ def write_fitted_model(result: FitResult, path, data_label: str = "") -> None:
             got = PARAMETERS[n].get(back) if n != "avionics_gain" else None
             if got is not None and not math.isclose(got, result.values[i], rel_tol=1e-5):
                 raise RuntimeError(f"written {n} reads back as {got}, not {result.values[i]}")
+        for k, v in _law_values(result.model.friction).items():   # the fitted law, held parameters too
+            got = _law_values(back.friction).get(k)
+            if got is None or not math.isclose(got, v, rel_tol=1e-5, abs_tol=1e-12):
+                raise RuntimeError(f"written friction {k} reads back as {got}, not {v}")
     atomic_write(path, write)

@@ -158,15 +158,29 @@ def grid_search(prob, hx, he, wx, we, *, n_stiffness: int = N_STIFFNESS, n_torqu
         cost[a] = 0.5 * (_log_residual_cost(Hx, hx, wx) + _log_residual_cost(He, he, we))
     cands, ccost = _local_minima(cost, keep)
     starts = []
+    along = _torque_like_free(base, names) if Tg is not None else []
     for a, b in cands:
         s = np.ones(len(names))
         if Kg is not None:
             s[idx["load_stiffness"]] = Kg[a] / prob.p_ref[idx["load_stiffness"]]
         if Tg is not None:
             s[idx["coulomb_torque"]] = Tg[b] / prob.p_ref[idx["coulomb_torque"]]
+            s[along] = lam[b]      # free torque-like parameters start scaled with the level, as the grid had them
         starts.append(s)
     return GridSearch(Ks, Tg if Tg is not None else np.array([t_ref]), cost, tuple(starts), tuple(ccost),
                       time.perf_counter() - t0)
+
+
+def _torque_like_free(model, names) -> list[int]:
+    """Indices of the free friction parameters (other than the level) that are torque-like
+    (scale with the normal load): the grid moved them with T_c."""
+    import dataclasses
+
+    from taos.identify.surrogate import PARAMETERS
+
+    keys = {f.metadata.get("key") for f in dataclasses.fields(model.friction) if f.metadata.get("torque_like")}
+    return [i for i, n in enumerate(names) if n != "coulomb_torque" and PARAMETERS[n].section == "friction"
+            and PARAMETERS[n].toml_key in keys]
 
 
 def _local_minima(cost: np.ndarray, keep: int) -> tuple[list[tuple[int, int]], list[float]]:
