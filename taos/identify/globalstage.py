@@ -1,11 +1,12 @@
 """The fit's global first stage: a grid over the load stiffness and the friction level.
 
-The least-squares cost of a TVC record is far from convex in K_L and T_c: the piston notch
-is sharp (the load mode's damping ratio is near 0.005), so a start whose notch sits in the
-wrong place finds a local minimum, and a friction level tens of times off (the ambient
-model's 2,185 in-lbf against a hot-fire record's ~100,000) changes which points the
-friction holds. IPOPT (:mod:`taos.identify.fit`) converges fast from near the answer, so a
-cheap global look first picks where it starts.
+The least-squares cost of a TVC record need not be convex in K_L and T_c: the piston notch
+is sharp (the load mode's damping ratio is near 0.005) and a friction level tens of times off
+(the ambient model's 2,185 in-lbf against a hot-fire record's ~100,000) changes which points
+the friction holds. IPOPT (:mod:`taos.identify.fit`) converges fast from near the answer, so a
+cheap global look first picks where it starts (on the records tried so far IPOPT also reached
+the optimum from the start values once the bounds were physical, :mod:`taos.identify.physbounds`;
+the grid is the safeguard, and the start values stay among IPOPT's starts).
 
 :func:`grid_search` evaluates the describing-function surrogate of the fit
 (:mod:`taos.identify.surrogate`, same equations, same residuals) on a log grid spanning the
@@ -27,7 +28,7 @@ numpy instead of CasADi:
   residuals of :class:`taos.identify.fit.FitProblem`.
 
 The grid's local minima (8-neighbourhood), best first, are the starts IPOPT refines; the
-grid costs a few hundred milliseconds where the CasADi surrogate costs about 0.1 s a point.
+grid costs 0.3-2.5 s (benchmarks/bench_fit.py), a few per cent of a fit.
 """
 
 from __future__ import annotations
