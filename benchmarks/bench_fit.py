@@ -95,7 +95,7 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     g = grid_search(prob, hx, he, wx, we, keep=3)
     rows.append(("global first stage alone: DF grid over K_L x T_c (numpy)", time.perf_counter() - t0, g.candidate_costs[0],
-                 None, f"{g.cost.size} cells, {len(g.candidates)} local minima"))
+                 None, f"{g.cost.size} cells, {len(g.candidates)} local minim{'um' if len(g.candidates) == 1 else 'a'}"))
     for label, glob in (("taos fit end to end, global stage + 1 IPOPT start (default since issue 29.7)", True),
                         ("taos fit end to end, local start only (before issue 29.7; peer)", False)):
         t0 = time.perf_counter()

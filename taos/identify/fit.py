@@ -156,6 +156,11 @@ class FitResult:
                          f"{b:>25s}  {PARAMETERS[n].unit or '-'}" + ("  AT BOUND" if n in atb else ""))
         for ax, v in self.notch_hz.items():
             lines.append(f"notch ({ax}) {v:.4f} Hz, load resonance {self.load_resonance_hz[ax]:.4f} Hz")
+        g = self.global_search
+        if g:
+            lines.append(f"global first stage: {g['grid'][0]} x {g['grid'][1]} describing-function grid over "
+                         f"load stiffness x friction level within the physical bounds ({g['wall_s']:.2f} s), "
+                         f"best {self.starts} of the start and {g['candidates']} grid minima refined by IPOPT")
         lines.append(f"residual rms {math.sqrt(2 * self.cost / self.n_residuals):.3g} (sigma units), "
                      f"{self.n_residuals} residuals, {self.corrections} defect corrections, {self.wall_s:.2f} s")
         lines.append(self.adequacy().message())
