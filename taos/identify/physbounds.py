@@ -10,11 +10,11 @@ gives, for the names that have one:
   (docs/theory/simplex.md) within the measured band widened by ``band_margin`` (an octave by
   default) on each side: lower K_L puts the notch below f_min / 2, higher above 2 f_max, where
   the record cannot tell K_L from zero or from a rigid load path. With J_n of each axis in
-  the record, the lower bound is the smallest and the upper the largest over the axes. For
-  the shipped RS-25 set and a 0.5-14 Hz Green Run record: 270 to 3.4e6 lbf/in, which holds
-  both Green Run fits (115,000 and 205,000 lbf/in) and the actuator's own oil column
-  4 beta A^2 / V_t (1.35e6 lbf/in, a stiffness the load path in series cannot usefully exceed
-  by much: the notch then leaves the band).
+  the record, the lower bound is the smallest and the upper the largest over the axes, and
+  the lower at least 1e-3 of the upper (the feedline stiffness K_n alone may already hold
+  w_L above f_min / 2). For the shipped RS-25 set and a 0.5-14 Hz Green Run record: 3,400 to
+  3.4e6 lbf/in (K_n alone puts w_L at 1.0 Hz), which holds both Green Run fits (115,000 and
+  205,000 lbf/in) and the actuator's own oil column 4 beta A^2 / V_t (1.35e6 lbf/in).
 * ``coulomb_torque`` T_c [N m]: between ``torque_floor`` (1e-4) times and once the torque the
   actuator can apply at stall, A P_s R (stall force at supply pressure times the moment arm;
   1.42e6 in-lbf for the RS-25 set). A larger friction would hold the engine against every
@@ -82,8 +82,7 @@ def physical_bounds(model: TvcModel, names, axes, freq_hz, *, band_margin: float
             flo, fhi = float(f.min()) / band_margin, float(f.max()) * band_margin
             lo = min(load_stiffness_for_resonance(model, a, flo) for a in axs)
             hi = max(load_stiffness_for_resonance(model, a, fhi) for a in axs)
-            # K_n alone may already put w_L above f_min / margin: the floor is then a small K_L
-            lo = max(lo, 1e-3 * hi)
+            lo = max(lo, 1e-3 * hi)   # K_n alone may hold w_L above f_min / margin
             out[n] = Bound(lo, hi, f"load resonance within [{flo:.3g}, {fhi:.3g}] Hz (measured band "
                                    f"x1/{band_margin:g}..x{band_margin:g})")
         elif n == "coulomb_torque":
