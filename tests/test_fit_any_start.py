@@ -182,3 +182,24 @@ def test_the_old_start_relative_bounds_could_not_reach_the_level(ambient):
     r = fit_frequency_response(ambient, estimate(load_test_data(RECORD)), ["load_stiffness", "coulomb_torque"],
                                bounds=old)
     assert "coulomb_torque" in r.at_bound and r.adequacy().verdict == "inadequate"
+
+
+@pytest.mark.slow
+def test_fitted_file_of_a_swapped_law_keeps_the_static_torque_above_the_level(tmp_path):
+    """``--friction coulomb-smooth`` on the ambient file (modified LuGre, T_s = T_c = 2,185 in-lbf),
+    the level fitted to the hot-fire record: the file's static torque is scaled with the level,
+    so the fitted file loads (T_s >= T_c) with the fitted law."""
+    from taos.model import load_model
+
+    out = tmp_path / "fitted.toml"
+    p = run_cli("fit", ROOT / "models" / "data" / "greenrun_hotfire_synthetic.csv", "--model",
+                MODELS / "rs25_ambient.toml", "--friction", "coulomb-smooth", "--free", "coulomb_torque",
+                "--starts", "1", "--no-correction", "--json", tmp_path / "fit.json", "--out-model", out)
+    assert p.returncode == 0, p.stderr
+    tc = json.loads((tmp_path / "fit.json").read_text())["parameters"]["coulomb_torque"]["value_si"]
+    assert tc > 20 * 2185.5 * to_si("1 in*lbf", "torque", source="", field="")   # beyond the old ceiling
+    back = load_model(out)
+    assert back.friction.name == "coulomb-smooth" and back.friction.coulomb_torque_Nm == pytest.approx(tc, rel=1e-5)
+    line = next(x for x in out.read_text().splitlines() if x.startswith("static_torque"))
+    assert "scaled with the fitted coulomb_torque" in line
+    assert load_model(out, friction="modified-lugre").friction.static_torque_Nm == pytest.approx(tc, rel=1e-5)

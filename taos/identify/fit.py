@@ -461,26 +461,34 @@ def _toml_value(p, v_si: float):
 def _keep_law_shape(result: FitResult, doc, todo: dict, note_stamp: str) -> None:
     """A fitted Coulomb torque T_c is the friction level: the fit scaled every held torque-like
     parameter of the law with it (:func:`taos.identify.surrogate.apply_values`), so the fitted
-    file scales those written in its own ``[friction]`` table too (the static torque T_s
-    above all, so T_s >= T_c, which loading a model requires: docs/reference/bounds.md); those
-    of a shared parameter set follow the file's ``coulomb_torque`` through its
+    file scales those written in its own ``[friction]`` table by T_c fitted / T_c of the file
+    (the static torque T_s above all, so T_s >= T_c, which loading a model requires:
+    docs/reference/bounds.md; also keys of other laws, for a law swapped by ``--friction``);
+    those of a shared parameter set follow the file's ``coulomb_torque`` through its
     ``reference_torque``."""
     import dataclasses as _dc
 
-    from taos.units import DIMENSIONS
+    from taos.friction import param_classes
+    from taos.units import DIMENSIONS, to_si
 
     ftab = doc.get("friction", {})
-    if "coulomb_torque" not in result.names:
+    if "coulomb_torque" not in result.names or "coulomb_torque" not in ftab:
         return
-    law = result.model.friction
-    for f in _dc.fields(law):
-        key = f.metadata.get("key")
-        if not f.metadata.get("torque_like") or key == "coulomb_torque" or key in result.names or key not in ftab:
+    src = result.initial.source
+    tc_file = to_si(str(ftab["coulomb_torque"]), "torque", source=src, field="friction.coulomb_torque")
+    if not tc_file > 0:
+        return
+    ratio = result.values[result.names.index("coulomb_torque")] / tc_file
+    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
+             if f.metadata.get("torque_like") and f.metadata["key"] != "coulomb_torque"}
+    for key, kind in kinds.items():
+        if key not in ftab or key in result.names:
             continue
-        unit = "in*lbf" if f.metadata["kind"] == "torque" else DIMENSIONS[f.metadata["kind"]][1]
-        v = from_si(getattr(law, f.name), DIMENSIONS[f.metadata["kind"]][1], unit)
-        todo[("friction", key)] = (f"{v:.6g} {unit}", f"# scaled with the fitted coulomb_torque by taos fit "
-                                                      f"({note_stamp}): the law's shape kept")
+        v = to_si(str(ftab[key]), kind, source=src, field=f"friction.{key}") * ratio
+        unit = "in*lbf" if kind == "torque" else DIMENSIONS[kind][1]
+        todo[("friction", key)] = (f"{from_si(v, DIMENSIONS[kind][1], unit):.6g} {unit}",
+                                   f"# scaled with the fitted coulomb_torque by taos fit ({note_stamp}): "
+                                   f"the law's shape kept")
 
 
 def fitted_model_text(result: FitResult, data_label: str = "") -> str:
