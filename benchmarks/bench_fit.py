@@ -9,7 +9,9 @@ rate; the loop's harmonics are what the defect correction adds), time-domain sin
 Run amplitudes (0.4 deg to 7 Hz, 0.8 deg above), 20 log-spaced frequencies 0.3-14 Hz, 0.5 %
 complex noise. Same start (K_L 150,000 lbf/in, T_c 100,000 in-lbf, sigma_0 and sigma_2 x 2),
 same bounds, same residual function (the CasADi surrogate evaluated numerically for scipy,
-its implicit amplitudes solved per call by the same bisection).
+its implicit amplitudes solved per call by the same bisection). Then the fit end to end with
+and without the global first stage (issue 29.7), from this start and from the ambient model's
+K_L and friction level.
 
 Usage: .venv/bin/python benchmarks/bench_fit.py [--repeat 3]
 """
@@ -30,7 +32,8 @@ sys.path.insert(0, str(ROOT))
 
 from taos.identify.estimation import MeasuredResponse  # noqa: E402
 from taos.identify.fit import FitProblem, _pack, _stack_points, fit_frequency_response  # noqa: E402
-from taos.identify.surrogate import solve_implicit  # noqa: E402
+from taos.identify.globalstage import grid_search  # noqa: E402
+from taos.identify.surrogate import PARAMETERS, solve_implicit  # noqa: E402
 from taos.planar.freqresp import sine_dwell_grid  # noqa: E402
 from taos.model import load_model  # noqa: E402
 from taos.units import to_si  # noqa: E402
@@ -71,7 +74,6 @@ def main(argv=None) -> int:
     start = dict(zip(FREE, start_vals))
     m0 = truth
     for n, v in start.items():
-        from taos.identify.surrogate import PARAMETERS
         m0 = PARAMETERS[n].set(m0, float(v))
 
     rows = []
@@ -91,9 +93,24 @@ def main(argv=None) -> int:
                  f"{st['iter_count']} iterations"))
     rows.append(("CasADi NLP build (once per model/free set/points)", t_build, math.nan, None, ""))
     t0 = time.perf_counter()
-    res_full = fit_frequency_response(m0, data, FREE, starts=1, correct=True)
-    rows.append(("taos fit end to end incl. build, statistics, defect correction", time.perf_counter() - t0,
-                 res_full.cost, res_full.values, f"{res_full.corrections} corrections"))
+    g = grid_search(prob, hx, he, wx, we, keep=3)
+    rows.append(("global first stage alone: DF grid over K_L x T_c (numpy)", time.perf_counter() - t0, g.candidate_costs[0],
+                 None, f"{g.cost.size} cells, {len(g.candidates)} local minim{'um' if len(g.candidates) == 1 else 'a'}"))
+    for label, glob in (("taos fit end to end, global stage + 1 IPOPT start (default since issue 29.7)", True),
+                        ("taos fit end to end, local start only (before issue 29.7; peer)", False)):
+        t0 = time.perf_counter()
+        res_full = fit_frequency_response(m0, data, FREE, starts=1, correct=True, global_stage=glob)
+        rows.append((label + ", incl. build, statistics, defect correction", time.perf_counter() - t0,
+                     res_full.cost, res_full.values, f"{res_full.corrections} corrections"))
+    amb = load_model(ROOT / "models" / "rs25_ambient.toml", friction="lugre")
+    m_amb = PARAMETERS["coulomb_torque"].set(truth, amb.friction.coulomb_torque_Nm)
+    m_amb = PARAMETERS["load_stiffness"].set(m_amb, amb.structure.load_stiffness_N_per_m)
+    for label, glob in (("same, from the AMBIENT start (115,000 lbf/in, 2,185 in-lbf), global stage", True),
+                        ("same, from the ambient start, local start only", False)):
+        t0 = time.perf_counter()
+        r = fit_frequency_response(m_amb, data, FREE, starts=1, correct=True, global_stage=glob)
+        rows.append((label, time.perf_counter() - t0, r.cost, r.values,
+                     f"{r.corrections} corrections, {r.adequacy().verdict}"))
 
     # scipy least_squares, finite differences, same residual
     lo, hi = prob.lbx[:4], prob.ubx[:4]
@@ -114,15 +131,17 @@ def main(argv=None) -> int:
     rows.append(("scipy least_squares, 2-point finite differences", min(ts), ls.cost, ls.x * prob.p_ref,
                  f"{nfev[0]} residual evaluations, status {ls.status}"))
 
+    import os
     print(f"# bench_fit: K_L + 3 LuGre parameters, {f.size} frequencies x (piston, engine), "
-          f"{'2-core shared machine'}; best of {args.repeat}")
+          f"{'2-core shared machine'}; best of {args.repeat} per solve; load average {os.getloadavg()}")
     print(f"truth: K_L {true[0] / LBF_IN:.0f} lbf/in, T_c {true[1] / INLBF:.0f} in*lbf, "
           f"sigma_0 {true[2]:.4g} N*m/rad, sigma_2 {true[3]:.4g} N*m*s/rad\n")
     print("| method | wall time [s] | cost | K_L [lbf/in] | T_c [in*lbf] | sigma_0 [N m/rad] | sigma_2 [N m s/rad] | note |")
     print("|---|---|---|---|---|---|---|---|")
     for name, t, cost, v, note in rows:
         if v is None:
-            print(f"| {name} | {t:.3f} | - | - | - | - | - | {note} |")
+            c = "-" if math.isnan(cost) else f"{cost:.5g}"
+            print(f"| {name} | {t:.3f} | {c} | - | - | - | - | {note} |")
         else:
             print(f"| {name} | {t:.3f} | {cost:.5g} | {v[0] / LBF_IN:.0f} | {v[1] / INLBF:.0f} | {v[2]:.4g} | "
                   f"{v[3]:.4g} | {note} |")

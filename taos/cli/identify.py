@@ -267,13 +267,17 @@ def add_parsers(sub) -> None:
     p.add_argument("--friction", help="swap the friction law before fitting (keeps the file's torque levels)")
     p.add_argument("--start", action="append", metavar="NAME=VALUE",
                    help="start value with unit, e.g. --start 'load_stiffness=150000 lbf/in' (repeatable)")
-    p.add_argument("--starts", type=int, default=3, help="number of starts (default 3)")
+    p.add_argument("--starts", type=int, default=3,
+                   help="number of IPOPT starts (default 3): the best of the start values and the local minima of "
+                        "a describing-function grid over load_stiffness and coulomb_torque when either is free")
     p.add_argument("--no-engine", action="store_true", help="fit the piston responses only")
     p.add_argument("--no-correction", action="store_true", help="skip the time-domain defect correction")
     p.add_argument("--min-coherence", type=float, default=0.5)
     p.add_argument("--bounds", action="append", metavar="NAME=LOW:HIGH",
                    help="bounds with units, e.g. --bounds 'load_stiffness=50000 lbf/in:400000 lbf/in' (repeatable; "
-                        "default 0.05 to 20 times the start, see the JSON 'bounds')")
+                        "default: physical ranges, the load resonance within the measured band and the friction "
+                        "torque up to the actuator's stall torque, else 0.05 to 20 times the start; see the JSON "
+                        "'bounds' and 'bounds_basis')")
     p.add_argument("--strict", action="store_true",
                    help="exit 4 when the model cannot explain the data (verdict 'inadequate'); without it the "
                         "verdict is a WARNING in the text and 'adequacy' in the JSON")

@@ -47,7 +47,8 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.identify.estimation import MeasuredResponse
-from taos.identify.surrogate import PARAMETERS, build_surrogate, check_free, solve_implicit
+from taos.identify.globalstage import grid_search
+from taos.identify.surrogate import PARAMETERS, apply_values, build_surrogate, check_free, solve_implicit
 from taos.model import TvcModel, inline_actuator_parameter_set, load_model, resolve_parameter_set
 from taos.results import atomic_write
 from taos.units import from_si
@@ -80,6 +81,8 @@ class FitResult:
     history: list = field(default_factory=list)
     lower_si: np.ndarray | None = None
     upper_si: np.ndarray | None = None
+    bound_basis: tuple[str, ...] = ()
+    global_search: dict | None = None
 
     @property
     def dof(self) -> int:
@@ -124,6 +127,7 @@ class FitResult:
                                "start_si": float(self.start_values[i]), "ci95_si": ci[i].tolist(),
                                "bounds_si": [float(lo[i]), float(hi[i])],
                                "bounds": [self.eng(i, float(lo[i])), self.eng(i, float(hi[i]))],
+                               "bounds_basis": self.bound_basis[i] if self.bound_basis else "",
                                "at_bound": n in self.at_bound,
                                "unit": PARAMETERS[n].unit or "1", "value": self.eng(i),
                                "std_error": abs(self.eng(i, self.values[i] + self.std_errors[i]) - self.eng(i)),
@@ -136,6 +140,7 @@ class FitResult:
             "breakaway_deflection_deg": math.degrees(self.model.breakaway_deflection_rad()),
             "friction_model": self.model.friction.name, "defect_corrections": self.corrections,
             "starts": self.starts, "wall_s": self.wall_s, "method": self.method,
+            "global_stage": self.global_search,
             "data": [{"source": d.source, "axis": d.axis, "method": d.method, "points": len(d),
                       "condition": d.condition, "engine_dc_observable": d.engine_dc_observable} for d in self.data],
         }
@@ -151,6 +156,11 @@ class FitResult:
                          f"{b:>25s}  {PARAMETERS[n].unit or '-'}" + ("  AT BOUND" if n in atb else ""))
         for ax, v in self.notch_hz.items():
             lines.append(f"notch ({ax}) {v:.4f} Hz, load resonance {self.load_resonance_hz[ax]:.4f} Hz")
+        g = self.global_search
+        if g:
+            lines.append(f"global first stage: {g['grid'][0]} x {g['grid'][1]} describing-function grid over "
+                         f"load stiffness x friction level within the physical bounds ({g['wall_s']:.2f} s), "
+                         f"best {self.starts} of the start and {g['candidates']} grid minima refined by IPOPT")
         lines.append(f"residual rms {math.sqrt(2 * self.cost / self.n_residuals):.3g} (sigma units), "
                      f"{self.n_residuals} residuals, {self.corrections} defect corrections, {self.wall_s:.2f} s")
         lines.append(self.adequacy().message())
@@ -188,12 +198,19 @@ class FitProblem:
     axes: np.ndarray
     freq_hz: np.ndarray
     amp_rad: np.ndarray
-    bounds: dict | None = None   # name -> (lower, upper) [SI]; default PARAMETERS' lo/hi x start
+    bounds: dict | None = None   # name -> (lower, upper) [SI]; default physbounds, else PARAMETERS' lo/hi x start
 
     def __post_init__(self):
         import casadi as ca
 
+        from taos.identify.physbounds import physical_bounds
+
         self.params = check_free(self.model, self.free)
+        phys = physical_bounds(self.model, self.free, self.axes, self.freq_hz)
+        given = dict(self.bounds or {})
+        self.bound_basis = {n: ("--bounds" if n in given else phys[n].basis if n in phys else
+                                f"{PARAMETERS[n].lo:g} to {PARAMETERS[n].hi:g} x the start") for n in self.free}
+        self.bounds = {**{n: (b.lower, b.upper) for n, b in phys.items()}, **given}
         self.sur = build_surrogate(self.model, self.params, self.axes, self.freq_hz, self.amp_rad)
         npar, nu, m = len(self.params), self.sur.n_u, self.freq_hz.size
         s = ca.SX.sym("s", npar)
@@ -229,9 +246,12 @@ class FitProblem:
         hi = np.array([b[p.name][1] / r if p.name in b else p.hi for p, r in zip(self.params, self.sur.p_ref)])
         if np.any(lo >= 1.0) or np.any(hi <= 1.0):
             k = int(np.flatnonzero((lo >= 1.0) | (hi <= 1.0))[0])
-            raise InputError("command line", "--bounds", f"bounds of {self.params[k].name} around its start value",
-                             got=f"[{lo[k] * self.sur.p_ref[k]:.6g}, {hi[k] * self.sur.p_ref[k]:.6g}] SI, start "
-                                 f"{self.sur.p_ref[k]:.6g}")
+            name = self.params[k].name
+            where = ("command line", "--bounds") if self.bound_basis[name] == "--bounds" else \
+                (self.model.source, f"{self.params[k].section}.{self.params[k].toml_key}")
+            raise InputError(*where, f"a start value of {name} inside its bounds ({self.bound_basis[name]})",
+                             got=f"start {self.sur.p_ref[k]:.6g} SI, bounds [{lo[k] * self.sur.p_ref[k]:.6g}, "
+                                 f"{hi[k] * self.sur.p_ref[k]:.6g}] SI")
         return lo, hi
 
     @property
@@ -287,9 +307,7 @@ def _pack(hx, he, wx, we):
 
 
 def _apply(model: TvcModel, names, values) -> TvcModel:
-    for n, v in zip(names, values):
-        model = PARAMETERS[n].set(model, float(v))
-    return model
+    return apply_values(model, list(names), [float(v) for v in values])
 
 
 def simulate_points(model: TvcModel, axes, freq_hz, amp_rad) -> tuple[np.ndarray, np.ndarray]:
@@ -308,11 +326,29 @@ def simulate_points(model: TvcModel, axes, freq_hz, amp_rad) -> tuple[np.ndarray
     return hx, he
 
 
+def _first_starts(prob: FitProblem, P, grid, starts: int, seed: int) -> list[np.ndarray]:
+    """IPOPT's starts (scaled): with a grid (:mod:`taos.identify.globalstage`), the ``starts``
+    best of {the start values, the grid's local minima} by the surrogate's exact cost; without
+    one, the start values then log-uniform draws within a factor of 2 of them."""
+    npar = len(prob.free)
+    if grid is None:
+        rng = np.random.default_rng(seed)
+        return [np.ones(npar) if k == 0 else np.exp(rng.uniform(-math.log(2), math.log(2), npar))
+                for k in range(starts)]
+    pool = [np.ones(npar), *grid.candidates]
+    costs = []
+    for s0 in pool:
+        r = np.asarray(prob.r_fn(s0, solve_implicit(prob.sur, s0), P)).ravel()
+        costs.append(0.5 * float(r @ r) if np.all(np.isfinite(r)) else math.inf)
+    return [pool[k] for k in np.argsort(costs, kind="stable")[:starts]]
+
+
 def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], free: Sequence[str], *, start: dict | None = None, starts: int = 3,
                            seed: int = 0, use_engine: bool = True, min_coherence: float = 0.5,
                            sigma_floor: float = 1e-3, correct: bool | None = None, max_corrections: int = 6,
                            correction_tol: float = 1e-4, absolute_sigma: bool = False,
-                           problem: FitProblem | None = None, bounds: dict | None = None) -> FitResult:
+                           problem: FitProblem | None = None, bounds: dict | None = None,
+                           global_stage: bool = True) -> FitResult:
     """Fit ``free`` parameters of ``model`` to measured responses (module docstring).
 
     Parameters
@@ -326,7 +362,12 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
     start : dict name -> SI value, optional
         Start values (default: the model's).
     starts : int
-        Number of starts (the first at the start values).
+        Number of IPOPT starts: with the global stage the best of the start values and the
+        grid's local minima, else the start values then random draws within a factor of 2.
+    global_stage : bool
+        Grid the surrogate's cost over the free ``load_stiffness`` and ``coulomb_torque`` within
+        their physical bounds first (:mod:`taos.identify.globalstage`), so the fit does not
+        depend on the start model; ``False``: local starts only.
     correct : bool, optional
         Defect correction against the time-domain sine dwell (default: when the model has
         friction or a pressure-limited actuator, i.e. whenever the surrogate is not the
@@ -334,7 +375,8 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
     problem : FitProblem, optional
         A built problem to reuse (same model, free set and points).
     bounds : dict name -> (lower, upper) SI, optional
-        Bounds of free parameters (default: :data:`taos.identify.surrogate.PARAMETERS`' lo/hi
+        Bounds of free parameters (default: the physical ranges of
+        :mod:`taos.identify.physbounds`, else :data:`taos.identify.surrogate.PARAMETERS`' lo/hi
         times the start value). The result reports them and flags any value that ends on one.
     """
     t0 = time.perf_counter()
@@ -344,11 +386,10 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
     axes, f, A, hx, he, wx, we = _stack_points(data, use_engine, min_coherence, sigma_floor)
     prob = problem or FitProblem(m0, free, axes, f, A, bounds)
     P = _pack(hx, he, wx, we)
-    rng = np.random.default_rng(seed)
-    best = None
     npar = len(free)
-    for k in range(max(1, starts)):
-        s0 = np.ones(npar) if k == 0 else np.exp(rng.uniform(-math.log(2), math.log(2), npar))
+    grid = grid_search(prob, hx, he, wx, we, keep=max(1, starts)) if global_stage else None
+    best = None
+    for s0 in _first_starts(prob, P, grid, max(1, starts), seed):
         s, u, cost = prob.solve(P, s0)
         if best is None or cost < best[2] - 1e-12 * abs(best[2]):
             best = (s, u, cost)
@@ -403,7 +444,9 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
                      notch_hz={a: load_resonance_from_notch(mfit, a) for a in ax_set},
                      load_resonance_hz={a: mfit.load_resonance_hz(a) for a in ax_set}, corrections=ncorr,
                      starts=max(1, starts), wall_s=time.perf_counter() - t0, absolute_sigma=absolute_sigma,
-                     history=history, lower_si=prob.lbx[:npar] * prob.p_ref, upper_si=prob.ubx[:npar] * prob.p_ref)
+                     history=history, lower_si=prob.lbx[:npar] * prob.p_ref, upper_si=prob.ubx[:npar] * prob.p_ref,
+                     bound_basis=tuple(prob.bound_basis[n] for n in free),
+                     global_search=grid.to_dict() if grid is not None else None)
 
 
 # -- writing the fitted model ------------------------------------------------------------------
@@ -415,22 +458,37 @@ def _toml_value(p, v_si: float):
     return f"{from_si(v_si, _si_unit(p.kind), p.unit):.6g} {p.unit}"
 
 
-def _keep_static_above_coulomb(result: FitResult, doc, todo: dict, note_stamp: str) -> None:
-    """A fitted Coulomb torque T_c scales the file's static torque T_s with it (T_s / T_c kept:
-    both levels are proportional to the bearing normal load), so the fitted file keeps
-    T_s >= T_c, which loading a model requires (docs/reference/bounds.md)."""
-    from taos.units import to_si
+def _keep_law_shape(result: FitResult, doc, todo: dict, note_stamp: str) -> None:
+    """A fitted Coulomb torque T_c is the friction level: the fit scaled every held torque-like
+    parameter of the law with it (:func:`taos.identify.surrogate.apply_values`), so the fitted
+    file scales those written in its own ``[friction]`` table by T_c fitted / T_c of the file
+    (the static torque T_s above all, so T_s >= T_c, which loading a model requires:
+    docs/reference/bounds.md; also keys of other laws, for a law swapped by ``--friction``);
+    those of a shared parameter set follow the file's ``coulomb_torque`` through its
+    ``reference_torque``."""
+    import dataclasses as _dc
+
+    from taos.friction import param_classes
+    from taos.units import DIMENSIONS, to_si
 
     ftab = doc.get("friction", {})
-    if "coulomb_torque" not in result.names or "static_torque" not in ftab:
+    if "coulomb_torque" not in result.names or "coulomb_torque" not in ftab:
         return
-    p = PARAMETERS["coulomb_torque"]
-    tc_new = result.values[result.names.index("coulomb_torque")]
-    tc_old = result.initial.friction.coulomb_torque_Nm
-    ts_old = to_si(str(ftab["static_torque"]), "torque", source=result.initial.source, field="friction.static_torque")
-    ts_new = max(ts_old * tc_new / tc_old if tc_old > 0 else ts_old, tc_new)
-    todo[("friction", "static_torque")] = (_toml_value(p, ts_new), f"# scaled with the fitted coulomb_torque by "
-                                           f"taos fit ({note_stamp}): T_s/T_c kept")
+    src = result.initial.source
+    tc_file = to_si(str(ftab["coulomb_torque"]), "torque", source=src, field="friction.coulomb_torque")
+    if not tc_file > 0:
+        return
+    ratio = result.values[result.names.index("coulomb_torque")] / tc_file
+    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
+             if f.metadata.get("torque_like") and f.metadata["key"] != "coulomb_torque"}
+    for key, kind in kinds.items():
+        if key not in ftab or key in result.names:
+            continue
+        v = to_si(str(ftab[key]), kind, source=src, field=f"friction.{key}") * ratio
+        unit = "in*lbf" if kind == "torque" else DIMENSIONS[kind][1]
+        todo[("friction", key)] = (f"{from_si(v, DIMENSIONS[kind][1], unit):.6g} {unit}",
+                                   f"# scaled with the fitted coulomb_torque by taos fit ({note_stamp}): "
+                                   f"the law's shape kept")
 
 
 def fitted_model_text(result: FitResult, data_label: str = "") -> str:
@@ -460,7 +518,7 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
                 todo[(p.section, "crossover_command")] = (["0 deg"], "# added by taos fit")
         else:
             todo[(p.section, p.toml_key)] = (_toml_value(p, result.values[i]), note)
-    _keep_static_above_coulomb(result, doc, todo, note_stamp=stamp)
+    _keep_law_shape(result, doc, todo, note_stamp=stamp)
     file_law = str(result.initial.friction_table.get("model", result.initial.friction.name))
     if result.initial.friction.name != file_law:
         todo[("friction", "model")] = (result.initial.friction.name,
@@ -484,6 +542,11 @@ def fitted_model_text(result: FitResult, data_label: str = "") -> str:
     return head + tomlkit.dumps(doc)
 
 
+def _law_values(law) -> dict:
+    import dataclasses as _dc
+    return {f.name: float(getattr(law, f.name)) for f in _dc.fields(law)}
+
+
 def write_fitted_model(result: FitResult, path, data_label: str = "") -> None:
     """Write the fitted model file (TOML with units, fitted values commented), atomically,
     after checking that it loads back to the fitted values."""
@@ -496,4 +559,8 @@ def write_fitted_model(result: FitResult, path, data_label: str = "") -> None:
             got = PARAMETERS[n].get(back) if n != "avionics_gain" else None
             if got is not None and not math.isclose(got, result.values[i], rel_tol=1e-5):
                 raise RuntimeError(f"written {n} reads back as {got}, not {result.values[i]}")
+        for k, v in _law_values(result.model.friction).items():   # the fitted law, held parameters too
+            got = _law_values(back.friction).get(k)
+            if got is None or not math.isclose(got, v, rel_tol=1e-5, abs_tol=1e-12):
+                raise RuntimeError(f"written friction {k} reads back as {got}, not {v}")
     atomic_write(path, write)

@@ -60,7 +60,8 @@ class FitParam:
     unit: str
     get: Callable[[TvcModel], float]
     set: Callable[[TvcModel, object], TvcModel]
-    lo: float = 0.05   # bounds: [lo, hi] times the start value (positive quantities)
+    lo: float = 0.05   # bounds: [lo, hi] times the start value, for parameters without a physical
+    #                    range (taos.identify.physbounds)
     hi: float = 20.0
 
 
@@ -89,12 +90,39 @@ def _p(name, section, key, part, fld, kind, unit, **kw):
     return FitParam(name, section, key, kind, unit, _get(part, fld), _rep(part, fld), **kw)
 
 
+def _friction_level_set(m, v):
+    """Set the friction LEVEL T_c = ``v``: every torque-like parameter of the law (static
+    torque, bristle stiffness and damping, viscous and stick damping) scales with it
+    (:meth:`taos.friction.FrictionLaw.scaled`), as friction proportional to the bearing normal
+    load does and as the model file's parameter set is scaled to its ``coulomb_torque``
+    (``reference_torque``): the pre-sliding angle T_c / sigma_0, the Stribeck ratio T_s / T_c
+    and the LuGre passivity ratios (:meth:`taos.friction.LuGre.passivity_ratios`, homogeneous
+    of degree 0 in these) stay the hardware's at every level the fit tries. A torque-like
+    parameter that is itself free is set after this (:func:`apply_values`)."""
+    law = m.friction
+    tc = law.coulomb_torque_Nm
+    if isinstance(tc, (int, float)) and tc > 0:
+        return dataclasses.replace(m, friction=law.scaled(v / tc))
+    return dataclasses.replace(m, friction=dataclasses.replace(law, coulomb_torque_Nm=v))
+
+
+def apply_values(model: TvcModel, names, values) -> TvcModel:
+    """``model`` with parameters ``names`` set to ``values`` (SI, floats or CasADi SX), the
+    friction level first (it scales the law's other torque-like parameters, which a free one
+    then overrides), so the result does not depend on the order of ``--free``."""
+    pairs = sorted(zip(names, values), key=lambda nv: nv[0] != "coulomb_torque")
+    for n, v in pairs:
+        model = PARAMETERS[n].set(model, v)
+    return model
+
+
 #: name -> FitParam
 PARAMETERS: dict[str, FitParam] = {p.name: p for p in (
     _p("load_stiffness", "structure", "load_stiffness", "structure", "load_stiffness_N_per_m", "stiffness", "lbf/in"),
     _p("load_damping_ratio", "structure", "load_damping_ratio", "structure", "load_damping_ratio", "dimensionless",
        "", lo=1e-2, hi=1e2),
-    _p("coulomb_torque", "friction", "coulomb_torque", "friction", "coulomb_torque_Nm", "torque", "in*lbf"),
+    FitParam("coulomb_torque", "friction", "coulomb_torque", "torque", "in*lbf", _get("friction", "coulomb_torque_Nm"),
+             _friction_level_set),
     _p("bristle_stiffness", "friction", "bristle_stiffness", "friction", "bristle_stiffness_Nm_per_rad",
        "rotational_stiffness", "N*m/rad", lo=1e-3, hi=1e3),
     _p("viscous_damping", "friction", "viscous_damping", "friction", "viscous_damping_Nms_per_rad",
@@ -206,14 +234,15 @@ def build_surrogate(model: TvcModel, params, axes, freq_hz, amp_rad) -> Surrogat
     fam = friction_family(model)
     p_ref = np.array([p.get(model) for p in params])
     s = ca.SX.sym("s", len(params))
-    msym = model
     kav = 1.0
+    names, vals = [], []
     for i, p in enumerate(params):
-        v = p_ref[i] * s[i]
         if p.name == "avionics_gain":
             kav = s[i]
         else:
-            msym = p.set(msym, v)
+            names.append(p.name)
+            vals.append(p_ref[i] * s[i])
+    msym = apply_values(model, names, vals)
     law = msym.friction
     entry = model.friction.entry
     axes = np.asarray(axes)
