@@ -165,10 +165,9 @@ def advance(bs, fk, fp, Kc, dt, qa0, qa1, qb0, qb1, tol, max_split, fast_steps):
     m0 = 0.0
     m1 = 0.0
     n = 0
+    tau = fast_time(zdot3, torque3, fp, Kc, bs[BS_W], bs[BS_W + 1], bs[BS_Z], bs[BS_Z + 1], bs[BS_T], bs[BS_T + 1])
     while True:
         rem = dt - tb
-        tau = fast_time(zdot3, torque3, fp, Kc, bs[BS_W], bs[BS_W + 1], bs[BS_Z], bs[BS_Z + 1], bs[BS_T],
-                        bs[BS_T + 1])
         hb = min(hb, max(fast_steps * tau, hmin))
         last = hb >= rem * (1.0 - 1e-9)
         if last:
@@ -189,6 +188,8 @@ def advance(bs, fk, fp, Kc, dt, qa0, qa1, qb0, qb1, tol, max_split, fast_steps):
         n += 1
         if last or hb >= rem * (1.0 - 1e-9):
             break
+        # the fast mode's time constant at the committed state (a rejected trial keeps it)
+        tau = fast_time(zdot3, torque3, fp, Kc, w0, w1, z0, z1, t0, t1)
         tb += hb
         if err > 0.0:
             hb = hb * min(2.0, 0.9 * (tol / err) ** (1.0 / 3.0))
