@@ -59,12 +59,25 @@ from numba import njit
 
 from ._layout import BS_H, BS_PHI, BS_PHI_PREV, BS_SLIP, BS_T, BS_W, BS_Z, BS_Z_PREV
 
-#: local error tolerance on the bearing slip per substep [rad]
-TOL_RAD = 1e-8
+#: local error tolerance on the bearing slip per substep [rad] at a body step of TOL_STEP_S;
+#: scaled with the body step cubed (:func:`tolerance`)
+TOL_RAD = 1e-6
+#: the body step [s] at which the local error tolerance is TOL_RAD
+TOL_STEP_S = 5e-4
 #: the shortest substep is the body step over this
 MAX_SPLIT = 32.0
 #: a substep at most this many fast-mode time constants where the fast mode is unstable
 FAST_STEPS = 0.5
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def tolerance(dt):
+    """Local error tolerance [rad] of a bearing substep within a body step ``dt`` [s]:
+    TOL_RAD (dt / TOL_STEP_S)^3, the order of the body step's own local error in the bearing
+    coupling (third order), so that the substeps' error falls with the step at the scheme's
+    second order."""
+    r = dt / TOL_STEP_S
+    return TOL_RAD * r * r * r
 
 
 @njit(cache=True, error_model="numpy", inline="always")

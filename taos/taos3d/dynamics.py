@@ -453,7 +453,7 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     ps0, ps1 = pose_psi(x, P)
     # the bearing by variable-step BDF2 under its own error control (taos.taos3d._bearing),
     # psi linear over the step; the engine gets the mean torque over the step
-    m0, m1, _ = _bg.advance(bs, fid, fp, P.bearing_compliance, dt, qa0, qa1, ps0, ps1, _bg.TOL_RAD, _bg.MAX_SPLIT,
+    m0, m1, _ = _bg.advance(bs, fid, fp, P.bearing_compliance, dt, qa0, qa1, ps0, ps1, _bg.tolerance(dt), _bg.MAX_SPLIT,
                             _bg.FAST_STEPS)
     _torque_kick(x, m0 - T0, m1 - T1, dt, P)  # the mean of T over the step (second order)
     t0, t1, z0, z1 = bs[BS_T], bs[BS_T + 1], bs[BS_Z], bs[BS_Z + 1]
