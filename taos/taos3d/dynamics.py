@@ -49,7 +49,7 @@ at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler be
 unstable fast mode (a relaxation oscillation of the slip rate), which a fixed implicit step
 damps away; the bearing substeps resolve it. The shipped LuGre laws' torque rises with the
 slip rate (rational bristle-damping decay), and modified LuGre's 60 s engine angle converges
-at second order: 2.0e-5 deg at 4e-4 s against a 1.25e-5 s run (tests/test_taos3d_step.py,
+at second order: 1.8e-5 deg at 4e-4 s against a 2.5e-5 s run (tests/test_taos3d_step.py,
 benchmarks/RESULTS.md; :mod:`taos.taos3d._bearing`, docs/theory/taos3d.md). The stiff bearing time constant
 never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
 the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
