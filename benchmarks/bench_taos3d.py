@@ -1,7 +1,7 @@
 """TAOS 3-D model speed and step accuracy, beside a MuJoCo rigid-engine peer in the same run
 (writes nothing; paste the output into benchmarks/RESULTS.md).
 
-Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
+Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5] [--only-speed]
       (the peer needs the optional extra: pip install -e .[bench], i.e. mujoco >= 3.1;
       without it the peer is skipped with one line)
 
@@ -9,7 +9,8 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
    60 s, as benchmarks/bench_taos.py), hot-fire FEM gimbal, modified-LuGre bearing, at the
    model's default step (taos.taos3d.simulate.DEFAULT_DT_S, 4e-4 s) and at 2e-4 s (the former
    default); records every 2 ms. Best and median of ``--repeat`` runs (the machine is
-   shared: both are printed).
+   shared: both are printed), and the best CPU time (process time: on a shared machine it
+   leaves out the waiting). ``--only-speed``: this part and the peer (5.) alone.
 2. Accuracy of the step: 4 s of the same run (modified LuGre, and Coulomb smooth, whose error
    is not masked by stick-slip timing) against a 2.5e-5 s reference, at the default step and
    at 2e-4 s (the former kernel's stored records, removed from tests/data (git history),

@@ -27,7 +27,7 @@ is advanced in substeps h_b that its own error estimate chooses:
   28) the error estimate split half the body steps of the 60 s Green Run at 4e-4 s into 3-13
   substeps (3.0 a step, plus 1.2 rejected trials: two thirds of the
   run time) for no measurable accuracy (the 60 s engine angle 1.97e-5 deg from the 2.5e-5 s
-  run at 4e-4 s, 1.82e-5 with the scaled tolerance, one substep in 99.7 % of the steps);
+  run at 4e-4 s, 1.82e-5 with the scaled tolerance, one substep in 99.9 % of the steps);
 * where the law's fast mode is unstable (:func:`fast_time`, from the law's continuous-time
   vector kernels ``zdot3`` and ``torque3``) a substep is at most :data:`FAST_STEPS` of its
   time constant: an L-stable implicit step longer than that damps the instability away, and
