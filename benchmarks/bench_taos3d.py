@@ -1,7 +1,7 @@
 """TAOS 3-D model speed and step accuracy, beside a MuJoCo rigid-engine peer in the same run
 (writes nothing; paste the output into benchmarks/RESULTS.md).
 
-Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
+Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5] [--only-speed]
       (the peer needs the optional extra: pip install -e .[bench], i.e. mujoco >= 3.1;
       without it the peer is skipped with one line)
 
@@ -9,7 +9,8 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5]
    60 s, as benchmarks/bench_taos.py), hot-fire FEM gimbal, modified-LuGre bearing, at the
    model's default step (taos.taos3d.simulate.DEFAULT_DT_S, 4e-4 s) and at 2e-4 s (the former
    default); records every 2 ms. Best and median of ``--repeat`` runs (the machine is
-   shared: both are printed).
+   shared: both are printed), and the best CPU time (process time: on a shared machine it
+   leaves out the waiting). ``--only-speed``: this part and the peer (5.) alone.
 2. Accuracy of the step: 4 s of the same run (modified LuGre, and Coulomb smooth, whose error
    is not masked by stick-slip timing) against a 2.5e-5 s reference, at the default step and
    at 2e-4 s (the former kernel's stored records, removed from tests/data (git history),
@@ -81,12 +82,17 @@ REF_DT = 2.5e-5
 T_ACC = 4.0
 
 
+CPU = {}  # best process (CPU) time of the last timed() call [s]: on a shared machine it excludes waiting
+
+
 def timed(fn, repeat):
-    walls = []
+    walls, cpus = [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         out = fn()
         walls.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
+    CPU["best"] = min(cpus)
     return out, min(walls), statistics.median(walls)
 
 
@@ -99,7 +105,7 @@ def taos_speed(tm, prof, dt, repeat):
     n = len(cmd) - 1
     print(f"[taos3d] dt {dt:g} s: 60 s Green Run in {best:.3f} s wall (best of {repeat}; median {med:.3f} s) "
           f"= {T_RUN / best:.1f}x real time (median {T_RUN / med:.1f}x), {1e6 * best / n:.2f} us/step "
-          f"(median {1e6 * med / n:.2f}), {n} steps")
+          f"(median {1e6 * med / n:.2f}), {n} steps; best CPU time {CPU['best']:.3f} s = {T_RUN / CPU['best']:.1f}x")
     return out
 
 
@@ -280,7 +286,7 @@ def mujoco_peer(tm, prof, repeat, taos_rec):
         diff = np.degrees(np.sqrt(((th[every - 1::every][:k] - taos_rec[1:k + 1, 0:2]) ** 2).mean()))
         print(f"[mujoco {mujoco.__version__}] dt {dt:g} s, rollout (native, 1 thread): 60 s in {best:.3f} s wall "
               f"(best of {repeat}; median {med:.3f} s) = {T_RUN / best:.1f}x real time (median {T_RUN / med:.1f}x), "
-              f"{1e6 * best / n:.2f} us/step; peak angles {np.degrees(np.abs(th).max(axis=0)).round(3)} deg, "
+              f"{1e6 * best / n:.2f} us/step, best CPU time {CPU['best']:.3f} s = {T_RUN / CPU['best']:.1f}x; peak angles {np.degrees(np.abs(th).max(axis=0)).round(3)} deg, "
               f"rms angle difference from TAOS {diff:.3f} deg")
         if dt == 1e-3:  # the same peer stepped from Python, as a user script would
             d2 = mujoco.MjData(m)
@@ -415,6 +421,7 @@ def main():
     ap.add_argument("--no-dwells", action="store_true", help="skip the sine-dwell accuracy part")
     ap.add_argument("--no-conv60", action="store_true", help="skip the 60 s modified-LuGre convergence part")
     ap.add_argument("--only-conv60", action="store_true", help="run the 60 s convergence part alone")
+    ap.add_argument("--only-speed", action="store_true", help="run the speed part and the MuJoCo peer alone")
     ap.add_argument("--decay-impact", action="store_true",
                     help="run only the planar impact of the rational decay against the former exponential")
     args = ap.parse_args()
@@ -433,6 +440,9 @@ def main():
     rec = taos_speed(tm, prof, DEFAULT_DT_S, args.repeat)
     taos_speed(tm, prof, ALT_DT, args.repeat)
     mujoco_peer(tm, prof, args.repeat, rec)
+    if args.only_speed:
+        print(f"machine load (uptime): {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+        return
     accuracy(prof)
     if not args.no_conv60:
         convergence60(prof)

@@ -199,16 +199,33 @@ def switching_residual(coeffs, s, p, dt, kappa, Kc, d0, d1, z0, z1):
     return math.sqrt(u0 * u0 + u1 * u1) - 1.0, s * u0, s * u1
 
 
+#: relative size of the last slip-speed correction at which :func:`solve_slip` stops
+SLIP_RTOL = 1e-13
+
+
+@njit(inline="always")
+def _secant_step(s_prev, h_prev, s, h, step):
+    """Next bracket-search step [rad/s] from (s, h) away from s_prev: the distance to the
+    secant's root estimate through (s_prev, h_prev) and (s, h) while the residual's magnitude
+    falls, else twice ``step``."""
+    if abs(h) < abs(h_prev):
+        return abs(h * (s - s_prev) / (h_prev - h))
+    return 2.0 * step
+
+
 @njit(inline="always")
 def solve_slip(resid, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1, s0):
     """Slip rate (w0, w1) [rad/s] solving the scalar consistency resid(s) = 0, continued from
     the previous step's slip speed ``s0`` [rad/s]: the residual's sign at s0 says which way the
-    slip speed moves (up while |w(s)| > s); a bracket grows from s0 that way, first to the
-    fixed-point image |w(s0)|, then by doubling steps, until the sign changes (resid(0) >= 0,
-    so downwards it ends at s = 0 at the latest), then bracketed Illinois regula falsi on it. Where the backward-Euler equation has
-    several roots (Stribeck friction falling with the slip speed faster than dt / Kc) this
-    keeps the branch the bearing is on while that branch exists (stick-slip hysteresis: the
-    limit of a vanishing bearing inertia relaxing the slip speed from s0)."""
+    slip speed moves (up while |w(s)| > s); the search moves from s0 that way only, first to
+    the fixed-point image |w(s0)|, then by secant steps (doubling while the residual does not
+    fall; :func:`_secant_step`), until the sign changes (resid(0) >= 0, so downwards it ends
+    at s = 0 at the latest), then bracketed Illinois regula falsi on it; it stops when the
+    next correction is below :data:`SLIP_RTOL` of the slip speed (returning the rate at the
+    last evaluated speed). Where the backward-Euler equation has several roots (Stribeck
+    friction falling with the slip speed faster than dt / Kc) this keeps the branch the
+    bearing is on while that branch exists (stick-slip hysteresis: the limit of a vanishing
+    bearing inertia relaxing the slip speed from s0)."""
     s_a = max(s0, 0.0)
     h_a, w0, w1 = resid(coeffs, s_a, p, dt, kappa, Kc, d0, d1, z0, z1)
     if h_a == 0.0:
@@ -222,10 +239,13 @@ def solve_slip(resid, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1, s0):
             h_hi, w0, w1 = resid(coeffs, s_hi, p, dt, kappa, Kc, d0, d1, z0, z1)
             if h_hi <= 0.0:
                 break
+            step = _secant_step(s_lo, h_lo, s_hi, h_hi, step)
+            if step <= SLIP_RTOL * s_hi:
+                return w0, w1
             s_lo, h_lo = s_hi, h_hi
-            step *= 2.0
         if h_hi == 0.0:
             return w0, w1
+        s_k = s_hi
     else:  # below s0, at s = 0 at the latest
         s_hi, h_hi = s_a, h_a
         step = -h_a
@@ -235,14 +255,20 @@ def solve_slip(resid, coeffs, p, dt, kappa, Kc, d0, d1, z0, z1, s0):
             h_lo, w0, w1 = resid(coeffs, s_lo, p, dt, kappa, Kc, d0, d1, z0, z1)
             if h_lo >= 0.0:
                 break
+            step = _secant_step(s_hi, h_hi, s_lo, h_lo, step)
+            if step <= SLIP_RTOL * s_lo:
+                return w0, w1
             s_hi, h_hi = s_lo, h_lo
-            step *= 2.0
         if h_lo == 0.0:
             return w0, w1
+        s_k = s_lo
     side = 0
     for _ in range(200):
         s = (s_lo * h_hi - s_hi * h_lo) / (h_hi - h_lo)
+        if abs(s - s_k) <= SLIP_RTOL * s_k:
+            break  # the rate at s_k (the last evaluated speed) is converged
         h, w0, w1 = resid(coeffs, s, p, dt, kappa, Kc, d0, d1, z0, z1)
+        s_k = s
         if h > 0.0:
             s_lo, h_lo = s, h
             if side == 1:

@@ -49,7 +49,7 @@ at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler be
 unstable fast mode (a relaxation oscillation of the slip rate), which a fixed implicit step
 damps away; the bearing substeps resolve it. The shipped LuGre laws' torque rises with the
 slip rate (rational bristle-damping decay), and modified LuGre's 60 s engine angle converges
-at second order: 2.0e-5 deg at 4e-4 s against a 1.25e-5 s run (tests/test_taos3d_step.py,
+at second order: 1.8e-5 deg at 4e-4 s against a 2.5e-5 s run (tests/test_taos3d_step.py,
 benchmarks/RESULTS.md; :mod:`taos.taos3d._bearing`, docs/theory/taos3d.md). The stiff bearing time constant
 never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
 the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
@@ -453,7 +453,7 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
     ps0, ps1 = pose_psi(x, P)
     # the bearing by variable-step BDF2 under its own error control (taos.taos3d._bearing),
     # psi linear over the step; the engine gets the mean torque over the step
-    m0, m1, _ = _bg.advance(bs, fid, fp, P.bearing_compliance, dt, qa0, qa1, ps0, ps1, _bg.TOL_RAD, _bg.MAX_SPLIT,
+    m0, m1, _ = _bg.advance(bs, fid, fp, P.bearing_compliance, dt, qa0, qa1, ps0, ps1, _bg.tolerance(dt), _bg.MAX_SPLIT,
                             _bg.FAST_STEPS)
     _torque_kick(x, m0 - T0, m1 - T1, dt, P)  # the mean of T over the step (second order)
     t0, t1, z0, z1 = bs[BS_T], bs[BS_T + 1], bs[BS_Z], bs[BS_Z + 1]
