@@ -95,6 +95,11 @@ def cmd_estimate(args) -> int:
     d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
          "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
          "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict(model=model) for r in responses]}
+    if args.method == "auto":  # every segment of every axis, estimated or not (taos.identify.segments)
+        from taos.identify.segments import segment_record
+        used = {(r.axis, s["index"]) for r in responses for s in r.meta.get("segments") or () if s["used"]}
+        d["segments"] = [{**s.to_dict(), "used": (ax, s.index) in used}
+                         for ax, ss in segment_record(data).items() for s in ss]
     from taos.results import output_provenance
     d["provenance"] = {**output_provenance([model] if model is not None else [], inputs=[("data", args.data)]),
                        "method": args.method, "nperseg": args.nperseg, "seeds": "none (deterministic)"}
@@ -102,6 +107,8 @@ def cmd_estimate(args) -> int:
         write_json(args.json, d)
     out = sys.stderr if args.json == "-" else sys.stdout
     if not args.json or args.json == "-":
+        if d.get("segments"):
+            print(_segment_table(d["segments"]), file=out)
         for r, rd in zip(responses, d["responses"]):
             ex = rd.get("excitation") or {}
             forced = " (forced by --method)" if r.meta.get("method_forced") else ""
@@ -121,6 +128,18 @@ def cmd_estimate(args) -> int:
                             f"{r.coherence_engine[k]:6.3f}")
                 print(row, file=out)
     return 0
+
+
+def _segment_table(segments: list[dict]) -> str:
+    """The excitation segments as text: axis, index, kind, time span, frequencies, amplitude, use."""
+    lines = [f"{'axis':5s} {'#':>2s} {'excitation':10s} {'from_s':>8s} {'to_s':>8s} {'freq_hz':>13s} {'amp_deg':>8s}  used"]
+    for s in segments:
+        f0, f1 = s["freq_range_hz"]
+        fr = "-" if f0 is None else (f"{f0:.3g}" if abs(f1 - f0) <= 1e-4 * f0 else f"{f0:.3g}-{f1:.3g}")
+        a = "-" if s["amplitude_deg"] is None else f"{s['amplitude_deg']:.3g}"
+        lines.append(f"{s['axis']:5s} {s['index']:2d} {s['kind']:10s} {s['t0_s']:8.2f} {s['t1_s']:8.2f} {fr:>13s} "
+                     f"{a:>8s}  {'yes' if s['used'] else 'no'}")
+    return "\n".join(lines)
 
 
 def cmd_fit(args) -> int:

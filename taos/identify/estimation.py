@@ -67,6 +67,9 @@ class MeasuredResponse:
     source: str = ""
     condition: str = ""
     meta: dict = field(default_factory=dict)
+    #: per point, the index of the command segment it was estimated from
+    #: (:mod:`taos.identify.segments`; None when not segmented)
+    segment_index: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.freq_hz.size)
@@ -78,7 +81,8 @@ class MeasuredResponse:
         return replace(self, freq_hz=self.freq_hz[m], amplitude_rad=self.amplitude_rad[m],
                        piston_m_per_rad=self.piston_m_per_rad[m], engine=opt(self.engine),
                        coherence_piston=self.coherence_piston[m], coherence_engine=opt(self.coherence_engine),
-                       sigma_piston=self.sigma_piston[m], sigma_engine=opt(self.sigma_engine))
+                       sigma_piston=self.sigma_piston[m], sigma_engine=opt(self.sigma_engine),
+                       segment_index=opt(self.segment_index))
 
     def to_freqresp(self, moment_arm_m: float):
         """As a :class:`~taos.planar.freqresp.FrequencyResponse` (piston x_p / (R theta_c)) for plots."""
@@ -117,6 +121,8 @@ class MeasuredResponse:
         R = moment_arm_m if moment_arm_m is not None else self.meta.get("moment_arm_m")
         return {"axis": self.axis, "method": self.method, "source": self.source, "condition": self.condition,
                 "excitation": self.meta.get("excitation"),
+                "segments": self.meta.get("segments"),
+                "point_segment": None if self.segment_index is None else [int(k) for k in self.segment_index],
                 "freq_hz": self.freq_hz.tolist(), "amplitude_deg": np.degrees(self.amplitude_rad).tolist(),
                 "piston_definition": "x_p / (R theta_c), dimensionless" if R else
                 "x_p / (R theta_c) needs the moment arm (taos estimate --model MODEL); see piston_in_per_deg",
@@ -429,10 +435,28 @@ def choose_method(data: TestData, method: str = "auto") -> tuple[str, list[Excit
 
 
 def estimate(data: TestData, method: str = "auto", **kwargs: Any) -> list[MeasuredResponse]:
-    """Responses of a record by the estimator :func:`choose_method` picks (``method`` 'auto',
-    or forced 'dwell'/'h1'). Each response's ``meta['excitation']`` holds what was detected
-    and why; for a sweep the H1 points carry the sweep's envelope amplitude (the amplitude
-    the describing function sees), not the bin's share of the power."""
+    """Responses of a record, one per axis.
+
+    ``method`` 'auto' classifies each axis' command segment by segment
+    (:func:`taos.identify.segments.segment_record`: dwells, sweeps, multisines, steps/ramps,
+    quiet) and estimates every dwell, sweep and multisine segment with its own estimator
+    (:func:`taos.identify.segments.estimate_by_segment`), so pitch dwells and a yaw sweep in one
+    record are estimated in one call; ``meta['excitation']`` sums up what was found and why and
+    ``meta['segments']`` lists the segments. 'dwell' or 'h1' forces one estimator over the whole
+    record (the whole-record classification :func:`classify_record` is then the evidence).
+    For a sweep the H1 points carry the sweep's envelope amplitude (the amplitude the
+    describing function sees), not the bin's share of the power."""
+    extra = {"moment_arm_m": float(data.metadata["moment_arm_m"])} if "moment_arm_m" in data.metadata else {}
+    if method == "auto":
+        from taos.identify.segments import axis_excitation, estimate_by_segment, segment_record
+
+        unknown = set(kwargs) - {"axes", "nperseg"}
+        if unknown:
+            raise TypeError(f"estimate(method='auto') takes axes and nperseg, not {', '.join(sorted(unknown))}")
+        segs = segment_record(data)
+        out = estimate_by_segment(data, kwargs.get("axes"), nperseg=kwargs.get("nperseg"), segments=segs)
+        return [replace(r, meta={**r.meta, "excitation": axis_excitation(segs[r.axis]), "method_forced": False,
+                                 **extra}) for r in out]
     chosen, exc = choose_method(data, method)
     out = estimate_dwells(data, **kwargs) if chosen == "dwell" else estimate_h1(data, **kwargs)
     by_axis = {e.axis: e for e in exc}
@@ -441,6 +465,5 @@ def estimate(data: TestData, method: str = "auto", **kwargs: Any) -> list[Measur
         e = by_axis[r.axis]
         if chosen == "h1" and e.kind == "sweep":
             r = replace(r, amplitude_rad=np.full(r.freq_hz.shape, e.amplitude_rad))
-        extra = {"moment_arm_m": float(data.metadata["moment_arm_m"])} if "moment_arm_m" in data.metadata else {}
-        res.append(replace(r, meta={**r.meta, "excitation": e.to_dict(), "method_forced": method != "auto", **extra}))
+        res.append(replace(r, meta={**r.meta, "excitation": e.to_dict(), "method_forced": True, **extra}))
     return res
