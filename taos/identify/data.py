@@ -13,7 +13,9 @@ Signals (canonical names, unit kind)::
     records it), supply_pressure [pressure]
 
 CSV layout: optional leading ``#`` lines holding TOML metadata (``# condition = "hot fire"``,
-``# engine_angle_reference = "relative"``, ``# synthetic = true``), then a header row whose
+``# engine_angle_reference = "relative"``, ``# synthetic = true``, ``# test_date = 2026-03-09``: the
+date of the test, a TOML date or ISO-8601 text, which orders a test series in ``taos compare
+--records``), then a header row whose
 columns are ``signal [unit]`` (``pitch_command [deg]``), then numbers. Or any column names
 with a sidecar TOML beside the file (``run.csv`` + ``run.toml``)::
 

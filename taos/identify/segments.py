@@ -6,7 +6,7 @@ A test record often mixes excitations: pitch dwells while yaw sweeps, a quiet st
 time span and evidence:
 
 1. **dwell**: runs of upward zero crossings at a constant period, at least 3 cycles
-   (:func:`taos.identify.estimation.detect_dwells` on the whole command, so a record made of
+   (:func:`taos.identify.excitation.detect_dwells` on the whole command, so a record made of
    dwells only is estimated exactly as before). The crossing detector counts a dwell from its
    first *armed* crossing and ends it at its last one, so the first cycle of a record and the
    last cycle before a stop fall outside; an active remainder shorter than 1.5 periods beside
@@ -17,12 +17,12 @@ time span and evidence:
    least ``min_quiet_s`` (0.4 s). A sine slower than about 0.1 Hz is flat enough at its peaks
    to read as quiet for up to ~0.35 s, below that minimum.
 3. The active remainders between them: **sweep** or **multisine** by
-   :func:`taos.identify.estimation.classify_excitation` on the piece (monotone instantaneous
+   :func:`taos.identify.excitation.classify_excitation` on the piece (monotone instantaneous
    frequency; a few spectral lines holding 95 % of the power); **step/ramp** when the piece has
    fewer than 4 upward zero crossings about its mean and the command moves from one level to
    another (net change at least half its range); else **unknown** (reported, never used).
 
-Estimation (:func:`estimate_by_segment`): the dwell segments of an axis by the sine-dwell
+Estimation (:func:`taos.identify.estimation.estimate_by_segment`): the dwell segments of an axis by the sine-dwell
 correlation (:func:`~taos.identify.estimation.estimate_dwells`, with the other axis' dwell
 frequencies fitted alongside), each sweep or multisine segment by H1
 (:func:`~taos.identify.estimation.estimate_h1`) over its own time span only; the points of one
@@ -100,7 +100,9 @@ def _quiet_mask(t, u, tol: float, window_s: float, min_quiet_s: float):
     dt = float(np.median(np.diff(t)))
     w = max(3, int(round(window_s / dt)) | 1)
     rng = maximum_filter1d(u, w, mode="nearest") - minimum_filter1d(u, w, mode="nearest")
-    flat = maximum_filter1d((rng <= tol).astype(np.int8), w, mode="constant", cval=0).astype(bool)
+    # widened by half a window less two samples: two holds at different levels stay apart, the
+    # samples of the jump between them an active piece of their own (a step)
+    flat = maximum_filter1d((rng <= tol).astype(np.int8), max(1, w - 4), mode="constant", cval=0).astype(bool)
     out = np.zeros(u.size, bool)
     for i0, i1 in _runs(flat):
         if t[i1 - 1] - t[i0] >= min_quiet_s:
@@ -110,7 +112,7 @@ def _quiet_mask(t, u, tol: float, window_s: float, min_quiet_s: float):
 
 def _classify_piece(t, u, axis: str) -> tuple[str, str, tuple[float, float], float]:
     """(kind, reason, freq range, amplitude) of an active piece that is not a dwell."""
-    from taos.identify.estimation import _rising_crossings, classify_excitation
+    from taos.identify.excitation import _rising_crossings, classify_excitation
 
     u0 = u - u.mean()
     rng = float(u.max() - u.min())
@@ -148,7 +150,7 @@ def segment_command(t_s, command_rad, axis: str = "pitch", *, quiet_tol: float =
     min_quiet_s : float
         Shortest quiet stretch [s].
     """
-    from taos.identify.estimation import detect_dwells
+    from taos.identify.excitation import detect_dwells
 
     t = np.asarray(t_s, float)
     u = np.asarray(command_rad, float)
@@ -201,65 +203,6 @@ def segment_command(t_s, command_rad, axis: str = "pitch", *, quiet_tol: float =
 def segment_record(data: TestData) -> dict[str, list[ExcitationSegment]]:
     """:func:`segment_command` of every commanded axis of a record: {axis: segments}."""
     return {ax: segment_command(data.t_s, data.command_rad[i], ax) for i, ax in enumerate(data.axes)}
-
-
-def _merge(rs: list, axis: str):
-    """One MeasuredResponse of ``axis`` from per-segment responses (points in frequency order)."""
-    from taos.identify.estimation import MeasuredResponse
-
-    order = np.argsort(np.concatenate([r.freq_hz for r in rs]), kind="stable")
-    cat = lambda name, dt=float: np.concatenate([np.asarray(getattr(r, name), dt) for r in rs])[order]  # noqa: E731
-    has_e = all(r.engine is not None for r in rs)
-    r0 = rs[0]
-    return MeasuredResponse(axis, cat("freq_hz"), cat("amplitude_rad"), cat("piston_m_per_rad", complex),
-                            cat("engine", complex) if has_e else None, cat("coherence_piston"),
-                            cat("coherence_engine") if has_e else None, cat("sigma_piston"),
-                            cat("sigma_engine") if has_e else None, "+".join(sorted({r.method for r in rs})),
-                            r0.engine_dc_observable, r0.source, r0.condition,
-                            meta={k: v for r in rs for k, v in r.meta.items()}, segment_index=cat("segment_index", int))
-
-
-def estimate_by_segment(data: TestData, axes=None, *, nperseg: int | None = None,
-                        segments: dict[str, list[ExcitationSegment]] | None = None) -> list:
-    """Responses of each axis from its dwell, sweep and multisine segments (module docstring);
-    each response's ``meta['segments']`` lists all the axis' segments (``used`` true for those
-    estimated) and ``segment_index`` tags every point."""
-    from taos.identify.estimation import estimate_dwells, estimate_h1
-
-    segs = segments if segments is not None else segment_record(data)
-    axes = data.axes if axes is None else tuple(axes)
-    dwell_runs = {ax: [s.dwell for s in ss if s.kind == "dwell"] for ax, ss in segs.items()}
-    out = []
-    for ax in axes:
-        data.axis_index(ax)
-        usable = [s for s in segs[ax] if s.method is not None]
-        if not usable:
-            raise InputError(data.source, f"{ax}_command", "a dwell, sweep or multisine segment on this axis (or "
-                             "force --method dwell|h1)", got="unsure: " + "; ".join(
-                                 f"{s.reason} (#{s.index} {s.kind} {s.t0_s:.2f}-{s.t1_s:.2f} s)" for s in segs[ax])[:400])
-        parts = []
-        dw = [s for s in usable if s.kind == "dwell"]
-        if dw:
-            r = estimate_dwells(data, (ax,), segments={**dwell_runs, ax: [s.dwell for s in dw]})[0]
-            idx = np.array([min(dw, key=lambda s: abs(s.dwell.freq_hz - f)).index for f in r.freq_hz], int)
-            parts.append(replace(r, segment_index=idx))
-        for s in usable:
-            if s.method != "h1":
-                continue
-            sub = data.window(s.t0_s, s.t1_s)
-            nps = nperseg
-            if nps is not None and nps > sub.t_s.size:
-                raise InputError("command line", "--nperseg", f"a segment length within the {sub.t_s.size} samples "
-                                 f"of {ax} segment #{s.index} ({s.kind} {s.t0_s:.2f}-{s.t1_s:.2f} s)", got=str(nps))
-            r = estimate_h1(sub, (ax,), nperseg=nps)[0]
-            if s.kind == "sweep":  # the envelope is the amplitude the describing function sees
-                r = replace(r, amplitude_rad=np.full(r.freq_hz.shape, s.amplitude_rad))
-            parts.append(replace(r, segment_index=np.full(r.freq_hz.shape, s.index, int)))
-        merged = _merge(parts, ax)
-        used = {s.index for s in usable}
-        out.append(replace(merged, meta={**merged.meta, "segments": [
-            {**s.to_dict(), "used": s.index in used} for s in segs[ax]]}))
-    return out
 
 
 def axis_excitation(segs: list[ExcitationSegment]) -> dict:
