@@ -96,7 +96,8 @@ def test_mixed_record_estimated_in_one_call_with_segments_reported(mixed, tmp_pa
     # the text report names each segment, axis, kind and span
     r = run_cli("estimate", mixed)
     assert r.returncode == 0, r.stderr
-    assert re.search(r"^yaw +1 sweep +2\.0\d +22\.0\d +0\.7\d*-1[34]\.\d +0\.4\d* +yes$", r.stdout, re.M), r.stdout[:900]
+    row = r"^yaw +1 sweep +2\.0\d +22\.0\d +0\.7\d*-1[34]\.\d +0\.4\d* +yes$"
+    assert re.search(row, r.stdout, re.M), r.stdout[:900]
     assert re.search(r"^pitch +5 quiet +2[01]\.\d\d +2[23]\.\d\d .* no$", r.stdout, re.M)
 
 

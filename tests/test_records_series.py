@@ -65,3 +65,29 @@ def test_series_recovers_the_known_drift_of_K_L_friction_and_notch(tmp_path):
         assert t["slope_std_error"] < 0.05 * abs(true_slope)
     table = (out / "series_table.txt").read_text()
     assert "load_stiffness" in table and "trend per unit of x" in table and table.count("adequate") == 4
+
+
+def test_order_by_test_date_only_when_every_record_has_one(tmp_path):
+    """Dates (a TOML date, or ISO text with a time) order the series in days since the first test;
+    one record without a date leaves the given order (x = 1, 2, ...)."""
+    import datetime as dt
+
+    from taos.identify.data import TestData, load_test_data
+    from taos.identify.series import _order
+
+    t = np.arange(64) / 100.0
+    u = 0.01 * np.sin(2 * np.pi * 2 * t)[None]
+
+    def rec(meta):
+        return TestData("r.csv", t, ("pitch",), u, 0.01 * u, None, metadata=meta)
+
+    # a date written by to_csv is read back as a TOML date
+    p = tmp_path / "dated.csv"
+    rec({"test_date": dt.date(2026, 3, 9)}).to_csv(p)
+    assert "# test_date = 2026-03-09\n" in p.read_text()
+    d = load_test_data(p)
+    idx, x, dates, label = _order([rec({"test_date": "2026-03-12T12:00:00"}), d], ["a", "b"])
+    assert (idx, x, label) == ([1, 0], [0.0, 3.5], "days since 2026-03-09 (test_date)")
+    assert dates == ["2026-03-09", "2026-03-12T12:00:00"]
+    idx, x, dates, label = _order([rec({"test_date": "2026-03-12"}), rec({})], ["a", "b"])
+    assert (idx, x, dates, label) == ([0, 1], [1.0, 2.0], ["", ""], "record order")

@@ -132,7 +132,8 @@ def cmd_estimate(args) -> int:
 
 def _segment_table(segments: list[dict]) -> str:
     """The excitation segments as text: axis, index, kind, time span, frequencies, amplitude, use."""
-    lines = [f"{'axis':5s} {'#':>2s} {'excitation':10s} {'from_s':>8s} {'to_s':>8s} {'freq_hz':>13s} {'amp_deg':>8s}  used"]
+    lines = [f"{'axis':5s} {'#':>2s} {'excitation':10s} {'from_s':>8s} {'to_s':>8s} {'freq_hz':>13s} "
+             f"{'amp_deg':>8s}  used"]
     for s in segments:
         f0, f1 = s["freq_range_hz"]
         fr = "-" if f0 is None else (f"{f0:.3g}" if abs(f1 - f0) <= 1e-4 * f0 else f"{f0:.3g}-{f1:.3g}")

@@ -288,9 +288,9 @@ def estimate_by_segment(data: TestData, axes=None, *, nperseg: int | None = None
         data.axis_index(ax)
         usable = [s for s in segs[ax] if s.method is not None]
         if not usable:
+            found = "; ".join(f"{s.reason} (#{s.index} {s.kind} {s.t0_s:.2f}-{s.t1_s:.2f} s)" for s in segs[ax])
             raise InputError(data.source, f"{ax}_command", "a dwell, sweep or multisine segment on this axis (or "
-                             "force --method dwell|h1)", got="unsure: " + "; ".join(
-                                 f"{s.reason} (#{s.index} {s.kind} {s.t0_s:.2f}-{s.t1_s:.2f} s)" for s in segs[ax])[:400])
+                             "force --method dwell|h1)", got="unsure: " + found[:400])
         parts = []
         dw = [s for s in usable if s.kind == "dwell"]
         if dw:

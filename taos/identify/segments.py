@@ -157,7 +157,8 @@ def segment_command(t_s, command_rad, axis: str = "pitch", *, quiet_tol: float =
     amp = float(np.max(np.abs(u - np.median(u)))) if u.size else 0.0
     if amp <= 0.0:
         return [ExcitationSegment(axis, 0, "quiet", float(t[0]), float(t[-1]),
-                                  f"the command is constant at {math.degrees(u[0]):.3g} deg", amplitude_rad=float(u[0]))]
+                                  f"the command is constant at {math.degrees(u[0]):.3g} deg",
+                                  amplitude_rad=float(u[0]))]
     pieces: list[list] = []                # [kind, i0, i1, dwell]
     dwells = detect_dwells(t, u)
     taken = np.zeros(u.size, bool)
