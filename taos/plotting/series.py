@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import legend_once, wrapped_title  # (importing _common also sets the Agg backend)
+from ._common import wrapped_title  # (importing _common also sets the Agg backend)
 from ..linear import gain_db, phase_deg, phase_deg_continuous
 from ..units import from_si
 
@@ -45,18 +45,16 @@ def plot_series_responses(series, curves: dict, title: str | None = None):
             if lin is not None:
                 R = rec.fit.model.actuator.moment_arm_m
                 ref_f, ref_ph = np.asarray(lin.freq_hz), phase_deg(lin.piston)
-                ax[0, j].plot(lin.freq_hz, gain_db(lin.piston * R * IN_PER_DEG), ":", color=c, lw=1, gid="linear",
-                              label=f"{rec.label}: fitted model, linear")
+                ax[0, j].plot(lin.freq_hz, gain_db(lin.piston * R * IN_PER_DEG), ":", color=c, lw=1, gid="linear")
                 ax[1, j].plot(lin.freq_hz, ref_ph, ":", color=c, lw=1, gid="linear")
             for d, mp in zip(rec.fit.data, rec.fit.fitted_piston):
                 if d.axis != axis:
                     continue
                 ax[0, j].plot(d.freq_hz, gain_db(d.piston_m_per_rad * IN_PER_DEG), "o", mfc="none", color=c,
-                              gid="data", label=f"{rec.label}: data ({d.method})")
+                              gid="data")
                 ax[1, j].plot(d.freq_hz, phase_deg_continuous(d.freq_hz, d.piston_m_per_rad, ref_ph, ref_f), "o",
                               mfc="none", color=c, gid="data")
-                ax[0, j].plot(d.freq_hz, gain_db(mp * IN_PER_DEG), "x-", lw=0.8, ms=5, color=c, gid="model",
-                              label=f"{rec.label}: fitted model at the data's amplitudes")
+                ax[0, j].plot(d.freq_hz, gain_db(mp * IN_PER_DEG), "x-", lw=0.8, ms=5, color=c, gid="model")
                 ax[1, j].plot(d.freq_hz, phase_deg_continuous(d.freq_hz, mp, ref_ph, ref_f), "x-", lw=0.8, ms=5,
                               color=c, gid="model")
     for j, axis in enumerate(axes):
@@ -67,9 +65,29 @@ def plot_series_responses(series, curves: dict, title: str | None = None):
     for a in ax.flat:
         a.set_xscale("log")
         a.grid(True, which="both", alpha=0.3)
-    legend_once(fig, ax[0, -1], fontsize=7, loc="lower left")
+    _legend(fig, ax[0, -1], series)
     fig.suptitle(wrapped_title(fig, title or f"{len(series.records)} records: estimated responses and fits"))
     return fig
+
+
+def _legend(fig, a, series) -> None:
+    """One entry per record (its colour; a colour bar over the record order beyond 10 records)
+    and one per style: data, fitted model at the data, fitted linear response."""
+    from matplotlib.lines import Line2D
+
+    cols = _colours(len(series.records))
+    styles = [Line2D([], [], color="0.4", marker="o", mfc="none", ls="none", label="data"),
+              Line2D([], [], color="0.4", marker="x", lw=0.8, label="fitted model at the data's amplitudes"),
+              Line2D([], [], color="0.4", ls=":", lw=1, label="fitted model, linear (no friction)")]
+    if len(series.records) <= 10:
+        recs = [Line2D([], [], color=c, lw=3, label=r.label) for c, r in zip(cols, series.records)]
+        a.legend(handles=recs + styles, fontsize=7, loc="lower left")
+        return
+    import matplotlib as mpl
+
+    sm = mpl.cm.ScalarMappable(cmap="viridis", norm=mpl.colors.Normalize(1, len(series.records)))
+    fig.colorbar(sm, ax=a, label=f"record (1 = {series.records[0].label})")
+    a.legend(handles=styles, fontsize=7, loc="lower left")
 
 
 def plot_series_trend(series, title: str | None = None):
