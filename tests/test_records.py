@@ -123,6 +123,21 @@ def test_greenrun_uses_a_mixed_record(mixed, tmp_path):
     assert re.search(r"pitch: dwell \(6 segments \(5 dwell, 1 quiet\): #0 dwell 0\.00-6\.0\d s", html)
 
 
+@pytest.mark.slow
+def test_fit_of_a_mixed_record_recovers_the_hardware(mixed, tmp_path):
+    """Pitch dwells and the yaw sweep's H1 points fitted together give back the hot-fire model's
+    K_L (205,000 lbf/in) and Coulomb torque (117,525 in-lbf) within 3 standard errors."""
+    out = tmp_path / "fit.json"
+    r = run_cli("fit", mixed, "--model", MODELS / "rs25_hotfire.toml", "--free", "load_stiffness,coulomb_torque",
+                "--starts", "1", "--json", out)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(out.read_text())
+    assert {(x["axis"], x["method"]) for x in d["data"]} == {("pitch", "sine-dwell"), ("yaw", "h1")}
+    for name, true in (("load_stiffness", 205000.0), ("coulomb_torque", 117525.0)):
+        p = d["parameters"][name]
+        assert abs(p["value"] - true) < 3 * p["std_error"] and p["std_error"] < 0.005 * true, (name, p)
+
+
 def _one_line(r):
     assert r.returncode == 2, (r.returncode, r.stderr)
     lines = [x for x in r.stderr.splitlines() if x.strip()]
