@@ -95,6 +95,11 @@ def cmd_estimate(args) -> int:
     d = {"source": data.source, "condition": data.condition, "synthetic": data.synthetic,
          "sample_rate_hz": data.sample_rate_hz, "resampled": data.resampled,
          "engine_dc_observable": data.engine_absolute, "responses": [r.to_dict(model=model) for r in responses]}
+    if args.method == "auto":  # every segment of every axis, estimated or not (taos.identify.segments)
+        from taos.identify.segments import segment_record
+        used = {(r.axis, s["index"]) for r in responses for s in r.meta.get("segments") or () if s["used"]}
+        d["segments"] = [{**s.to_dict(), "used": (ax, s.index) in used}
+                         for ax, ss in segment_record(data).items() for s in ss]
     from taos.results import output_provenance
     d["provenance"] = {**output_provenance([model] if model is not None else [], inputs=[("data", args.data)]),
                        "method": args.method, "nperseg": args.nperseg, "seeds": "none (deterministic)"}
@@ -102,6 +107,8 @@ def cmd_estimate(args) -> int:
         write_json(args.json, d)
     out = sys.stderr if args.json == "-" else sys.stdout
     if not args.json or args.json == "-":
+        if d.get("segments"):
+            print(_segment_table(d["segments"]), file=out)
         for r, rd in zip(responses, d["responses"]):
             ex = rd.get("excitation") or {}
             forced = " (forced by --method)" if r.meta.get("method_forced") else ""
@@ -121,6 +128,19 @@ def cmd_estimate(args) -> int:
                             f"{r.coherence_engine[k]:6.3f}")
                 print(row, file=out)
     return 0
+
+
+def _segment_table(segments: list[dict]) -> str:
+    """The excitation segments as text: axis, index, kind, time span, frequencies, amplitude, use."""
+    lines = [f"{'axis':5s} {'#':>2s} {'excitation':10s} {'from_s':>8s} {'to_s':>8s} {'freq_hz':>13s} "
+             f"{'amp_deg':>8s}  used"]
+    for s in segments:
+        f0, f1 = s["freq_range_hz"]
+        fr = "-" if f0 is None else (f"{f0:.3g}" if abs(f1 - f0) <= 1e-4 * f0 else f"{f0:.3g}-{f1:.3g}")
+        a = "-" if s["amplitude_deg"] is None else f"{s['amplitude_deg']:.3g}"
+        lines.append(f"{s['axis']:5s} {s['index']:2d} {s['kind']:10s} {s['t0_s']:8.2f} {s['t1_s']:8.2f} {fr:>13s} "
+                     f"{a:>8s}  {'yes' if s['used'] else 'no'}")
+    return "\n".join(lines)
 
 
 def cmd_fit(args) -> int:
@@ -216,7 +236,100 @@ def write_comparison(cmp, out_dir, json_path: str | None = None):
     return out
 
 
+SERIES_FILES = ("series_table.txt", "series.json", "responses_overlay.png", "trend.png")
+
+
+def write_series(series, out_dir, json_path: str | None = None, model_path=None, record_paths=()):
+    """Write ``series_table.txt``, ``series.json``, ``responses_overlay.png`` and ``trend.png`` of
+    a :class:`taos.identify.series.RecordSeries` into ``out_dir`` (each complete or not at all;
+    foreign files left alone), and the JSON also to ``json_path``. Returns the folder."""
+    import json
+
+    import matplotlib.pyplot as plt
+
+    from taos.identify.series import series_curves
+    from taos.plotting import series as ps
+    from taos.results import output_provenance, write_output_folder
+
+    curves = series_curves(series)
+
+    def fig_writer(make, *a):
+        def write(p):
+            fig = make(series, *a)
+            try:
+                fig.savefig(p, dpi=120, format="png")
+            finally:
+                plt.close(fig)
+        return write
+
+    payload = {**series.to_dict(), "provenance": output_provenance([series.model], [("data", p) for p in record_paths])}
+    text = json.dumps(payload, indent=2, allow_nan=False, default=str) + "\n"
+    out = write_output_folder(out_dir, {
+        "series_table.txt": lambda p: p.write_text(series.table() + "\n"),
+        "series.json": lambda p: p.write_text(text),
+        "responses_overlay.png": fig_writer(ps.plot_series_responses, curves),
+        "trend.png": fig_writer(ps.plot_series_trend),
+    })
+    if json_path:
+        write_json(json_path, json.loads(text))
+    return out
+
+
+def _cmd_compare_series(args) -> int:
+    """``taos compare --model MODEL --records R1 R2 ... --out DIR``: a test series fitted record by
+    record and its trend (:mod:`taos.identify.series`)."""
+    from taos.identify.series import MAX_RECORDS, MIN_RECORDS, fit_series
+    from taos.model import load_model
+    from taos.results import check_output_folder
+
+    if args.model_a is not None or args.model_b is not None:
+        raise InputError("command line", "MODEL_A MODEL_B", "either two models (MODEL_A MODEL_B) or --model MODEL "
+                         "--records R1 R2 ..., not both", got=" ".join(x for x in (args.model_a, args.model_b) if x))
+    if args.data:
+        raise InputError("command line", "--data", "no --data with --records (each record is fitted from --model)",
+                         got=" ".join(args.data))
+    if not args.model:
+        raise InputError("command line", "--model", "a start model for the series (--model MODEL --records ...)",
+                         got="none")
+    if not MIN_RECORDS <= len(args.records) <= MAX_RECORDS:
+        raise InputError("command line", "--records", f"{MIN_RECORDS} to {MAX_RECORDS} record files",
+                         got=str(len(args.records)))
+    from taos.bounds import MAX_STARTS
+    if not 1 <= args.starts <= MAX_STARTS:
+        raise InputError("command line", "--starts", f"a number of starts from 1 to {MAX_STARTS}", got=str(args.starts))
+    check_output_folder(args.out, SERIES_FILES)
+    _outputs(args, "json")
+    free = [x.strip() for x in (args.free or "load_stiffness,coulomb_torque").split(",")]
+    if not all(free):
+        raise InputError("command line", "--free", "parameter names separated by single commas", got=repr(args.free))
+    labels = [x.strip() for x in args.labels.split(",")] if args.labels is not None else None
+    model = load_model(args.model)
+    from taos.identify.data import load_test_data
+    from taos.identify.surrogate import check_free
+    check_free(model, free)
+    datas = [load_test_data(p) for p in args.records]          # every record read and validated first
+    axes = None if args.axis in (None, "both") else (args.axis,)
+    for p, d in zip(args.records, datas):
+        if axes and axes[0] not in d.axes:
+            raise InputError(str(p), f"{axes[0]}_command", f"a {axes[0]} axis in the data", got=", ".join(d.axes))
+    series = fit_series(model, datas, free, labels=labels, method=args.method, axes=axes, nperseg=args.nperseg,
+                        starts=args.starts, progress=not args.json == "-")
+    out = write_series(series, args.out, json_path=args.json, record_paths=args.records)
+    stream = sys.stderr if args.json == "-" else sys.stdout
+    print(series.table(), file=stream)
+    print(f"wrote {out}/ ({', '.join(SERIES_FILES)})", file=stream)
+    return 0
+
+
 def cmd_compare(args) -> int:
+    if args.records:
+        return _cmd_compare_series(args)
+    if args.model is not None or args.free is not None:
+        raise InputError("command line", "--model" if args.model is not None else "--free",
+                         "--records R1 R2 ... with it (series mode), or two models MODEL_A MODEL_B", got="no --records")
+    if args.model_a is None or args.model_b is None:
+        raise InputError("command line", "MODEL_A MODEL_B", "two models (or --model MODEL --records R1 R2 ...)",
+                         got=" ".join(x for x in (args.model_a, args.model_b) if x) or "none")
     from taos.identify.compare import compare_models
     from taos.model import load_model
 
@@ -287,12 +400,19 @@ def add_parsers(sub) -> None:
     est_opts(p)
     p.set_defaults(func=cmd_fit)
 
-    p = sub.add_parser("compare", help="two model conditions side by side (e.g. ambient vs hot fire)")
-    p.add_argument("model_a")
-    p.add_argument("model_b")
+    p = sub.add_parser("compare", help="two model conditions side by side (e.g. ambient vs hot fire), or a series "
+                       "of test records fitted one by one with the trend of K_L, notch and friction level")
+    p.add_argument("model_a", nargs="?", help="model of condition A (two-model mode)")
+    p.add_argument("model_b", nargs="?", help="model of condition B (two-model mode)")
     p.add_argument("--data", nargs=2, metavar=("A_DATA", "B_DATA"), help="test data of each condition")
+    p.add_argument("--model", help="series mode: the start model every record is fitted from")
+    p.add_argument("--records", nargs="+", metavar="RECORD", help="series mode: two or more test records (.csv/.h5), "
+                   "in test order (or sorted by their test_date metadata when every record carries one)")
+    p.add_argument("--free", help="series mode: fitted parameters (default load_stiffness,coulomb_torque)")
+    p.add_argument("--starts", type=int, default=1, help="series mode: starts per fit (default 1)")
     p.add_argument("--out", required=True, help="output folder")
-    p.add_argument("--labels", help="two labels, comma-separated (default: the model names)")
+    p.add_argument("--labels", help="labels, comma-separated: two (default the model names), or one per record "
+                   "(default the file names)")
     p.add_argument("--json", metavar="PATH", help="also write the comparison JSON here ('-' for standard output)")
     est_opts(p)
     p.set_defaults(func=cmd_compare)

@@ -13,7 +13,9 @@ Signals (canonical names, unit kind)::
     records it), supply_pressure [pressure]
 
 CSV layout: optional leading ``#`` lines holding TOML metadata (``# condition = "hot fire"``,
-``# engine_angle_reference = "relative"``, ``# synthetic = true``), then a header row whose
+``# engine_angle_reference = "relative"``, ``# synthetic = true``, ``# test_date = 2026-03-09``: the
+date of the test, a TOML date or ISO-8601 text, which orders a test series in ``taos compare
+--records``), then a header row whose
 columns are ``signal [unit]`` (``pitch_command [deg]``), then numbers. Or any column names
 with a sidecar TOML beside the file (``run.csv`` + ``run.toml``)::
 
@@ -37,6 +39,7 @@ expected, got)``; nothing is written by reading.
 
 from __future__ import annotations
 
+import datetime as _dt
 import io
 import math
 from dataclasses import dataclass, field
@@ -115,6 +118,16 @@ class TestData:
     def sample_rate_hz(self) -> float:
         return float(1.0 / np.median(np.diff(self.t_s)))
 
+    def window(self, t0_s: float, t1_s: float) -> "TestData":
+        """The samples with t0_s <= t <= t1_s [s] (a segment of the record; same metadata)."""
+        from dataclasses import replace
+
+        m = (self.t_s >= t0_s) & (self.t_s <= t1_s)
+        opt = lambda a: None if a is None else np.asarray(a)[..., m]  # noqa: E731
+        return replace(self, t_s=self.t_s[m], command_rad=self.command_rad[:, m], piston_m=self.piston_m[:, m],
+                       engine_rad=opt(self.engine_rad), load_pressure_Pa=opt(self.load_pressure_Pa),
+                       spool_flow_m_s=opt(self.spool_flow_m_s), supply_pressure_Pa=opt(self.supply_pressure_Pa))
+
     def axis_index(self, axis: str) -> int:
         if axis not in self.axes:
             raise InputError(self.source, f"{axis}_command", f"a {axis} command column", got="none")
@@ -143,7 +156,7 @@ class TestData:
             names.append("supply_pressure [psi]")
         meta = {"condition": self.condition, "synthetic": self.synthetic,
                 "engine_angle_reference": "absolute" if self.engine_absolute else "relative",
-                **{k: v for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool))}}
+                **{k: v for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool, _dt.date))}}
         buf = io.StringIO()
         for k, v in meta.items():
             buf.write(f"# {k} = {_toml_value(v)}\n")
@@ -154,6 +167,8 @@ class TestData:
 
 
 def _toml_value(v) -> str:
+    if isinstance(v, _dt.date):   # a TOML date or date-time literal
+        return v.isoformat()
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, (int, float)):
@@ -188,7 +203,7 @@ def _split_header(name: str) -> tuple[str, str | None]:
 
 #: metadata keys the loader reads; other metadata is kept as free-form provenance, but a key
 #: close to one of these (a typo such as ``conditon``) is refused with the nearest suggested
-META_KEYS = {"condition", "synthetic", "engine_angle_reference", "description"}
+META_KEYS = {"condition", "synthetic", "engine_angle_reference", "description", "test_date"}
 
 
 def _check_meta(meta: dict, src: str, sidecar: bool) -> None:
@@ -202,9 +217,32 @@ def _check_meta(meta: dict, src: str, sidecar: bool) -> None:
                 raise InputError(src, k, f"a known key (did you mean {guess!r}?)", got="an unknown key")
     if "synthetic" in meta and not isinstance(meta["synthetic"], bool):
         raise InputError(src, "synthetic", "true or false", got=repr(meta["synthetic"])[:60])
+    if "test_date" in meta:
+        _test_date(meta["test_date"], src)
     for k in ("condition", "engine_angle_reference", "description"):
         if k in meta and not isinstance(meta[k], str):
             raise InputError(src, k, "a text value", got=repr(meta[k])[:60])
+
+
+def _test_date(v, src: str):
+    """The ``test_date`` metadata as a :class:`datetime.date` or :class:`datetime.datetime`
+    (a TOML date or date-time, or ISO-8601 text), else InputError."""
+    import datetime as dt
+
+    if isinstance(v, (dt.date, dt.datetime)):
+        return v
+    if isinstance(v, str):
+        try:
+            return dt.datetime.fromisoformat(v) if "T" in v or " " in v.strip() else dt.date.fromisoformat(v)
+        except ValueError:
+            pass
+    raise InputError(src, "test_date", "a date like 2026-03-14 (ISO 8601, or a TOML date)", got=repr(v)[:60])
+
+
+def record_date(data: "TestData"):
+    """The record's ``test_date`` (:class:`datetime.date`/``datetime``) or None."""
+    v = data.metadata.get("test_date")
+    return None if v is None else _test_date(v, data.source)
 
 
 def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:

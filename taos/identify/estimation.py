@@ -38,6 +38,8 @@ import numpy as np
 from taos.harmonics import fit_sines
 
 from taos.identify.data import TestData
+from taos.identify.excitation import (  # noqa: F401 (re-exported: the estimators' segment finders)
+    DwellSegment, Excitation, _rising_crossings, classify_excitation, classify_record, detect_dwells)
 from taos.errors import InputError
 from taos.linear import gain_db
 from taos.units import from_si
@@ -67,6 +69,9 @@ class MeasuredResponse:
     source: str = ""
     condition: str = ""
     meta: dict = field(default_factory=dict)
+    #: per point, the index of the command segment it was estimated from
+    #: (:mod:`taos.identify.segments`; None when not segmented)
+    segment_index: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.freq_hz.size)
@@ -78,7 +83,8 @@ class MeasuredResponse:
         return replace(self, freq_hz=self.freq_hz[m], amplitude_rad=self.amplitude_rad[m],
                        piston_m_per_rad=self.piston_m_per_rad[m], engine=opt(self.engine),
                        coherence_piston=self.coherence_piston[m], coherence_engine=opt(self.coherence_engine),
-                       sigma_piston=self.sigma_piston[m], sigma_engine=opt(self.sigma_engine))
+                       sigma_piston=self.sigma_piston[m], sigma_engine=opt(self.sigma_engine),
+                       segment_index=opt(self.segment_index))
 
     def to_freqresp(self, moment_arm_m: float):
         """As a :class:`~taos.planar.freqresp.FrequencyResponse` (piston x_p / (R theta_c)) for plots."""
@@ -117,6 +123,7 @@ class MeasuredResponse:
         R = moment_arm_m if moment_arm_m is not None else self.meta.get("moment_arm_m")
         return {"axis": self.axis, "method": self.method, "source": self.source, "condition": self.condition,
                 "excitation": self.meta.get("excitation"),
+                "point_segment": None if self.segment_index is None else [int(k) for k in self.segment_index],
                 "freq_hz": self.freq_hz.tolist(), "amplitude_deg": np.degrees(self.amplitude_rad).tolist(),
                 "piston_definition": "x_p / (R theta_c), dimensionless" if R else
                 "x_p / (R theta_c) needs the moment arm (taos estimate --model MODEL); see piston_in_per_deg",
@@ -127,162 +134,6 @@ class MeasuredResponse:
                 "engine": gp(self.engine, re), "coherence_piston": self.coherence_piston.tolist(),
                 "coherence_engine": None if self.coherence_engine is None else self.coherence_engine.tolist(),
                 "engine_dc_observable": self.engine_dc_observable}
-
-
-@dataclass(frozen=True)
-class DwellSegment:
-    """A sine-dwell segment of one axis' command: [t0_s, t1_s] holding ``cycles`` whole cycles."""
-
-    t0_s: float
-    t1_s: float
-    freq_hz: float
-    cycles: int
-
-
-# -- sine dwells --------------------------------------------------------------------------
-def _rising_crossings(t, u, hyst):
-    """Times of upward zero crossings of u with hysteresis ``hyst`` (linear interpolation)."""
-    out = []
-    armed = False
-    for i in range(1, u.size):
-        if u[i] < -hyst:
-            armed = True
-        if armed and u[i - 1] <= 0.0 < u[i]:
-            out.append(t[i - 1] + (t[i] - t[i - 1]) * (-u[i - 1]) / (u[i] - u[i - 1]))
-            armed = False
-    return np.asarray(out)
-
-
-def detect_dwells(t_s, command_rad, *, period_tol: float = 0.02, min_cycles: int = 3) -> list[DwellSegment]:
-    """Sine-dwell segments of a command: runs of upward zero crossings with a constant
-    period, at least ``min_cycles`` cycles.
-
-    A run continues while every period stays within ``period_tol`` of the run's *first*
-    period (not merely of its neighbour), so the slowly changing period of a logarithmic
-    sweep (about k/f per cycle, 1 % at 8 Hz for 0.5-14 Hz in 40 s) never passes as a dwell."""
-    t = np.asarray(t_s, float)
-    u = np.asarray(command_rad, float)
-    amp = np.max(np.abs(u)) if u.size else 0.0
-    if amp <= 0:
-        return []
-    tc = _rising_crossings(t, u, 0.05 * amp)
-    segs: list[DwellSegment] = []
-    if tc.size < 2:
-        return segs
-    P = np.diff(tc)
-    start = 0
-    for k in range(1, P.size + 1):
-        if k == P.size or abs(P[k] / P[start] - 1.0) > period_tol:
-            ncyc = k - start
-            if ncyc >= min_cycles and abs(_period_drift(P[start:k])) <= 0.25 * period_tol:
-                t0, t1 = tc[start], tc[k]
-                segs.append(DwellSegment(float(t0), float(t1), float(ncyc / (t1 - t0)), int(ncyc)))
-            start = k
-    return segs
-
-
-def _period_drift(P) -> float:
-    """Relative change of the period over a run of periods, from a least-squares line
-    (0 for a dwell up to crossing jitter; about n k / f for n cycles of a log sweep)."""
-    P = np.asarray(P, float)
-    if P.size < 2:
-        return 0.0
-    slope = np.polyfit(np.arange(P.size), P, 1)[0]
-    return float(slope * (P.size - 1) / P.mean())
-
-
-@dataclass(frozen=True)
-class Excitation:
-    """What a command record is, and why: ``kind`` is 'dwell', 'sweep', 'multisine' or
-    'unknown'; ``reason`` one sentence with the evidence; ``method`` the estimator it calls for
-    ('dwell', 'h1' or None when unsure); ``amplitude_rad`` the command's sine amplitude (the
-    envelope of a sweep, the dwell amplitudes' maximum, the peak of a multisine)."""
-
-    axis: str
-    kind: str
-    reason: str
-    method: str | None
-    freq_range_hz: tuple[float, float] = (math.nan, math.nan)
-    amplitude_rad: float = math.nan
-
-    def to_dict(self) -> dict:
-        return {"axis": self.axis, "kind": self.kind, "reason": self.reason, "method": self.method,
-                "freq_range_hz": [None if not math.isfinite(x) else x for x in self.freq_range_hz],
-                "amplitude_deg": math.degrees(self.amplitude_rad) if math.isfinite(self.amplitude_rad) else None}
-
-
-def classify_excitation(t_s, command_rad, axis: str = "pitch", *, dwell_fraction: float = 0.8,
-                        monotone_fraction: float = 0.95, line_power: float = 0.95) -> Excitation:
-    """Classify one command as sine dwells, a sweep or a multisine, with the evidence.
-
-    Rules (in order), from the upward zero crossings (instantaneous frequency f_k = 1/P_k)
-    and the record's periodogram:
-
-    * **dwell** when constant-period runs (:func:`detect_dwells`) hold at least
-      ``dwell_fraction`` of all cycles;
-    * **sweep** when f_k moves one way in at least ``monotone_fraction`` of the cycles and
-      spans more than a factor 1.5 (logarithmic if log f is closer to a line in time than f);
-    * **multisine** when at most a few dozen spectral lines (peaks above 1 % of the largest,
-      +-1 bin) hold at least ``line_power`` of the command's power;
-    * else **unknown**: the caller refuses to guess (force ``--method``).
-    """
-    t = np.asarray(t_s, float)
-    u = np.asarray(command_rad, float)
-    u0 = u - np.mean(u)
-    amp_pk = float(np.max(np.abs(u))) if u.size else 0.0
-    if amp_pk <= 0:
-        return Excitation(axis, "unknown", "the command is identically zero", None)
-    tc = _rising_crossings(t, u, 0.05 * amp_pk)
-    if tc.size < 4:
-        return Excitation(axis, "unknown", f"only {tc.size} upward zero crossings (too few cycles to tell)", None)
-    P = np.diff(tc)
-    f_inst = 1.0 / P
-    segs = detect_dwells(t, u)
-    dwell_cycles = sum(s.cycles for s in segs)
-    frac = dwell_cycles / P.size
-    fr = (float(f_inst.min()), float(f_inst.max()))
-    if frac >= dwell_fraction:
-        fl = ", ".join(f"{s.freq_hz:.3g}" for s in segs)
-        return Excitation(axis, "dwell", f"{len(segs)} constant-period segment(s) at {fl} Hz hold {frac:.0%} of "
-                          f"the {P.size} cycles", "dwell", (min(s.freq_hz for s in segs), max(s.freq_hz for s in segs)),
-                          amp_pk)
-    df = np.diff(f_inst)
-    up = float(np.mean(df > 0)) if df.size else 0.0
-    mono = max(up, 1.0 - up)
-    span = fr[1] / fr[0]
-    if mono >= monotone_fraction and span > 1.5:
-        tm = 0.5 * (tc[1:] + tc[:-1])
-        r2 = {}
-        for name, y in (("logarithmic", np.log(f_inst)), ("linear", f_inst)):
-            c = np.polyfit(tm, y, 1)
-            res = y - np.polyval(c, tm)
-            r2[name] = 1.0 - float(np.sum(res ** 2) / max(np.sum((y - y.mean()) ** 2), 1e-300))
-        kind = max(r2, key=r2.get)
-        env = float(np.percentile(np.abs(u0), 99.9))
-        return Excitation(axis, "sweep", f"instantaneous frequency {'rises' if up >= 0.5 else 'falls'} in {mono:.0%} "
-                          f"of {P.size} cycles from {fr[0]:.3g} to {fr[1]:.3g} Hz ({kind} sweep: R^2 = {r2[kind]:.4f}); "
-                          f"only {frac:.0%} of the cycles sit in constant-period runs", "h1", fr, env)
-    spec = np.abs(np.fft.rfft(u0)) ** 2
-    fbin = np.fft.rfftfreq(u0.size, float(np.median(np.diff(t))))
-    pk = np.flatnonzero((spec > 0.01 * spec.max()) & (spec >= np.roll(spec, 1)) & (spec >= np.roll(spec, -1)))
-    pk = pk[pk > 0]
-    near = np.zeros(spec.size, bool)
-    for k in pk:
-        near[max(k - 1, 0):k + 2] = True
-    share = float(spec[near].sum() / max(spec.sum(), 1e-300))
-    if 2 <= pk.size <= 64 and share >= line_power:
-        return Excitation(axis, "multisine", f"{pk.size} spectral lines from {fbin[pk].min():.3g} to "
-                          f"{fbin[pk].max():.3g} Hz hold {share:.0%} of the command power; zero crossings are neither "
-                          f"constant-period ({frac:.0%} of cycles) nor monotone ({mono:.0%})", "h1",
-                          (float(fbin[pk].min()), float(fbin[pk].max())), amp_pk)
-    return Excitation(axis, "unknown", f"not dwells ({frac:.0%} of {P.size} cycles at a constant period), not a sweep "
-                      f"(frequency monotone in {mono:.0%} of cycles, span x{span:.2g}), not a multisine "
-                      f"({pk.size} lines hold {share:.0%} of the power)", None, fr, amp_pk)
-
-
-def classify_record(data: TestData) -> list[Excitation]:
-    """:func:`classify_excitation` of each commanded axis of a record."""
-    return [classify_excitation(data.t_s, data.command_rad[i], ax) for i, ax in enumerate(data.axes)]
 
 
 def estimate_dwells(data: TestData, axes=None, *, segments: dict | None = None, settle_fraction: float = 0.5,
@@ -406,6 +257,65 @@ def estimate_h1(data: TestData, axes=None, *, nperseg: int | None = None, window
     return out
 
 
+# -- mixed records: segment by segment ----------------------------------------------------
+def _merge(rs: list, axis: str):
+    """One MeasuredResponse of ``axis`` from per-segment responses (points in frequency order)."""
+    order = np.argsort(np.concatenate([r.freq_hz for r in rs]), kind="stable")
+    cat = lambda name, dt=float: np.concatenate([np.asarray(getattr(r, name), dt) for r in rs])[order]  # noqa: E731
+    has_e = all(r.engine is not None for r in rs)
+    r0 = rs[0]
+    return MeasuredResponse(axis, cat("freq_hz"), cat("amplitude_rad"), cat("piston_m_per_rad", complex),
+                            cat("engine", complex) if has_e else None, cat("coherence_piston"),
+                            cat("coherence_engine") if has_e else None, cat("sigma_piston"),
+                            cat("sigma_engine") if has_e else None, "+".join(sorted({r.method for r in rs})),
+                            r0.engine_dc_observable, r0.source, r0.condition,
+                            meta={k: v for r in rs for k, v in r.meta.items()}, segment_index=cat("segment_index", int))
+
+
+def estimate_by_segment(data: TestData, axes=None, *, nperseg: int | None = None,
+                        segments: dict | None = None) -> list[MeasuredResponse]:
+    """Responses of each axis from its dwell, sweep and multisine segments
+    (:mod:`taos.identify.segments`, whose docstring states the rules);
+    each response's ``meta['segments']`` lists all the axis' segments (``used`` true for those
+    estimated) and ``segment_index`` tags every point."""
+    from taos.identify.segments import segment_record
+
+    segs = segments if segments is not None else segment_record(data)
+    axes = data.axes if axes is None else tuple(axes)
+    dwell_runs = {ax: [s.dwell for s in ss if s.kind == "dwell"] for ax, ss in segs.items()}
+    out = []
+    for ax in axes:
+        data.axis_index(ax)
+        usable = [s for s in segs[ax] if s.method is not None]
+        if not usable:
+            found = "; ".join(f"{s.reason} (#{s.index} {s.kind} {s.t0_s:.2f}-{s.t1_s:.2f} s)" for s in segs[ax])
+            raise InputError(data.source, f"{ax}_command", "a dwell, sweep or multisine segment on this axis (or "
+                             "force --method dwell|h1)", got="unsure: " + found[:400])
+        parts = []
+        dw = [s for s in usable if s.kind == "dwell"]
+        if dw:
+            r = estimate_dwells(data, (ax,), segments={**dwell_runs, ax: [s.dwell for s in dw]})[0]
+            idx = np.array([min(dw, key=lambda s: abs(s.dwell.freq_hz - f)).index for f in r.freq_hz], int)
+            parts.append(replace(r, segment_index=idx))
+        for s in usable:
+            if s.method != "h1":
+                continue
+            sub = data.window(s.t0_s, s.t1_s)
+            nps = nperseg
+            if nps is not None and nps > sub.t_s.size:
+                raise InputError("command line", "--nperseg", f"a segment length within the {sub.t_s.size} samples "
+                                 f"of {ax} segment #{s.index} ({s.kind} {s.t0_s:.2f}-{s.t1_s:.2f} s)", got=str(nps))
+            r = estimate_h1(sub, (ax,), nperseg=nps)[0]
+            if s.kind == "sweep":  # the envelope is the amplitude the describing function sees
+                r = replace(r, amplitude_rad=np.full(r.freq_hz.shape, s.amplitude_rad))
+            parts.append(replace(r, segment_index=np.full(r.freq_hz.shape, s.index, int)))
+        merged = _merge(parts, ax)
+        used = {s.index for s in usable}
+        out.append(replace(merged, meta={**merged.meta, "segments": [
+            {**s.to_dict(), "used": s.index in used} for s in segs[ax]]}))
+    return out
+
+
 def choose_method(data: TestData, method: str = "auto") -> tuple[str, list[Excitation]]:
     """The estimator for a record and the per-axis evidence (:func:`classify_excitation`).
 
@@ -429,10 +339,29 @@ def choose_method(data: TestData, method: str = "auto") -> tuple[str, list[Excit
 
 
 def estimate(data: TestData, method: str = "auto", **kwargs: Any) -> list[MeasuredResponse]:
-    """Responses of a record by the estimator :func:`choose_method` picks (``method`` 'auto',
-    or forced 'dwell'/'h1'). Each response's ``meta['excitation']`` holds what was detected
-    and why; for a sweep the H1 points carry the sweep's envelope amplitude (the amplitude
-    the describing function sees), not the bin's share of the power."""
+    """Responses of a record, one per axis.
+
+    ``method`` 'auto' classifies each axis' command segment by segment
+    (:func:`taos.identify.segments.segment_record`: dwells, sweeps, multisines, steps/ramps,
+    quiet) and estimates every dwell, sweep and multisine segment with its own estimator
+    (:func:`taos.identify.segments.estimate_by_segment`), so pitch dwells and a yaw sweep in one
+    record are estimated in one call; ``meta['excitation']`` sums up what was found and why and
+    ``meta['segments']`` lists the segments. 'dwell' or 'h1' forces one estimator over the whole
+    record (the whole-record classification :func:`classify_record` is then the evidence).
+    For a sweep the H1 points carry the sweep's envelope amplitude (the amplitude the
+    describing function sees), not the bin's share of the power."""
+    extra = {"moment_arm_m": float(data.metadata["moment_arm_m"])} if "moment_arm_m" in data.metadata else {}
+    if method == "auto":
+        from taos.identify.segments import axis_excitation, segment_record
+
+        unknown = set(kwargs) - {"axes", "nperseg"}
+        if unknown:
+            raise TypeError(f"estimate(method='auto') takes axes and nperseg, not {', '.join(sorted(unknown))}")
+        segs = segment_record(data)
+        out = estimate_by_segment(data, kwargs.get("axes"), nperseg=kwargs.get("nperseg"), segments=segs)
+        return [replace(r, meta={**r.meta, "excitation": {**axis_excitation(segs[r.axis]),
+                                                          "segments": r.meta["segments"]},
+                                 "method_forced": False, **extra}) for r in out]
     chosen, exc = choose_method(data, method)
     out = estimate_dwells(data, **kwargs) if chosen == "dwell" else estimate_h1(data, **kwargs)
     by_axis = {e.axis: e for e in exc}
@@ -441,6 +370,5 @@ def estimate(data: TestData, method: str = "auto", **kwargs: Any) -> list[Measur
         e = by_axis[r.axis]
         if chosen == "h1" and e.kind == "sweep":
             r = replace(r, amplitude_rad=np.full(r.freq_hz.shape, e.amplitude_rad))
-        extra = {"moment_arm_m": float(data.metadata["moment_arm_m"])} if "moment_arm_m" in data.metadata else {}
-        res.append(replace(r, meta={**r.meta, "excitation": e.to_dict(), "method_forced": method != "auto", **extra}))
+        res.append(replace(r, meta={**r.meta, "excitation": e.to_dict(), "method_forced": True, **extra}))
     return res
