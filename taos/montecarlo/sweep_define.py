@@ -188,7 +188,7 @@ def _text(k: SweptKey, value: float) -> tuple[object, str]:
     """(TOML value, text) of a sampled number of range ``k``."""
     if k.integer:
         return int(value), str(int(value))
-    txt = f"{value!r} {k.unit}".strip()
+    txt = f"{float(value)!r} {k.unit}".strip()
     return (txt if k.unit else float(value)), txt
 
 
