@@ -211,13 +211,25 @@ BAD = [
 
 
 @pytest.mark.parametrize("extra,needle", BAD, ids=[str(i) for i in range(len(BAD))])
-def test_bad_input_is_one_line_and_exit_2_with_nothing_written(tmp_path, extra, needle):
+def test_bad_input_is_one_line_and_exit_2_with_nothing_written(tmp_path, monkeypatch, capsys, extra, needle):
+    """Through the console script's entry (:func:`taos.cli.main`) in this process."""
+    from taos.cli import main
+
     if "--metric" not in extra:
         extra = [*extra, "--metric", "load_resonance_hz"]
-    r = run_cli("sweep", AMBIENT, *extra, "--json", tmp_path / "s.json", "--out", tmp_path / "o", cwd=tmp_path)
-    assert r.returncode == 2, r.stderr
-    assert len(r.stderr.strip().splitlines()) == 1 and needle in r.stderr, r.stderr
+    monkeypatch.chdir(tmp_path)
+    code = main(["sweep", str(AMBIENT), *extra, "--json", str(tmp_path / "s.json"), "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert len(err.strip().splitlines()) == 1 and needle in err, err
     assert not (tmp_path / "s.json").exists() and not (tmp_path / "o").exists() and not (tmp_path / "x.png").exists()
+
+
+def test_a_bad_value_from_the_console_script_is_one_line(tmp_path):
+    r = run_cli("sweep", AMBIENT, "--set", "structure.load_stiffness=5 kg", "--metric", "notch_hz",
+                "--json", tmp_path / "s.json")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "--set structure.load_stiffness" in r.stderr
+    assert not (tmp_path / "s.json").exists()
 
 
 def test_list_metrics_names_every_family():
