@@ -120,6 +120,21 @@ def test_latin_hypercube_puts_one_sample_in_each_stratum(tmp_path):
     assert [p["factors"] for p in again["points"]] == [p["factors"] for p in d["points"]]
 
 
+def test_sobol_indices_of_the_load_resonance_fall_on_the_load_stiffness(tmp_path):
+    """w_L = sqrt((K_L R^2 + K_n)/J) (seed paper eq. 1) has no piston area in it: on Saltelli's
+    design the other key's first-order and total indices are zero (the estimators difference
+    equal outputs), the load stiffness carries the variance (ST = 1 within the estimator's noise
+    at N = 8)."""
+    d = sweep_json(tmp_path, AMBIENT, "--sensitivity", "sobol", "--samples", "8",
+                   "--set", "structure.load_stiffness=100000 lbf/in:130000 lbf/in",
+                   "--set", "actuator.piston_area=13.5 in**2:16.5 in**2", "--metric", "load_resonance_hz")
+    assert d["grid"]["design"] == "sobol" and d["counts"]["ok"] == 8 * (2 + 2)
+    rows = {r["parameter"]: r for r in d["sensitivity"]["load_resonance_hz"]["indices"]}
+    assert rows["actuator.piston_area"]["S1"] == pytest.approx(0, abs=1e-12)
+    assert rows["actuator.piston_area"]["ST"] == pytest.approx(0, abs=1e-12)
+    assert rows["structure.load_stiffness"]["ST"] == pytest.approx(1, abs=0.3)
+
+
 def test_plot_of_a_two_key_grid(tmp_path):
     png = tmp_path / "sweep.png"
     r = run_cli("sweep", AMBIENT, "--set", "structure.load_stiffness=100000 lbf/in,150000 lbf/in",
@@ -207,6 +222,10 @@ BAD = [
       "--set", "engine.mass=3000 kg", "--plot", "x.png"], "--plot"),
     (["--set", "structure.load_stiffness=1e5 lbf/in", "--resume"], "--resume"),
     (["--set", "structure.load_stiffness=1e5 lbf/in", "--workers", "0"], "--workers"),
+    (["--sensitivity", "sobol", "--samples", "6", "--set", "structure.load_stiffness=1e5 lbf/in:2e5 lbf/in"],
+     "a power of two"),
+    (["--sensitivity", "sobol", "--samples", "8", "--set", "structure.load_stiffness=1e5 lbf/in,2e5 lbf/in"],
+     "a range LO:HI of real values"),
 ]
 
 

@@ -27,7 +27,7 @@ def _definition(args):
     if not args.metric:
         raise InputError("command line", "--metric", "at least one metric (taos sweep --list-metrics)", got="none")
     keys = [parse_set(s) for s in args.set]
-    design = make_design(keys, args.samples, args.seed)
+    design = make_design(keys, args.samples, args.seed, args.sensitivity)
     metrics = tuple(m.strip() for m in ",".join(args.metric).split(","))
     amps = None if args.amplitudes_deg is None else tuple(parse_float_list(args.amplitudes_deg, "--amplitudes-deg"))
     freqs = None if args.freq_hz is None else tuple(parse_float_list(args.freq_hz, "--freq-hz"))
@@ -91,6 +91,12 @@ def cmd_sweep(args) -> int:
         _table(res)
     print(f"{c['points']} points: {c['ok']} ok, {c['unstable']} unstable, {c['failed']} failed "
           f"({d['timing']['points_executed']} computed now, {d['timing']['executor']})", file=out)
+    for m, sens in (d.get("sensitivity") or {}).items():
+        if sens["indices"]:
+            print(f"{m}: " + ", ".join(f"{r['parameter']} S1 {r['S1']:.2f} +- {r['S1_conf']:.2f}, ST {r['ST']:.2f} "
+                                        f"+- {r['ST_conf']:.2f}" for r in sens["indices"]), file=out)
+        else:
+            print(f"{m}: no Sobol' indices ({sens['error']})", file=out)
     for u in d["unstable"][:5]:
         print(f"unstable at {u['set']}: {u['reason']}", file=out)
     for f in d["failed"][:5]:
@@ -118,7 +124,8 @@ def add_parsers(sub) -> None:
         "                   every combination of the listed values of each --set\n"
         "  Latin hypercube: --samples 50 --set 'structure.load_stiffness=80000 lbf/in:200000 lbf/in'\n"
         "                   LO:HI is a range sampled uniformly (whole numbers when both ends are);\n"
-        "                   a listed key is sampled among its values\n\n"
+        "                   a listed key is sampled among its values\n"
+        "  Sobol' indices:  --sensitivity sobol --samples 64 with every --set a range LO:HI\n\n"
         "Values are written as in the model file (a number with its unit, a plain number, or a word)\n"
         "and checked exactly as the model loader checks the file. Unstable variants are results\n"
         "(listed apart), not errors. Metrics: taos sweep --list-metrics.")
@@ -129,6 +136,8 @@ def add_parsers(sub) -> None:
                    help="figures per point, e.g. load_resonance_hz,engine_peaking_db,phase_margin_deg,lco")
     p.add_argument("--list-metrics", action="store_true", help="list the metrics and exit")
     p.add_argument("--samples", type=_whole, help="a Latin hypercube of N points instead of the grid")
+    p.add_argument("--sensitivity", choices=("sobol",), help="Sobol' indices of every metric: Saltelli's design "
+                   "over the --set ranges, --samples N base points (a power of two; N (k + 2) points)")
     p.add_argument("--seed", type=_whole, default=0, help="seed of the Latin hypercube (default 0)")
     p.add_argument("--axis", choices=("pitch", "yaw"), default="pitch", help="axis of the figures (default pitch)")
     p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels")

@@ -321,8 +321,31 @@ class SweepResult:
             points.append(row)
         counts = {"points": d.n, "ok": int(np.sum(self.status == store.STATUS["ok"])), "failed": len(failed),
                   "unstable": len(unstable)}
-        return {"format": FORMAT, "model_file": self.definition.model_file, "axis": self.definition.axis,
+        out = {"format": FORMAT, "model_file": self.definition.model_file, "axis": self.definition.axis,
                 "grid": d.to_dict(), "factor_units": {k.key: k.unit for k in d.keys},
                 "metrics": [{"name": m, "meaning": METRICS[m].meaning} for m in self.definition.metrics],
                 "counts": counts, "points": points, "failed": failed, "unstable": unstable,
                 "provenance": self.provenance, "timing": self.timing}
+        if d.design == "sobol":
+            out["sensitivity"] = {m: self.sensitivity(m) for m in self.definition.metrics if not METRICS[m].flag}
+        return out
+
+    def sensitivity(self, metric: str, confidence: float = 0.95) -> dict:
+        """First-order and total Sobol' indices of ``metric`` with their bootstrap half-widths
+        (:func:`taos.montecarlo.sensitivity.indices`; a Sobol' design only); ``indices`` None
+        with the reason when a point is not ok or the figure does not exist everywhere."""
+        from taos.montecarlo import sensitivity
+
+        d = self.definition.design
+        if d.design != "sobol":
+            raise ValueError("Sobol' indices need the sobol design")
+        y = self.values[metric]
+        base = {"method": "sobol", "output": metric, "points": d.n, "confidence": confidence}
+        bad = int(np.sum((self.status != store.STATUS["ok"]) | ~np.isfinite(y)))
+        if bad:
+            return base | {"indices": None, "error": f"{bad} points failed, unstable or without the figure: "
+                           "the estimators need every point"}
+        prob = {"num_vars": len(d.keys), "names": [k.key for k in d.keys],
+                "bounds": [list(k.numbers) for k in d.keys], "dists": ["unif"] * len(d.keys)}
+        return base | {"indices": sensitivity.indices("sobol", prob, d.factors, y, seed=d.seed,
+                                                      confidence=confidence)}

@@ -9,7 +9,10 @@ gives a range instead (two numbers with units of one dimension), for a Latin hyp
 * **latin-hypercube** (``--samples N``): N points, one per stratum of each key
   (:class:`scipy.stats.qmc.LatinHypercube`, seeded): a range is sampled uniformly between its
   ends (whole numbers when both ends are whole numbers without unit), a list by picking the
-  value of the stratum.
+  value of the stratum;
+* **sobol** (``--sensitivity sobol --samples N``): Saltelli's design of N (k + 2) points over the
+  ranges (uniform), for first-order and total Sobol' indices of every metric
+  (:mod:`taos.montecarlo.sensitivity`, SALib).
 
 Each point of the design is a set of overrides ``{"section.key": TOML value}`` that the model
 loader (:func:`taos.model.load_model`) writes into the file before checking it, so a swept
@@ -39,7 +42,7 @@ MAX_KEYS = 6
 MAX_VALUES = 500
 MAX_POINTS = 10_000
 MAX_TEXT = 4000
-DESIGNS = ("grid", "latin-hypercube")
+DESIGNS = ("grid", "latin-hypercube", "sobol")
 _KEY = re.compile(r"^[a-z][a-z0-9_]*\.[a-z][a-z0-9_]*$")
 _NUM_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d{1,3})?)\s+(\S.*?)\s*$")
 _WHERE = "command line"
@@ -192,9 +195,42 @@ def _text(k: SweptKey, value: float) -> tuple[object, str]:
     return (txt if k.unit else float(value)), txt
 
 
-def make_design(keys: list[SweptKey], samples: int | None = None, seed: int = 0) -> SweepDesign:
-    """The grid of ``keys`` (``samples`` None) or a Latin hypercube of ``samples`` points."""
+def _sobol_design(keys: list[SweptKey], base: int, seed: int) -> SweepDesign:
+    """Saltelli's design for first-order and total Sobol' indices over the ranges of ``keys``
+    (:func:`taos.montecarlo.sensitivity.design`): ``base`` (a power of two) times (k + 2) points."""
+    from taos.montecarlo import sensitivity
+
+    bad = [k for k in keys if not k.is_range or k.integer]
+    if bad:
+        raise InputError(_WHERE, f"--set {bad[0].key}", "a range LO:HI of real values for Sobol' indices",
+                         got="a list" if not bad[0].is_range else "whole-number ends")
+    n = base * (len(keys) + 2)
+    if base < 2 or base & (base - 1) or n > MAX_POINTS:
+        raise InputError(_WHERE, "--samples", f"a power of two N with N (k + 2) at most {MAX_POINTS} points "
+                         "(Saltelli's design)", got=f"{base} ({n} points)")
+    prob = {"num_vars": len(keys), "names": [k.key for k in keys], "bounds": [list(k.numbers) for k in keys],
+            "dists": ["unif"] * len(keys)}
+    factors = sensitivity.design("sobol", prob, base, seed=seed)
+    pairs = [[_text(k, v) for k, v in zip(keys, row)] for row in factors]
+    over = tuple({k.key: p[0] for k, p in zip(keys, row)} for row in pairs)
+    texts = tuple({k.key: p[1] for k, p in zip(keys, row)} for row in pairs)
+    return SweepDesign(tuple(keys), "sobol", np.asarray(factors, float), over, texts, None, seed)
+
+
+def make_design(keys: list[SweptKey], samples: int | None = None, seed: int = 0,
+                sensitivity: str | None = None) -> SweepDesign:
+    """The grid of ``keys`` (``samples`` None), a Latin hypercube of ``samples`` points, or
+    (``sensitivity="sobol"``) Saltelli's design of ``samples`` base points over the ranges."""
     _check_keys(keys)
+    if sensitivity is not None:
+        if sensitivity != "sobol":
+            raise InputError(_WHERE, "--sensitivity", "sobol", got=repr(sensitivity))
+        if samples is None:
+            raise InputError(_WHERE, "--sensitivity", "--samples N too (N base points, a power of two)",
+                             got="no --samples")
+        if not 0 <= seed < 2 ** 32:
+            raise InputError(_WHERE, "--seed", "a whole number from 0 to 2**32 - 1", got=str(seed))
+        return _sobol_design(keys, samples, seed)
     if samples is None:
         rng = [k for k in keys if k.is_range]
         if rng:
