@@ -40,6 +40,10 @@ def _definition(args):
                            flight_file=args.flight, avionics=args.avionics, amplitudes_deg=amps, freq_hz=freqs)
 
 
+def _where(texts: dict) -> str:
+    return ", ".join(f"{k}={v}" for k, v in texts.items())
+
+
 def _table(res) -> None:
     d = res.definition
     keys = [k.key for k in d.design.keys]
@@ -98,9 +102,9 @@ def cmd_sweep(args) -> int:
         else:
             print(f"{m}: no Sobol' indices ({sens['error']})", file=out)
     for u in d["unstable"][:5]:
-        print(f"unstable at {u['set']}: {u['reason']}", file=out)
+        print(f"unstable at {_where(u['set'])}: {u['reason']}", file=out)
     for f in d["failed"][:5]:
-        print(f"failed at {f['set']}: {f['reason']}", file=out)
+        print(f"failed at {_where(f['set'])}: {f['reason']}", file=out)
     return 0
 
 

@@ -20,7 +20,7 @@ def _label(k) -> str:
 
 
 def _marks(ax, x, y_base, status) -> None:
-    for code, style, name in ((STATUS["diverged"], "rx", "unstable"), (STATUS["failed"], "+", "failed")):
+    for code, style, name in ((STATUS["diverged"], "x", "unstable"), (STATUS["failed"], "+", "failed")):
         m = status == code
         if np.any(m):
             ax.plot(x[m], np.full(int(m.sum()), y_base), style, color="C3" if name == "unstable" else "0.5",
