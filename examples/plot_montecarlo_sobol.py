@@ -44,7 +44,8 @@ sens = {m: result.sensitivity(m)["indices"] for m in metrics}
 for m, rows in sens.items():
     print(m)
     for r in rows:
-        print(f"  {r['parameter']:<26s} S1 {r['S1']:5.2f} +- {r['S1_conf']:.2f}   ST {r['ST']:5.2f} +- {r['ST_conf']:.2f}")
+        print(f"  {r['parameter']:<26s} S1 {r['S1']:5.2f} +- {r['S1_conf']:.2f}   "
+              f"ST {r['ST']:5.2f} +- {r['ST_conf']:.2f}")
 
 wl = {r["parameter"]: r for r in sens["load_resonance_hz"]}
 others = max(wl[k]["ST"] for k in wl if k != "structure.load_stiffness")

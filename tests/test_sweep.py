@@ -247,7 +247,8 @@ def test_bad_input_is_one_line_and_exit_2_with_nothing_written(tmp_path, monkeyp
 def test_a_bad_value_from_the_console_script_is_one_line(tmp_path):
     r = run_cli("sweep", AMBIENT, "--set", "structure.load_stiffness=5 kg", "--metric", "notch_hz",
                 "--json", tmp_path / "s.json")
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "--set structure.load_stiffness" in r.stderr
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "--set structure.load_stiffness" in r.stderr
     assert not (tmp_path / "s.json").exists()
 
 

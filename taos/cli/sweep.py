@@ -80,7 +80,8 @@ def cmd_sweep(args) -> int:
         raise InputError("command line", "--plot", "a sweep of one or two keys (a metric over them)",
                          got=f"{len(defn.design.keys)} keys")
     from taos.montecarlo.sweep import run_sweep
-    res = run_sweep(defn, args.out, workers=1 if args.workers is None else args.workers, scheduler=args.scheduler, resume=args.resume,
+    workers = 1 if args.workers is None else args.workers
+    res = run_sweep(defn, args.out, workers=workers, scheduler=args.scheduler, resume=args.resume,
                     progress=not args.no_progress and sys.stderr.isatty(), batch=args.batch)
     if args.plot:
         from taos.plotting import save

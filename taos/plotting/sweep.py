@@ -52,7 +52,8 @@ def plot_sweep(res, title: str | None = None):
             for j, v in enumerate(sorted(set(x2))):
                 s = x2 == v
                 o = np.argsort(x[s])
-                ax.plot(x[s][o], y[s][o], "o-", color=f"C{j % 10}", label=f"{keys[1].key} = {d.texts[int(np.flatnonzero(s)[0])][keys[1].key]}")
+                shown = d.texts[int(np.flatnonzero(s)[0])][keys[1].key]
+                ax.plot(x[s][o], y[s][o], "o-", color=f"C{j % 10}", label=f"{keys[1].key} = {shown}")
             _marks(ax, x, _base(y), res.status)
         else:
             sc = ax.scatter(x, d.factors[:, 1], c=y, cmap="viridis", s=30)
