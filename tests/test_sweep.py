@@ -103,6 +103,18 @@ def test_unstable_variants_are_results_listed_apart(tmp_path):
     assert d["points"][0]["metrics"]["gain_margin_db"] > d["points"][1]["metrics"]["gain_margin_db"]
 
 
+def test_a_point_whose_figures_fail_is_stored_failed_with_its_reason(ambient):
+    """The run kind keeps going past a point it cannot compute: status failed, the reason, NaN."""
+    from taos.montecarlo.store import STATUS
+    from taos.montecarlo.sweep import SweepRuns
+
+    kind = SweepRuns((ambient, ambient), np.array([[1.0], [2.0]]), ("lco", "load_resonance_hz"), "pitch", None, "x")
+    out = kind.run_batch(("k",), np.array([[2.0], [1.0]]), np.zeros(2, np.int64))
+    assert list(out["status"]) == [STATUS["failed"]] * 2
+    assert "need a flight file" in out["error"][0] and np.isnan(out["load_resonance_hz"]).all()
+
+
+@pytest.mark.slow
 def test_latin_hypercube_puts_one_sample_in_each_stratum(tmp_path):
     """--samples N over a range: every sample inside it, one in each of N equal strata; a listed
     key sampled among its values; the same seed, the same points; the values as text with the
