@@ -527,26 +527,46 @@ def model_inputs(model: "TvcModel") -> dict:
     return {role: {"file": f, "sha256": h} for role, (f, h) in model.input_files.items()}
 
 
-def load_model(path: str | Path, friction: str | None = None) -> TvcModel:
+def _with_overrides(doc: dict, overrides: Mapping[str, Any]) -> tuple[dict, dict]:
+    """The model file's tables with ``overrides`` (``"section.key" -> TOML value``) written in,
+    and, per section, the overrides of keys the file does not hold itself (for ``[actuator]`` and
+    ``[friction]``: written after the parameter set is merged, so a swept set key is a variant of
+    the hardware and a swept model-file key is scaled with as the file's own would be)."""
+    doc, late = dict(doc), {}
+    for dotted, value in overrides.items():
+        section, _, key = dotted.partition(".")
+        table = dict(doc[section]) if isinstance(doc.get(section), Mapping) else {}
+        if section in ("actuator", "friction") and key not in table:
+            late.setdefault(section, {})[key] = value
+        else:
+            table[key] = value
+        doc[section] = table
+    return doc, late
+
+
+def load_model(path: str | Path, friction: str | None = None, overrides: Mapping[str, Any] | None = None) -> TvcModel:
     """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
+    ``overrides``: ``{"section.key": TOML value}`` replacing (or adding) keys of the file before
+    it is checked, exactly as if the file held them (``taos sweep``).
 
     Raises :class:`~taos.errors.InputError` (one line: file, field, expectation) on bad input.
     """
     p = resolve(path, "model")
     src = str(p)
     raw, doc = read_toml(p, "a readable model file")
+    doc, late = _with_overrides(doc, overrides or {})
     _check_keys(doc, KNOWN_SECTIONS, src, "")
     if "name" in doc and not isinstance(doc["name"], str):
         raise InputError(src, "name", "a text name", got=repr(doc["name"])[:60])
     engine = parse_engine(doc, src)
-    atab = actuator_table_with_parameter_set(_section(doc, "actuator", src), p, src)
+    atab = actuator_table_with_parameter_set(_section(doc, "actuator", src), p, src) | late.get("actuator", {})
     actuator = parse_actuator({"actuator": atab}, src)
     st = _section(doc, "structure", src)
     _check_keys(st, {"load_stiffness", "load_damping_ratio"}, src, "structure")
     structure = Structure(_need(st, "load_stiffness", "stiffness", src, "structure", positive=True),
                           (_need(st, "load_damping_ratio", "dimensionless", src, "structure", nonnegative=True)
                            if "load_damping_ratio" in st else 0.0))
-    ftab = friction_table_with_parameter_set(_section(doc, "friction", src), p, src)
+    ftab = friction_table_with_parameter_set(_section(doc, "friction", src), p, src) | late.get("friction", {})
     law = friction_from_table(ftab, src, model=friction)
     avionics = parse_avionics(doc, src)
     extra = {k: doc[k] for k in ("gimbal", "geometry") if k in doc}

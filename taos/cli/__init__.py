@@ -42,7 +42,7 @@ from taos.errors import run_cli as run  # noqa: E402
 
 #: subcommand modules, in help order
 COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.export",
-            "taos.cli.montecarlo", "taos.cli.fmu"]
+            "taos.cli.montecarlo", "taos.cli.sweep", "taos.cli.fmu"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -10,7 +10,10 @@
   intervals, envelopes, Spearman with Holm's correction;
 * :mod:`taos.montecarlo.sensitivity` - Sobol' and Morris indices (SALib), logistic regression;
 * :mod:`taos.montecarlo.analytic` - analytic run kinds (Ishigami) and the engine on any design;
-* :mod:`taos.montecarlo.executor` - a flight campaign end to end.
+* :mod:`taos.montecarlo.executor` - a flight campaign end to end;
+* :mod:`taos.montecarlo.sweep` - a parameter sweep over model-file keys (grid, Latin hypercube,
+  Saltelli's design for Sobol' indices) run on the engine (``taos sweep``), its design
+  (:mod:`taos.montecarlo.sweep_define`) and figures (:mod:`taos.montecarlo.sweep_metrics`).
 """
 
 from taos.montecarlo.analytic import Ishigami, run_design
@@ -20,6 +23,9 @@ from taos.montecarlo.executor import run_campaign
 from taos.montecarlo.run import FlightRuns
 from taos.montecarlo.stats import CampaignResult, summarise, wilson_interval
 from taos.montecarlo.store import open_store
+from taos.montecarlo.sweep import SweepDefinition, SweepResult, run_sweep
+from taos.montecarlo.sweep_define import make_design, parse_set
 
 __all__ = ["Campaign", "Dispersion", "load_campaign", "run_campaign", "FlightRuns", "CampaignResult",
-           "summarise", "wilson_interval", "Design", "RunKind", "Ishigami", "run_design", "open_store"]
+           "summarise", "wilson_interval", "Design", "RunKind", "Ishigami", "run_design", "open_store",
+           "SweepDefinition", "SweepResult", "run_sweep", "make_design", "parse_set"]

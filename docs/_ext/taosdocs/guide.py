@@ -102,6 +102,15 @@ STEPS: tuple[Step, ...] = (
     Step("montecarlo", "taos montecarlo post_separation --runs 4 --workers 1 --out out/mc --no-progress",
          outputs=("out/mc/summary.json", "out/mc/campaign.zarr", "out/mc/montecarlo.png"),
          figures=("out/mc/montecarlo.png",), show_stdout=5),
+    # -- Sweeps ------------------------------------------------------------------------------
+    Step("sweep", "taos sweep rs25_ambient --set 'structure.load_stiffness=80000 lbf/in,115000 lbf/in,150000 lbf/in' "
+         "--set 'actuator.loop_gain=20 1/s,40 1/s,400 1/s' --metric load_resonance_hz,engine_peaking_db,"
+         "phase_margin_deg --out out/sweep --json out/sweep.json --plot out/sweep.png",
+         outputs=("out/sweep.json", "out/sweep.png", "out/sweep/sweep.zarr", "out/sweep/sweep.json"),
+         figures=("out/sweep.png",), show_stdout=14),
+    Step("sweep_lco", f"taos sweep rs25_flight --flight core_stage {LCO_SHORT} --set 'structure.load_stiffness="
+         "115000 lbf/in,160000 lbf/in,205000 lbf/in' --metric lco,lco_engine_amplitude_deg,lco_margin_db "
+         "--plot out/sweep_lco.png", outputs=("out/sweep_lco.png",), figures=("out/sweep_lco.png",), show_stdout=6),
     # -- MASV --------------------------------------------------------------------------------
     Step("masv_modes", "masv modes core_stage", show_stdout=30),
     Step("masv_freqresp", "masv freqresp core_stage --freq-hz 0.5,1,2,3,5,7,10,14 --plot out/masv_grid.png "
