@@ -269,3 +269,15 @@ def confirm_many(jobs, threads: int | None = None, **kw) -> list[Confirmation]:
         return [confirm(p, m, s, **kw) for p, m, s in jobs]
     with ThreadPoolExecutor(max_workers=min(threads, len(jobs)), thread_name_prefix="taos-confirm") as ex:
         return list(ex.map(lambda j: confirm(*j, **kw), jobs))
+
+
+def compile_kernel(model) -> None:
+    """Compile (or load from the cache) the confirmation's kernel with ``model``'s plant types:
+    a run of no step on its simplex plant (``python -m taos.cli.warmup`` calls it)."""
+    from taos.planar.simplex import simplex_plant
+
+    plant = simplex_plant(model, "pitch")
+    n = plant.ss.A.shape[0]
+    y, aux = np.empty((1, n)), np.empty((1, _dyn.N_AUX))
+    _integrate_nogil(*kernel_args(plant, model), np.eye(n), model.friction.entry.rates, model.friction.pack(),
+                     model.avionics.pack(), np.zeros(n), 0.0, np.zeros((1, plant.n_ext)), 1e-4, 1, y, aux)
