@@ -32,8 +32,9 @@ show.
 ``CHUNK_CYCLES`` cycles; after each, the command's fundamental is fitted over every whole cycle
 (up-crossing to up-crossing) and the sequence a_k of cycle amplitudes is read:
 
-* ``sustained``: the last ``SETTLED_CYCLES`` ratios a_k / a_(k-1) within ``SETTLED_TOL`` of 1,
-  above the threshold (0.004 deg, just under one avionics LSB, as
+* ``sustained``: the last ``SETTLED_CYCLES`` ratios a_k / a_(k-1) within ``SETTLED_TOL`` of 1 and
+  the drift still to come, were the last changes to go on geometrically, within it too
+  (|d_k| rho / (1 - rho) / a_k, d_k = a_k - a_(k-1), rho = d_k / d_(k-1)), above the threshold (0.004 deg, just under one avionics LSB, as
   :func:`taos.flight.lco.measure_oscillation`): a limit cycle, measured over those cycles;
 * ``decays``: a_k below the threshold, or a geometric decay whose Aitken limit
   a_k - (a_k - a_(k-1))^2 / (a_k - 2 a_(k-1) + a_(k-2)) lies below it with a steady ratio
@@ -181,13 +182,26 @@ def cycle_amplitudes(t: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return np.asarray(out_t), np.asarray(out_a)
 
 
+def _drift_left(a: np.ndarray) -> float:
+    """The relative change still to come of the cycle amplitudes ``a`` if their last changes
+    go on geometrically, |d_k| rho / (1 - rho) / a_k with rho = d_k / d_(k-1) (0 when the last
+    change is below 0.1 %; inf while the changes do not shrink)."""
+    d = np.diff(a[-3:])
+    if abs(d[-1]) < 1e-3 * a[-1]:
+        return 0.0
+    rho = d[-1] / d[-2] if d[-2] != 0 else math.inf
+    if rho >= 1.0:
+        return math.inf
+    return abs(d[-1]) * max(rho, 0.0) / (1.0 - max(rho, 0.0)) / a[-1]
+
+
 def _decide(a: np.ndarray) -> str | None:
     """``sustained``, ``decays`` or None (run on) from the cycle amplitudes ``a`` (module docstring)."""
     if a.size and a[-1] < THRESHOLD_RAD:
         return "decays"
     if a.size >= SETTLED_CYCLES + 1:
         r = a[-SETTLED_CYCLES:] / a[-SETTLED_CYCLES - 1:-1]
-        if np.all(np.abs(r - 1.0) < SETTLED_TOL):
+        if np.all(np.abs(r - 1.0) < SETTLED_TOL) and _drift_left(a) < SETTLED_TOL:
             return "sustained"
     if a.size >= 4:
         d = np.diff(a[-4:])
