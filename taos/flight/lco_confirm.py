@@ -52,6 +52,7 @@ result is bit-identical to a serial run.
 from __future__ import annotations
 
 import math
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -215,10 +216,11 @@ def _decide(a: np.ndarray) -> str | None:
 
 
 def confirm(plant, model, start: CycleStart, *, duration_s: float = 300.0, window_s: float = 120.0,
-            dt_s: float = DEFAULT_DT_S) -> Confirmation:
+            dt_s: float = DEFAULT_DT_S, cancel: threading.Event | None = None) -> Confirmation:
     """Run the closed loop ``plant`` (with ``model``'s friction and avionics) from ``start`` and
     decide (module docstring). ``duration_s`` [s] the longest run, ``window_s`` [s] the window of
-    the final measurement when undecided, ``dt_s`` [s] the RK4 step."""
+    the final measurement when undecided, ``dt_s`` [s] the RK4 step; ``cancel``: when set, the
+    run stops after its current piece (raises :class:`RuntimeError`)."""
     from taos.errors import SimulationUnstable
     from taos.flight.lco import FlightHistory, measure_oscillation
 
@@ -236,6 +238,8 @@ def confirm(plant, model, start: CycleStart, *, duration_s: float = 300.0, windo
     ts, cs, es = [np.zeros(1)], [np.array([float(plant.cmd_c @ x)])], [np.array([float(ss.C[o("theta_rad")] @ x)])]
     done, outcome = 0, None
     while done < n_max and outcome is None:
+        if cancel is not None and cancel.is_set():
+            raise RuntimeError("confirmation cancelled")
         k = min(chunk, n_max - done)
         nrec = k // RECORD_EVERY + 1
         y = np.empty((nrec, Cy.shape[0]))
@@ -281,8 +285,16 @@ def confirm_many(jobs, threads: int | None = None, **kw) -> list[Confirmation]:
     threads = numba.get_num_threads() if threads is None else threads
     if threads <= 1 or len(jobs) <= 1:
         return [confirm(p, m, s, **kw) for p, m, s in jobs]
-    with ThreadPoolExecutor(max_workers=min(threads, len(jobs)), thread_name_prefix="taos-confirm") as ex:
-        return list(ex.map(lambda j: confirm(*j, **kw), jobs))
+    cancel = threading.Event()   # an interrupt (or a failed run) stops the other runs after their piece
+    ex = ThreadPoolExecutor(max_workers=min(threads, len(jobs)), thread_name_prefix="taos-confirm")
+    try:
+        futs = [ex.submit(confirm, *j, cancel=cancel, **kw) for j in jobs]
+        return [f.result() for f in futs]
+    except BaseException:
+        cancel.set()
+        raise
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
 
 
 def compile_kernel(model) -> None:
