@@ -12,6 +12,9 @@ import numpy as np
 from taos.errors import InputError
 from taos.results import write_json
 
+#: at most this many points in a verdict map
+MAX_MAP_POINTS = 400
+
 
 def cmd_lco(args) -> int:
     from taos.flight.vehicle import load_flight
@@ -41,6 +44,10 @@ def cmd_lco(args) -> int:
         raise InputError("command line", "--signoff", "--requirements FILE with it", got="no --requirements")
     if args.sweep:
         return _sweep(args, flight, model, amps, freqs)
+    for opt in ("out", "resume", "workers", "scheduler"):
+        if getattr(args, opt):
+            raise InputError("command line", "--" + opt, "--sweep too (a stored map campaign)",
+                             got=str(getattr(args, opt)))
     if args.plot_map:
         raise InputError("command line", "--plot-map", "--sweep too (the map is of a sweep)", got=args.plot_map)
     if args.plot_time and args.no_time_domain:
@@ -84,33 +91,78 @@ def cmd_lco(args) -> int:
 
 
 def _sweep(args, flight, model, amps, freqs) -> int:
-    """``taos lco --sweep NAME=V1,V2 [--sweep NAME2=...]``: the verdict map (prediction only)."""
-    from taos.flight.lco_map import lco_map, parse_sweep
-    for opt in ("plot", "plot_df", "plot_time", "df_out"):   # the sweep is prediction only: these would be ignored
+    """``taos lco --sweep NAME=V1,V2 [--sweep NAME2=...]``: the verdict map, each point confirmed in
+    the time domain (unless ``--no-time-domain``); with ``--out DIR`` run as a stored, resumable
+    campaign on the Monte Carlo engine."""
+    from taos.flight.lco_map import MapSettings, check_axes, lco_map, parse_sweep
+    for opt in ("plot", "plot_df", "plot_time", "df_out"):   # these would be ignored: one map for all points
         if getattr(args, opt):
             raise InputError("command line", "--" + opt.replace("_", "-"), "not with --sweep (a verdict map; its "
                              "plot is --plot-map)", got=getattr(args, opt))
     if len(args.sweep) > 2:
         raise InputError("command line", "--sweep", "one or two sweeps", got=f"{len(args.sweep)}")
-    axes = [parse_sweep(s) for s in args.sweep]
+    axes = check_axes(parse_sweep(s) for s in args.sweep)
+    n = int(np.prod([len(a.values) for a in axes]))
+    if n > MAX_MAP_POINTS:
+        raise InputError("command line", "--sweep", f"at most {MAX_MAP_POINTS} map points", got=f"{n} points")
     if args.axis:
         flight = dataclasses.replace(flight, axis=args.axis)
-    m = lco_map(flight, model, axes, amplitudes_rad=amps, freq_hz=freqs, avionics=args.avionics)
+    settings = MapSettings(None if amps is None else tuple(amps), None if freqs is None else tuple(freqs),
+                           args.avionics, not args.no_time_domain, args.td_start, args.duration,
+                           min(120.0, 0.5 * args.duration))
+    failed = []
+    if args.out:
+        import json as _json
+
+        from taos.flight.lco_campaign import FORMAT, run_map_campaign
+        from taos.flight.vehicle import load_flight
+        from taos.model import load_model
+        from taos.montecarlo.inputs import digest, recording
+        with recording() as input_files:   # every file a load of the inputs reads (the map's inputs hash)
+            load_flight(args.flight)
+            load_model(args.model, friction=args.friction)
+        if args.workers is not None and not 0 <= args.workers <= 64:
+            raise InputError("command line", "--workers", "0 to 64 workers", got=str(args.workers))
+        text = _json.dumps({"format": FORMAT, "settings": dataclasses.asdict(settings), "axis": flight.axis,
+                            "friction": args.friction, "load_stiffness": args.load_stiffness}, sort_keys=True)
+        sha, table = digest(input_files, text)
+        m, failed = run_map_campaign(flight, model, axes, settings, args.out, inputs_sha256=sha, input_files=table,
+                                     workers=args.workers or 0, scheduler=args.scheduler, resume=args.resume,
+                                     progress=args.json != "-")
+    else:
+        for opt in ("resume", "workers", "scheduler"):
+            if getattr(args, opt):
+                raise InputError("command line", "--" + opt, "--out DIR too (a stored campaign)",
+                                 got=str(getattr(args, opt)))
+        m = lco_map(flight, model, axes, amplitudes_rad=amps, freq_hz=freqs, avionics=args.avionics,
+                    time_domain=settings.time_domain, start=settings.start, duration_s=settings.duration_s,
+                    window_s=settings.window_s)
     if args.plot_map:
         from taos.plotting import save
         from taos.plotting.lco_map import plot_lco_map
         save(plot_lco_map(m), args.plot_map)
     d = {"sweep": m.to_dict(), "avionics": args.avionics}
+    if failed:
+        d["sweep"]["failed"] = failed
     if args.json:
         write_json(args.json, d)
-    else:
-        for idx in np.ndindex(m.lco.shape):
-            where = ", ".join(f"{a.name} = {a.values[i]:.4g} {a.unit}" for a, i in zip(m.axes, idx))
-            if m.lco[idx]:
-                print(f"{where}: LCO engine {m.engine_amplitude_deg[idx]:.4f} deg at {m.frequency_hz[idx]:.3f} Hz")
-            else:
-                print(f"{where}: no LCO, margin {m.margin_db[idx]:.2f} dB")
-    return 0
+    out = sys.stderr if args.json == "-" else sys.stdout
+    td = d["sweep"]["time_domain"]
+    for k, idx in enumerate(np.ndindex(m.lco.shape)):
+        where = ", ".join(f"{a.name} = {a.values[i]:.4g} {a.unit}" for a, i in zip(m.axes, idx))
+        pred = (f"LCO engine {m.engine_amplitude_deg[idx]:.4f} deg at {m.frequency_hz[idx]:.3f} Hz"
+                if (m.prediction_lco[idx] if m.prediction_lco is not None else m.lco[idx])
+                else f"no LCO, margin {m.margin_db[idx]:.2f} dB")
+        if td is None:
+            print(f"{where}: {pred}", file=out)
+            continue
+        g = lambda key: np.ravel(np.array(td[key], dtype=object))[k]  # noqa: E731
+        conf = (f"LCO engine {g('engine_amplitude_deg'):.4f} deg at {g('frequency_hz'):.3f} Hz" if g("lco") else
+                f"no LCO ({g('outcome') or 'not run'})")
+        print(f"{where}: {conf} (time domain, {g('simulated_s') or 0:.0f} s); predicted {pred}", file=out)
+    for f in failed:
+        print(f"failed: {f['at']}: {f['error']}", file=sys.stderr)
+    return 3 if failed else 0
 
 
 def add_parsers(sub) -> None:
@@ -137,9 +189,18 @@ def add_parsers(sub) -> None:
     p.add_argument("--plot-time", metavar="PNG_OR_SVG", help="engine-angle time history")
     p.add_argument("--df-out", metavar="HDF5", help="save the describing-function map")
     p.add_argument("--sweep", action="append", metavar="NAME=V1,V2,...",
-                   help="verdict map over one or two parameters (repeat for two; prediction only): "
-                   "bristle_stiffness, coulomb_torque, load_stiffness, integral_gain, attitude_gain, rate_gain; "
-                   "values in SI or each with its unit")
+                   help="verdict map over one or two parameters (repeat for two), each point confirmed in the time "
+                   "domain unless --no-time-domain: bristle_stiffness, coulomb_torque, load_stiffness, integral_gain, "
+                   "attitude_gain, rate_gain; values in SI or each with its unit")
+    p.add_argument("--td-start", choices=("predicted", "rest"), default="predicted",
+                   help="with --sweep: start each confirmation run on the describing function's periodic solution "
+                   "(default; a few cycles decide) or from rest as the single analysis does (--duration long)")
+    p.add_argument("--out", metavar="DIR", help="with --sweep: run the map as a stored campaign (DIR/map.json, "
+                   "DIR/map.zarr) on the Monte Carlo engine")
+    p.add_argument("--resume", action="store_true", help="with --out: run the map points not yet stored")
+    p.add_argument("--workers", type=int, help="with --out: local Dask worker processes (default 0: this process, "
+                   "both cores, no Dask start-up)")
+    p.add_argument("--scheduler", help="with --out: an existing Dask scheduler, e.g. tcp://127.0.0.1:8786")
     p.add_argument("--plot-map", metavar="PNG_OR_SVG", help="with --sweep: the verdict map")
     p.add_argument("--requirements", metavar="TOML", help="flight sign-off: check the stated limits (gain and phase "
                    "margins, LCO amplitude and frequency band) over the nominal case or every --sweep point; "

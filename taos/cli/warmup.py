@@ -22,6 +22,8 @@ def main() -> None:
     simulate(model, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
     sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1)
     model.friction.response([0.0, 0.1], 1e-3)
+    from taos.flight.lco_confirm import compile_kernel
+    compile_kernel(model)   # the verdict map's confirmation runs (taos lco --sweep)
     from taos.taos3d import simulate_taos, taos_freqresp, taos_model
     tm = taos_model(model)
     simulate_taos(tm, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
