@@ -141,14 +141,15 @@ def run_dwells(args, Cy, kern, amps, freqs, npc, n_settle, n_meas, out, status):
     A, bc = args[0], args[2]
     dts = 1.0 / (freqs * npc)
     uniq, inv = np.unique(dts, return_inverse=True)
-    M = max(_ex.table_nodes(A, 0.5 * h) for h in uniq)
+    ms = np.array([_ex.table_nodes(A, 0.5 * h) for h in uniq], np.int64)  # each step's own table
     co = [_ex.etd_coefficients(A, float(h)) for h in uniq]
     stack = [np.ascontiguousarray(np.stack([c[i] for c in co])) for i in range(6)]
-    tabs = [_ex.command_table(A, bc, 0.5 * float(h), M) for h in uniq]
-    G = np.ascontiguousarray(np.stack([t[0] for t in tabs]))
-    D = np.ascontiguousarray(np.stack([t[1] for t in tabs]))
-    idx = inv.astype(np.int64)
-    _ex.dwell_batch(*args, Cy, *kern, *stack, G, D, idx, idx, amps, freqs, npc, n_settle, n_meas, out, status)
+    G = np.zeros((uniq.size, ms.max() + 1, A.shape[0]))
+    D = np.zeros_like(G)
+    for i, h in enumerate(uniq):
+        G[i, :ms[i] + 1], D[i, :ms[i] + 1] = _ex.command_table(A, bc, 0.5 * float(h), int(ms[i]))
+    idx = inv.astype(np.int64).ravel()
+    _ex.dwell_batch(*args, Cy, *kern, *stack, G, D, ms, idx, idx, amps, freqs, npc, n_settle, n_meas, out, status)
 
 
 def exp_steps_per_cycle(args, model, inertia_kgm2: float, amps, freqs, cap_s: float | None,

@@ -179,9 +179,9 @@ def _matvec_add(M, v, out, scale):
 
 
 @njit(cache=True, fastmath=_FM, inline="always")
-def _g_at(G, D, H, tau, out, scale):
-    """out += scale * g(tau) by cubic Hermite interpolation of the table (G, D) on [0, H]."""
-    M = G.shape[0] - 1
+def _g_at(G, D, H, M, tau, out, scale):
+    """out += scale * g(tau) by cubic Hermite interpolation of the table (G, D) (its first
+    M + 1 rows) on [0, H]."""
     d = H / M
     s = tau / d
     i = int(s)
@@ -201,7 +201,7 @@ def _g_at(G, D, H, tau, out, scale):
 
 
 @njit(cache=True, fastmath=_FM)
-def _stair(G, D, H, cmax, w, ph0, ph1, avp, out):
+def _stair(G, D, H, M, cmax, w, ph0, ph1, avp, out):
     """out = the staircase's response over one half step (module docstring, part 2): the
     command c = cmax sin(phase) [rad] from phase ``ph0`` to ``ph1`` [rad] (one monotone
     quarter-wave), ``w`` [rad/s]; returns the avionics output u [rad] at its end."""
@@ -212,7 +212,7 @@ def _stair(G, D, H, cmax, w, ph0, ph1, avp, out):
     c1 = cmax * math.sin(ph1)
     if c1 == c0:
         u = _av.apply(c0, avp)
-        _g_at(G, D, H, H, out, u)
+        _g_at(G, D, H, M, H, out, u)
         return u
     up = c1 > c0
     # band of the start in the direction of motion, its level index j and its output u
@@ -220,7 +220,7 @@ def _stair(G, D, H, cmax, w, ph0, ph1, avp, out):
     j = math.floor(q) if up else math.ceil(q)
     dj = 1 if up else -1
     u = _av.apply((j + 0.5 * dj) * lsb2, avp)
-    _g_at(G, D, H, H, out, u)
+    _g_at(G, D, H, M, H, out, u)
     # quarter-wave of the half step: crossing phase of sin(phase) = s
     qm = math.floor((0.5 * (ph0 + ph1)) / (0.5 * math.pi))
     base = 2.0 * math.pi * math.floor(qm / 4.0)
@@ -240,7 +240,7 @@ def _stair(G, D, H, cmax, w, ph0, ph1, avp, out):
             ph = base + math.pi - a
         un = _av.apply(lev + 0.5 * dj * lsb2, avp)
         if un != u:
-            _g_at(G, D, H, H - (ph - ph0) / w, out, un - u)
+            _g_at(G, D, H, M, H - (ph - ph0) / w, out, un - u)
             u = un
     return u
 
@@ -270,14 +270,15 @@ def _nonlin(x, z, r, u, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, N):
 
 
 @njit(cache=True, fastmath=_FM)
-def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, amp,
+def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, amp,
                    n_per_cycle, dt, x, z, k0, nsteps, meas, out):
     """``nsteps`` ETDRK4 steps (module docstring) of r = amp sin(2 pi k / n_per_cycle) on every
     external input channel, from step index ``k0`` (phase), in place on ``x`` (n,) [x]; returns
     (z [rad], status -1 or the failing step, max |z| [rad]). With ``meas`` accumulates the
     correlation sums of y = Cy x at the step starts into ``out`` (n_y, 3) (as
     :func:`taos.planar.dynamics.sine_steps`). ``E`` .. ``F3``: :func:`etd_coefficients` for
-    ``dt`` [s]; ``G``, ``D``: :func:`command_table` for dt / 2; ``n_per_cycle`` a multiple of 4.
+    ``dt`` [s]; ``G``, ``D``: :func:`command_table` for dt / 2, its first ``tab_m`` + 1 rows
+    (``tab_m`` <= 0: all); ``n_per_cycle`` a multiple of 4.
     Plant arrays and kernels: :mod:`taos.planar.dynamics`."""
     n = x.shape[0]
     ny = Cy.shape[0]
@@ -289,6 +290,7 @@ def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, 
     wdt = 2.0 * math.pi / n_per_cycle
     w = wdt / dt
     H = 0.5 * dt
+    M = G.shape[0] - 1 if tab_m <= 0 else tab_m
     Nu = np.empty(n)
     Na = np.empty(n)
     Nb = np.empty(n)
@@ -318,8 +320,8 @@ def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, 
         rm = amp * math.sin(ph + 0.5 * wdt)
         r1 = amp * math.sin(ph + wdt)
         if stair:
-            um = _stair(G, D, H, cmax, w, ph, ph + 0.5 * wdt, avp, g1)
-            u1 = _stair(G, D, H, cmax, w, ph + 0.5 * wdt, ph + wdt, avp, g2)
+            um = _stair(G, D, H, M, cmax, w, ph, ph + 0.5 * wdt, avp, g1)
+            u1 = _stair(G, D, H, M, cmax, w, ph + 0.5 * wdt, ph + wdt, avp, g2)
         else:
             um = _av.apply(dcs * rm, avp)
             u1 = _av.apply(dcs * r1, avp)
@@ -365,7 +367,7 @@ def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, 
 
 
 @njit(cache=True, fastmath=_FM)
-def _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, amp, freq,
+def _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, amp, freq,
                n_per_cycle, n_settle, n_meas, out):
     """One sine dwell from rest by ETDRK4 (as :func:`taos.planar.dynamics._sine_dwell_one`:
     ``n_settle`` settling steps, then the normalised correlations over ``n_meas`` steps into
@@ -375,11 +377,11 @@ def _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, 
     dt = 1.0 / (freq * n_per_cycle)
     out[:, :] = 0.0
     z, st, _ = sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D,
-                              amp, n_per_cycle, dt, x, 0.0, 0, n_settle, False, out)
+                              tab_m, amp, n_per_cycle, dt, x, 0.0, 0, n_settle, False, out)
     if st >= 0:
         return st
     _, st, _ = sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D,
-                              amp, n_per_cycle, dt, x, z, n_settle, n_meas, True, out)
+                              tab_m, amp, n_per_cycle, dt, x, z, n_settle, n_meas, True, out)
     if st >= 0:
         return st + n_settle
     for o in range(Cy.shape[0]):
@@ -390,16 +392,17 @@ def _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, 
 
 
 @njit(cache=True, parallel=True, fastmath=_FM)
-def dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, offs, tab,
-                amps, freqs, n_per_cycle, n_settle, n_meas, out, status):
+def dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, offs,
+                tab, amps, freqs, n_per_cycle, n_settle, n_meas, out, status):
     """Independent ETDRK4 sine dwells in parallel (each as :func:`_dwell_one`). Dwell b uses
     the step coefficients ``E[offs[b]]`` .. ``F3[offs[b]]`` ((k, n, n) stacks, one per
-    distinct step) and the command table ``G[tab[b]]``, ``D[tab[b]]`` ((k, M + 1, n)); the
+    distinct step) and the command table ``G[tab[b]]``, ``D[tab[b]]`` ((k, M + 1, n), the
+    first ``tab_m[tab[b]]`` + 1 rows: each step's table has its own size); the
     rest per entry as :func:`taos.planar.dynamics.sine_dwell_batch`. A dwell's result does not
     depend on the other dwells (bit for bit)."""
     for b in prange(amps.shape[0]):
         o = offs[b]
         t = tab[b]
         status[b] = _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E[o], E2[o], P2[o], F1[o],
-                               F2[o], F3[o], G[t], D[t], amps[b], freqs[b], n_per_cycle[b], n_settle[b],
+                               F2[o], F3[o], G[t], D[t], tab_m[t], amps[b], freqs[b], n_per_cycle[b], n_settle[b],
                                n_meas[b], out[b])
