@@ -152,22 +152,18 @@ def run_dwells(args, Cy, kern, amps, freqs, npc, n_settle, n_meas, out, status):
     _ex.dwell_batch(*args, Cy, *kern, *stack, G, D, ms, idx, idx, amps, freqs, npc, n_settle, n_meas, out, status)
 
 
-def exp_steps_per_cycle(args, model, inertia_kgm2: float, amps, freqs, cap_s: float | None,
+def exp_steps_per_cycle(args, model, inertia_kgm2: float, amps, freqs, fixed_dt_s: float,
                         min_steps_per_cycle: int) -> np.ndarray:
     """Steps a cycle (int64, multiples of 4) of ETDRK4 dwells at ``amps`` [r] x ``freqs`` [Hz]
-    (paired): the step of :func:`dwell_step_s`, at most ``cap_s`` [s] when given, halved until
-    the friction law's own explicit-step rule accepts it (:meth:`taos.friction.FrictionLaw.check_step`:
-    the switching Coulomb law's stick band)."""
+    (paired): the step of :func:`dwell_step_s` (``fixed_dt_s`` [s] where the limits are
+    reached), halved until the friction law's own explicit-step rule accepts it
+    (:meth:`taos.friction.FrictionLaw.check_step`: the switching Coulomb law's stick band)."""
     from ..errors import InputError
-    from .simulate import DEFAULT_DT_S
 
-    fixed = DEFAULT_DT_S if cap_s is None else min(cap_s, DEFAULT_DT_S)
     out = np.empty(len(amps), np.int64)
     memo: dict[float, float] = {}
     for i, (a, f) in enumerate(zip(amps, freqs)):
-        h, _ = dwell_step_s(args, model, float(a), float(f), fixed)
-        if cap_s is not None:
-            h = min(h, cap_s)
+        h, _ = dwell_step_s(args, model, float(a), float(f), fixed_dt_s)
         if h not in memo:
             hh = h
             for _ in range(60):

@@ -218,15 +218,15 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     ``integrator``: ``"exp"`` (settled dwells; default) advances the linear block exactly and
     the quantised command exactly, the friction and limits by ETDRK4
     (:mod:`taos.planar._expstep`), at the step the friction loop needs
-    (:mod:`taos.planar._expplan`; ``dt_max_s`` caps it only when given); ``"rk4"`` the
-    fixed-step RK4 kernel at ``dt_max_s`` (default :data:`taos.planar.simulate.DEFAULT_DT_S`).
+    (:mod:`taos.planar._expplan`; ``dt_max_s`` is then the fixed step kept by the dwells whose
+    linear orbit reaches the rate limit or the hard stops); ``"rk4"`` the fixed-step RK4
+    kernel at ``dt_max_s`` (default :data:`taos.planar.simulate.DEFAULT_DT_S`).
     Shooting always uses the RK4 kernel."""
     if method not in STEADY_METHODS:
         raise ValueError(f"method must be one of {STEADY_METHODS}, got {method!r}")
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
     use_exp = integrator == "exp" and method == "settle"
-    cap_s = dt_max_s
     if dt_max_s is None:
         dt_max_s = DEFAULT_DT_S
     if measure_cycles is None:
@@ -240,7 +240,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     if use_exp:
         from ._expplan import exp_steps_per_cycle
 
-        npc = exp_steps_per_cycle(args, model, plant.inertia_kgm2, A, F, cap_s, min_steps_per_cycle)
+        npc = exp_steps_per_cycle(args, model, plant.inertia_kgm2, A, F, dt_max_s, min_steps_per_cycle)
     else:
         npc = np.maximum(np.ceil(1.0 / (F * dt_max_s)), min_steps_per_cycle).astype(np.int64)
     nbud = np.maximum(settle_cycles, np.ceil(ts * F)).astype(np.int64)
