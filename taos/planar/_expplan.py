@@ -135,20 +135,26 @@ def steps_per_cycle(h_s: float, freq: float, min_steps_per_cycle: int) -> int:
     return int(4 * math.ceil(n / 4))
 
 
-def run_dwells(args, Cy, kern, amps, freqs, npc, n_settle, n_meas, out, status):
-    """ETDRK4 dwells (:func:`taos.planar._expstep.dwell_batch`) for ``npc`` steps a cycle each:
-    the coefficient matrices and command tables are built once per distinct step."""
-    A, bc = args[0], args[2]
-    dts = 1.0 / (freqs * npc)
+def step_tables(A: np.ndarray, bc: np.ndarray, dts: np.ndarray):
+    """Coefficients for the steps ``dts`` [s] (one entry per dwell): the ETDRK4 matrices
+    (:func:`taos.planar._expstep.etd_coefficients`) and command tables, each built once per
+    distinct step and stacked. Returns ((E, E2, P2, F1, F2, F3) stacks (k, n, n), G, D
+    (k, M + 1, n), tab_m (k,) int64, idx (len(dts),) int64: the stack entry of each dwell)."""
     uniq, inv = np.unique(dts, return_inverse=True)
     ms = np.array([_ex.table_nodes(A, 0.5 * h) for h in uniq], np.int64)  # each step's own table
     co = [_ex.etd_coefficients(A, float(h)) for h in uniq]
-    stack = [np.ascontiguousarray(np.stack([c[i] for c in co])) for i in range(6)]
+    stack = tuple(np.ascontiguousarray(np.stack([c[i] for c in co])) for i in range(6))
     G = np.zeros((uniq.size, ms.max() + 1, A.shape[0]))
     D = np.zeros_like(G)
     for i, h in enumerate(uniq):
         G[i, :ms[i] + 1], D[i, :ms[i] + 1] = _ex.command_table(A, bc, 0.5 * float(h), int(ms[i]))
-    idx = inv.astype(np.int64).ravel()
+    return stack, G, D, ms, inv.astype(np.int64).ravel()
+
+
+def run_dwells(args, Cy, kern, amps, freqs, npc, n_settle, n_meas, out, status):
+    """ETDRK4 dwells (:func:`taos.planar._expstep.dwell_batch`) for ``npc`` steps a cycle each
+    (coefficients from :func:`step_tables`)."""
+    stack, G, D, ms, idx = step_tables(args[0], args[2], 1.0 / (freqs * npc))
     _ex.dwell_batch(*args, Cy, *kern, *stack, G, D, ms, idx, idx, amps, freqs, npc, n_settle, n_meas, out, status)
 
 

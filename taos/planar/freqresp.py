@@ -179,7 +179,7 @@ def deal_by_cost(cost) -> np.ndarray:
 
 #: how a sine dwell reaches the periodic orbit it measures (``taos freqresp --steady``)
 STEADY_METHODS = ("settle", "shoot")
-#: how a settled dwell is integrated: exponential Runge-Kutta (:mod:`taos.planar._expstep`) or
+#: how a dwell is integrated: exponential Runge-Kutta (:mod:`taos.planar._expstep`) or
 #: the fixed-step RK4 kernel (:mod:`taos.planar.dynamics`)
 INTEGRATORS = ("exp", "rk4")
 
@@ -221,12 +221,12 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     (:mod:`taos.planar._expplan`; ``dt_max_s`` is then the fixed step kept by the dwells whose
     linear orbit reaches the rate limit or the hard stops); ``"rk4"`` the fixed-step RK4
     kernel at ``dt_max_s`` (default :data:`taos.planar.simulate.DEFAULT_DT_S`).
-    Shooting always uses the RK4 kernel."""
+    Shooting integrates its periods with the same integrator."""
     if method not in STEADY_METHODS:
         raise ValueError(f"method must be one of {STEADY_METHODS}, got {method!r}")
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
-    use_exp = integrator == "exp" and method == "settle"
+    use_exp = integrator == "exp"
     if dt_max_s is None:
         dt_max_s = DEFAULT_DT_S
     if measure_cycles is None:
@@ -253,7 +253,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     out = np.zeros((A.size, 2, 3))
     status = np.full(A.size, -1, np.int64)
     extra = {}
-    if use_exp:
+    if use_exp and method == "settle":
         from ._expplan import run_dwells
 
         run_dwells(args, Cy, kern, A, F, npc, nbud * npc, nmeas, out, status)
@@ -273,8 +273,17 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
         scale = np.ones((A.size, n + 1))
         scale[:, :n] = np.maximum(mag, 1e-9 * np.maximum(mag.max(axis=1, keepdims=True), 1e-300))
         info = np.zeros((A.size, len(steady.INFO)))
-        steady.shoot_batch(*args, Cy, *kern, A, F, npc, nbud, nmeas, y0, scale, nz, tol, k_rre, max_cycles,
-                           out, info, status)
+        if use_exp:
+            from ._expplan import step_tables
+
+            tabs = step_tables(Am, bc, 1.0 / (F * npc))
+        else:   # unused coefficient stacks of the right types
+            z3 = np.zeros((1, n, n))
+            tabs = ((z3,) * 6, np.zeros((1, 2, n)), np.zeros((1, 2, n)), np.ones(1, np.int64),
+                    np.zeros(A.size, np.int64))
+        stack, G, D, ms, idx = tabs
+        steady.shoot_batch(*args, Cy, *kern, *stack, G, D, ms, idx, use_exp, A, F, npc, nbud, nmeas, y0, scale, nz,
+                           tol, k_rre, max_cycles, out, info, status)
         extra = {"residual": info[:, steady.INFO_RESIDUAL], "periods": info[:, steady.INFO_PERIODS].astype(np.int64),
                  "converged": info[:, steady.INFO_CONVERGED] > 0.5}
     bad = np.flatnonzero(status >= 0)
@@ -324,8 +333,7 @@ def sine_dwell_family(model: TvcModel, freq_hz, amplitudes_rad, axis: str = "pit
     rp, re = linear_phase_reference(model, f, axis)
     prov = {"model_sha256": model.sha256, "method": "sine-dwell", "steady_state": pts.method,
             "dt_max_s": kwargs.get("dt_max_s") or DEFAULT_DT_S,
-            "integrator": ("etdrk4" if kwargs.get("integrator", "exp") == "exp" and pts.method == "settle"
-                           else "rk4-fixed-step")}
+            "integrator": "etdrk4" if kwargs.get("integrator", "exp") == "exp" else "rk4-fixed-step"}
     fam = []
     for i, a in enumerate(amps):
         p = dict(prov)
