@@ -45,7 +45,8 @@ with w = c_w . x [rad/s], T_a = c_a . x [N m] and the limit corrections of
 
 The step h is chosen from the friction loop's own rates (:func:`friction_loop_rate`) and the
 measurement's sampling (:mod:`taos.planar.freqresp`), never from the linear block's.
-Work per step: nine 8 x 8 products and four friction-kernel calls, about three RK4 steps.
+Work per step: ten 8 x 8 matrix-vector products, four friction-kernel calls and the
+command's level crossings (a few RK4 steps' worth).
 """
 
 from __future__ import annotations
