@@ -18,7 +18,10 @@ scipy LSODA peer, in the same run.
 4. Time-domain accuracy of single dwells (2 cycles from rest, a quarter-cycle record): max
    engine error against RK4 at dt = 2.5e-5 s, of ETDRK4 at its chosen step and of RK4 at 2e-4 s.
 
-Run:  .venv/bin/python benchmarks/bench_expstep.py [--quick]
+5. ``--before-after`` (alone): the 3-call job and the map as whole processes with the RK4 kernel
+   and with the exponential integrator, in the same run.
+
+Run:  .venv/bin/python benchmarks/bench_expstep.py [--quick] [--before-after]
 """
 
 from __future__ import annotations
@@ -157,6 +160,28 @@ def time_domain(m, amp, f):
     return (math.degrees(np.max(np.abs(np.array(th) - ref))), math.degrees(np.max(np.abs(r4 - ref))), dt, why)
 
 
+def before_after(quick=False):
+    """The same jobs as whole processes (``python -c``, start-up included) with the RK4 kernel
+    (before) and the exponential integrator (after), in the same run."""
+    code = ("import sys; from taos.model import load_model; from taos.planar.freqresp import sine_dwell_family; "
+            f"m = load_model({MODEL!r}, friction={LAW!r}); "
+            "sine_dwell_family(m, [float(x) for x in sys.argv[1].split(',')], "
+            "[float(x) * 3.141592653589793 / 180 for x in sys.argv[2].split(',')], integrator=sys.argv[3])")
+    run = lambda f, a, i: wall([sys.executable, "-c", code, csv(f), csv(a), i])  # noqa: E731
+    run([1.0], [0.1], "exp")
+    run([1.0], [0.1], "rk4")
+    print("### Whole processes (python -c, start-up included), before and after\n")
+    print("| job | RK4 kernel (before) [s] | ETDRK4 (after) [s] | ratio |\n|---|---|---|---|")
+    jobs = [("3 calls of 10 dwells", [(JOB_FREQ, [a]) for a in JOB_AMPS])]
+    if not quick:
+        jobs.append(("8 x 30 map, one call", [(MAP_FREQ, MAP_AMPS)]))
+    for name, calls in jobs:
+        tb = sum(run(f, a, "rk4") for f, a in calls)
+        ta = sum(run(f, a, "exp") for f, a in calls)
+        print(f"| {name} | {tb:.2f} | {ta:.2f} | {tb / ta:.1f}x |")
+    print()
+
+
 def main(quick=False):
     from taos.linear import gain_db
     from taos.model import load_model
@@ -205,10 +230,10 @@ def main(quick=False):
         res[name] = (time.perf_counter() - t0, p, e)
     _, pr, er = res["RK4 kernel, dt 5e-5 s, 60 s settling (reference)"]
     print(f"### In-process, kernels warm: {amps.size} x {freqs.size} map\n")
+    sim_in = simulated_s(ts, list(amps), list(freqs))
+    print(f"LSODA peers for this map, scaled: {per_s * sim_in:.0f} s Python rhs, {per_sc * sim_in:.0f} s numba rhs\n")
     print("| integrator | wall [s] | engine vs 60 s reference [dB / deg] | piston vs 60 s reference [dB / deg] |")
     print("|---|---|---|---|")
-    sim_in = simulated_s(ts, list(amps), list(freqs))
-    print(f"(LSODA peers for this map, scaled: {per_s * sim_in:.0f} s Python rhs, {per_sc * sim_in:.0f} s numba rhs)\n")
     for name, (t, p, e) in res.items():
         d = lambda a, b: (np.max(np.abs(gain_db(a) - gain_db(b))), np.max(np.abs(np.degrees(np.angle(a / b)))))  # noqa: E731
         de, dp = d(e, er), d(p, pr)
@@ -222,4 +247,8 @@ def main(quick=False):
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    if "--before-after" in sys.argv:
+        print(f"uptime: {os.popen('uptime').read().strip()}\n")
+        before_after(quick="--quick" in sys.argv)
+    else:
+        main(quick="--quick" in sys.argv)
