@@ -179,6 +179,9 @@ def deal_by_cost(cost) -> np.ndarray:
 
 #: how a sine dwell reaches the periodic orbit it measures (``taos freqresp --steady``)
 STEADY_METHODS = ("settle", "shoot")
+#: how a dwell is integrated: exponential Runge-Kutta (:mod:`taos.planar._expstep`) or
+#: the fixed-step RK4 kernel (:mod:`taos.planar.dynamics`)
+INTEGRATORS = ("exp", "rk4")
 
 
 @dataclass(frozen=True, eq=False)
@@ -197,9 +200,9 @@ class DwellPoints:
 
 
 def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,
-                      dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int | None = None,
+                      dt_max_s: float | None = None, settle_cycles: int = 2, measure_cycles: int | None = None,
                       settle_s: float | None = None, min_steps_per_cycle: int = 64, method: str = "settle",
-                      tol: float = 1e-4, k_rre: int = 4, max_cycles: int = 8) -> DwellPoints:
+                      tol: float = 1e-4, k_rre: int = 4, max_cycles: int = 8, integrator: str = "exp") -> DwellPoints:
     """Sine dwells at paired points (``amplitudes_rad`` [rad], ``freq_hz`` [Hz], equal
     lengths), all in one parallel call of the compiled kernel; each dwell is independent, so a
     point's result does not depend on the other points (bit for bit).
@@ -210,9 +213,22 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     (:mod:`taos.planar.steady`, to the scaled residual ``tol``, ``k_rre`` + 1 periods per
     extrapolation, at most ``max_cycles`` extrapolations, then integration for the settling
     budget), measured over ``measure_cycles`` cycles (default 1: the orbit is periodic). Steps: at most ``dt_max_s`` [s] and at least
-    ``min_steps_per_cycle`` per cycle, an integer number per cycle."""
+    ``min_steps_per_cycle`` per cycle, an integer number per cycle.
+
+    ``integrator``: ``"exp"`` (settled dwells; default) advances the linear block exactly and
+    the quantised command exactly, the friction and limits by ETDRK4
+    (:mod:`taos.planar._expstep`), at the step the friction loop needs
+    (:mod:`taos.planar._expplan`; ``dt_max_s`` is then the fixed step kept by the dwells whose
+    linear orbit reaches the rate limit or the hard stops); ``"rk4"`` the fixed-step RK4
+    kernel at ``dt_max_s`` (default :data:`taos.planar.simulate.DEFAULT_DT_S`).
+    Shooting integrates its periods with the same integrator."""
     if method not in STEADY_METHODS:
         raise ValueError(f"method must be one of {STEADY_METHODS}, got {method!r}")
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
+    use_exp = integrator == "exp"
+    if dt_max_s is None:
+        dt_max_s = DEFAULT_DT_S
     if measure_cycles is None:
         measure_cycles = 2 if method == "settle" else 1
     A = np.atleast_1d(np.asarray(amplitudes_rad, float))
@@ -220,19 +236,28 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     plant = simplex_plant(model, axis)
     check_friction_step(model, plant.inertia_kgm2, dt_max_s)
     ts = settle_time_s(model, axis) if settle_s is None else settle_s
-    npc = np.maximum(np.ceil(1.0 / (F * dt_max_s)), min_steps_per_cycle).astype(np.int64)
+    args = kernel_args(plant, model)
+    if use_exp:
+        from ._expplan import exp_steps_per_cycle
+
+        npc = exp_steps_per_cycle(args, model, plant.inertia_kgm2, A, F, dt_max_s, min_steps_per_cycle)
+    else:
+        npc = np.maximum(np.ceil(1.0 / (F * dt_max_s)), min_steps_per_cycle).astype(np.int64)
     nbud = np.maximum(settle_cycles, np.ceil(ts * F)).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
     o = plant.ss.output_index
     Cy = np.ascontiguousarray(plant.ss.C[[o("x_p_m"), o("theta_rad")]])
-    args = kernel_args(plant, model)
     kern = (model.friction.entry.rates, model.friction.pack(), model.avionics.pack())
     perm = deal_by_cost(nbud * npc + nmeas)   # each dwell is independent; results are put back
     A, F, npc, nbud, nmeas = A[perm], F[perm], npc[perm], nbud[perm], nmeas[perm]
     out = np.zeros((A.size, 2, 3))
     status = np.full(A.size, -1, np.int64)
     extra = {}
-    if method == "settle":
+    if use_exp and method == "settle":
+        from ._expplan import run_dwells
+
+        run_dwells(args, Cy, kern, A, F, npc, nbud * npc, nmeas, out, status)
+    elif method == "settle":
         from . import dynamics as _ig
 
         _ig.sine_dwell_batch(*args, Cy, *kern, A, F, npc, nbud * npc, nmeas, out, status)
@@ -248,8 +273,17 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
         scale = np.ones((A.size, n + 1))
         scale[:, :n] = np.maximum(mag, 1e-9 * np.maximum(mag.max(axis=1, keepdims=True), 1e-300))
         info = np.zeros((A.size, len(steady.INFO)))
-        steady.shoot_batch(*args, Cy, *kern, A, F, npc, nbud, nmeas, y0, scale, nz, tol, k_rre, max_cycles,
-                           out, info, status)
+        if use_exp:
+            from ._expplan import step_tables
+
+            tabs = step_tables(Am, bc, 1.0 / (F * npc))
+        else:   # unused coefficient stacks of the right types
+            z3 = np.zeros((1, n, n))
+            tabs = ((z3,) * 6, np.zeros((1, 2, n)), np.zeros((1, 2, n)), np.ones(1, np.int64),
+                    np.zeros(A.size, np.int64))
+        stack, G, D, ms, idx = tabs
+        steady.shoot_batch(*args, Cy, *kern, *stack, G, D, ms, idx, use_exp, A, F, npc, nbud, nmeas, y0, scale, nz,
+                           tol, k_rre, max_cycles, out, info, status)
         extra = {"residual": info[:, steady.INFO_RESIDUAL], "periods": info[:, steady.INFO_PERIODS].astype(np.int64),
                  "converged": info[:, steady.INFO_CONVERGED] > 0.5}
     bad = np.flatnonzero(status >= 0)
@@ -298,7 +332,8 @@ def sine_dwell_family(model: TvcModel, freq_hz, amplitudes_rad, axis: str = "pit
     piston, engine = pts.piston.reshape(shape), pts.engine.reshape(shape)
     rp, re = linear_phase_reference(model, f, axis)
     prov = {"model_sha256": model.sha256, "method": "sine-dwell", "steady_state": pts.method,
-            "dt_max_s": kwargs.get("dt_max_s", DEFAULT_DT_S)}
+            "dt_max_s": kwargs.get("dt_max_s") or DEFAULT_DT_S,
+            "integrator": "etdrk4" if kwargs.get("integrator", "exp") == "exp" else "rk4-fixed-step"}
     fam = []
     for i, a in enumerate(amps):
         p = dict(prov)

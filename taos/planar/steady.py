@@ -5,7 +5,8 @@ r(t) = A sin(w t), T = 2 pi / w [s], with y = (x, z) the linear states (SI, as
 :class:`taos.planar.simplex.LurePlant`) and the friction law's state z [rad]. Settling finds it by
 integrating from rest through the slowest transient (seconds of the lightly damped load mode).
 Shooting solves the fixed-point problem of the one-period map P (``n_per_cycle`` steps of
-the same compiled RK4 step as every other run, :func:`taos.planar.dynamics._rk4_step`)::
+the dwell's integrator: the ETDRK4 step of :mod:`taos.planar._expstep` by default, or the
+compiled RK4 step of :func:`taos.planar.dynamics._rk4_step`)::
 
     G(y0) = P(y0) - y0 = 0
 
@@ -45,6 +46,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from . import _expstep as _ex
 from . import dynamics as _ig
 
 _FM = _ig._FM
@@ -57,8 +59,23 @@ INFO_RESIDUAL, INFO_PERIODS, INFO_EXTRAPOLATIONS, INFO_CONVERGED = range(len(INF
 
 
 @njit(cache=True, fastmath=_FM)
-def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, src, dst, s, nz, set_zscale,
-            x, corr, k1, k2, k3, k4, xt, r0, rm, r1):
+def _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, x, z, nsteps,
+           meas, out, k1, k2, k3, k4, xt, r0, rm, r1):
+    """``nsteps`` steps from phase 0 (whole cycles) by the ETDRK4 kernel
+    (:func:`taos.planar._expstep.sine_steps_exp`, coefficients ``ex`` = (E, E2, P2, F1, F2, F3,
+    G, D, tab_m)) when ``use_exp``, else by the RK4 kernel (:func:`taos.planar.dynamics.sine_steps`);
+    returns (z, status, max |z|) as they do."""
+    if use_exp:
+        E, E2, P2, F1, F2, F3, G, D, tab_m = ex
+        return _ex.sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D,
+                                  tab_m, amp, n_per_cycle, dt, x, z, 0, nsteps, meas, out)
+    return _ig.sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z, nsteps,
+                          meas, out, k1, k2, k3, k4, xt, r0, rm, r1)
+
+
+@njit(cache=True, fastmath=_FM)
+def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, src, dst, s, nz,
+            set_zscale, x, corr, k1, k2, k3, k4, xt, r0, rm, r1):
     """One period of the map: dst = P(src), src/dst = (x, z) (n + 1,) [x, rad]; ``corr``
     (n_y, 3) receives the period's correlation sums (:func:`taos.planar.dynamics.sine_steps`).
     With ``set_zscale`` the friction state's scale s[n] becomes the largest |z| of the period
@@ -72,8 +89,9 @@ def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cyc
     for j in range(n):
         x[j] = src[j]
     corr[:, :] = 0.0
-    z, st, zmax = _ig.sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x,
-                                 src[n] if nz else 0.0, n_per_cycle, True, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+    z0 = src[n] if nz else 0.0
+    z, st, zmax = _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, x,
+                         z0, n_per_cycle, True, corr, k1, k2, k3, k4, xt, r0, rm, r1)
     if set_zscale and nz:
         s[n] = max(zmax, 1e-300)
     d = 0.0
@@ -87,8 +105,8 @@ def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cyc
 
 
 @njit(cache=True, fastmath=_FM)
-def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, n_per_cycle, n_budget, n_meas,
-               y0, scale, nz, tol, k_rre, max_cycles, out, info):
+def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, freq, n_per_cycle, n_budget,
+               n_meas, y0, scale, nz, tol, k_rre, max_cycles, out, info):
     """Periodic steady state of one dwell (module docstring). ``y0`` (n + 1): the start
     (x0, z0); ``scale`` (n + 1): s_i (its last entry is replaced by the friction state's scale
     after the first period); ``nz`` 1 if the law has a state; ``k_rre`` + 1 periods per
@@ -120,8 +138,8 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
     while not converged:
         used = kk
         for i in range(1, kk):
-            st, d = _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, Y[i - 1],
-                            Y[i], s, nz, periods == 0, x, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+            st, d = _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt,
+                            Y[i - 1], Y[i], s, nz, periods == 0, x, corr, k1, k2, k3, k4, xt, r0, rm, r1)
             periods += 1
             if st >= 0:
                 return st + (periods - 1) * n_per_cycle
@@ -166,8 +184,8 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
         # fallback: integrate on from the last point until the settled dwell's budget is spent
         cur = Y[0].copy()
         for _ in range(max(n_budget - periods, 1)):
-            st, d = _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, cur,
-                            nxt, s, nz, periods == 0, x, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+            st, d = _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt,
+                            cur, nxt, s, nz, periods == 0, x, corr, k1, k2, k3, k4, xt, r0, rm, r1)
             periods += 1
             if st >= 0:
                 return st + (periods - 1) * n_per_cycle
@@ -184,8 +202,9 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
     else:
         out[:, :] = 0.0
         x[:] = ystar[:n]
-        _, st, _ = _ig.sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x,
-                                  ystar[n] if nz else 0.0, n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
+        z0 = ystar[n] if nz else 0.0
+        _, st, _ = _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, x,
+                          z0, n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
         if st >= 0:
             return st + periods * n_per_cycle
     for o in range(Cy.shape[0]):
@@ -200,14 +219,19 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, 
 
 
 @njit(cache=True, parallel=True, fastmath=_FM)
-def shoot_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps, freqs, n_per_cycle, n_budget, n_meas,
-                y0, scale, nz, tol, k_rre, max_cycles, out, info, status):
+def shoot_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, idx, use_exp,
+                amps, freqs, n_per_cycle, n_budget, n_meas, y0, scale, nz, tol, k_rre, max_cycles, out, info, status):
     """Independent shooting dwells in parallel: :func:`_shoot_one` for every entry b of ``amps``
     (n_b,) [r] and ``freqs`` (n_b,) [Hz] with its ``n_per_cycle``, ``n_budget``, ``n_meas``
     (n_b,), start ``y0`` and scales ``scale`` (n_b, n + 1), into ``out[b]`` (n_b, n_y, 3),
-    ``info[b]`` (n_b, len(INFO)) and ``status[b]`` (n_b,) int; the rest as :func:`_shoot_one`."""
+    ``info[b]`` (n_b, len(INFO)) and ``status[b]`` (n_b,) int; the rest as :func:`_shoot_one`.
+    With ``use_exp`` the periods are ETDRK4 steps with the coefficient stacks ``E`` .. ``D``,
+    ``tab_m`` at ``idx[b]`` (as :func:`taos.planar._expstep.dwell_batch`), else RK4 steps (the
+    stacks unused)."""
     for b in prange(amps.shape[0]):
-        status[b] = _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps[b], freqs[b],
+        i = idx[b]
+        ex = (E[i], E2[i], P2[i], F1[i], F2[i], F3[i], G[i], D[i], tab_m[i])
+        status[b] = _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amps[b], freqs[b],
                                n_per_cycle[b], n_budget[b], n_meas[b], y0[b], scale[b], nz, tol, k_rre,
                                max_cycles, out[b], info[b])
 
