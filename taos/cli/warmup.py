@@ -21,6 +21,12 @@ def main() -> None:
     model = load_model("rs25_hotfire")
     simulate(model, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
     sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1)
+    # the exponential (ETDRK4) and RK4 dwell kernels, settled and shooting (both integrators'
+    # shooting kernel compile together: minutes on a loaded machine if a test paid for it)
+    sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1,
+                    integrator="rk4")
+    sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1,
+                    method="shoot", max_cycles=1)
     model.friction.response([0.0, 0.1], 1e-3)
     from taos.flight.lco_confirm import compile_kernel
     compile_kernel(model)   # the verdict map's confirmation runs (taos lco --sweep)
