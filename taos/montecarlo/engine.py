@@ -9,7 +9,9 @@
   50 to 1000 runs, fewer when the campaign is too small to keep every worker busy). A batch's
   results are written into the store (:mod:`taos.montecarlo.store`) the moment they arrive and
   released from the workers; the client never holds more than one batch of outputs.
-* **No run lost.** A worker that dies: Dask re-runs its batches elsewhere (``RETRIES``). A run
+* **No run lost.** A worker that dies: Dask re-runs its batches elsewhere (``RETRIES``); a batch
+  cancelled because the dead worker held the scattered run kind is submitted again with the run
+  kind scattered anew (``RESUBMITS``). A run
   that fails in itself is stored as failed with its reason. An interrupted campaign resumes by
   running the batches whose status is still "not run".
 * **Reproducible.** A run is a pure function of its design row and seed, so the stored values are
@@ -35,6 +37,8 @@ from taos.errors import InputError
 from taos.montecarlo import store
 
 RETRIES = 3
+#: times a batch cancelled with a lost worker is submitted again
+RESUBMITS = 5
 TASK_S = 10.0
 MIN_BATCH, MAX_BATCH = 50, 1000
 CONNECT_TIMEOUT_S = 20.0
@@ -160,6 +164,42 @@ def pending_batches(path: Path, part: Part, batch: int) -> list[int]:
     return [s for s in range(0, part.design.n, batch) if np.any(st[s:s + batch] == store.STATUS["pending"])]
 
 
+def _on_cluster(client, kind: RunKind, todo: list, batch: int, stored) -> None:
+    """Submit every batch of ``todo`` ((part, start row) pairs) and hand each result to
+    ``stored`` as it arrives. The run kind is scattered to every worker once; when a worker dies
+    holding it, the scheduler may forget it and cancel the batches waiting on it ("already
+    forgotten"): such a batch is submitted again with the run kind scattered anew (at most
+    ``RESUBMITS`` times per batch), so a lost worker costs time, never a run."""
+    from concurrent.futures import CancelledError
+
+    from dask.distributed import as_completed
+    gen = [0, client.scatter(kind, broadcast=True, hash=False)]  # generation, scattered run kind
+
+    def submit(p: Part, s: int, tries: int):
+        d = p.design
+        f = client.submit(run_task, gen[1], d.names, d.factors[s:s + batch], d.seeds[s:s + batch],
+                          pure=False, retries=RETRIES)
+        meta[f.key] = (p, s, tries, gen[0])
+        return f
+
+    meta: dict = {}
+    ac = as_completed([submit(p, s, 0) for p, s in todo])
+    for f in ac:
+        p, s, tries, g = meta.pop(f.key)
+        try:
+            out = f.result()
+        except CancelledError:
+            if tries >= RESUBMITS:
+                raise
+            if g == gen[0]:  # the run kind this batch waited on is gone: scatter it again, once
+                gen[:] = [g + 1, client.scatter(kind, broadcast=True, hash=False)]
+            f.release()
+            ac.add(submit(p, s, tries + 1))
+            continue
+        stored(p, s, out)
+        f.release()  # the batch's results leave the worker once stored
+
+
 def execute(path: Path, kind: RunKind, parts: Sequence[Part], batch: int, client, progress: bool = False) -> int:
     """Run every pending batch of ``parts`` (stored at ``path``) on ``client`` (None: in this
     process); returns the number of runs executed."""
@@ -180,18 +220,7 @@ def execute(path: Path, kind: RunKind, parts: Sequence[Part], batch: int, client
                 d = p.design
                 stored(p, s, run_task(kind, d.names, d.factors[s:s + batch], d.seeds[s:s + batch]))
             return total
-        from dask.distributed import as_completed
-        kf = client.scatter(kind, broadcast=True, hash=False)
-        futs = {}
-        for p, s in todo:
-            d = p.design
-            f = client.submit(run_task, kf, d.names, d.factors[s:s + batch], d.seeds[s:s + batch],
-                              pure=False, retries=RETRIES)
-            futs[f.key] = (f, p, s)
-        for f in as_completed([v[0] for v in futs.values()]):
-            _, p, s = futs.pop(f.key)
-            stored(p, s, f.result())
-            f.release()  # the batch's results leave the worker once stored
+        _on_cluster(client, kind, todo, batch, stored)
         return total
     finally:
         if bar is not None:
