@@ -241,7 +241,7 @@ _RECORDED = ("attitude_rad", "rate_rad_s", "delta_cmd_rad", "theta_rad", "omega_
 
 def _fly_lanes(lanes: list[_Lane], ax: str, t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
     """Fly ``lanes`` (equal keys) in one call of
-    :func:`taos.planar.dynamics.integrate_segments_lanes`; per lane (the :data:`SIGNALS`\ [:8]
+    :func:`taos.planar.dynamics.integrate_segments_lanes`; per lane (the first 8 :data:`SIGNALS`
     at the records (n_rec, 8), the external inputs there (n_rec, 2)) or the
     :class:`~taos.errors.SimulationUnstable` it ended with."""
     from taos.errors import SimulationUnstable

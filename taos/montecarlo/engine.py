@@ -98,12 +98,13 @@ class Part:
 
 def cpu_target() -> str:
     """The CPU the compiled kernels target on this process (numba's host CPU unless
-    ``NUMBA_CPU_NAME`` is set) and the kernels' fast-math flags."""
+    ``NUMBA_CPU_NAME`` is set) and the fast-math flags of the flight runs' kernel
+    (:func:`taos.planar.dynamics.integrate_segments_lanes`, the friction and avionics kernels it
+    calls: compiled without fast-math, so 'off')."""
     import numba
     from llvmlite import binding
-    from taos.planar.dynamics import _FM
     name = numba.config.CPU_NAME or binding.get_host_cpu_name()
-    return f"{name};fastmath={'+'.join(sorted(_FM)) if _FM else 'off'}"
+    return f"{name};fastmath=off"
 
 
 def run_task(kind: RunKind, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray) -> dict:
