@@ -239,7 +239,7 @@ _RECORDED = ("attitude_rad", "rate_rad_s", "delta_cmd_rad", "theta_rad", "omega_
              "booster_deflection_rad")
 
 
-def _fly_lanes(lanes: list[_Lane], ax: str, t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
+def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
     """Fly ``lanes`` (equal keys) in one call of
     :func:`taos.planar.dynamics.integrate_segments_lanes`; per lane (the first 8 :data:`SIGNALS`
     at the records (n_rec, 8), the external inputs there (n_rec, 2)) or the
@@ -327,7 +327,7 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
         t = grids[members[0][0]][2]
         ng = -(-len(members) // LANES)  # as few kernel calls as LANES allows, of even sizes
         for chunk in (members[g * len(members) // ng:(g + 1) * len(members) // ng] for g in range(ng)):
-            for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], axis, t, bounds, rec, dt_s)):
+            for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], t, bounds, rec, dt_s)):
                 if isinstance(flown, Exception):
                     res[i] = flown
                     continue
@@ -374,14 +374,15 @@ def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = 
     if progress:
         from tqdm import tqdm
         it = tqdm(it, desc="ascent", unit="axis")
-    flown = []
-    for ax in it:
-        r = _external_inputs(ascent, ax, t, seed, dt_s)
-        ln = _lane(ascent, model, ax, t, bounds, rec, dt_s, start_s, attitude0_rad, r)
-        (f,) = _fly_lanes([ln], ax, t, bounds, rec, dt_s)
+    lanes = [_lane(ascent, model, ax, t, bounds, rec, dt_s, start_s, attitude0_rad,
+                   _external_inputs(ascent, ax, t, seed, dt_s)) for ax in it]
+    if len({ln.key for ln in lanes}) == 1:  # the axes side by side in one kernel call
+        flown = _fly_lanes(lanes, t, bounds, rec, dt_s)
+    else:
+        flown = [f for ln in lanes for f in _fly_lanes([ln], t, bounds, rec, dt_s)]
+    for f in flown:
         if isinstance(f, Exception):
             raise f
-        flown.append(f)
     return _history(ascent, model, tuple(axes), flown, grid, dt_s, seed, start_s, attitude0_rad)
 
 

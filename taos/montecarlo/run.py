@@ -36,8 +36,9 @@ from taos.montecarlo.campaign import Campaign, apply_factors
 from taos.montecarlo.store import STATUS
 
 RECORD_INTERVAL_S = 0.02
-#: measured cost of one RK4 step of the flight plant, for sizing batches [s] (benchmarks/RESULTS.md)
-STEP_COST_S = 2.5e-6
+#: measured cost of one RK4 step of a flight run in the lockstep kernel, for sizing batches [s]
+#: (CPU time under load, benchmarks/RESULTS.md issue 26: 0.11 s per 200,000-step run)
+STEP_COST_S = 5.5e-7
 STOP_FRACTION = 0.98
 #: the largest fundamental of a signal bounded by its peak: a square wave's, 4/pi (1 % margin)
 FUNDAMENTAL_BOUND = 4 / math.pi * 1.01
