@@ -2,16 +2,16 @@
 :class:`RunKind`), run in batches on Dask and stored as they arrive.
 
 * **Inputs by value.** The run kind carries its parsed inputs (models, tables: no file path a
-  worker would open) and their content hash ``inputs_sha256``. It is sent to the workers once per
-  campaign (``Client.scatter``); nothing is cached on a worker under any other key, so a
-  persistent cluster flies whatever the client loaded.
+  worker would open) and their content hash ``inputs_sha256``. It is sent to the cluster once per
+  campaign, as the pickled argument of a task the batches depend on (recomputed from the
+  scheduler's copy if a worker holding it dies); nothing is cached on a worker under any other
+  key, so a persistent cluster flies whatever the client loaded.
 * **Batches.** A task is a batch of runs (:func:`batch_size`: about ``TASK_S`` seconds of work,
   50 to 1000 runs, fewer when the campaign is too small to keep every worker busy). A batch's
   results are written into the store (:mod:`taos.montecarlo.store`) the moment they arrive and
   released from the workers; the client never holds more than one batch of outputs.
 * **No run lost.** A worker that dies: Dask re-runs its batches elsewhere (``RETRIES``); a batch
-  cancelled because the dead worker held the scattered run kind is submitted again with the run
-  kind scattered anew (``RESUBMITS``). A run
+  cancelled all the same is submitted again with the run kind sent anew (``RESUBMITS``). A run
   that fails in itself is stored as failed with its reason. An interrupted campaign resumes by
   running the batches whose status is still "not run".
 * **Reproducible.** A run is a pure function of its design row and seed, so the stored values are
@@ -165,16 +165,28 @@ def pending_batches(path: Path, part: Part, batch: int) -> list[int]:
     return [s for s in range(0, part.design.n, batch) if np.any(st[s:s + batch] == store.STATUS["pending"])]
 
 
+def _unpickled(blob: bytes):
+    """The run kind back from its pickled bytes (the task that holds it on the cluster)."""
+    import cloudpickle
+    return cloudpickle.loads(blob)
+
+
 def _on_cluster(client, kind: RunKind, todo: list, batch: int, stored) -> None:
     """Submit every batch of ``todo`` ((part, start row) pairs) and hand each result to
-    ``stored`` as it arrives. The run kind is scattered to every worker once; when a worker dies
-    holding it, the scheduler may forget it and cancel the batches waiting on it ("already
-    forgotten"): such a batch is submitted again with the run kind scattered anew (at most
-    ``RESUBMITS`` times per batch), so a lost worker costs time, never a run."""
+    ``stored`` as it arrives.
+
+    The run kind goes to the cluster once, as the pickled argument of a task that returns it
+    (:func:`_unpickled`) and every batch depends on: a worker that dies holding it costs a
+    recomputation from the scheduler's copy, never the batches (data scattered from the client
+    has no such copy: the scheduler forgot it with its last holder and cancelled the batches
+    waiting on it, "already forgotten"). A batch cancelled all the same is submitted again, with
+    the run kind sent anew, at most ``RESUBMITS`` times."""
     from concurrent.futures import CancelledError
 
+    import cloudpickle
     from dask.distributed import as_completed
-    gen = [0, client.scatter(kind, broadcast=True, hash=False)]  # generation, scattered run kind
+    blob = cloudpickle.dumps(kind)
+    gen = [0, client.submit(_unpickled, blob, pure=False, retries=RETRIES)]  # generation, the run kind
 
     def submit(p: Part, s: int, tries: int):
         d = p.design
@@ -192,8 +204,8 @@ def _on_cluster(client, kind: RunKind, todo: list, batch: int, stored) -> None:
         except CancelledError:
             if tries >= RESUBMITS:
                 raise
-            if g == gen[0]:  # the run kind this batch waited on is gone: scatter it again, once
-                gen[:] = [g + 1, client.scatter(kind, broadcast=True, hash=False)]
+            if g == gen[0]:  # the run kind this batch waited on is gone: send it again, once
+                gen[:] = [g + 1, client.submit(_unpickled, blob, pure=False, retries=RETRIES)]
             f.release()
             ac.add(submit(p, s, tries + 1))
             continue
