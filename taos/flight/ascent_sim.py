@@ -295,7 +295,7 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
 
 
 #: runs flown in lockstep by one kernel call (the lanes of :func:`simulate_ascents`)
-LANES = 16
+LANES = 32
 
 
 def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, start_s: float = 0.0,
