@@ -15,6 +15,11 @@ The vehicle properties and the scheduled FCS gains are held constant over each u
 interval: the attitude and rate are kept continuous across a change of the tail-wags-dog
 coefficient b (xi = theta - b delta is re-based), the friction state is carried as it is. At
 separation the attitude rate receives the file's ``separation_rate_kick``.
+
+An axis is one call of :func:`taos.planar.dynamics.integrate_segments_lanes` through all its
+intervals (each interval's plant as data, the re-basing and the kick as state jumps);
+:func:`simulate_ascents` flies many runs (Monte Carlo batches) side by side in the same kernel,
+:data:`LANES` at a time, each run's numbers its own.
 """
 
 from __future__ import annotations
@@ -294,8 +299,15 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
     return out
 
 
-#: runs flown in lockstep by one kernel call (the lanes of :func:`simulate_ascents`)
+#: runs flown in lockstep by one kernel call (the lanes of :func:`simulate_ascents`), and the
+#: memory one call may take for its inputs and records [bytes] (fewer lanes for long runs)
 LANES = 32
+LANE_BYTES = 1 << 30
+
+
+def _lane_bytes(ln: _Lane, n_t: int, rec: int) -> int:
+    """Memory of one lane in a kernel call: its inputs, recorded states and matrices [bytes]."""
+    return 8 * (ln.r.size + ((n_t - 1) // rec + 1) * (ln.x0.size + 3) + ln.mats.size) + 1
 
 
 def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, start_s: float = 0.0,
@@ -325,7 +337,8 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
         groups.setdefault((ln.key, rec, len(t), bounds), []).append((i, ln))
     for (_, rec, _, bounds), members in groups.items():
         t = grids[members[0][0]][2]
-        ng = -(-len(members) // LANES)  # as few kernel calls as LANES allows, of even sizes
+        lanes = max(1, min(LANES, LANE_BYTES // _lane_bytes(members[0][1], len(t), rec)))
+        ng = -(-len(members) // lanes)  # as few kernel calls as allowed, of even sizes
         for chunk in (members[g * len(members) // ng:(g + 1) * len(members) // ng] for g in range(ng)):
             for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], t, bounds, rec, dt_s)):
                 if isinstance(flown, Exception):
