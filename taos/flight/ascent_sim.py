@@ -264,7 +264,7 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
     jcoef = np.ascontiguousarray(np.stack([ln.jcoef for ln in lanes], axis=-1))
     kick = np.ascontiguousarray(np.stack([ln.kick for ln in lanes], axis=-1))
     x0 = np.ascontiguousarray(np.stack([ln.x0 for ln in lanes], axis=-1))
-    r = np.ascontiguousarray(np.stack([ln.r for ln in lanes], axis=-1), dtype=np.float64)
+    r = np.ascontiguousarray(np.stack([ln.r for ln in lanes]), dtype=np.float64)  # (R, n_steps + 1, n_r)
     n, nl = x0.shape
     nrec = (len(t) - 1) // rec + 1
     X = np.empty((nrec, n, nl))

@@ -400,8 +400,8 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
         re-based on a change of plant), then x += kick[s].
     x0 : (n, R) float64; z0 : (R,) float64
         Initial states [x], [rad] (not modified).
-    r : (n_steps + 1, n_r, R) float64
-        External input samples [r], linearly interpolated between samples.
+    r : (R, n_steps + 1, n_r) float64
+        External input samples [r] of each lane, linearly interpolated between samples.
     dt : float
         Step [s].
     rec_every : int
@@ -418,8 +418,8 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
     """
     n, nl = x0.shape
     nseg = bounds.shape[0] - 1
-    nsteps = r.shape[0] - 1
-    nr = r.shape[1]
+    nsteps = r.shape[1] - 1
+    nr = r.shape[2]
     X = x0.copy()
     Z = z0.copy()
     XT = np.empty((n, nl))
@@ -450,8 +450,8 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
         k1n = min(k + 1, nsteps)
         for j in range(nr):
             for q in range(nl):
-                R0[j, q] = r[k, j, q]
-                R1[j, q] = r[k1n, j, q]
+                R0[j, q] = r[q, k, j]
+                R1[j, q] = r[q, k1n, j]
                 RM[j, q] = 0.5 * (R0[j, q] + R1[j, q])
         # the derivative at the step start (K1), with T_f and u there for the record
         _rates_lanes(X, Z, R0, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D1, K1)
