@@ -1,19 +1,28 @@
 """Monte Carlo campaign speed and scaling.
 
-    python benchmarks/bench_montecarlo.py [--runs 2000] [--peer-runs 20] [--big-runs 100000] [--out DIR]
+    PYTHONPATH=. python benchmarks/bench_montecarlo.py [--runs 2000] [--peer-runs 32] [--big-runs 100000] [--out DIR]
+
+One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run scaling part):
 
 1. The peer: ``--peer-runs`` runs of the soft case (models/montecarlo/post_separation.toml, 200 s
-   of flight, 1 ms RK4) one after another in this process, no Dask: the one-run cost, and the
-   share of it spent in the compiled kernel (taos.planar.dynamics.integrate_samples, timed).
+   of flight, 1 ms RK4) as one batch in this process, no Dask: the one-run cost (wall and CPU
+   seconds per run), the share of it spent in the compiled kernel
+   (taos.planar.dynamics.integrate_segments_lanes, timed), and the same runs through the
+   previous per-run path (one dense RK4 call per 5 s segment with the plant rebuilt each time,
+   ``--legacy-runs``; the tests' reference) for the ratio in the same run. Run from the project
+   root with ``PYTHONPATH=.`` (it imports the reference from tests/).
 2. The soft campaign, ``--runs`` runs on a LocalCluster of 2 workers, end to end (cluster start-up
-   included), as ``taos montecarlo post_separation --runs N --case soft`` runs it.
-3. Scaling: ``--big-runs`` runs of models/montecarlo/scaling_short.toml (10 s of flight) on a
-   loopback cluster (a scheduler and 2 workers as separate processes), the client being the
-   ``taos montecarlo --scheduler`` command in its own process: its wall time and peak resident
-   memory (getrusage of that process), and the cost of storing one batch at the start and at the
-   end of the full store (O(1) per stored run).
+   included), as ``taos montecarlo post_separation --runs N --case soft`` runs it; its LCO
+   fraction.
+3. Scaling (``--with-big``): ``--big-runs`` runs of models/montecarlo/scaling_short.toml (10 s of
+   flight) on a loopback cluster (a scheduler and 2 workers as separate processes), the client
+   being the ``taos montecarlo --scheduler`` command in its own process: its wall time and peak
+   resident memory (getrusage of that process), and the cost of storing one batch at the start
+   and at the end of the full store (O(1) per stored run).
 Prints Markdown rows for benchmarks/RESULTS.md, with the machine load (os.getloadavg) at the start
-and end: figures taken while other jobs share the cores are pessimistic.
+and end: figures taken while other jobs share the cores are pessimistic. Python byte code is
+compiled first (``compileall``, as an ordinary install leaves it): without it every worker
+process compiles the sources again when PYTHONDONTWRITEBYTECODE is set.
 """
 
 from __future__ import annotations
@@ -40,15 +49,9 @@ from taos.montecarlo.executor import flight_runs, montecarlo_design
 BIN = Path(sys.executable).parent
 
 
-def peer(n: int) -> tuple[float, float]:
-    """(seconds per run, kernel share) of n soft runs in this process."""
-    import taos.planar.dynamics as dyn
-    c = load_campaign("post_separation")
-    kind, _ = flight_runs(c, "soft", None)
-    d = montecarlo_design(c, n + 1)
-    kind.run_batch(d.names, d.factors[:1], d.seeds[:1])  # load the compiled kernels
-    spent = [0.0]
-    orig = dyn.integrate_samples
+def _timed(mod, name: str, spent: list):
+    """Wrap ``mod.name`` so that the seconds spent in it add up in ``spent[0]``; returns the undo."""
+    orig = getattr(mod, name)
 
     def timed(*a):
         t = time.perf_counter()
@@ -56,14 +59,46 @@ def peer(n: int) -> tuple[float, float]:
             return orig(*a)
         finally:
             spent[0] += time.perf_counter() - t
-    dyn.integrate_samples = timed
+    setattr(mod, name, timed)
+    return lambda: setattr(mod, name, orig)
+
+
+def legacy_run(kind, names, factors, seed) -> float:
+    """One soft run through the previous path (issue 26 before the lockstep kernel: a dense RK4
+    call per 5 s segment with the plant rebuilt from scratch each time), as the tests' reference
+    (tests/test_montecarlo.py::per_segment_reference) flies it."""
+    from taos.montecarlo.campaign import apply_factors
+    from tests.test_montecarlo import per_segment_reference
+    c = kind.campaign
+    asc, model, _ = apply_factors(kind.ascent, kind.model, c.cases["soft"], dict(zip(names, map(float, factors))))
+    return float(per_segment_reference(asc, model, c.axis, c.start_s, c.start_s + c.duration_s, c.dt_s, seed)[-1])
+
+
+def peer(n: int, n_legacy: int) -> dict:
+    """One-run cost of n soft runs as one batch in this process, the kernel's share, and the
+    previous per-run path on the first ``n_legacy`` of them."""
+    import taos.planar.dynamics as dyn
+    c = load_campaign("post_separation")
+    kind, _ = flight_runs(c, "soft", None)
+    d = montecarlo_design(c, n + 1)
+    kind.run_batch(d.names, d.factors[:2], d.seeds[:2])  # load the compiled kernels
+    spent = [0.0]
+    undo = _timed(dyn, "integrate_segments_lanes", spent)
     try:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         kind.run_batch(d.names, d.factors[1:], d.seeds[1:])
-        el = time.perf_counter() - t0
+        el, cpu = time.perf_counter() - t0, time.process_time() - c0
     finally:
-        dyn.integrate_samples = orig
-    return el / n, spent[0] / el
+        undo()
+    res = {"runs": n, "s_per_run": el / n, "cpu_s_per_run": cpu / n, "kernel_share": spent[0] / el}
+    if n_legacy:
+        legacy_run(kind, d.names, d.factors[0], int(d.seeds[0]))
+        t0, c0 = time.perf_counter(), time.process_time()
+        for i in range(1, n_legacy + 1):
+            legacy_run(kind, d.names, d.factors[i], int(d.seeds[i]))
+        res.update(legacy_runs=n_legacy, legacy_s_per_run=(time.perf_counter() - t0) / n_legacy,
+                   legacy_cpu_s_per_run=(time.process_time() - c0) / n_legacy)
+    return res
 
 
 def _free_port() -> int:
@@ -146,20 +181,27 @@ def big(n: int, root: Path) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--runs", type=int, default=2000)
-    ap.add_argument("--peer-runs", type=int, default=20)
+    ap.add_argument("--peer-runs", type=int, default=32)
+    ap.add_argument("--legacy-runs", type=int, default=4)
     ap.add_argument("--big-runs", type=int, default=100_000)
+    ap.add_argument("--with-big", action="store_true", help="also run the 100,000-run scaling part")
     ap.add_argument("--skip", default="", help="comma-separated parts to skip: peer,soft,big")
     ap.add_argument("--out", default=None, help="keep the campaigns here (default: a temporary folder)")
     a = ap.parse_args()
-    skip = set(a.skip.split(","))
+    skip = set(a.skip.split(",")) | (set() if a.with_big else {"big"})
+    import compileall
+    import taos
+    for d in {Path(taos.__file__).parent, Path(np.__file__).parent.parent}:
+        compileall.compile_dir(str(d), quiet=2, workers=2)
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
     root = Path(a.out) if a.out else Path(tempfile.mkdtemp(prefix="bench_mc_"))
     root.mkdir(parents=True, exist_ok=True)
     load0 = os.getloadavg()
     res: dict = {"cores": os.cpu_count(), "load_start": load0}
     if "peer" not in skip:
-        per_run, share = peer(a.peer_runs)
-        res["peer"] = {"runs": a.peer_runs, "s_per_run": per_run, "kernel_share": share}
-        print(f"peer: {per_run:.3f} s per run, kernel {100 * share:.0f} %", flush=True)
+        res["peer"] = p = peer(a.peer_runs, a.legacy_runs)
+        print(f"peer: {p['s_per_run']:.4f} s per run ({p['cpu_s_per_run']:.4f} s CPU), kernel "
+              f"{100 * p['kernel_share']:.0f} %", flush=True)
     if "soft" not in skip:
         out = root / "soft"
         shutil.rmtree(out, ignore_errors=True)
@@ -181,13 +223,18 @@ def main() -> None:
     print(f"\nload average at start {load0[0]:.1f}, at end {res['load_end'][0]:.1f} on {os.cpu_count()} cores")
     if "peer" in res:
         p = res["peer"]
-        print(f"| one soft run in-process (peer) | {p['runs']} | 1 | {p['s_per_run']:.3f} s/run | kernel "
-              f"{100 * p['kernel_share']:.0f} % |")
+        print(f"| one soft run in-process, one batch (peer) | {p['runs']} | 1 | {p['s_per_run']:.4f} s/run "
+              f"({p['cpu_s_per_run']:.4f} s CPU) | kernel {100 * p['kernel_share']:.0f} % |")
+        if "legacy_runs" in p:
+            print(f"| same, previous per-run path (dense RK4 per segment, plant rebuilt) | {p['legacy_runs']} | 1 | "
+                  f"{p['legacy_s_per_run']:.4f} s/run ({p['legacy_cpu_s_per_run']:.4f} s CPU) | x"
+                  f"{p['legacy_cpu_s_per_run'] / p['cpu_s_per_run']:.2f} CPU against the peer |")
     if "soft" in res:
         s = res["soft"]
         f = s["lco_fraction"]
         print(f"| soft campaign, LocalCluster 2 workers, end to end | {s['runs']} | 2 | {s['wall_s']:.1f} s | batch "
-              f"{s['batch']}; LCO {f['lco_runs']}/{s['runs_ok']} ok, {s['runs_failed']} failed, "
+              f"{s['batch']}; LCO {f['lco_runs']} of {s['runs_ok']} ok ({f['value']:.3f}, 95 % {f['ci_low']:.3f}-"
+              f"{f['ci_high']:.3f}), {s['runs_failed']} failed, "
               f"{s['runs_diverged']} diverged |")
     if "big" in res:
         b = res["big"]

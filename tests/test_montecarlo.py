@@ -295,3 +295,78 @@ def test_flight_sensitivity_designs_run_through_the_campaign_engine(tmp_path):
             col = ds["factor"].values[:, j]
             lo = d.low if math.isfinite(d.low) else 0.0
             assert col.min() >= lo - 1e-12 and (not math.isfinite(d.high) or col.max() <= d.high + 1e-12)
+
+
+# -- the lockstep flight kernel -------------------------------------------------------------
+def per_segment_reference(asc, model, axis: str, start_s: float, end_s: float, dt_s: float, seed: int,
+                          record_interval_s: float = 0.02) -> np.ndarray:
+    """The commanded angle [rad] at the records flown the previous way (an independent path):
+    one dense :func:`taos.planar.simulate.integrate_plant` call per segment, the plant rebuilt
+    from scratch (:func:`ascent_plant`, no shared parts) each time, xi re-based and the
+    separation kick applied between the calls."""
+    from taos.flight.ascent_sim import _external_inputs, _grid, ascent_plant, flight_at
+    from taos.planar.simulate import integrate_plant
+    _, rec, t, bounds = _grid(asc, start_s, end_s, dt_s, record_interval_s)
+    r = _external_inputs(asc, axis, t, seed, dt_s)
+    sep = asc.boosters.separation_time_s
+    x = z = b_prev = None
+    cmd = []
+    for k0, k1 in zip(bounds[:-1], bounds[1:]):
+        fl, a_b = flight_at(asc, t[k0] + 0.5 * (t[k1] - t[k0]), axis)
+        p = ascent_plant(fl, model, axis, a_b, asc.boosters.actuator_time_constant_s)
+        si, b = p.ss.state_index, fl.vehicle.twd_coefficient(axis)
+        if x is None:
+            x, z = np.zeros(p.ss.A.shape[0]), 0.0
+        else:
+            x[si("xi_rad")] += (b_prev - b) * x[si("theta_rad")]
+            x[si("xi_rate_rad_s")] += (b_prev - b) * x[si("omega_rad_s")]
+        if abs(t[k0] - sep) < 0.5 * dt_s * rec + 1e-12:
+            x[si("xi_rate_rad_s")] += asc.boosters.separation_rate_kick_rad_s
+        y, aux = integrate_plant(p, model, r[k0:k1 + 1], dt_s, rec, x0=x, z0=z)
+        o = p.ss.output_index
+        cmd.append((y[:, o("delta_cmd_rad")] + r[k0:k1 + 1:rec, 0])[: None if k1 == bounds[-1] else -1])
+        x, z, b_prev = y[-1, o(f"state:{p.ss.states[0]}"):][: len(x)].copy(), float(aux[-1, 1]), b
+    return np.concatenate(cmd)
+
+
+@pytest.fixture(scope="module")
+def dispersed_runs():
+    """Five dispersed soft-case runs of the post-separation campaign: (ascent, model, seed)."""
+    from taos.montecarlo.campaign import apply_factors
+    from taos.montecarlo.executor import flight_runs, montecarlo_design
+    c = load_campaign("post_separation")
+    kind, _ = flight_runs(c, "soft", None)
+    d = montecarlo_design(c, 5)
+    runs = []
+    for i in range(5):
+        a2, m2, _ = apply_factors(kind.ascent, kind.model, c.cases["soft"], dict(zip(d.names, map(float, d.factors[i]))))
+        runs.append((a2, m2, int(d.seeds[i])))
+    return c, runs
+
+
+def test_lockstep_runs_are_bit_identical_alone_and_in_any_company(dispersed_runs):
+    """A run's numbers do not depend on the other runs of its kernel call, their number or its
+    place among them (the store's bit-identity across batch sizes rests on this)."""
+    from taos.flight.ascent_sim import simulate_ascents
+    c, runs = dispersed_runs
+    kw = dict(axis=c.axis, start_s=c.start_s, end_s=c.start_s + 12.0, dt_s=c.dt_s, record_interval_s=0.02)
+    together = simulate_ascents(runs, **kw)
+    for order in ([0], [3], [4, 2], [1, 0, 4, 3, 2]):
+        for i, h in zip(order, simulate_ascents([runs[i] for i in order], **kw)):
+            for k, v in h.signals.items():
+                assert np.array_equal(v, together[i].signals[k]), (order, i, k)
+
+
+def test_lockstep_kernel_matches_the_per_segment_dense_path(dispersed_runs):
+    """The lockstep sparse kernel against the previous path (dense RK4 per segment, the plant
+    rebuilt each time) over 30 s through the booster separation (the kick) and six changes of
+    plant (xi re-based): the same flight to rounding (sums in another order)."""
+    from taos.flight.ascent_sim import simulate_ascents
+    c, runs = dispersed_runs
+    end = c.start_s + 30.0
+    flown = simulate_ascents(runs[:3], axis=c.axis, start_s=c.start_s, end_s=end, dt_s=c.dt_s, record_interval_s=0.02)
+    for (asc, model, seed), h in zip(runs[:3], flown):
+        ref = per_segment_reference(asc, model, c.axis, c.start_s, end, c.dt_s, seed)
+        got = h.signal("command_rad", c.axis)
+        assert np.max(np.abs(ref)) > 1e-4  # the kick moved it
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))

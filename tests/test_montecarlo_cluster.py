@@ -192,9 +192,6 @@ def _stored(out: Path) -> int:
     return 0 if st is None else int((st > 0).sum())
 
 
-@pytest.mark.xfail(strict=False, reason="known race (issue 26, open): when the killed worker held the scattered "
-                   "inputs, a batch can be cancelled ('already forgotten') and the client exits 1; seen in 1 "
-                   "of 4 full runs; the fix is to resubmit a cancelled batch with the inputs scattered again")
 def test_killing_a_worker_loses_no_run(reference, tmp_path):
     """A worker killed mid-campaign: Dask re-runs its batches on the other one; the campaign
     ends with every run and the same store."""

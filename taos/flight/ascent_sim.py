@@ -15,6 +15,11 @@ The vehicle properties and the scheduled FCS gains are held constant over each u
 interval: the attitude and rate are kept continuous across a change of the tail-wags-dog
 coefficient b (xi = theta - b delta is re-based), the friction state is carried as it is. At
 separation the attitude rate receives the file's ``separation_rate_kick``.
+
+An axis is one call of :func:`taos.planar.dynamics.integrate_segments_lanes` through all its
+intervals (each interval's plant as data, the re-basing and the kick as state jumps);
+:func:`simulate_ascents` flies many runs (Monte Carlo batches) side by side in the same kernel,
+:data:`LANES` at a time, each run's numbers its own.
 """
 
 from __future__ import annotations
@@ -27,13 +32,14 @@ import numpy as np
 
 from taos.flight.ascent import Ascent, aero_instability, control_acceleration, pti_command, wind_speed
 from taos.flight.lco import FlightHistory, measure_oscillation
-from taos.flight.vehicle import FlightModel, flight_plant
+from taos.flight.vehicle import FlightModel, PlantParts, flight_plant
 from taos.harmonics import fit_sines
 from taos.linear import StateSpace
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
+from taos.planar import saturation as sat
 from taos.planar.simplex import LurePlant, extend_plant
-from taos.planar.simulate import check_friction_step, integrate_plant
+from taos.planar.simulate import check_friction_step, kernel_args
 
 AXES = ("pitch", "yaw")
 DEFAULT_DT_S = 5e-4
@@ -62,13 +68,13 @@ def flight_at(ascent: Ascent, t_s: float, axis: str) -> tuple[FlightModel, float
 
 
 def ascent_plant(flight: FlightModel, model: TvcModel, axis: str, booster_accel_per_s2: float,
-                 booster_time_constant_s: float) -> LurePlant:
+                 booster_time_constant_s: float, *, parts: PlantParts | None = None) -> LurePlant:
     """:func:`~taos.flight.vehicle.flight_plant` with the booster TVC state and the disturbance
     input added (module docstring). External inputs ``pti_rad`` [rad], ``disturbance_rad_s2``
     [rad/s^2]; the flight plant's limits carried (:func:`~taos.planar.simplex.extend_plant`).
     Outputs: the flight plant's, ``booster_deflection_rad``, then every state
-    (``state:<name>``) so a run can be continued."""
-    base = flight_plant(flight, model, axis)
+    (``state:<name>``) so a run can be continued. ``parts``: as for ``flight_plant``."""
+    base = flight_plant(flight, model, axis, parts=parts)
     ss = base.ss
     n = ss.A.shape[0]
     ixr = ss.state_index("xi_rate_rad_s")
@@ -139,16 +145,9 @@ class AscentHistory:
         atomic_write(path, write)
 
 
-def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = AXES, start_s: float = 0.0,
-                    end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,
-                    seed: int = 0, attitude0_rad: float = 0.0, progress: bool = False) -> AscentHistory:
-    """Fly ``ascent`` from ``start_s`` to ``end_s`` [s] (default the trajectory's end) with the
-    TVC ``model`` on each of ``axes``.
-
-    ``dt_s`` RK4 step [s]; ``record_interval_s`` output spacing [s] (a whole number of steps);
-    ``seed`` draws the turbulence (axis k uses the stream SeedSequence([seed, k])), so a run is a
-    pure function of its inputs; ``attitude0_rad`` initial attitude error [rad]. Raises
-    :class:`~taos.errors.SimulationUnstable` on a non-finite state."""
+def _grid(ascent: Ascent, start_s: float, end_s: float | None, dt_s: float, record_interval_s: float):
+    """(end [s], record step in steps, t (n_steps + 1,) [s], segment bounds (step indices)): the
+    segments are the file's update interval, split at the booster separation."""
     end = ascent.end_time_s if end_s is None else float(end_s)
     rec = max(1, int(round(record_interval_s / dt_s)))
     nsteps = int(math.ceil((end - start_s) / dt_s / rec)) * rec
@@ -161,54 +160,200 @@ def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = 
     sep = ascent.boosters.separation_time_s
     if start_s < sep < end:
         bounds.add(int(round((sep - start_s) / dt_s / rec)) * rec)
-    bounds = sorted(bounds)
+    return end, rec, t, tuple(sorted(bounds))
+
+
+def _external_inputs(ascent: Ascent, ax: str, t: np.ndarray, seed: int, dt_s: float) -> np.ndarray:
+    """(n_steps + 1, 2): the PTI [rad] and the wind disturbance M_a alpha_w [rad/s^2]; the
+    turbulence of axis k drawn from SeedSequence([seed, k])."""
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), AXES.index(ax)]))
+    w = wind_speed(ascent, t, rng, dt_s)
+    comp = math.cos(ascent.wind.azimuth_rad) if ax == "pitch" else math.sin(ascent.wind.azimuth_rad)
+    dist = aero_instability(ascent, t) * comp * w / ascent.trajectory.at("velocity_m_s", t)
+    return np.column_stack([pti_command(ascent, ax, t), dist])
+
+
+@dataclass(frozen=True, eq=False)
+class _Lane:
+    """One run of one axis prepared for the lockstep kernel: its segment plants, their matrices
+    (n_seg, n + 8, n + n_r + 5) in the layout of :func:`taos.planar.dynamics._rates_lanes`, the
+    packed limits' heads (n_seg, N_HEAD), the xi re-basing coefficients (n_seg, 2) and kicks
+    (n_seg, n) at the segment starts, the initial state, the external inputs."""
+
+    plants: list
+    mats: np.ndarray
+    heads: np.ndarray
+    jcoef: np.ndarray
+    kick: np.ndarray
+    x0: np.ndarray
+    r: np.ndarray
+    model: TvcModel
+
+    @property
+    def key(self) -> tuple:
+        """Lanes with equal keys can share one kernel call."""
+        return (self.mats.shape, self.model.friction.name, self.model.avionics.pack().shape,
+                self.model.friction.pack().shape)
+
+
+def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple, rec: int, dt_s: float,
+          start_s: float, attitude0_rad: float, r: np.ndarray) -> _Lane:
+    """Each segment's plant is :func:`ascent_plant` frozen at the segment's middle (the parts
+    that do not change, built once); theta = xi + b delta and theta' are kept continuous across a
+    change of b by re-basing xi; the separation kick lands on xi' at the separation."""
+    sep = ascent.boosters.separation_time_s
+    parts = PlantParts.of(ascent.flight, model, ax)
+    plants, bs = [], []
+    for k0, k1 in zip(bounds[:-1], bounds[1:]):
+        flight, a_b = flight_at(ascent, t[k0] + 0.5 * (t[k1] - t[k0]), ax)
+        plants.append(ascent_plant(flight, model, ax, a_b, ascent.boosters.actuator_time_constant_s, parts=parts))
+        bs.append(flight.vehicle.twd_coefficient(ax))
+    p0 = plants[0]
+    si = p0.ss.state_index
+    n, ne = p0.ss.A.shape[0], p0.n_ext
+    check_friction_step(model, p0.inertia_kgm2, dt_s)
+    mats = np.zeros((len(plants), n + 3 + 5, n + ne + 5))
+    heads = np.zeros((len(plants), sat.N_HEAD))
+    iu = n + ne
+    for M, H, p in zip(mats, heads, plants):
+        A, Br, bc, bf, cc, dc, cw, ca, lim = kernel_args(p, model)
+        M[:n, :n], M[:n, n:iu], M[:n, iu], M[:n, iu + 1] = A, Br, bc, bf
+        M[n, :n], M[n, n:iu], M[n + 1, :n], M[n + 2, :n] = cc, dc, cw, ca
+        if lim.size:  # the limit rows over x (u_v also over u) and their columns (taos.planar.saturation)
+            row = lambda i: lim[sat.row_start(i, n):sat.row_start(i + 1, n)]  # noqa: E731
+            for j, i in enumerate((sat.ROW_UV, sat.ROW_Q, sat.ROW_P, sat.ROW_THETA, sat.ROW_OMEGA)):
+                M[n + 3 + j, :n] = row(i)
+            M[n + 3, iu] = lim[sat.LIM_KVR]
+            for j, i in enumerate((sat.ROW_UV_IN, sat.ROW_FLOW_IN, sat.ROW_STOP_IN)):
+                M[:n, iu + 2 + j] = row(i)
+            H[:] = lim[:sat.N_HEAD]
+    jcoef = np.zeros((len(plants), 2))
+    kick = np.zeros((len(plants), n))
+    for s_, k0 in enumerate(bounds[:-1]):
+        if s_:
+            jcoef[s_] = bs[s_ - 1] - bs[s_]
+        if start_s < sep and abs(t[k0] - sep) < 0.5 * dt_s * rec + 1e-12 and ascent.boosters.count:
+            kick[s_, si("xi_rate_rad_s")] = ascent.boosters.separation_rate_kick_rad_s
+    x0 = np.zeros(n)
+    x0[si("xi_rad")] = attitude0_rad
+    return _Lane(plants, mats, heads, jcoef, kick, x0, r, model)
+
+
+#: recorded outputs of the ascent plant, in the order of SIGNALS[:8] (friction torque from aux)
+_RECORDED = ("attitude_rad", "rate_rad_s", "delta_cmd_rad", "theta_rad", "omega_rad_s", "x_p_m", None,
+             "booster_deflection_rad")
+
+
+def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
+    """Fly ``lanes`` (equal keys) in one call of
+    :func:`taos.planar.dynamics.integrate_segments_lanes`; per lane (the first 8 :data:`SIGNALS`
+    at the records (n_rec, 8), the external inputs there (n_rec, 2)) or the
+    :class:`~taos.errors.SimulationUnstable` it ended with."""
+    from taos.errors import SimulationUnstable
+    from taos.planar import dynamics as _dy
+
+    mats = np.stack([ln.mats for ln in lanes], axis=-1)           # (n_seg, n + 3, n + n_r + 2, R)
+    mask = np.any(mats != 0.0, axis=(0, 3))
+    ip = np.concatenate([[0], np.cumsum(mask.sum(axis=1))]).astype(np.int64)
+    ix = np.nonzero(mask)[1].astype(np.int64)
+    mx = np.ascontiguousarray(mats[:, mask, :])                    # (n_seg, nnz, R)
+    heads = np.ascontiguousarray(np.stack([ln.heads for ln in lanes], axis=1))  # (n_seg, R, N_HEAD)
+    si = lanes[0].plants[0].ss.state_index
+    jdst = np.array([si("xi_rad"), si("xi_rate_rad_s")], np.int64)
+    jsrc = np.array([si("theta_rad"), si("omega_rad_s")], np.int64)
+    jcoef = np.ascontiguousarray(np.stack([ln.jcoef for ln in lanes], axis=-1))
+    kick = np.ascontiguousarray(np.stack([ln.kick for ln in lanes], axis=-1))
+    x0 = np.ascontiguousarray(np.stack([ln.x0 for ln in lanes], axis=-1))
+    r = np.ascontiguousarray(np.stack([ln.r for ln in lanes]), dtype=np.float64)  # (R, n_steps + 1, n_r)
+    n, nl = x0.shape
+    nrec = (len(t) - 1) // rec + 1
+    X = np.empty((nrec, n, nl))
+    aux = np.empty((nrec, _dy.N_AUX, nl))
+    status = np.empty(nl, np.int64)
+    m0 = lanes[0].model
+    _dy.integrate_segments_lanes(ip, ix, mx, heads, m0.friction.entry.rates,
+                                 np.stack([ln.model.friction.pack() for ln in lanes]),
+                                 np.stack([ln.model.avionics.pack() for ln in lanes]),
+                                 np.asarray(bounds, np.int64), jdst, jsrc, jcoef, kick, x0, np.zeros(nl), r, dt_s,
+                                 rec, X, aux, status)
+    out = []
+    for q, ln in enumerate(lanes):
+        if status[q] >= 0:
+            out.append(SimulationUnstable(float(t[status[q]]), f"{ln.model.friction.name} friction, dt = {dt_s} s"))
+            continue
+        Xq = X[:, :, q]
+        Y = np.empty((nrec, 8))
+        for p, k0, k1 in zip(ln.plants, bounds[:-1], bounds[1:]):
+            sl = slice(k0 // rec, k1 // rec + (1 if k1 == bounds[-1] else 0))
+            o = p.ss.output_index
+            for j, name in enumerate(_RECORDED):
+                if name is not None:  # y = C x term by term: the same bits whatever the lane's memory layout
+                    row = p.ss.C[o(name)]
+                    y = np.zeros(sl.stop - sl.start)
+                    for i in np.flatnonzero(row):
+                        y += row[i] * Xq[sl, i]
+                    Y[sl, j] = y
+        Y[:, 2] += ln.r[::rec, 0]  # the FCS command: the PTI is added to it
+        Y[:, 6] = aux[:, _dy.AUX_TF, q]
+        out.append((Y, ln.r[::rec]))
+    return out
+
+
+#: runs flown in lockstep by one kernel call (the lanes of :func:`simulate_ascents`), and the
+#: memory one call may take for its inputs and records [bytes] (fewer lanes for long runs)
+LANES = 32
+LANE_BYTES = 1 << 30
+
+
+def _lane_bytes(ln: _Lane, n_t: int, rec: int) -> int:
+    """Memory of one lane in a kernel call: its inputs, recorded states and matrices [bytes]."""
+    return 8 * (ln.r.size + ((n_t - 1) // rec + 1) * (ln.x0.size + 3) + ln.mats.size) + 1
+
+
+def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, start_s: float = 0.0,
+                     end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,
+                     attitude0_rad: float = 0.0) -> list:
+    """Fly many ascents on one ``axis``: ``runs`` is a list of (ascent, TVC model, seed); returns,
+    per run, its :class:`AscentHistory` (as :func:`simulate_ascent` with ``axes=(axis,)``) or the
+    exception it ended with (:class:`~taos.errors.SimulationUnstable`,
+    :class:`~taos.errors.InputError`, ValueError, ArithmeticError).
+
+    Runs with the same plant structure and segments are integrated :data:`LANES` at a time in
+    lockstep (vectorised across the runs); a run's numbers do not depend on the other runs nor on
+    how many there are."""
+    from taos.errors import InputError, SimulationUnstable
+    res: list = [None] * len(runs)
+    groups: dict = {}
+    grids = {}
+    for i, (asc, model, seed) in enumerate(runs):
+        try:
+            end, rec, t, bounds = _grid(asc, start_s, end_s, dt_s, record_interval_s)
+            r = _external_inputs(asc, axis, t, seed, dt_s)
+            ln = _lane(asc, model, axis, t, bounds, rec, dt_s, start_s, attitude0_rad, r)
+        except (SimulationUnstable, InputError, ValueError, ArithmeticError) as e:
+            res[i] = e
+            continue
+        grids[i] = (end, rec, t, bounds)
+        groups.setdefault((ln.key, rec, len(t), bounds), []).append((i, ln))
+    for (_, rec, _, bounds), members in groups.items():
+        t = grids[members[0][0]][2]
+        lanes = max(1, min(LANES, LANE_BYTES // _lane_bytes(members[0][1], len(t), rec)))
+        ng = -(-len(members) // lanes)  # as few kernel calls as allowed, of even sizes
+        for chunk in (members[g * len(members) // ng:(g + 1) * len(members) // ng] for g in range(ng)):
+            for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], t, bounds, rec, dt_s)):
+                if isinstance(flown, Exception):
+                    res[i] = flown
+                    continue
+                asc, model, seed = runs[i]
+                res[i] = _history(asc, model, (axis,), [flown], grids[i], dt_s, seed, start_s, attitude0_rad)
+    return res
+
+
+def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tuple, dt_s: float, seed: int,
+             start_s: float, attitude0_rad: float) -> AscentHistory:
+    end, rec, t, _ = grid
     out = {k: [] for k in SIGNALS}
-    pw = {ax: ascent.pti_windows(ax) for ax in axes}
-    it = list(enumerate(axes))
-    if progress:
-        from tqdm import tqdm
-        it = tqdm(it, desc="ascent", unit="axis")
-    for ai, ax in it:
-        rng = np.random.default_rng(np.random.SeedSequence([int(seed), AXES.index(ax)]))
-        w = wind_speed(ascent, t, rng, dt_s)
-        comp = math.cos(ascent.wind.azimuth_rad) if ax == "pitch" else math.sin(ascent.wind.azimuth_rad)
-        dist = aero_instability(ascent, t) * comp * w / ascent.trajectory.at("velocity_m_s", t)
-        r = np.column_stack([pti_command(ascent, ax, t), dist])
-        ys, auxs = [], []
-        x = z = None
-        b_prev = None
-        for k0, k1 in zip(bounds[:-1], bounds[1:]):
-            tm = t[k0] + 0.5 * (t[k1] - t[k0])
-            flight, a_b = flight_at(ascent, tm, ax)
-            plant = ascent_plant(flight, model, ax, a_b, ascent.boosters.actuator_time_constant_s)
-            si = plant.ss.state_index
-            b = flight.vehicle.twd_coefficient(ax)
-            if x is None:
-                check_friction_step(model, plant.inertia_kgm2, dt_s)
-                x = np.zeros(plant.ss.A.shape[0])
-                x[si("xi_rad")] = attitude0_rad
-                z = 0.0
-            else:  # keep theta = xi + b delta and theta' continuous across a change of b
-                d, dd = x[si("theta_rad")], x[si("omega_rad_s")]
-                x[si("xi_rad")] += (b_prev - b) * d
-                x[si("xi_rate_rad_s")] += (b_prev - b) * dd
-            if start_s < sep and abs(t[k0] - sep) < 0.5 * dt_s * rec + 1e-12 and ascent.boosters.count:
-                x[si("xi_rate_rad_s")] += ascent.boosters.separation_rate_kick_rad_s
-            y, aux = integrate_plant(plant, model, r[k0:k1 + 1], dt_s, rec, x0=x, z0=z)
-            o = plant.ss.output_index
-            nst = plant.ss.A.shape[0]
-            x = y[-1, o(f"state:{plant.ss.states[0]}"):o(f"state:{plant.ss.states[0]}") + nst].copy()
-            z = float(aux[-1, 1])
-            b_prev = b
-            last = k1 == nsteps
-            keep = slice(None) if last else slice(0, -1)
-            ys.append(np.column_stack([y[keep, o("attitude_rad")], y[keep, o("rate_rad_s")],
-                                       y[keep, o("delta_cmd_rad")] + r[k0:k1 + 1:rec, 0][keep],
-                                       y[keep, o("theta_rad")], y[keep, o("omega_rad_s")], y[keep, o("x_p_m")],
-                                       aux[keep, 0], y[keep, o("booster_deflection_rad")]]))
-            auxs.append(r[k0:k1 + 1:rec][keep])
-        Y = np.vstack(ys)
-        Rr = np.vstack(auxs)
+    for Y, Rr in flown:
         for j, k in enumerate(SIGNALS[:8]):
             out[k].append(Y[:, j])
         out["pti_rad"].append(Rr[:, 0])
@@ -220,8 +365,38 @@ def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = 
             "seed": int(seed), "start_s": start_s, "end_s": end, "attitude0_rad": attitude0_rad,
             "friction_model": model.friction.name}
     return AscentHistory(t_s=t[::rec], axes=tuple(axes), signals={k: np.vstack(v) for k, v in out.items()},
-                         separation_time_s=sep, pti_windows=pw, friction_model=model.friction.name,
+                         separation_time_s=ascent.boosters.separation_time_s,
+                         pti_windows={ax: ascent.pti_windows(ax) for ax in axes}, friction_model=model.friction.name,
                          load_stiffness_N_per_m=model.structure.load_stiffness_N_per_m, provenance=prov)
+
+
+def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = AXES, start_s: float = 0.0,
+                    end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,
+                    seed: int = 0, attitude0_rad: float = 0.0, progress: bool = False) -> AscentHistory:
+    """Fly ``ascent`` from ``start_s`` to ``end_s`` [s] (default the trajectory's end) with the
+    TVC ``model`` on each of ``axes``.
+
+    ``dt_s`` RK4 step [s]; ``record_interval_s`` output spacing [s] (a whole number of steps);
+    ``seed`` draws the turbulence (axis k uses the stream SeedSequence([seed, k])), so a run is a
+    pure function of its inputs; ``attitude0_rad`` initial attitude error [rad]. Each axis is
+    one call of the compiled kernel through all the segments (:func:`simulate_ascents`' kernel,
+    one lane). Raises :class:`~taos.errors.SimulationUnstable` on a non-finite state."""
+    grid = _grid(ascent, start_s, end_s, dt_s, record_interval_s)
+    _, rec, t, bounds = grid
+    it = list(axes)
+    if progress:
+        from tqdm import tqdm
+        it = tqdm(it, desc="ascent", unit="axis")
+    lanes = [_lane(ascent, model, ax, t, bounds, rec, dt_s, start_s, attitude0_rad,
+                   _external_inputs(ascent, ax, t, seed, dt_s)) for ax in it]
+    if len({ln.key for ln in lanes}) == 1:  # the axes side by side in one kernel call
+        flown = _fly_lanes(lanes, t, bounds, rec, dt_s)
+    else:
+        flown = [f for ln in lanes for f in _fly_lanes([ln], t, bounds, rec, dt_s)]
+    for f in flown:
+        if isinstance(f, Exception):
+            raise f
+    return _history(ascent, model, tuple(axes), flown, grid, dt_s, seed, start_s, attitude0_rad)
 
 
 # -- windows --------------------------------------------------------------------------------

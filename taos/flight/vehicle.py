@@ -272,13 +272,20 @@ def fcs_filter_tf(fcs: FlightControl) -> tuple[np.ndarray, np.ndarray]:
     return np.polymul(num, pn), np.polymul(den, pd)
 
 
-def vehicle_fcs_state_space(flight: FlightModel, axis: str | None = None) -> StateSpace:
+def fcs_filter_ss(fcs: FlightControl) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(A, B, C, D) of :func:`fcs_filter_tf` in controller canonical form (``scipy.signal.tf2ss``)."""
+    return scipy.signal.tf2ss(*fcs_filter_tf(fcs))
+
+
+def vehicle_fcs_state_space(flight: FlightModel, axis: str | None = None, *,
+                            filter_ss: tuple | None = None) -> StateSpace:
     """Vehicle + FCS as one linear block (equations in the module docstring).
 
     Inputs :data:`VF_INPUTS` (engine deflection [rad] and rate [rad/s]); outputs
     :data:`VF_OUTPUTS` (FCS engine command [rad], attitude [rad], attitude rate [rad/s]).
     States: ``xi_rad``, ``xi_rate_rad_s`` (attitude minus the TWD part), ``int_attitude_rad_s``,
-    then the filter / delay states."""
+    then the filter / delay states. ``filter_ss``: :func:`fcs_filter_ss` of ``flight.fcs`` when
+    already computed (it does not depend on the gains or the vehicle)."""
     axis = axis or flight.axis
     v, f = flight.vehicle, flight.fcs
     a = v.control_acceleration_per_s2(axis)
@@ -292,8 +299,7 @@ def vehicle_fcs_state_space(flight: FlightModel, axis: str | None = None) -> Sta
     c_u = f.attitude_gain * c_th + f.rate_gain_s * c_q + np.array([0.0, 0.0, f.integral_gain_per_s])
     d_u = f.attitude_gain * d_th + f.rate_gain_s * d_q
     # filter chain driven by u, output -F P u
-    num, den = fcs_filter_tf(f)
-    Af, Bf, Cf, Df = scipy.signal.tf2ss(num, den)
+    Af, Bf, Cf, Df = fcs_filter_ss(f) if filter_ss is None else filter_ss
     nf = Af.shape[0]
     nb = 2 if v.bending_frequency_hz > 0 else 0  # optional first bending mode (eta, eta')
     n = 3 + nf + nb
@@ -337,17 +343,36 @@ def loop_freqresp(flight: FlightModel, freq_hz, axis: str | None = None) -> np.n
     return -(h[:, 0] + 2j * np.pi * f * h[:, 1])
 
 
-def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None) -> LurePlant:
+@dataclass(frozen=True, eq=False)
+class PlantParts:
+    """The parts of :func:`flight_plant` that do not change with the vehicle's properties or
+    the FCS gains: the simplex block and its packed limits for one model and axis, the FCS
+    filter's state space. Built once for the many plants of one flown ascent."""
+
+    tvc: StateSpace
+    limits: np.ndarray
+    filter_ss: tuple
+
+    @classmethod
+    def of(cls, flight: FlightModel, model: TvcModel, axis: str | None = None) -> "PlantParts":
+        axis = axis or flight.axis
+        return cls(simplex_state_space(model, axis), simplex_limits(model, axis), fcs_filter_ss(flight.fcs))
+
+
+def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None, *,
+                 parts: PlantParts | None = None) -> LurePlant:
     """Closed flight loop: vehicle + FCS + the linear simplex TVC block as a Lur'e plant.
 
     The avionics sit on the FCS command channel (``cmd_c`` = the FCS command row over the
     joint state); the friction element acts at the gimbal as in :func:`simplex_plant`.
     External input ``pti_rad``: a programmed test input added to the FCS command [rad].
     Outputs: the simplex outputs, then :data:`VF_OUTPUTS`. States: the simplex states, then
-    the vehicle + FCS states."""
+    the vehicle + FCS states. ``parts``: :meth:`PlantParts.of` of the same ``model``, ``axis``
+    and FCS filter when already built (the same plant, without rebuilding them)."""
     axis = axis or flight.axis
-    tv = simplex_state_space(model, axis)
-    vf = vehicle_fcs_state_space(flight, axis)
+    parts = parts or PlantParts.of(flight, model, axis)
+    tv = parts.tvc
+    vf = vehicle_fcs_state_space(flight, axis, filter_ss=parts.filter_ss)
     nt, nv = tv.A.shape[0], vf.A.shape[0]
     n = nt + nv
     # TVC outputs feeding the vehicle: delta = theta, delta' = omega (rows over the TVC state)
@@ -370,7 +395,7 @@ def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None) 
                      rate_c=C[ss.output_index("omega_rad_s")].copy(),
                      applied_c=C[ss.output_index("applied_torque_Nm")].copy(),
                      inertia_kgm2=model.engine.inertia(axis),
-                     limits=embed_limits(simplex_limits(model, axis), n, 0))
+                     limits=embed_limits(parts.limits, n, 0))
 
 
 # -- margins ------------------------------------------------------------------------------

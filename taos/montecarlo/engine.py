@@ -2,14 +2,16 @@
 :class:`RunKind`), run in batches on Dask and stored as they arrive.
 
 * **Inputs by value.** The run kind carries its parsed inputs (models, tables: no file path a
-  worker would open) and their content hash ``inputs_sha256``. It is sent to the workers once per
-  campaign (``Client.scatter``); nothing is cached on a worker under any other key, so a
-  persistent cluster flies whatever the client loaded.
+  worker would open) and their content hash ``inputs_sha256``. It is sent to the cluster once per
+  campaign, as the pickled argument of a task the batches depend on (recomputed from the
+  scheduler's copy if a worker holding it dies); nothing is cached on a worker under any other
+  key, so a persistent cluster flies whatever the client loaded.
 * **Batches.** A task is a batch of runs (:func:`batch_size`: about ``TASK_S`` seconds of work,
   50 to 1000 runs, fewer when the campaign is too small to keep every worker busy). A batch's
   results are written into the store (:mod:`taos.montecarlo.store`) the moment they arrive and
   released from the workers; the client never holds more than one batch of outputs.
-* **No run lost.** A worker that dies: Dask re-runs its batches elsewhere (``RETRIES``). A run
+* **No run lost.** A worker that dies: Dask re-runs its batches elsewhere (``RETRIES``); a batch
+  cancelled all the same is submitted again with the run kind sent anew (``RESUBMITS``). A run
   that fails in itself is stored as failed with its reason. An interrupted campaign resumes by
   running the batches whose status is still "not run".
 * **Reproducible.** A run is a pure function of its design row and seed, so the stored values are
@@ -35,6 +37,8 @@ from taos.errors import InputError
 from taos.montecarlo import store
 
 RETRIES = 3
+#: times a batch cancelled with a lost worker is submitted again
+RESUBMITS = 5
 TASK_S = 10.0
 MIN_BATCH, MAX_BATCH = 50, 1000
 CONNECT_TIMEOUT_S = 20.0
@@ -94,12 +98,13 @@ class Part:
 
 def cpu_target() -> str:
     """The CPU the compiled kernels target on this process (numba's host CPU unless
-    ``NUMBA_CPU_NAME`` is set) and the kernels' fast-math flags."""
+    ``NUMBA_CPU_NAME`` is set) and the fast-math flags of the flight runs' kernel
+    (:func:`taos.planar.dynamics.integrate_segments_lanes`, the friction and avionics kernels it
+    calls: compiled without fast-math, so 'off')."""
     import numba
     from llvmlite import binding
-    from taos.planar.dynamics import _FM
     name = numba.config.CPU_NAME or binding.get_host_cpu_name()
-    return f"{name};fastmath={'+'.join(sorted(_FM)) if _FM else 'off'}"
+    return f"{name};fastmath=off"
 
 
 def run_task(kind: RunKind, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray) -> dict:
@@ -160,6 +165,54 @@ def pending_batches(path: Path, part: Part, batch: int) -> list[int]:
     return [s for s in range(0, part.design.n, batch) if np.any(st[s:s + batch] == store.STATUS["pending"])]
 
 
+def _unpickled(blob: bytes):
+    """The run kind back from its pickled bytes (the task that holds it on the cluster)."""
+    import cloudpickle
+    return cloudpickle.loads(blob)
+
+
+def _on_cluster(client, kind: RunKind, todo: list, batch: int, stored) -> None:
+    """Submit every batch of ``todo`` ((part, start row) pairs) and hand each result to
+    ``stored`` as it arrives.
+
+    The run kind goes to the cluster once, as the pickled argument of a task that returns it
+    (:func:`_unpickled`) and every batch depends on: a worker that dies holding it costs a
+    recomputation from the scheduler's copy, never the batches (data scattered from the client
+    has no such copy: the scheduler forgot it with its last holder and cancelled the batches
+    waiting on it, "already forgotten"). A batch cancelled all the same is submitted again, with
+    the run kind sent anew, at most ``RESUBMITS`` times."""
+    from concurrent.futures import CancelledError
+
+    import cloudpickle
+    from dask.distributed import as_completed
+    blob = cloudpickle.dumps(kind)
+    gen = [0, client.submit(_unpickled, blob, pure=False, retries=RETRIES)]  # generation, the run kind
+
+    def submit(p: Part, s: int, tries: int):
+        d = p.design
+        f = client.submit(run_task, gen[1], d.names, d.factors[s:s + batch], d.seeds[s:s + batch],
+                          pure=False, retries=RETRIES)
+        meta[f.key] = (p, s, tries, gen[0])
+        return f
+
+    meta: dict = {}
+    ac = as_completed([submit(p, s, 0) for p, s in todo])
+    for f in ac:
+        p, s, tries, g = meta.pop(f.key)
+        try:
+            out = f.result()
+        except CancelledError:
+            if tries >= RESUBMITS:
+                raise
+            if g == gen[0]:  # the run kind this batch waited on is gone: send it again, once
+                gen[:] = [g + 1, client.submit(_unpickled, blob, pure=False, retries=RETRIES)]
+            f.release()
+            ac.add(submit(p, s, tries + 1))
+            continue
+        stored(p, s, out)
+        f.release()  # the batch's results leave the worker once stored
+
+
 def execute(path: Path, kind: RunKind, parts: Sequence[Part], batch: int, client, progress: bool = False) -> int:
     """Run every pending batch of ``parts`` (stored at ``path``) on ``client`` (None: in this
     process); returns the number of runs executed."""
@@ -180,18 +233,7 @@ def execute(path: Path, kind: RunKind, parts: Sequence[Part], batch: int, client
                 d = p.design
                 stored(p, s, run_task(kind, d.names, d.factors[s:s + batch], d.seeds[s:s + batch]))
             return total
-        from dask.distributed import as_completed
-        kf = client.scatter(kind, broadcast=True, hash=False)
-        futs = {}
-        for p, s in todo:
-            d = p.design
-            f = client.submit(run_task, kf, d.names, d.factors[s:s + batch], d.seeds[s:s + batch],
-                              pure=False, retries=RETRIES)
-            futs[f.key] = (f, p, s)
-        for f in as_completed([v[0] for v in futs.values()]):
-            _, p, s = futs.pop(f.key)
-            stored(p, s, f.result())
-            f.release()  # the batch's results leave the worker once stored
+        _on_cluster(client, kind, todo, batch, stored)
         return total
     finally:
         if bar is not None:

@@ -29,15 +29,16 @@ import numpy as np
 
 from taos.errors import InputError, SimulationUnstable
 from taos.flight.ascent import Ascent
-from taos.flight.ascent_sim import simulate_ascent
+from taos.flight.ascent_sim import simulate_ascents
 from taos.flight.lco import measure_oscillation
 from taos.model import TvcModel
 from taos.montecarlo.campaign import Campaign, apply_factors
 from taos.montecarlo.store import STATUS
 
 RECORD_INTERVAL_S = 0.02
-#: measured cost of one RK4 step of the flight plant, for sizing batches [s] (benchmarks/RESULTS.md)
-STEP_COST_S = 2.5e-6
+#: measured cost of one RK4 step of a flight run in the lockstep kernel, for sizing batches [s]
+#: (CPU time under load, benchmarks/RESULTS.md issue 26: 0.11 s per 200,000-step run)
+STEP_COST_S = 5.5e-7
 STOP_FRACTION = 0.98
 #: the largest fundamental of a signal bounded by its peak: a square wave's, 4/pi (1 % margin)
 FUNDAMENTAL_BOUND = 4 / math.pi * 1.01
@@ -87,19 +88,34 @@ class FlightRuns:
         n, m = len(seeds), len(self.trace_t_s)
         out = {"status": np.zeros(n, np.int8), "error": [""] * n, "trace": np.full((n, m), np.nan),
                **{k: np.full(n, np.nan) for k in self.scalars}, **{k: np.zeros(n, bool) for k in self.flags}}
+        c = self.campaign
+        runs, rows = [], []
         for i in range(n):
-            self._one(dict(zip(names, (float(v) for v in factors[i]))), int(seeds[i]), out, i)
+            try:
+                a2, m2, _ = apply_factors(self.ascent, self.model, c.cases[self.case],
+                                          dict(zip(names, (float(v) for v in factors[i]))))
+            except (InputError, ValueError, ArithmeticError) as e:
+                self._failed(out, i, e)
+                continue
+            runs.append((a2, m2, int(seeds[i])))
+            rows.append(i)
+        # the batch's runs in lockstep (taos.flight.ascent_sim.simulate_ascents): each run's
+        # numbers are its own, whatever else is in the batch
+        flown = simulate_ascents(runs, axis=c.axis, start_s=c.start_s, end_s=c.start_s + c.duration_s, dt_s=c.dt_s,
+                                 record_interval_s=max(RECORD_INTERVAL_S, c.dt_s))
+        for i, h in zip(rows, flown):
+            if isinstance(h, (SimulationUnstable, InputError, ValueError, ArithmeticError)):
+                self._failed(out, i, h)
+            else:
+                self._measure(h, out, i)
         return out
 
-    def _one(self, factors: dict, seed: int, out: dict, i: int) -> None:
+    @staticmethod
+    def _failed(out: dict, i: int, e: Exception) -> None:
+        out["status"][i], out["error"][i] = STATUS["failed"], str(e).splitlines()[0][:300]
+
+    def _measure(self, h, out: dict, i: int) -> None:
         c = self.campaign
-        try:
-            a2, m2, _ = apply_factors(self.ascent, self.model, c.cases[self.case], factors)
-            h = simulate_ascent(a2, m2, axes=(c.axis,), start_s=c.start_s, end_s=c.start_s + c.duration_s,
-                                dt_s=c.dt_s, record_interval_s=max(RECORD_INTERVAL_S, c.dt_s), seed=seed)
-        except (SimulationUnstable, InputError, ValueError, ArithmeticError) as e:
-            out["status"][i], out["error"][i] = STATUS["failed"], str(e).splitlines()[0][:300]
-            return
         t_end = float(h.t_s[-1])
         osc = measure_oscillation(h.flight_history(c.axis, t_end - c.analysis_window_s, t_end),
                                   window_s=c.analysis_window_s)

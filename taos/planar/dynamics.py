@@ -303,3 +303,200 @@ def sine_dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps,
     for b in prange(amps.shape[0]):
         status[b] = _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps[b], freqs[b],
                                     n_per_cycle[b], n_settle[b], n_meas[b], out[b])
+
+
+# -- sparse, piecewise-constant plants, many runs in lockstep (Monte Carlo batches) ------------
+#: rows of the lockstep kernels' sparse matrix after the n state rows, and columns of v after
+#: the state and the external inputs (:func:`_rates_lanes`)
+LANE_ROWS = ("command", "friction_rate", "applied_torque", "valve_command", "valve_flow", "load_pressure",
+             "engine_angle", "engine_rate")
+LANE_COLS = ("u", "friction_torque", "valve_excess", "flow_correction", "stop_torque")
+
+
+@njit(cache=True, inline="always")
+def _rows(ip, ix, mx, V, h0, h1, OUT, o0):
+    """OUT[o0 + h - h0, :] = row h of the lanes' sparse matrix times V, for h0 <= h < h1."""
+    nl = V.shape[1]
+    for h in range(h0, h1):
+        o = o0 + h - h0
+        for q in range(nl):
+            OUT[o, q] = 0.0
+        for k in range(ip[h], ip[h + 1]):
+            col = ix[k]
+            for q in range(nl):
+                OUT[o, q] += mx[k, q] * V[col, q]
+
+
+@njit(cache=True, inline="always")
+def _rates_lanes(X, Z, R, ip, ix, mx, head, fid, fp, avp, V, C, U, TF, DZ, DX):
+    """The state equations of the module docstring for R independent plants ("lanes") at once,
+    every linear part as one sparse matrix with a pattern common to all lanes.
+
+    ``X`` (n, R) [x] states, ``Z`` (R,) [rad] friction states, ``R`` (n_r, R) [r] external
+    inputs. The CSR matrix (``ip``, ``ix``; entries ``mx`` (nnz, R), one column per lane) acts
+    on v = (x, r, u, T_f, e_v, c_q, T_stop) (:data:`LANE_COLS`): rows 0..n-1 give dx/dt =
+    [A Br bc bf uv_in flow_in stop_in] v; the rows after them (:data:`LANE_ROWS`) the
+    pre-avionics command c = [cc dc] (x, r), the friction relative rate w = cw x, the applied
+    torque T_a = ca x, then the limit rows of :mod:`taos.planar.saturation` over (x, u): valve
+    command u_v, valve flow q, load pressure P_L, engine angle and rate. Per lane: u =
+    avionics(c), (dz/dt, T_f) = friction(w, z, T_a), the valve excess e_v, the flow correction
+    c_q and the stop torque T_stop from the single definitions in :mod:`taos.planar.saturation`
+    with the lane's packed head ``head`` (R, N_HEAD) (all off: zeros); ``fp`` (R, NPARAM),
+    ``avp`` (R, .) each lane's friction and avionics packs, ``fid`` the law's kernel.
+    Writes dx/dt into ``DX`` (n, R), u [rad] into ``U``, T_f [N m] into ``TF``, dz/dt [rad/s]
+    into ``DZ`` (R,); ``V`` (n + n_r + 5, R), ``C`` (8, R) scratch.
+
+    The loops over lanes are element-wise (no sum across lanes), so a lane's result does not
+    depend on R or on its position: compiled without fast-math, vector and scalar code give the
+    same bits."""
+    n = X.shape[0]
+    nr = R.shape[0]
+    nl = X.shape[1]
+    iu = n + nr
+    for i in range(n):
+        for q in range(nl):
+            V[i, q] = X[i, q]
+    for j in range(nr):
+        for q in range(nl):
+            V[n + j, q] = R[j, q]
+    _rows(ip, ix, mx, V, n, n + 3, C, 0)
+    for q in range(nl):
+        U[q] = _av.apply(C[0, q], avp[q])
+        DZ[q], TF[q] = fid(C[1, q], Z[q], C[2, q], fp[q])
+        V[iu, q] = U[q]
+        V[iu + 1, q] = TF[q]
+    _rows(ip, ix, mx, V, n + 3, n + 8, C, 3)
+    for q in range(nl):
+        hq = head[q]
+        V[iu + 2, q] = _lim.valve_excess(hq, C[3, q])
+        V[iu + 3, q] = _lim.pressure_flow_correction(hq, C[4, q], C[5, q])
+        V[iu + 4, q] = _lim.stop_torque(C[6, q], C[7, q], hq[_lim.LIM_THMAX], hq[_lim.LIM_KS], hq[_lim.LIM_CS])
+    _rows(ip, ix, mx, V, 0, n, DX, 0)
+
+
+@njit(cache=True)
+def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc, jcoef, kick, x0, z0, r, dt,
+                             rec_every, x_out, aux_out, status):
+    """RK4 (as :func:`integrate_samples`) of R independent runs in lockstep ("lanes"), each
+    through a sequence of plants held over segments of steps, all in one sparse pattern.
+
+    Parameters
+    ----------
+    ip, ix : (n + 9,), (nnz,) int64
+        CSR row pointers and column indices of the lanes' matrix (:func:`_rates_lanes`: n
+        state rows, then :data:`LANE_ROWS`, over v = (x, r, :data:`LANE_COLS`)).
+    mx : (n_seg, nnz, R) float64
+        The matrix entries of each segment's plant, per lane (units as A, Br, bc, ..., ca and
+        the limit rows and columns of :mod:`taos.planar.saturation`).
+    head : (n_seg, R, N_HEAD) float64
+        The packed limits' head (slots ``LIM_*``; zeros: no limits).
+    fid : friction law kernel; fp : (R, NPARAM) float64; avp : (R, .) float64
+        The law's ``rates`` kernel (module docstring), each lane's packed friction parameters and
+        packed avionics.
+    bounds : (n_seg + 1,) int64
+        Segment s covers steps bounds[s] .. bounds[s + 1]; bounds[0] = 0, bounds[-1] = n_steps.
+    jdst, jsrc : (m_j,) int64; jcoef : (n_seg, m_j, R) float64; kick : (n_seg, n, R) [x]
+        State jumps at the start of segment s: x[jdst[j]] += jcoef[s, j] x[jsrc[j]] (a state
+        re-based on a change of plant), then x += kick[s].
+    x0 : (n, R) float64; z0 : (R,) float64
+        Initial states [x], [rad] (not modified).
+    r : (R, n_steps + 1, n_r) float64
+        External input samples [r] of each lane, linearly interpolated between samples.
+    dt : float
+        Step [s].
+    rec_every : int
+        Record every that many steps.
+    x_out : (n_steps // rec_every + 1, n, R) float64
+        Receives the states at the records (at a segment start: after its jumps).
+    aux_out : (n_steps // rec_every + 1, N_AUX, R) float64
+        Receives (T_f [N m], z [rad], u [rad]) (``AUX_*``).
+    status : (R,) int64
+        Receives -1 or the index of the step at which that lane's state became non-finite (a
+        failed lane runs on, its numbers meaningless; all failed: the integration stops).
+
+    No fast-math: a lane's numbers are the same for any R and any position among the lanes.
+    """
+    n, nl = x0.shape
+    nseg = bounds.shape[0] - 1
+    nsteps = r.shape[1] - 1
+    nr = r.shape[2]
+    X = x0.copy()
+    Z = z0.copy()
+    XT = np.empty((n, nl))
+    K1, K2, K3, K4 = np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl))
+    D1, D2, D3, D4 = np.empty(nl), np.empty(nl), np.empty(nl), np.empty(nl)
+    ZT = np.empty(nl)
+    U, TF = np.empty(nl), np.empty(nl)
+    R0, RM, R1 = np.empty((nr, nl)), np.empty((nr, nl)), np.empty((nr, nl))
+    V = np.zeros((n + nr + 5, nl))
+    C = np.empty((8, nl))
+    status[:] = -1
+    alive = nl
+    rec = 0
+    seg = 0
+    M = mx[0]
+    L = head[0]
+    for k in range(nsteps + 1):
+        if seg < nseg and k == bounds[seg]:
+            for j in range(jdst.shape[0]):
+                for q in range(nl):
+                    X[jdst[j], q] += jcoef[seg, j, q] * X[jsrc[j], q]
+            for i in range(n):
+                for q in range(nl):
+                    X[i, q] += kick[seg, i, q]
+            M = mx[seg]
+            L = head[seg]
+            seg += 1
+        k1n = min(k + 1, nsteps)
+        for j in range(nr):
+            for q in range(nl):
+                R0[j, q] = r[q, k, j]
+                R1[j, q] = r[q, k1n, j]
+                RM[j, q] = 0.5 * (R0[j, q] + R1[j, q])
+        # the derivative at the step start (K1), with T_f and u there for the record
+        _rates_lanes(X, Z, R0, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D1, K1)
+        if k % rec_every == 0:
+            for i in range(n):
+                for q in range(nl):
+                    x_out[rec, i, q] = X[i, q]
+            for q in range(nl):
+                aux_out[rec, AUX_TF, q] = TF[q]
+                aux_out[rec, AUX_Z, q] = Z[q]
+                aux_out[rec, AUX_U, q] = U[q]
+            rec += 1
+        if k == nsteps:
+            break
+        for i in range(n):
+            for q in range(nl):
+                XT[i, q] = X[i, q] + 0.5 * dt * K1[i, q]
+        for q in range(nl):
+            ZT[q] = Z[q] + 0.5 * dt * D1[q]
+        _rates_lanes(XT, ZT, RM, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D2, K2)
+        for i in range(n):
+            for q in range(nl):
+                XT[i, q] = X[i, q] + 0.5 * dt * K2[i, q]
+        for q in range(nl):
+            ZT[q] = Z[q] + 0.5 * dt * D2[q]
+        _rates_lanes(XT, ZT, RM, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D3, K3)
+        for i in range(n):
+            for q in range(nl):
+                XT[i, q] = X[i, q] + dt * K3[i, q]
+        for q in range(nl):
+            ZT[q] = Z[q] + dt * D3[q]
+        _rates_lanes(XT, ZT, R1, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D4, K4)
+        for i in range(n):
+            for q in range(nl):
+                X[i, q] += dt * (K1[i, q] + 2.0 * K2[i, q] + 2.0 * K3[i, q] + K4[i, q]) / 6.0
+        for q in range(nl):
+            Z[q] = Z[q] + dt * (D1[q] + 2.0 * D2[q] + 2.0 * D3[q] + D4[q]) / 6.0
+        for q in range(nl):
+            if status[q] < 0:
+                ok = math.isfinite(Z[q])
+                for i in range(n):
+                    ok = ok and math.isfinite(X[i, q])
+                if not ok:
+                    status[q] = k + 1
+                    alive -= 1
+        if alive == 0:
+            break
+    return alive

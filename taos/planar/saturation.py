@@ -209,31 +209,52 @@ def apply_valve_pressure(lim, x, off, u, dx):
     if lim.shape[0] == 0:
         return
     m = (lim.shape[0] - N_HEAD) // N_ROWS
+    if lim[LIM_VMAX] > 0.0:
+        a = valve_excess(lim, _dot(lim, ROW_UV, m, x, off) + lim[LIM_KVR] * u)
+        if a != 0.0:
+            _axpy(lim, ROW_UV_IN, m, a, dx, off)
+    if lim[LIM_PS] > 0.0:
+        _axpy(lim, ROW_FLOW_IN, m, pressure_flow_correction(lim, _dot(lim, ROW_Q, m, x, off),
+                                                            _dot(lim, ROW_P, m, x, off)), dx, off)
+
+
+@njit(cache=True, fastmath=_FM, inline="always")
+def valve_excess(lim, uv):
+    """The valve-command correction along the ``uv_in`` column for the valve command ``uv``
+    [m/s]: sat(u_v, v_max) - u_v (0 inside the rate limit or with it off); ``lim`` the packed
+    head (slots ``LIM_*``)."""
     vmax = lim[LIM_VMAX]
     if vmax > 0.0:
-        uv = _dot(lim, ROW_UV, m, x, off) + lim[LIM_KVR] * u
         if uv > vmax:
-            _axpy(lim, ROW_UV_IN, m, vmax - uv, dx, off)
-        elif uv < -vmax:
-            _axpy(lim, ROW_UV_IN, m, -vmax - uv, dx, off)
+            return vmax - uv
+        if uv < -vmax:
+            return -vmax - uv
+    return 0.0
+
+
+@njit(cache=True, fastmath=_FM, inline="always")
+def pressure_flow_correction(lim, q, p):
+    """The continuity-equation flow correction along the ``flow_in`` column [m/s]: the
+    square-root law's departure from the linear valve, q (g(d) - 1), minus the relief flow over
+    piston area (module docstring), for the valve flow state ``q`` [m/s] and load pressure ``p``
+    [Pa]; 0 with the pressure limit off. ``lim`` the packed head (slots ``LIM_*``)."""
     ps = lim[LIM_PS]
-    if ps > 0.0:
-        q = _dot(lim, ROW_Q, m, x, off)
-        p = _dot(lim, ROW_P, m, x, off)
-        sg = 1.0 if q >= 0 else -1.0
-        d = (ps - sg * p) / ps  # pressure margin across the metering orifices [-]
-        eps = lim[LIM_EPS]
-        if d >= eps:  # square-root law (d < 0: back to supply), linear within eps of stall
-            g = math.sqrt(d)
-        elif d <= -eps:
-            g = -math.sqrt(-d)
-        else:
-            g = d / math.sqrt(eps)
-        corr = q * (g - 1.0)
-        over = abs(p) - lim[LIM_PR]
-        if over > 0.0:  # cross-port relief: Q_r / A = (K_r / A) (|P_L| - P_r) sgn(P_L)
-            corr -= lim[LIM_KRA] * over * (1.0 if p > 0 else -1.0)
-        _axpy(lim, ROW_FLOW_IN, m, corr, dx, off)
+    if ps <= 0.0:
+        return 0.0
+    sg = 1.0 if q >= 0 else -1.0
+    d = (ps - sg * p) / ps  # pressure margin across the metering orifices [-]
+    eps = lim[LIM_EPS]
+    if d >= eps:  # square-root law (d < 0: back to supply), linear within eps of stall
+        g = math.sqrt(d)
+    elif d <= -eps:
+        g = -math.sqrt(-d)
+    else:
+        g = d / math.sqrt(eps)
+    corr = q * (g - 1.0)
+    over = abs(p) - lim[LIM_PR]
+    if over > 0.0:  # cross-port relief: Q_r / A = (K_r / A) (|P_L| - P_r) sgn(P_L)
+        corr -= lim[LIM_KRA] * over * (1.0 if p > 0 else -1.0)
+    return corr
 
 
 @njit(cache=True, fastmath=_FM)
