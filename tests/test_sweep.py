@@ -208,6 +208,29 @@ def test_lco_verdict_flips_between_the_papers_soft_and_stiff_structure(tmp_path)
     assert [p["metrics"] for p in local["points"]] == [p["metrics"] for p in d["points"]]
 
 
+
+@pytest.mark.slow
+def test_time_domain_verdict_equals_taos_lco_on_each_point(tmp_path):
+    """``lco_confirmed`` is ``taos lco``'s verdict (the flight loop flown in the time domain
+    decides): over the paper's soft and stiff load paths (sec. 3.2: a cycle with the soft one,
+    none with the stiff one) each point equals the ``taos lco --load-stiffness`` command run on
+    its own, amplitude and frequency included."""
+    grid = ("--amplitudes-deg", "0.01,0.05,0.2,1", "--freq-hz", "0.05,0.1,0.2,0.5")
+    d = sweep_json(tmp_path, FLIGHT_MODEL, "--flight", FLIGHT, "--set",
+                   "structure.load_stiffness=115000 lbf/in,205000 lbf/in", "--metric",
+                   "lco,lco_confirmed,lco_confirmed_engine_amplitude_deg,lco_confirmed_frequency_hz", *grid)
+    soft, stiff = (p["metrics"] for p in d["points"])
+    assert soft["lco_confirmed"] is True and stiff["lco_confirmed"] is False
+    for point, k in ((soft, "115000 lbf/in"), (stiff, "205000 lbf/in")):
+        r = run_cli("lco", FLIGHT_MODEL, "--flight", FLIGHT, "--load-stiffness", k, *grid, "--json", "-")
+        assert r.returncode == 0, r.stderr
+        lco = json.loads(r.stdout)
+        assert point["lco_confirmed"] is lco["verdict"]["lco"]
+        assert point["lco"] is lco["lco"]
+        td = lco["time_domain"]
+        assert point["lco_confirmed_engine_amplitude_deg"] == td["engine_amplitude_deg"]
+        assert point["lco_confirmed_frequency_hz"] == td["frequency_hz"]
+
 BAD = [
     (["--set", "structure.load_stifness=1 lbf/in"], "--set structure.load_stifness: expected a known key"),
     (["--set", "foo.bar=1"], "--set foo.bar"),

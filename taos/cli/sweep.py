@@ -45,6 +45,8 @@ def _where(texts: dict) -> str:
 
 
 def _table(res) -> None:
+    from taos.montecarlo.sweep_metrics import METRICS
+
     d = res.definition
     keys = [k.key for k in d.design.keys]
     head = keys + list(d.metrics) + ["status"]
@@ -55,7 +57,7 @@ def _table(res) -> None:
         st = res.status_name(i)
         for m in d.metrics:
             v = res.values[m][i]
-            cells.append("-" if st != "ok" or v != v else (("yes" if v else "no") if m == "lco" else f"{v:.5g}"))
+            cells.append("-" if st != "ok" or v != v else (("yes" if v else "no") if METRICS[m].flag else f"{v:.5g}"))
         cells.append(st)
         print("  ".join(c.rjust(n) for c, n in zip(cells, w)))
     if d.design.n > MAX_ROWS:

@@ -159,7 +159,7 @@ def check_metrics(names: tuple[str, ...], flight_file: str | None) -> None:
             g = nearest(n, list(METRICS))
             raise InputError("command line", "--metric", ("a known metric" + (f" (did you mean {g!r}?)" if g else
                              " (taos sweep --list-metrics)")), got=repr(n))
-    if flight_file is None and any(METRICS[n].family == "lco" for n in names):
+    if flight_file is None and any(METRICS[n].family in ("lco", "lco_time") for n in names):
         raise InputError("command line", "--flight", "a flight file for the LCO metrics (e.g. "
                          "models/flight/core_stage.toml)", got="none")
 
