@@ -203,7 +203,7 @@ def _act_linear(Aa, bxc, bf, ux, F, x, off, dx, m):
 
 
 #: the actuator rate/pressure limits (taos.planar.saturation), the same source compiled inline here
-_valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.apply_valve_pressure.py_func)
+_valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.valve_pressure_rows.py_func)
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
@@ -234,6 +234,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     cL, ivp, L0 = P.line_damping_Ns_per_m, P.act_vp_index, P.line_length0_m
     lim = P.limits  # actuator/gimbal limits packed over one actuator's state (taos.planar.saturation)
     na = Aa.shape[0]
+    mlim = (lim.shape[0] - _lim.N_HEAD) // _lim.N_ROWS if lim.shape[0] > 0 else 0  # states lim is packed over
     p0, p1, p2 = x[X_P], x[X_P + 1], x[X_P + 2]
     qx, qy, qz, qw = x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3]
     R = _rotation(qx, qy, qz, qw)
@@ -298,13 +299,20 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
         Tw1 += m1
         Tw2 += m2
         u = u0 if a == 0 else u1
-        if na == 6:  # the second-order valve: a fixed size LLVM unrolls (the same sums)
+        # the linear actuator, then the rate and pressure limits (none if lim is empty); the
+        # sizes of the second- and first-order valves' actuators as literals: fixed-size loops
+        if na == 6:
             _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, 6)
-        elif na == 5:  # the first-order valve
+        elif na == 5:
             _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, 5)
         else:
             _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, na)
-        _valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
+        if mlim == 6:
+            _valve_pressure(lim, x, off, u, dx, 6)
+        elif mlim == 5:
+            _valve_pressure(lim, x, off, u, dx, 5)
+        elif mlim > 0:
+            _valve_pressure(lim, x, off, u, dx, mlim)
         aux[AUX_FL + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
     Yv0, Yv1, Yv2, Yv3, Yv4, Yv5 = _mv6(Y, vx, vy, vz, wx, wy, wz)
