@@ -208,6 +208,14 @@ _valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def rhs(x, T0, T1, u0, u1, P, dx, aux):
+    """State derivative of the TAOS engine + actuators (module docstring); arguments as
+    :func:`_rhs`, whose compiled body this calls (the step inlines that body instead: a call
+    passes the packed model's ~150 machine words on the stack)."""
+    _rhs(x, T0, T1, u0, u1, P, dx, aux)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _rhs(x, T0, T1, u0, u1, P, dx, aux):
     """State derivative of the TAOS engine + actuators (module docstring).
 
     Parameters
@@ -471,19 +479,32 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi):
     n = x.shape[0]
     T0, T1 = bs[BS_T], bs[BS_T + 1]
     qa0, qa1 = psi[0], psi[1]  # the pose-demanded bearing angle at the step start
-    if not k1_ready:
-        rhs(x, T0, T1, u[U_START], u[U_START + 1], P, k1, aux)
-    um0, um1 = u[U_MID], u[U_MID + 1]
     h = 0.5 * dt
-    for i in range(n):
-        xt[i] = x[i] + h * k1[i]
-    rhs(xt, T0, T1, um0, um1, P, k2, aux)
-    for i in range(n):
-        xt[i] = x[i] + h * k2[i]
-    rhs(xt, T0, T1, um0, um1, P, k3, aux)
-    for i in range(n):
-        xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0, T1, u[U_END], u[U_END + 1], P, k4, aux)
+    # the four stages through one inlined right-hand side (one copy of its code, no call)
+    for st in range(4):
+        if st == 0:
+            if k1_ready:
+                continue
+            for i in range(n):
+                xt[i] = x[i]
+            ko = k1
+            ua, ub = u[U_START], u[U_START + 1]
+        elif st == 1:
+            for i in range(n):
+                xt[i] = x[i] + h * k1[i]
+            ko = k2
+            ua, ub = u[U_MID], u[U_MID + 1]
+        elif st == 2:
+            for i in range(n):
+                xt[i] = x[i] + h * k2[i]
+            ko = k3
+            ua, ub = u[U_MID], u[U_MID + 1]
+        else:
+            for i in range(n):
+                xt[i] = x[i] + dt * k3[i]
+            ko = k4
+            ua, ub = u[U_END], u[U_END + 1]
+        _rhs(xt, T0, T1, ua, ub, P, ko, aux)
     h6 = dt / 6.0
     for i in range(n):
         x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
