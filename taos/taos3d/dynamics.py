@@ -442,6 +442,13 @@ def stage_inputs(c0, cm, c1, avp):
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi):
+    """One step (:func:`_step`, whose compiled body this calls; the run's loop
+    :func:`_steps` inlines that body instead); arguments and return as :func:`_step`."""
+    return _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi):
     """One step (module docstring): RK4 on (q, v, actuators) with the bearing torque T held at
     its step-start value, the BDF2 bearing update, the trapezoidal torque kick.
 
@@ -585,18 +592,24 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
 
     Returns -1, or the first step whose state became non-finite."""
     n = x0.shape[0]
-    x = x0
-    bs = bs0
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    xt = np.empty(n)
-    aux = np.empty(N_AUX)
-    c0 = np.empty(2)
-    cm = np.empty(2)
-    c1 = np.empty(2)
-    psi = np.empty(2)
+    return _steps(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out, np.empty((5, n)), np.empty(N_AUX),
+                  np.empty((4, 2)))
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _steps(P, fid, fp, avp, x, bs, r, dt, rec_every, out, ks, aux, cs):
+    """:func:`integrate`'s loop (arguments as there; ``ks`` (5, n), ``aux`` (N_AUX,), ``cs``
+    (4, 2) scratch), compiled without reference counting, with the step inlined (a call
+    passes the packed model's ~150 machine words on the stack)."""
+    k1 = ks[0]
+    k2 = ks[1]
+    k3 = ks[2]
+    k4 = ks[3]
+    xt = ks[4]
+    c0 = cs[0]
+    cm = cs[1]
+    c1 = cs[2]
+    psi = cs[3]
     psi[0], psi[1] = pose_psi(x, P)
     nsteps = r.shape[0] - 1
     rec = 0
@@ -614,7 +627,7 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
             rec += 1
         if k == nsteps:
             break
-        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready, psi):
+        if not _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready, psi):
             return k + 1
     return -1
 
