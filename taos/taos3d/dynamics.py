@@ -659,23 +659,27 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
         Receives the Fourier coefficients.
 
     Returns -1, or the first step whose state became non-finite."""
-    n = x0.shape[0]
-    x = x0.copy()
-    bs = np.zeros(N_BEARING)
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    xt = np.empty(n)
-    aux = np.empty(N_AUX)
-    rec = np.empty(len(REC))
-    c0 = np.empty(2)
-    cm = np.empty(2)
-    c1 = np.empty(2)
+    return _dwell_steps(P, fid, fp, avp, x0.copy(), np.zeros(N_BEARING), amp, freq, fmeas, dt, nset, nmeas, out,
+                        np.empty((5, x0.shape[0])), np.empty(N_AUX), np.empty(len(REC)), np.empty((4, 2)))
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out, ks, aux, rec, cs):
+    """:func:`_dwell_one`'s loop from the state ``x``, bearing state ``bs`` (scratch ``ks``
+    (5, n), ``aux``, ``rec``, ``cs`` (4, 2)), compiled without reference counting, with the
+    step inlined (as :func:`_steps`)."""
+    k1 = ks[0]
+    k2 = ks[1]
+    k3 = ks[2]
+    k4 = ks[3]
+    xt = ks[4]
+    c0 = cs[0]
+    cm = cs[1]
+    c1 = cs[2]
     for o in range(4):
         for j in range(3):
             out[o, j] = 0.0
-    psi = np.empty(2)
+    psi = cs[3]
     psi[0], psi[1] = pose_psi(x, P)
     w = 2.0 * math.pi
     for k in range(nset + nmeas):
@@ -694,7 +698,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
                 out[o, 0] += y * s
                 out[o, 1] += y * c
                 out[o, 2] += y
-        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset, psi):
+        if not _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset, psi):
             return k + 1
     for o in range(4):
         out[o, 0] *= 2.0 / nmeas
