@@ -317,14 +317,10 @@ def _rhs(x, T0, T1, u0, u1, P, dx, aux):
         # sizes of the second- and first-order valves' actuators as literals: fixed-size loops
         if na == 6:
             _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, 6)
-        elif na == 5:
-            _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, 5)
         else:
             _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, na)
         if mlim == 6:
             _valve_pressure(lim, x, off, u, dx, 6)
-        elif mlim == 5:
-            _valve_pressure(lim, x, off, u, dx, 5)
         elif mlim > 0:
             _valve_pressure(lim, x, off, u, dx, mlim)
         aux[AUX_FL + a] = F
