@@ -65,9 +65,10 @@ the recorded step reuses its derivative as the first RK4 stage. A numba call pas
 packed model ``P`` as about 150 machine words on the stack, so the run's loops
 (:func:`_steps`, :func:`_dwell_steps`) inline the step (:func:`_step`), which runs its four
 stages through one inlined right-hand side; :func:`rhs` and :func:`step` are the callable
-(non-inlined) forms. The actuator block and its limits run with the actuator's state size as a
-literal (unrolled loops), and the log map needs no library call (:func:`_logq4`): issue 28,
-1.29 -> 0.92 us a step at 4e-4 s, the arithmetic unchanged to rounding.
+(non-inlined) forms. The actuator block and its limits run with the second-order valve's state
+size (6) as a literal (unrolled loops; other sizes the runtime-size loops), and the log map
+needs no library call (:func:`_logq4`): issue 28, 1.29 -> 0.92 us a step at 4e-4 s, the
+arithmetic unchanged to rounding (benchmarks/RESULTS.md).
 
 Packed data (every index below is a module constant of :mod:`taos.taos3d._layout`, re-exported
 here, used by the packer :func:`taos.taos3d.simulate.pack` and the kernels alike;
@@ -314,7 +315,7 @@ def _rhs(x, T0, T1, u0, u1, P, dx, aux):
         Tw2 += m2
         u = u0 if a == 0 else u1
         # the linear actuator, then the rate and pressure limits (none if lim is empty); the
-        # sizes of the second- and first-order valves' actuators as literals: fixed-size loops
+        # second-order valve's size (6 states) as a literal: fixed-size loops
         if na == 6:
             _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, 6)
         else:
