@@ -208,7 +208,13 @@ def apply_valve_pressure(lim, x, off, u, dx):
     """
     if lim.shape[0] == 0:
         return
-    m = (lim.shape[0] - N_HEAD) // N_ROWS
+    valve_pressure_rows(lim, x, off, u, dx, (lim.shape[0] - N_HEAD) // N_ROWS)
+
+
+@njit(cache=True, fastmath=_FM, inline="always")
+def valve_pressure_rows(lim, x, off, u, dx, m):
+    """:func:`apply_valve_pressure` for a non-empty ``lim`` packed over ``m`` states (inlined:
+    a caller that knows ``m`` at compile time, as the 3-D kernel, gets fixed-size loops)."""
     if lim[LIM_VMAX] > 0.0:
         a = valve_excess(lim, _dot(lim, ROW_UV, m, x, off) + lim[LIM_KVR] * u)
         if a != 0.0:

@@ -59,9 +59,16 @@ constant in time: every stage takes its mean over the step (:func:`stage_inputs`
 stage points. Quaternions are renormalised after each step. With friction off (T = 0) the
 scheme is plain RK4.
 
-The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays), and the
+The right-hand side :func:`_rhs` uses scalar locals and tuples only (no heap arrays), and the
 step's kernels allocate nothing and are compiled without reference counting (``_nrt=False``);
-the recorded step reuses its derivative as the first RK4 stage.
+the recorded step reuses its derivative as the first RK4 stage. A numba call passes the
+packed model ``P`` as about 150 machine words on the stack, so the run's loops
+(:func:`_steps`, :func:`_dwell_steps`) inline the step (:func:`_step`), which runs its four
+stages through one inlined right-hand side; :func:`rhs` and :func:`step` are the callable
+(non-inlined) forms. The actuator block and its limits run with the second-order valve's state
+size (6) as a literal (unrolled loops; other sizes the runtime-size loops), and the log map
+needs no library call (:func:`_logq4`): issue 28, 1.29 -> 0.92 us a step at 4e-4 s, the
+arithmetic unchanged to rounding (benchmarks/RESULTS.md).
 
 Packed data (every index below is a module constant of :mod:`taos.taos3d._layout`, re-exported
 here, used by the packer :func:`taos.taos3d.simulate.pack` and the kernels alike;
@@ -112,14 +119,24 @@ def _logq(q, r):
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _logq4(qx, qy, qz, qw):
-    """Rotation vector (r0, r1, r2) [rad] and angle [rad] of the unit quaternion (xyzw)."""
+    """Rotation vector (r0, r1, r2) [rad] and angle [rad] of the unit quaternion (xyzw):
+    a = 2 atan2(n, |w|), r = a q_xyz / n sgn(w) (n = |q_xyz|). Below t = n / |w| = 0.15 (angles
+    below 17 deg, the gimbal's range) atan(t) / t is its Taylor series to t^22 (the next term,
+    t^24 / 25, is below 1.1e-18 there): no call to atan2, whose call makes the compiled
+    right-hand side spill every live register."""
     s = 1.0 if qw >= 0 else -1.0
     n = math.sqrt(qx * qx + qy * qy + qz * qz)
-    a = 2.0 * math.atan2(n, abs(qw))
-    if n < 1e-12:
-        f = 2.0 * s / max(abs(qw), 1e-300)
-    else:
-        f = a / n * s
+    aw = abs(qw)
+    if n < 0.15 * aw:
+        t = n / aw
+        t2 = t * t
+        at = 1.0 + t2 * (-1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (-1.0 / 7.0 + t2 * (1.0 / 9.0 + t2 * (
+            -1.0 / 11.0 + t2 * (1.0 / 13.0 + t2 * (-1.0 / 15.0 + t2 * (1.0 / 17.0 + t2 * (
+                -1.0 / 19.0 + t2 * (1.0 / 21.0 + t2 * (-1.0 / 23.0)))))))))))  # atan(t) / t
+        f = 2.0 * at / aw * s
+        return f * qx, f * qy, f * qz, f * s * n
+    a = 2.0 * math.atan2(n, aw)
+    f = a / n * s
     return f * qx, f * qy, f * qz, a
 
 
@@ -180,12 +197,32 @@ def _world_torque(r0, r1, r2, th, g0, g1, g2):
     return g0 + 0.5 * rg0 + c * rrg0, g1 + 0.5 * rg1 + c * rrg1, g2 + 0.5 * rg2 + c * rrg2
 
 
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _act_linear(Aa, bxc, bf, ux, F, x, off, dx, m):
+    """dx[off:off+m] = A x[off:off+m] + b_xc ux + b_fl F: the linear actuator (m states,
+    :func:`taos.planar.actuator.actuator_state_space`) at the command ``ux`` = R u [m] and the load
+    force ``F`` [N]; inlined, so a literal ``m`` lets LLVM unroll the fixed-size products."""
+    for k in range(m):
+        s = bxc[k] * ux + bf[k] * F
+        for j in range(m):
+            s += Aa[k, j] * x[off + j]
+        dx[off + k] = s
+
+
 #: the actuator rate/pressure limits (taos.planar.saturation), the same source compiled inline here
-_valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.apply_valve_pressure.py_func)
+_valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.valve_pressure_rows.py_func)
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def rhs(x, T0, T1, u0, u1, P, dx, aux):
+    """State derivative of the TAOS engine + actuators (module docstring); arguments as
+    :func:`_rhs`, whose compiled body this calls (the step inlines that body instead: a call
+    passes the packed model's ~150 machine words on the stack)."""
+    _rhs(x, T0, T1, u0, u1, P, dx, aux)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _rhs(x, T0, T1, u0, u1, P, dx, aux):
     """State derivative of the TAOS engine + actuators (module docstring).
 
     Parameters
@@ -212,6 +249,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     cL, ivp, L0 = P.line_damping_Ns_per_m, P.act_vp_index, P.line_length0_m
     lim = P.limits  # actuator/gimbal limits packed over one actuator's state (taos.planar.saturation)
     na = Aa.shape[0]
+    mlim = (lim.shape[0] - _lim.N_HEAD) // _lim.N_ROWS if lim.shape[0] > 0 else 0  # states lim is packed over
     p0, p1, p2 = x[X_P], x[X_P + 1], x[X_P + 2]
     qx, qy, qz, qw = x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3]
     R = _rotation(qx, qy, qz, qw)
@@ -276,12 +314,16 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
         Tw1 += m1
         Tw2 += m2
         u = u0 if a == 0 else u1
-        for k in range(na):
-            s = bxc[k] * Rarm * u + bf[k] * F
-            for j in range(na):
-                s += Aa[k, j] * x[off + j]
-            dx[off + k] = s
-        _valve_pressure(lim, x, off, u, dx)  # rate and pressure limits (no-op if none)
+        # the linear actuator, then the rate and pressure limits (none if lim is empty); the
+        # second-order valve's size (6 states) as a literal: fixed-size loops
+        if na == 6:
+            _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, 6)
+        else:
+            _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, na)
+        if mlim == 6:
+            _valve_pressure(lim, x, off, u, dx, 6)
+        elif mlim > 0:
+            _valve_pressure(lim, x, off, u, dx, mlim)
         aux[AUX_FL + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
     Yv0, Yv1, Yv2, Yv3, Yv4, Yv5 = _mv6(Y, vx, vy, vz, wx, wy, wz)
@@ -316,9 +358,10 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
-def _torque_kick(x, d0, d1, h, P):
+def _torque_kick(x, r0, r1, r2, th, d0, d1, h, P):
     """x[7:13] += h a, a [m/s^2, rad/s^2] the engine's body-frame acceleration that a change
-    (d0, d1) [N m] of the bearing torque adds at the state x: the chain wrench changes by
+    (d0, d1) [N m] of the bearing torque adds at the state x (its rotation vector (r0, r1, r2)
+    and angle th [rad], :func:`_logq4` of its quaternion): the chain wrench changes by
     dW = Ks S Kc dT (phi = G e - Kc T in :func:`rhs`), acting on the engine as
     (-dW[:3], Jl^-T (-dW[3:])) in the world, Y^-1 of that in the body frame. ``h`` [s];
     ``P`` the packed model (:class:`TaosParams`)."""
@@ -331,7 +374,6 @@ def _torque_kick(x, d0, d1, h, P):
     g2 = -(BT[5, 0] * d0 + BT[5, 1] * d1)
     qx, qy, qz, qw = x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3]
     R = _rotation(qx, qy, qz, qw)
-    r0, r1, r2, th = _logq4(qx, qy, qz, qw)
     Tw0, Tw1, Tw2 = _world_torque(r0, r1, r2, th, g0, g1, g2)
     f0, f1, f2 = _rtv(R, dF0, dF1, dF2)
     f3, f4, f5 = _rtv(R, Tw0, Tw1, Tw2)
@@ -343,8 +385,14 @@ def _torque_kick(x, d0, d1, h, P):
 def pose_psi(x, P):
     """psi = G e: the bearing angles (pitch, yaw) that carry no torque at the pose of the state
     ``x`` (``X_*``) [rad]; ``P`` the packed model (:class:`TaosParams`)."""
-    G = P.slip_gain
     r0, r1, r2, _ = _logq4(x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3])
+    return _psi(x, r0, r1, r2, P)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _psi(x, r0, r1, r2, P):
+    """:func:`pose_psi` given the rotation vector (r0, r1, r2) [rad] of the state's quaternion."""
+    G = P.slip_gain
     e0, e1, e2 = x[X_P], x[X_P + 1], x[X_P + 2]
     p0 = G[0, 0] * e0 + G[0, 1] * e1 + G[0, 2] * e2 + G[0, 3] * r0 + G[0, 4] * r1 + G[0, 5] * r2
     p1 = G[1, 0] * e0 + G[1, 1] * e1 + G[1, 2] * e2 + G[1, 3] * r0 + G[1, 4] * r1 + G[1, 5] * r2
@@ -396,7 +444,14 @@ def stage_inputs(c0, cm, c1, avp):
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
+def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi):
+    """One step (:func:`_step`, whose compiled body this calls; the run's loop
+    :func:`_steps` inlines that body instead); arguments and return as :func:`_step`."""
+    return _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi):
     """One step (module docstring): RK4 on (q, v, actuators) with the bearing torque T held at
     its step-start value, the BDF2 bearing update, the trapezoidal torque kick.
 
@@ -426,36 +481,55 @@ def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready):
         Scratch for :func:`rhs`.
     k1_ready : bool
         k1 already holds the derivative at the step start (from the record, same inputs).
+    psi : (2,) float64
+        The pose-demanded bearing angle :func:`pose_psi` at the step start [rad]; receives
+        its value at the step end (the torque kick moves no pose: the next step's start).
 
     Returns True while the state stays finite."""
     n = x.shape[0]
     T0, T1 = bs[BS_T], bs[BS_T + 1]
-    qa0, qa1 = pose_psi(x, P)  # the pose-demanded bearing angle at the step start
-    if not k1_ready:
-        rhs(x, T0, T1, u[U_START], u[U_START + 1], P, k1, aux)
-    um0, um1 = u[U_MID], u[U_MID + 1]
+    qa0, qa1 = psi[0], psi[1]  # the pose-demanded bearing angle at the step start
     h = 0.5 * dt
-    for i in range(n):
-        xt[i] = x[i] + h * k1[i]
-    rhs(xt, T0, T1, um0, um1, P, k2, aux)
-    for i in range(n):
-        xt[i] = x[i] + h * k2[i]
-    rhs(xt, T0, T1, um0, um1, P, k3, aux)
-    for i in range(n):
-        xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0, T1, u[U_END], u[U_END + 1], P, k4, aux)
+    # the four stages through one inlined right-hand side (one copy of its code, no call)
+    for st in range(4):
+        if st == 0:
+            if k1_ready:
+                continue
+            for i in range(n):
+                xt[i] = x[i]
+            ko = k1
+            ua, ub = u[U_START], u[U_START + 1]
+        elif st == 1:
+            for i in range(n):
+                xt[i] = x[i] + h * k1[i]
+            ko = k2
+            ua, ub = u[U_MID], u[U_MID + 1]
+        elif st == 2:
+            for i in range(n):
+                xt[i] = x[i] + h * k2[i]
+            ko = k3
+            ua, ub = u[U_MID], u[U_MID + 1]
+        else:
+            for i in range(n):
+                xt[i] = x[i] + dt * k3[i]
+            ko = k4
+            ua, ub = u[U_END], u[U_END + 1]
+        _rhs(xt, T0, T1, ua, ub, P, ko, aux)
     h6 = dt / 6.0
     for i in range(n):
         x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
     qn = math.sqrt(x[X_Q] * x[X_Q] + x[X_Q + 1] * x[X_Q + 1] + x[X_Q + 2] * x[X_Q + 2] + x[X_Q + 3] * x[X_Q + 3])
     for i in range(X_Q, X_Q + 4):
         x[i] /= qn
-    ps0, ps1 = pose_psi(x, P)
+    r0, r1, r2, th = _logq4(x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3])
+    ps0, ps1 = _psi(x, r0, r1, r2, P)
+    psi[0] = ps0
+    psi[1] = ps1
     # the bearing by variable-step BDF2 under its own error control (taos.taos3d._bearing),
     # psi linear over the step; the engine gets the mean torque over the step
     m0, m1, _ = _bg.advance(bs, fid, fp, P.bearing_compliance, dt, qa0, qa1, ps0, ps1, _bg.tolerance(dt), _bg.MAX_SPLIT,
                             _bg.FAST_STEPS)
-    _torque_kick(x, m0 - T0, m1 - T1, dt, P)  # the mean of T over the step (second order)
+    _torque_kick(x, r0, r1, r2, th, m0 - T0, m1 - T1, dt, P)  # the mean of T over the step (second order)
     t0, t1, z0, z1 = bs[BS_T], bs[BS_T + 1], bs[BS_Z], bs[BS_Z + 1]
     s = t0 + t1 + z0 + z1  # a NaN or an infinity anywhere makes the sum non-finite
     for i in range(n):
@@ -521,17 +595,25 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
 
     Returns -1, or the first step whose state became non-finite."""
     n = x0.shape[0]
-    x = x0
-    bs = bs0
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    xt = np.empty(n)
-    aux = np.empty(N_AUX)
-    c0 = np.empty(2)
-    cm = np.empty(2)
-    c1 = np.empty(2)
+    return _steps(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out, np.empty((5, n)), np.empty(N_AUX),
+                  np.empty((4, 2)))
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _steps(P, fid, fp, avp, x, bs, r, dt, rec_every, out, ks, aux, cs):
+    """:func:`integrate`'s loop (arguments as there; ``ks`` (5, n), ``aux`` (N_AUX,), ``cs``
+    (4, 2) scratch), compiled without reference counting, with the step inlined (a call
+    passes the packed model's ~150 machine words on the stack)."""
+    k1 = ks[0]
+    k2 = ks[1]
+    k3 = ks[2]
+    k4 = ks[3]
+    xt = ks[4]
+    c0 = cs[0]
+    cm = cs[1]
+    c1 = cs[2]
+    psi = cs[3]
+    psi[0], psi[1] = pose_psi(x, P)
     nsteps = r.shape[0] - 1
     rec = 0
     for k in range(nsteps + 1):
@@ -548,7 +630,7 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
             rec += 1
         if k == nsteps:
             break
-        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready):
+        if not _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready, psi):
             return k + 1
     return -1
 
@@ -580,22 +662,28 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
         Receives the Fourier coefficients.
 
     Returns -1, or the first step whose state became non-finite."""
-    n = x0.shape[0]
-    x = x0.copy()
-    bs = np.zeros(N_BEARING)
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    xt = np.empty(n)
-    aux = np.empty(N_AUX)
-    rec = np.empty(len(REC))
-    c0 = np.empty(2)
-    cm = np.empty(2)
-    c1 = np.empty(2)
+    return _dwell_steps(P, fid, fp, avp, x0.copy(), np.zeros(N_BEARING), amp, freq, fmeas, dt, nset, nmeas, out,
+                        np.empty((5, x0.shape[0])), np.empty(N_AUX), np.empty(len(REC)), np.empty((4, 2)))
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out, ks, aux, rec, cs):
+    """:func:`_dwell_one`'s loop from the state ``x``, bearing state ``bs`` (scratch ``ks``
+    (5, n), ``aux``, ``rec``, ``cs`` (4, 2)), compiled without reference counting, with the
+    step inlined (as :func:`_steps`)."""
+    k1 = ks[0]
+    k2 = ks[1]
+    k3 = ks[2]
+    k4 = ks[3]
+    xt = ks[4]
+    c0 = cs[0]
+    cm = cs[1]
+    c1 = cs[2]
     for o in range(4):
         for j in range(3):
             out[o, j] = 0.0
+    psi = cs[3]
+    psi[0], psi[1] = pose_psi(x, P)
     w = 2.0 * math.pi
     for k in range(nset + nmeas):
         t = k * dt
@@ -613,7 +701,7 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
                 out[o, 0] += y * s
                 out[o, 1] += y * c
                 out[o, 2] += y
-        if not step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset):
+        if not _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset, psi):
             return k + 1
     for o in range(4):
         out[o, 0] *= 2.0 / nmeas
