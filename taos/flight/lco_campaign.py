@@ -182,7 +182,7 @@ def run_map_campaign(flight: FlightModel, model: TvcModel, axes, settings: MapSe
 def read_map(spath: Path, axes, friction_model: str, lgm: dict, settings: MapSettings) -> tuple[LcoMap, list[dict]]:
     """The map stored at ``spath`` (rows put back in grid order) and its failed points."""
     from taos.montecarlo import store
-    ds = store.open_store(spath)
+    ds = store.open_store(spath, dask=False)
     idx = np.asarray(ds["run"].values, np.int64)
     n = idx.size
     pts = {}

@@ -170,7 +170,7 @@ def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | Non
         if cluster is not None:
             cluster.close()
     wall = time.perf_counter() - t0
-    ds, nom = store.open_store(spath), store.open_store(spath, "nominal")
+    ds, nom = store.open_store(spath, dask=False), store.open_store(spath, "nominal", dask=False)
     flown = {str(v) for g in (ds, nom) for v in np.unique(g["inputs_sha256"].values)}
     if flown != {kind.inputs_sha256}:
         raise RuntimeError(f"the store holds runs flown with other inputs: {sorted(flown)}")

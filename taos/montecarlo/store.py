@@ -80,15 +80,18 @@ def write_batch(path: Path, start: int, out: Mapping[str, np.ndarray], group: st
                                                                                     zarr_format=2)
 
 
-def open_store(path: Path, group: str | None = None, consolidated: bool | None = None):
-    """The store (or its ``group``) as a lazy :class:`xarray.Dataset`."""
+def open_store(path: Path, group: str | None = None, consolidated: bool | None = None, *, dask: bool = True):
+    """The store (or its ``group``) as a lazy :class:`xarray.Dataset`; ``dask=False`` reads it
+    without dask arrays, so a read never becomes a task of a Dask client that happens to be
+    active in this process (its workers may not see this file system, or may be gone)."""
     import xarray as xr
-    return xr.open_zarr(path, group=group, zarr_format=2, consolidated=consolidated)
+    return xr.open_zarr(path, group=group, zarr_format=2, consolidated=consolidated,
+                        **({} if dask else {"chunks": None}))
 
 
 def status(path: Path, group: str | None = None) -> np.ndarray | None:
-    """Every run's status code, or None when the store cannot be read."""
+    """Every run's status code, or None when the store cannot be read (read in this process)."""
     try:
-        return np.asarray(open_store(path, group, consolidated=False)["status"].values, np.int8)
+        return np.asarray(open_store(path, group, consolidated=False, dask=False)["status"].values, np.int8)
     except (OSError, KeyError, ValueError):
         return None

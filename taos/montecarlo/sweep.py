@@ -267,7 +267,7 @@ def run_sweep(defn: SweepDefinition, out_dir: str | Path | None = None, *, worke
             if cluster is not None:
                 cluster.close()
         wall = time.perf_counter() - t0
-        ds = store.open_store(spath).load()
+        ds = store.open_store(spath, dask=False).load()
     finally:
         if tmp is not None:
             tmp.cleanup()

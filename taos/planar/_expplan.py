@@ -16,7 +16,9 @@ and the limits, and the measurement:
   sigma_1 / J [1/s] and, sliding at rate w, the bristle relaxation sigma_0 |w| / G(w) [1/s]
   (Dahl, LuGre). They are taken at 64 points of the second cycle of the friction law driven by
   the linear orbit's rate (:func:`taos.friction._kernels.prescribed_rate_response`, an upper
-  bound: friction only slows the engine), and the step is h <= :data:`KAPPA` / max |lambda(M)|.
+  bound: friction only slows the engine) and at its rate reversals (w = 0, where a regularised
+  law is stiffest: a smooth Coulomb law's slope T_c / v_eps), and the step is
+  h <= :data:`KAPPA` / max |lambda(M)|.
 * **Limits.** The supply-pressure law adds the rate |dN_P / dP_L| = (4 beta / V_t) |q|
   g'(d) / P_s on the load-pressure state (largest along the orbit); the step keeps h times it
   within :data:`KAPPA` too. A dwell whose linear orbit reaches the valve's rate limit or the
@@ -104,9 +106,14 @@ def dwell_step_s(args, model, amp: float, freq: float, fixed_dt_s: float) -> tup
     ta = xs @ ca
     fp, fid = model.friction.pack(), model.friction.entry.rates
     _, z = prescribed_rate_response(fid, fp, np.ascontiguousarray(w), 1.0 / (freq * N_ORBIT), 0.0)
-    sl = slice(N_ORBIT, 2 * N_ORBIT, N_ORBIT // 64)
-    rho = _friction_rate(fid, fp, np.ascontiguousarray(w[sl]), np.ascontiguousarray(ta[sl]),
-                         np.ascontiguousarray(z[sl]), float(cw @ bf), float(ca @ bf))
+    sl = np.arange(N_ORBIT, 2 * N_ORBIT, N_ORBIT // 64)
+    # and the rate reversals, where a regularised law is stiffest (a smooth Coulomb law's slope
+    # T_c / v_eps at w = 0 is a spike far narrower than the 64 samples' spacing)
+    c2 = w[N_ORBIT:2 * N_ORBIT]
+    rev = N_ORBIT + np.flatnonzero(np.signbit(c2[:-1]) != np.signbit(c2[1:]))
+    ws = np.concatenate([w[sl], np.zeros(rev.size)])
+    rho = _friction_rate(fid, fp, np.ascontiguousarray(ws), np.ascontiguousarray(ta[np.r_[sl, rev]]),
+                         np.ascontiguousarray(z[np.r_[sl, rev]]), float(cw @ bf), float(ca @ bf))
     why = "friction"
     if lim.size:
         m = _lim.n_limit_states(lim)
