@@ -55,3 +55,44 @@ def apply_array(c, p):
     for i in range(c.shape[0]):
         out[i] = apply(c[i], p)
     return out
+
+
+@njit(cache=True, inline="always")
+def apply_lanes(C, P, S, out):
+    """:func:`apply` per lane, as element-wise loops over the lanes with the branches as selects
+    (vectorised by LLVM; compiled without fast-math each lane gets :func:`apply`'s bits): ``C``
+    (R,) commands [rad], ``P`` (AV_TABLE + 2 n, R) the lanes' packs by slot (``P[:, q]`` lane
+    q's :meth:`taos.planar.avionics.Avionics.pack`, one table length n for all) -> ``out`` (R,)
+    [rad]; ``S`` (2, R) scratch. The table search is :func:`apply`'s scan (the first segment
+    whose upper magnitude reaches |c|), run over every segment with a found flag per lane."""
+    nl = C.shape[0]
+    n = (P.shape[0] - AV_TABLE) // 2
+    for q in range(nl):
+        c = C[q]
+        lsb = P[AV_LSB, q]
+        x = c / lsb
+        # rounding, or truncation toward zero (+ 0.0: float(int(x)) gives +0.0 for -1 < x < 0)
+        xq = math.floor(x + 0.5) if P[AV_ROUND, q] > 0.5 else np.trunc(x) + 0.0
+        out[q] = (xq * lsb) if lsb > 0.0 else c
+    if n == 0:
+        return
+    ia = AV_TABLE
+    ig = AV_TABLE + n
+    G = S[0]
+    F = S[1]  # 1: the gain is found (outside the table, or its segment reached)
+    for q in range(nl):
+        a = abs(out[q])
+        G[q] = P[ig, q] if a <= P[ia, q] else P[ig + n - 1, q]
+        F[q] = 0.0 if (a > P[ia, q] and a < P[ia + n - 1, q]) else 1.0
+    for i in range(n - 1):
+        for q in range(nl):
+            a = abs(out[q])
+            lo = P[ia + i, q]
+            hi = P[ia + i + 1, q]
+            take = F[q] == 0.0 and hi >= a
+            w = (a - lo) / (hi - lo)
+            gi = P[ig + i, q] + w * (P[ig + i + 1, q] - P[ig + i, q])
+            G[q] = gi if take else G[q]
+            F[q] = 1.0 if take else F[q]
+    for q in range(nl):
+        out[q] = G[q] * out[q]

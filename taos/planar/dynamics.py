@@ -328,53 +328,48 @@ def _rows(ip, ix, mx, V, h0, h1, OUT, o0):
 
 
 @njit(cache=True, inline="always")
-def _rates_lanes(X, Z, R, ip, ix, mx, head, fid, fp, avp, V, C, U, TF, DZ, DX):
+def _rates_lanes(Z, ip, ix, mx, H, fid, fp, AVP, V, C, S, U, TF, DZ, DX):
     """The state equations of the module docstring for R independent plants ("lanes") at once,
     every linear part as one sparse matrix with a pattern common to all lanes.
 
-    ``X`` (n, R) [x] states, ``Z`` (R,) [rad] friction states, ``R`` (n_r, R) [r] external
-    inputs. The CSR matrix (``ip``, ``ix``; entries ``mx`` (nnz, R), one column per lane) acts
-    on v = (x, r, u, T_f, e_v, c_q, T_stop) (:data:`LANE_COLS`): rows 0..n-1 give dx/dt =
-    [A Br bc bf uv_in flow_in stop_in] v; the rows after them (:data:`LANE_ROWS`) the
-    pre-avionics command c = [cc dc] (x, r), the friction relative rate w = cw x, the applied
-    torque T_a = ca x, then the limit rows of :mod:`taos.planar.saturation` over (x, u): valve
-    command u_v, valve flow q, load pressure P_L, engine angle and rate. Per lane: u =
-    avionics(c), (dz/dt, T_f) = friction(w, z, T_a), the valve excess e_v, the flow correction
-    c_q and the stop torque T_stop from the single definitions in :mod:`taos.planar.saturation`
-    with the lane's packed head ``head`` (R, N_HEAD) (all off: zeros); ``fp`` (R, NPARAM),
-    ``avp`` (R, .) each lane's friction and avionics packs, ``fid`` the law's kernel.
-    Writes dx/dt into ``DX`` (n, R), u [rad] into ``U``, T_f [N m] into ``TF``, dz/dt [rad/s]
-    into ``DZ`` (R,); ``V`` (n + n_r + 5, R), ``C`` (8, R) scratch.
+    ``V`` (n + n_r + 5, R) holds the lanes' states [x] in rows 0..n-1 and external inputs [r]
+    in rows n..n+n_r-1 on entry; ``Z`` (R,) [rad] the friction states. The CSR matrix (``ip``,
+    ``ix``; entries ``mx`` (nnz, R), one column per lane) acts on v = (x, r, u, T_f, e_v, c_q,
+    T_stop) (:data:`LANE_COLS`): rows 0..n-1 give dx/dt = [A Br bc bf uv_in flow_in stop_in] v;
+    the rows after them (:data:`LANE_ROWS`) the pre-avionics command c = [cc dc] (x, r), the
+    friction relative rate w = cw x, the applied torque T_a = ca x, then the limit rows of
+    :mod:`taos.planar.saturation` over (x, u): valve command u_v, valve flow q, load pressure
+    P_L, engine angle and rate. Per lane: u = avionics(c) (``_avionics_kernels.apply_lanes``
+    with ``AVP`` (AV_TABLE + 2 m, R), the lanes' packs by slot), (dz/dt, T_f) = friction(w, z,
+    T_a) (``fid`` the law's kernel, ``fp`` (R, NPARAM) each lane's pack), the valve excess e_v,
+    the flow correction c_q and the stop torque T_stop from the lane variants of the laws of
+    :mod:`taos.planar.saturation` with ``H`` (N_HEAD, R) the lanes' packed heads by slot (all
+    off: zeros). Writes dx/dt into ``DX`` (n, R), u [rad] into ``U``, T_f [N m] into ``TF``,
+    dz/dt [rad/s] into ``DZ`` (R,) and rows n+n_r.. of ``V``; ``C`` (8, R), ``S`` (2, R)
+    scratch.
 
     The loops over lanes are element-wise (no sum across lanes), so a lane's result does not
     depend on R or on its position: compiled without fast-math, vector and scalar code give the
-    same bits."""
-    n = X.shape[0]
-    nr = R.shape[0]
-    nl = X.shape[1]
-    iu = n + nr
-    for i in range(n):
-        for q in range(nl):
-            V[i, q] = X[i, q]
-    for j in range(nr):
-        for q in range(nl):
-            V[n + j, q] = R[j, q]
+    same bits. The avionics and the limit laws are vector loops across the lanes (branches as
+    selects); the friction law, a compiled callback, is called lane by lane."""
+    n = DX.shape[0]
+    iu = V.shape[0] - 5
+    nl = V.shape[1]
     _rows(ip, ix, mx, V, n, n + 3, C, 0)
+    _av.apply_lanes(C[0], AVP, S, U)
     for q in range(nl):
-        U[q] = _av.apply(C[0, q], avp[q])
         DZ[q], TF[q] = fid(C[1, q], Z[q], C[2, q], fp[q])
+    for q in range(nl):
         V[iu, q] = U[q]
         V[iu + 1, q] = TF[q]
     _rows(ip, ix, mx, V, n + 3, n + 8, C, 3)
-    for q in range(nl):
-        hq = head[q]
-        V[iu + 2, q] = _lim.valve_excess(hq, C[3, q])
-        V[iu + 3, q] = _lim.pressure_flow_correction(hq, C[4, q], C[5, q])
-        V[iu + 4, q] = _lim.stop_torque(C[6, q], C[7, q], hq[_lim.LIM_THMAX], hq[_lim.LIM_KS], hq[_lim.LIM_CS])
+    _lim.valve_excess_lanes(H, C[3], V[iu + 2])
+    _lim.pressure_flow_correction_lanes(H, C[4], C[5], V[iu + 3])
+    _lim.stop_torque_lanes(H, C[6], C[7], V[iu + 4])
     _rows(ip, ix, mx, V, 0, n, DX, 0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")  # x / 0 -> inf or NaN (the selects discard them), no exception
 def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc, jcoef, kick, x0, z0, r, dt,
                              rec_every, x_out, aux_out, status):
     """RK4 (as :func:`integrate_samples`) of R independent runs in lockstep ("lanes"), each
@@ -422,20 +417,29 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
     nr = r.shape[2]
     X = x0.copy()
     Z = z0.copy()
-    XT = np.empty((n, nl))
     K1, K2, K3, K4 = np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl))
     D1, D2, D3, D4 = np.empty(nl), np.empty(nl), np.empty(nl), np.empty(nl)
     ZT = np.empty(nl)
     U, TF = np.empty(nl), np.empty(nl)
     R0, RM, R1 = np.empty((nr, nl)), np.empty((nr, nl)), np.empty((nr, nl))
-    V = np.zeros((n + nr + 5, nl))
+    V = np.zeros((n + nr + 5, nl))  # rows 0..n-1: the stage's state, then its inputs (_rates_lanes)
     C = np.empty((8, nl))
+    S = np.empty((2, nl))
+    OK = np.empty(nl)
+    # the lanes' limit heads and avionics packs by slot (contiguous across lanes: vector loads)
+    H = np.empty((nseg, head.shape[2], nl))
+    for s in range(nseg):
+        for j in range(head.shape[2]):
+            for q in range(nl):
+                H[s, j, q] = head[s, q, j]
+    AVP = np.ascontiguousarray(avp.T)
     status[:] = -1
     alive = nl
     rec = 0
     seg = 0
     M = mx[0]
-    L = head[0]
+    L = H[0]
+    h2 = 0.5 * dt
     for k in range(nsteps + 1):
         if seg < nseg and k == bounds[seg]:
             for j in range(jdst.shape[0]):
@@ -445,16 +449,22 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
                 for q in range(nl):
                     X[i, q] += kick[seg, i, q]
             M = mx[seg]
-            L = head[seg]
+            L = H[seg]
             seg += 1
         k1n = min(k + 1, nsteps)
         for j in range(nr):
             for q in range(nl):
                 R0[j, q] = r[q, k, j]
                 R1[j, q] = r[q, k1n, j]
+        for j in range(nr):
+            for q in range(nl):
                 RM[j, q] = 0.5 * (R0[j, q] + R1[j, q])
+                V[n + j, q] = R0[j, q]
+        for i in range(n):
+            for q in range(nl):
+                V[i, q] = X[i, q]
         # the derivative at the step start (K1), with T_f and u there for the record
-        _rates_lanes(X, Z, R0, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D1, K1)
+        _rates_lanes(Z, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D1, K1)
         if k % rec_every == 0:
             for i in range(n):
                 for q in range(nl):
@@ -466,37 +476,45 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
             rec += 1
         if k == nsteps:
             break
+        for j in range(nr):
+            for q in range(nl):
+                V[n + j, q] = RM[j, q]
         for i in range(n):
             for q in range(nl):
-                XT[i, q] = X[i, q] + 0.5 * dt * K1[i, q]
+                V[i, q] = X[i, q] + h2 * K1[i, q]
         for q in range(nl):
-            ZT[q] = Z[q] + 0.5 * dt * D1[q]
-        _rates_lanes(XT, ZT, RM, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D2, K2)
+            ZT[q] = Z[q] + h2 * D1[q]
+        _rates_lanes(ZT, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D2, K2)
         for i in range(n):
             for q in range(nl):
-                XT[i, q] = X[i, q] + 0.5 * dt * K2[i, q]
+                V[i, q] = X[i, q] + h2 * K2[i, q]
         for q in range(nl):
-            ZT[q] = Z[q] + 0.5 * dt * D2[q]
-        _rates_lanes(XT, ZT, RM, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D3, K3)
+            ZT[q] = Z[q] + h2 * D2[q]
+        _rates_lanes(ZT, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D3, K3)
+        for j in range(nr):
+            for q in range(nl):
+                V[n + j, q] = R1[j, q]
         for i in range(n):
             for q in range(nl):
-                XT[i, q] = X[i, q] + dt * K3[i, q]
+                V[i, q] = X[i, q] + dt * K3[i, q]
         for q in range(nl):
             ZT[q] = Z[q] + dt * D3[q]
-        _rates_lanes(XT, ZT, R1, ip, ix, M, L, fid, fp, avp, V, C, U, TF, D4, K4)
+        _rates_lanes(ZT, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D4, K4)
         for i in range(n):
             for q in range(nl):
                 X[i, q] += dt * (K1[i, q] + 2.0 * K2[i, q] + 2.0 * K3[i, q] + K4[i, q]) / 6.0
         for q in range(nl):
             Z[q] = Z[q] + dt * (D1[q] + 2.0 * D2[q] + 2.0 * D3[q] + D4[q]) / 6.0
+        # x * 0 is 0 for a finite x and NaN otherwise: one vector pass finds the non-finite lanes
         for q in range(nl):
-            if status[q] < 0:
-                ok = math.isfinite(Z[q])
-                for i in range(n):
-                    ok = ok and math.isfinite(X[i, q])
-                if not ok:
-                    status[q] = k + 1
-                    alive -= 1
+            OK[q] = Z[q] * 0.0
+        for i in range(n):
+            for q in range(nl):
+                OK[q] += X[i, q] * 0.0
+        for q in range(nl):
+            if status[q] < 0 and not OK[q] == 0.0:
+                status[q] = k + 1
+                alive -= 1
         if alive == 0:
             break
     return alive

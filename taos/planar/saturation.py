@@ -329,3 +329,51 @@ def limit_rows_for_actuator(act) -> tuple[dict[str, np.ndarray], float]:
     p[ix["p_load_Pa"]] = 1.0
     flow[ix["p_load_Pa"]] = 4.0 * act.oil_bulk_modulus_Pa * act.piston_area_m2 / act.trapped_volume_m3
     return {"uv": uv, "uv_in": uv_in, "q": q, "p": p, "flow_in": flow}, act.loop_gain_per_s
+
+
+# -- the same laws across lanes (many plants in lockstep: taos.planar.dynamics._rates_lanes) ----
+# Each is the scalar law above written as one element-wise loop over the lanes, the branches as
+# selects (both sides computed, one kept), so that LLVM vectorises it; compiled without fast-math
+# it gives each lane the scalar function's bits. ``H`` (N_HEAD, R): the lanes' packed heads by
+# slot (``H[LIM_*, q]`` the head of lane q).
+@njit(cache=True, inline="always")
+def valve_excess_lanes(H, UV, out):
+    """:func:`valve_excess` per lane: ``UV`` (R,) valve commands [m/s] -> ``out`` (R,) [m/s]."""
+    for q in range(UV.shape[0]):
+        vmax = H[LIM_VMAX, q]
+        uv = UV[q]
+        e = (vmax - uv) if uv > vmax else ((-vmax - uv) if uv < -vmax else 0.0)
+        out[q] = e if vmax > 0.0 else 0.0
+
+
+@njit(cache=True, inline="always")
+def pressure_flow_correction_lanes(H, Q, P, out):
+    """:func:`pressure_flow_correction` per lane: ``Q`` (R,) valve flow states [m/s], ``P`` (R,)
+    load pressures [Pa] -> ``out`` (R,) [m/s]."""
+    for q in range(Q.shape[0]):
+        ps = H[LIM_PS, q]
+        qv = Q[q]
+        p = P[q]
+        sg = 1.0 if qv >= 0 else -1.0
+        d = (ps - sg * p) / ps
+        eps = H[LIM_EPS, q]
+        s = math.sqrt(abs(d))  # sqrt(d) for d >= eps, -sqrt(-d) for d <= -eps
+        g = s if d >= eps else (-s if d <= -eps else d / math.sqrt(eps))
+        corr = qv * (g - 1.0)
+        over = abs(p) - H[LIM_PR, q]
+        rel = H[LIM_KRA, q] * over * (1.0 if p > 0 else -1.0)
+        corr = (corr - rel) if over > 0.0 else corr
+        out[q] = corr if ps > 0.0 else 0.0
+
+
+@njit(cache=True, inline="always")
+def stop_torque_lanes(H, TH, OM, out):
+    """:func:`stop_torque` per lane: ``TH`` (R,) engine angles [rad], ``OM`` (R,) rates [rad/s]
+    -> ``out`` (R,) [N m], with each lane's ``LIM_THMAX``, ``LIM_KS``, ``LIM_CS``."""
+    for q in range(TH.shape[0]):
+        th = TH[q]
+        th_max = H[LIM_THMAX, q]
+        pen = abs(th) - th_max
+        sg = 1.0 if th > 0 else -1.0
+        t = -sg * max(0.0, H[LIM_KS, q] * pen + H[LIM_CS, q] * sg * OM[q])
+        out[q] = 0.0 if (th_max <= 0.0 or pen <= 0.0) else t
