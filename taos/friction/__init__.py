@@ -12,9 +12,9 @@ To add a law (everything in this folder, or in your own code): write a frozen pa
 class deriving :class:`FrictionLaw` with fields made by :func:`param`, its ``steady_state``
 (and ``describing_function``, ``check_step`` where they apply); write its kernels with the
 registry's signatures (``rates``, ``zdot3``, ``torque3``, ``bearing_step``; numba
-functions, see :mod:`._builtin` and its ``_law_*`` modules for the built-in ones and the helpers in :mod:`._vector`);
-and call :func:`register` with a :class:`FrictionLawEntry`. The tests parametrised over the
-registry then cover it.
+functions, see :mod:`._builtin` and its ``_law_*`` modules for the built-in ones, one module
+per law, and the helpers in :mod:`._vector`); and call :func:`register` with a
+:class:`FrictionLawEntry`. The tests parametrised over the registry then cover it.
 """
 
 from ._laws import (
