@@ -50,6 +50,7 @@ law: a command loads the kernels of the law it runs only (:func:`load_all` loads
 from __future__ import annotations
 
 import functools
+import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Callable
@@ -119,6 +120,7 @@ class FrictionLawEntry:
 
 _REGISTRY: dict[str, FrictionLawEntry] = {}
 _BUILTINS: dict = {"params": {}, "loader": None}
+_BUILTIN_LOCK = threading.RLock()
 
 #: the entry-point group through which installed packages add friction laws
 ENTRY_POINT_GROUP = "taos.friction_laws"
@@ -178,10 +180,11 @@ def declare_builtins(params: dict, loader: Callable[[str], object]) -> None:
 def _load_builtin(law_id: str) -> None:
     """Register built-in law ``law_id``'s entry (loads or compiles its C callbacks) and those
     declared with it, unless registered already."""
-    if law_id not in _REGISTRY and _BUILTINS["loader"] is not None:
-        for e in _BUILTINS["loader"](law_id):
-            if e.id not in _REGISTRY:
-                register(e, builtin=True)
+    with _BUILTIN_LOCK:   # threads asking for the same law at once register it once
+        if law_id not in _REGISTRY and _BUILTINS["loader"] is not None:
+            for e in _BUILTINS["loader"](law_id):
+                if e.id not in _REGISTRY:
+                    register(e, builtin=True)
 
 
 def load_all() -> None:
