@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml setup.py
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "Python 3.11+ needed"'
 	$(PYTHON) -m venv $(VENV)
 	( $(BIN)/python -m pip install --quiet uv && \
-	  $(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[test]' ) || \
+	  $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[test]' ) || \
 	  $(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
@@ -26,8 +26,13 @@ $(STAMP): pyproject.toml setup.py
 # cache and warms it again (about a minute); a fresh clone has no cache to drop.
 KERNEL_SOURCES := $(shell find taos -name '*.py' -not -path '*/__pycache__/*')
 WARM := $(VENV)/.warm
+# It also compiles the Python bytecode (.pyc) of taos and the venv's packages: where
+# PYTHONDONTWRITEBYTECODE is set nothing writes it otherwise, and every `taos` process then
+# compiles ~600 modules from source (about 1 s of start-up a process; benchmarks/RESULTS.md).
 $(WARM): $(STAMP) $(KERNEL_SOURCES)
 	find taos -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+	$(BIN)/python -m compileall -q -j 2 taos >/dev/null
+	-$(BIN)/python -m compileall -q -j 2 $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])') >/dev/null
 	$(BIN)/python -m taos.cli.warmup
 	touch $(WARM)
 

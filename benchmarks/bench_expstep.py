@@ -20,8 +20,16 @@ scipy LSODA peer, in the same run.
 
 5. ``--before-after`` (alone): the 3-call job and the map as whole processes with the RK4 kernel
    and with the exponential integrator, in the same run.
+6. ``--startup`` (alone): the per-process start-up. The 3-call job and the map as whole
+   processes (console script), median of 3 interleaved repeats, in four set-ups: every built-in
+   friction law's kernels loaded at start (as before the per-law split: ``load_all()`` then the
+   command) or only the law the command runs; and Python bytecode (.pyc) read, or every module
+   compiled from source (``PYTHONDONTWRITEBYTECODE=1`` with an empty ``PYTHONPYCACHEPREFIX``:
+   what a venv installed by uv without ``--compile-bytecode`` gives on a machine that sets
+   ``PYTHONDONTWRITEBYTECODE``); an empty ``python -c pass`` and ``import numba`` as floors; and the
+   LSODA peer (Python right-hand side, measured on two 2 s dwells and scaled, plus its start-up).
 
-Run:  .venv/bin/python benchmarks/bench_expstep.py [--quick] [--before-after]
+Run:  .venv/bin/python benchmarks/bench_expstep.py [--quick] [--before-after | --startup]
 """
 
 from __future__ import annotations
@@ -45,9 +53,9 @@ MAP_FREQ = list(np.round(np.logspace(np.log10(0.05), np.log10(15), 30), 5))
 TAOS = [str(Path(sys.executable).parent / "taos")]
 
 
-def wall(cmd):
+def wall(cmd, env=None):
     t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, env=env)
     return time.perf_counter() - t0
 
 
@@ -182,6 +190,85 @@ def before_after(quick=False):
     print()
 
 
+#: the command line with every built-in law's kernels loaded first (the registry before the
+#: per-law split loaded all eighteen C callbacks on the first lookup of any law)
+_ALL_LAWS = ("import sys; from taos.friction.registry import load_all; from taos.cli import main; "
+             "load_all(); sys.exit(main(sys.argv[1:]))")
+
+
+def _cpu_wall(cmd, env):
+    """(wall, user + system CPU) [s] of one process: the CPU time is the steadier figure on a
+    loaded machine."""
+    import resource
+
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = wall(cmd, env)
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return t, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
+def startup(quick=False):
+    """Item 6 of the module docstring: whole processes in four set-ups, against the LSODA peer."""
+    import statistics
+    import tempfile
+
+    from taos.model import load_model
+    from taos.planar.freqresp import settle_time_s
+
+    m = load_model(MODEL, friction=LAW)
+    ts = settle_time_s(m)
+    per_s = sum(lsoda_dwell(m, a * DEG, f, 2.0) for a, f in ((0.1, 0.5), (0.4, 2.0))) / 4.0
+    t_np = wall([sys.executable, "-c", "import numpy, scipy.integrate"])
+    empty = tempfile.mkdtemp(prefix="taos-nopyc-")
+    env_pyc = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONPYCACHEPREFIX")}
+    env_src = dict(env_pyc, PYTHONDONTWRITEBYTECODE="1", PYTHONPYCACHEPREFIX=empty)
+    setups = {"one law, bytecode (now, after `make .venv/.warm`)": (TAOS, env_pyc),
+              "all laws, bytecode": ([sys.executable, "-c", _ALL_LAWS], env_pyc),
+              "one law, from source": (TAOS, env_src),
+              "all laws, from source (before)": ([sys.executable, "-c", _ALL_LAWS], env_src)}
+    args = ["freqresp", MODEL, "--friction", LAW, "--json", os.devnull]
+    jobs = {"3 calls of 10 dwells": [["--freq-hz", csv(JOB_FREQ), "--amplitude-deg", f"{a:g}"] for a in JOB_AMPS]}
+    if not quick:
+        jobs["8 x 30 map, one call"] = [["--freq-hz", csv(MAP_FREQ), "--amplitude-deg", csv(MAP_AMPS)]]
+    peers = {"3 calls of 10 dwells": per_s * simulated_s(ts, JOB_AMPS, JOB_FREQ) + 3 * t_np,
+             "8 x 30 map, one call": per_s * simulated_s(ts, MAP_AMPS, MAP_FREQ) + t_np}
+    for pre, env in setups.values():
+        wall(pre + args + ["--freq-hz", "1", "--amplitude-deg", "0.1"], env)   # kernels cached, pages warm
+    floors = {"python -c pass": [sys.executable, "-c", "pass"],
+              "import numpy": [sys.executable, "-c", "import numpy"],
+              "import numba": [sys.executable, "-c", "import numba"],
+              "freqresp, 1 dwell": TAOS + args + ["--freq-hz", "1", "--amplitude-deg", "0.1"]}
+    times = {(s, j): [] for s in setups for j in jobs}
+    ftimes = {(f, e): [] for f in floors for e in ("bytecode", "from source")}
+    for _ in range(3):   # interleaved: the machine's load drifts
+        for s, (pre, env) in setups.items():
+            for j, calls in jobs.items():
+                times[s, j].append(np.sum([_cpu_wall(pre + args + c, env) for c in calls], axis=0))
+        for f, cmd in floors.items():
+            for e, env in (("bytecode", env_pyc), ("from source", env_src)):
+                ftimes[f, e].append(_cpu_wall(cmd, env))
+    cpu = {k: statistics.median(t[1] for t in v) for k, v in times.items()}
+    med = {k: statistics.median(t[0] for t in v) for k, v in times.items()}
+    print(f"### Start-up: whole processes, {MODEL}, {LAW} (median of 3)\n")
+    print("| job | " + " | ".join(f"{s} [s]" for s in setups) + " | LSODA peer [s] | speed-up (now) | speed-up (before) |")
+    print("|---|" + "---|" * (len(setups) + 3))
+    now, before = list(setups)[0], list(setups)[-1]
+    for j in jobs:
+        print(f"| {j} | " + " | ".join(f"{med[s, j]:.2f}" for s in setups)
+              + f" | {peers[j]:.1f} | {peers[j] / med[now, j]:.1f}x | {peers[j] / med[before, j]:.1f}x |")
+    print("\nCPU time (user + system, all processes of the job) [s]:\n")
+    print("| job | " + " | ".join(setups) + " |\n|---|" + "---|" * len(setups))
+    for j in jobs:
+        print(f"| {j} | " + " | ".join(f"{cpu[s, j]:.2f}" for s in setups) + " |")
+    print("\n| one process, wall / CPU [s] | bytecode | from source |\n|---|---|---|")
+    for f in floors:
+        b, src = (tuple(statistics.median(t[i] for t in ftimes[f, e]) for i in (0, 1))
+                  for e in ("bytecode", "from source"))
+        print(f"| {f} | {b[0]:.2f} / {b[1]:.2f} | {src[0]:.2f} / {src[1]:.2f} |")
+    print(f"\nLSODA peer: {per_s:.2f} s per simulated second (Python rhs), start-up {t_np:.2f} s a process; "
+          f"settling {ts:.2f} s + 2 + 2 cycles per dwell, scaled by simulated time\n")
+
+
 def main(quick=False):
     from taos.linear import gain_db
     from taos.model import load_model
@@ -247,8 +334,9 @@ def main(quick=False):
 
 
 if __name__ == "__main__":
-    if "--before-after" in sys.argv:
+    if "--before-after" in sys.argv or "--startup" in sys.argv:
         print(f"uptime: {os.popen('uptime').read().strip()}\n")
-        before_after(quick="--quick" in sys.argv)
+        (startup if "--startup" in sys.argv else before_after)(quick="--quick" in sys.argv)
+        print(f"uptime: {os.popen('uptime').read().strip()}")
     else:
         main(quick="--quick" in sys.argv)

@@ -291,3 +291,41 @@ def test_a_law_name_that_is_not_a_string_is_bad_input(bad):
 
     with pytest.raises(InputError, match="friction.model"):
         registry.params_of(bad, "m.toml")
+
+
+LAZY_PROBE = """
+import json, sys
+from taos import friction
+from taos.friction import registry
+before = [m for m in sys.modules if m.startswith("taos.friction._law_")]
+friction.get("dahl")
+one = sorted(m for m in sys.modules if m.startswith("taos.friction._law_"))
+ids = list(friction.ids())
+try:   # a run-time law cannot take a built-in id, whose kernels are not loaded
+    registry.register(registry.FrictionLawEntry("lugre", friction.LuGre, *[None] * 4))
+    taken = False
+except Exception as e:
+    taken = "duplicate" in str(e)
+unloaded = "taos.friction._law_lugre" not in sys.modules
+entries = {i: e.id for i, e in friction.LAWS.items()}
+print(json.dumps({"before": before, "one": one, "ids": ids, "taken": taken, "unloaded": unloaded,
+                  "entries": entries, "all": sorted(m for m in sys.modules if m.startswith("taos.friction._law_"))}))
+"""
+
+
+def test_a_law_lookup_loads_that_laws_kernels_only():
+    """Built-in laws register one at a time (their kernels' modules imported on first lookup):
+    ``get('dahl')`` loads the Dahl kernels only, the ids stay complete and in order, a built-in
+    id stays reserved before its kernels are loaded, and iterating ``LAWS`` loads every law."""
+    import json
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-c", LAZY_PROBE], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout.strip().splitlines()[-1])
+    assert d["before"] == [] and d["one"] == ["taos.friction._law_dahl"]
+    assert d["ids"][:6] == ["none", "coulomb-switching", "coulomb-smooth", "dahl", "lugre", "modified-lugre"]
+    assert d["taken"] and d["unloaded"]
+    assert all(d["entries"][i] == i for i in d["ids"][:6])
+    assert set(d["all"]) == {f"taos.friction._law_{n}" for n in ("none", "zero", "switching", "smooth", "dahl", "lugre")}

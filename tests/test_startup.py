@@ -2,7 +2,8 @@
 a timing; the times are in benchmarks/RESULTS.md, ``benchmarks/bench_maps.py``).
 
 ``taos info`` is linear analysis: it must not import numba (compiled kernels), scipy, pint
-(its unit table is remembered after the first run), h5py, casadi or matplotlib.
+(its unit table is remembered after the first run), h5py, casadi or matplotlib. A simulation
+command loads the compiled kernels of its own friction law only.
 """
 
 from __future__ import annotations
@@ -19,7 +20,8 @@ import contextlib, io, json, sys
 from taos.cli import main
 with contextlib.redirect_stdout(io.StringIO()):
     rc = main(sys.argv[1:])
-print(json.dumps({"rc": rc, "loaded": [m for m in %r if m in sys.modules]}))
+print(json.dumps({"rc": rc, "loaded": [m for m in %r if m in sys.modules],
+                  "laws": sorted(m for m in sys.modules if m.startswith("taos.friction._law_"))}))
 """ % (HEAVY,)
 
 
@@ -32,14 +34,22 @@ def _loaded(tmp_path, *argv):
 
 def test_help_imports_nothing_heavy(tmp_path):
     d = _loaded(tmp_path, "--help")
-    assert d["loaded"] == []
+    assert d["loaded"] == [] and d["laws"] == []
 
 
 def test_info_is_linear_analysis_without_kernels(tmp_path):
     first = _loaded(tmp_path, "info", "rs25_hotfire")   # a cold unit table asks pint once
     assert first["rc"] == 0 and "numba" not in first["loaded"]
     again = _loaded(tmp_path, "info", "rs25_hotfire")
-    assert again == {"rc": 0, "loaded": []}
+    assert again == {"rc": 0, "loaded": [], "laws": []}
+
+
+def test_a_dwell_command_loads_the_kernels_of_its_own_friction_law_only(tmp_path):
+    """``taos freqresp`` on a modified-LuGre model loads (from numba's cache) the LuGre kernel
+    set only, not every built-in law's C callbacks (:mod:`taos.friction._builtin`)."""
+    d = _loaded(tmp_path, "freqresp", "rs25_hotfire", "--freq-hz", "1", "--amplitude-deg", "0.1",
+                "--json", str(tmp_path / "fr.json"))
+    assert d["rc"] == 0 and d["laws"] == ["taos.friction._law_lugre"]
 
 
 def test_info_steps_adds_the_simulated_figures(tmp_path):

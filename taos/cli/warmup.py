@@ -28,6 +28,8 @@ def main() -> None:
     sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1,
                     method="shoot", max_cycles=1)
     model.friction.response([0.0, 0.1], 1e-3)
+    from taos.friction.registry import load_all
+    load_all()   # every built-in law's kernels (a command loads only its own law's)
     from taos.flight.lco_confirm import compile_kernel
     compile_kernel(model)   # the verdict map's confirmation runs (taos lco --sweep)
     from taos.taos3d import simulate_taos, taos_freqresp, taos_model

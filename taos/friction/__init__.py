@@ -12,9 +12,9 @@ To add a law (everything in this folder, or in your own code): write a frozen pa
 class deriving :class:`FrictionLaw` with fields made by :func:`param`, its ``steady_state``
 (and ``describing_function``, ``check_step`` where they apply); write its kernels with the
 registry's signatures (``rates``, ``zdot3``, ``torque3``, ``bearing_step``; numba
-functions, see :mod:`._builtin` for the built-in ones and the helpers in :mod:`._vector`);
-and call :func:`register` with a :class:`FrictionLawEntry`. The tests parametrised over the
-registry then cover it.
+functions, see :mod:`._builtin` and its ``_law_*`` modules for the built-in ones, one module
+per law, and the helpers in :mod:`._vector`); and call :func:`register` with a
+:class:`FrictionLawEntry`. The tests parametrised over the registry then cover it.
 """
 
 from ._laws import (
@@ -34,11 +34,13 @@ from ..descfcn import coulomb_describing_function, dahl_angle_df
 from .registry import LAWS, FrictionLawEntry, declare_builtins, get, ids, param_classes, params_of, register, unregister
 
 
-def _register_builtin_entries() -> None:
-    from . import _builtin  # noqa: F401  (registers the built-in laws' entries and kernels)
+def _builtin_entries(law_id: str) -> tuple:
+    from ._builtin import load  # the entries and kernels of one built-in law, on its first use
+
+    return load(law_id)
 
 
-declare_builtins(BUILTIN_PARAMS, _register_builtin_entries)
+declare_builtins(BUILTIN_PARAMS, _builtin_entries)
 
 
 def __getattr__(name: str):

@@ -42,13 +42,15 @@ import, or whose object is not an entry with its entry point's id, stops with
 
 Nothing here imports numba until a kernel is needed: the built-in laws' parameter classes are
 known without their kernels (:func:`params_of`, :func:`param_classes`; model loading and
-``taos info`` use these), and their entries, whose kernels are compiled C callbacks loaded from
-numba's cache, are registered on the first :func:`get` (or ``LAWS`` lookup) of any law.
+``taos info`` use these), and each built-in law's entry, whose kernels are compiled C callbacks
+loaded from numba's cache, is registered on the first :func:`get` (or ``LAWS`` lookup) of that
+law: a command loads the kernels of the law it runs only (:func:`load_all` loads every one).
 """
 
 from __future__ import annotations
 
 import functools
+import threading
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Callable
@@ -117,7 +119,8 @@ class FrictionLawEntry:
 
 
 _REGISTRY: dict[str, FrictionLawEntry] = {}
-_BUILTINS: dict = {"params": {}, "loader": None, "loaded": False}
+_BUILTINS: dict = {"params": {}, "loader": None}
+_BUILTIN_LOCK = threading.RLock()
 
 #: the entry-point group through which installed packages add friction laws
 ENTRY_POINT_GROUP = "taos.friction_laws"
@@ -166,18 +169,28 @@ def _plugin_entry(law_id: str) -> FrictionLawEntry | None:
     return entry
 
 
-def declare_builtins(params: dict, loader: Callable[[], None]) -> None:
-    """The built-in laws: their parameter classes by id, and the function that registers their
-    entries (called once, on the first lookup of an entry; :mod:`taos.friction` declares them)."""
+def declare_builtins(params: dict, loader: Callable[[str], object]) -> None:
+    """The built-in laws: their parameter classes by id, and the function returning the entries
+    declared with a built-in law id (called on the first lookup of that law's entry, it may
+    return the entries of other laws sharing its kernels; :mod:`taos.friction` declares them)."""
     _BUILTINS["params"] = dict(params)
     _BUILTINS["loader"] = loader
 
 
-def _load_builtins() -> None:
-    """Register the built-in laws' entries (compiles or loads their C callbacks)."""
-    if not _BUILTINS["loaded"] and _BUILTINS["loader"] is not None:
-        _BUILTINS["loaded"] = True
-        _BUILTINS["loader"]()
+def _load_builtin(law_id: str) -> None:
+    """Register built-in law ``law_id``'s entry (loads or compiles its C callbacks) and those
+    declared with it, unless registered already."""
+    with _BUILTIN_LOCK:   # threads asking for the same law at once register it once
+        if law_id not in _REGISTRY and _BUILTINS["loader"] is not None:
+            for e in _BUILTINS["loader"](law_id):
+                if e.id not in _REGISTRY:
+                    register(e, builtin=True)
+
+
+def load_all() -> None:
+    """Register every built-in law's entry (all their kernels: the warm-up compiles them)."""
+    for law_id in _builtin_params():
+        _load_builtin(law_id)
 
 
 def _builtin_params() -> dict:
@@ -188,8 +201,8 @@ class _Laws(Mapping):
     """id -> entry, read-only; the built-in entries are registered on first lookup."""
 
     def __getitem__(self, law_id: str) -> FrictionLawEntry:
-        if law_id not in _REGISTRY and law_id in _builtin_params():
-            _load_builtins()
+        if law_id not in _REGISTRY and isinstance(law_id, str) and law_id in _builtin_params():
+            _load_builtin(law_id)
         if law_id not in _REGISTRY:
             plugin = _plugin_entry(law_id)
             if plugin is not None:   # compiled and stored on first use
@@ -229,9 +242,8 @@ def register(entry: FrictionLawEntry, *, replace_existing: bool = False, builtin
     stored entry. Its parameter class must name the same id (``params.name``)."""
     if not entry.id or not isinstance(entry.id, str):
         raise InputError("friction registry", "id", "a non-empty law id", got=repr(entry.id))
-    if not builtin:
-        _load_builtins()
-    if entry.id in _REGISTRY and (not replace_existing or _REGISTRY[entry.id].builtin):
+    if entry.id in _REGISTRY and (not replace_existing or _REGISTRY[entry.id].builtin) or (
+            not builtin and entry.id in _builtin_params()):   # built-in laws are never replaced
         raise InputError("friction registry", entry.id, "an id not yet registered", got="a duplicate")
     if getattr(entry.params, "name", None) != entry.id:
         raise InputError("friction registry", f"{entry.id}.params", f"a parameter class with name = {entry.id!r}",
