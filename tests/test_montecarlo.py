@@ -81,6 +81,21 @@ def test_logistic_regression_recovers_the_generating_law():
     assert sens.logistic_regression(["a"], x[:, :1], np.ones(20_000, bool)) is None
 
 
+
+def test_separated_outcome_is_reported_not_an_infinite_odds_ratio():
+    """Complete separation (Albert and Anderson 1984): every run with factor a above its median
+    limit-cycles, none below; no maximum-likelihood coefficient exists. The result says so,
+    keeps the sign of a's effect, and is valid JSON (no inf/NaN); before, the odds ratio
+    overflowed to inf and the campaign's summary could not be written (exit 1 on 200 soft runs)."""
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=(400, 2))
+    yes = x[:, 0] > np.median(x[:, 0])
+    r = sens.logistic_regression(["a", "b"], x, yes)
+    assert r["separation"] and "separated" in r["note"]
+    c = {row["parameter"]: row for row in r["coefficients"]}
+    assert c["a"]["direction"] == 1 and c["a"]["odds_ratio_per_std"] is None and not c["a"]["significant"]
+    json.dumps(r, allow_nan=False)
+
 def test_runs_are_pure_functions_of_seed_and_index():
     c = load_campaign(SHORT)
     a = [run_factors(c, i) for i in range(5)]

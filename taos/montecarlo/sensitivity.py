@@ -95,6 +95,11 @@ def holm(pvalues) -> np.ndarray:
     return adj
 
 
+#: |coefficient per standard deviation| beyond which the fit is taken as separated (odds ratio
+#: e^30 ~ 1e13 per standard deviation: no physical factor acts so sharply on a Monte Carlo outcome)
+SEPARATION_COEF = 30.0
+
+
 def logistic_regression(names: Sequence[str], x: np.ndarray, yes: np.ndarray, max_iter: int = 50,
                         alpha: float = 0.05) -> dict | None:
     """Logistic regression of ``yes`` (bool per run) on the columns of ``x`` (module docstring);
@@ -119,15 +124,30 @@ def logistic_regression(names: Sequence[str], x: np.ndarray, yes: np.ndarray, ma
         if np.max(np.abs(step)) < 1e-10:
             converged = True
             break
+    # (quasi-)complete separation: a factor (or a combination) splits the outcomes, the likelihood
+    # keeps rising as a coefficient grows and no maximum-likelihood estimate exists (Albert and
+    # Anderson 1984); the coefficients' signs still say which way each factor pushes
+    separated = not converged or not np.all(np.isfinite(b)) or float(np.max(np.abs(b[1:]))) > SEPARATION_COEF
     p = 1 / (1 + np.exp(-np.clip(z @ b, -700, 700)))
     info = z.T @ (z * np.maximum(p * (1 - p), 1e-12)[:, None])
-    se = np.sqrt(np.diag(np.linalg.inv(info)))
-    pv = 2 * norm.sf(np.abs(b / se))
-    adj = holm(pv[1:])
-    rows = [{"parameter": names[j], "coefficient_per_std": float(b[i + 1]), "std_error": float(se[i + 1]),
-             "odds_ratio_per_std": float(np.exp(b[i + 1])), "p_value": float(pv[i + 1]), "p_holm": float(adj[i]),
-             "significant": bool(adj[i] < alpha), "factor_mean": float(mu[i]), "factor_std": float(sd[i])}
+    with np.errstate(all="ignore"):
+        se = np.sqrt(np.abs(np.diag(np.linalg.pinv(info))))
+        pv = 2 * norm.sf(np.abs(b / se))
+    adj = holm(np.where(np.isfinite(pv[1:]), pv[1:], 1.0))
+
+    def num(v: float) -> float | None:
+        return float(v) if math.isfinite(v) and not separated else None
+    rows = [{"parameter": names[j], "coefficient_per_std": num(b[i + 1]), "std_error": num(se[i + 1]),
+             "odds_ratio_per_std": num(math.exp(min(float(b[i + 1]), 700.0))), "p_value": num(pv[i + 1]),
+             "p_holm": num(adj[i]), "significant": bool(adj[i] < alpha) and not separated,
+             "direction": int(np.sign(b[i + 1])) if np.isfinite(b[i + 1]) else 0,
+             "factor_mean": float(mu[i]), "factor_std": float(sd[i])}
             for i, j in enumerate(keep)]
-    rows.sort(key=lambda r: -abs(r["coefficient_per_std"]))
-    return {"runs": n, "converged": converged, "intercept": float(b[0]), "coefficients": rows,
-            "method": "maximum likelihood (IRLS), Wald intervals, Holm-adjusted p"}
+    rows.sort(key=lambda r: -abs(r["coefficient_per_std"] or 0.0))
+    out = {"runs": n, "converged": converged, "separation": separated, "intercept": num(b[0]), "coefficients": rows,
+           "method": "maximum likelihood (IRLS), Wald intervals, Holm-adjusted p"}
+    if separated:
+        out["note"] = ("the outcome is (quasi-)separated by the factors: no maximum-likelihood coefficients exist "
+                       "(the values are null; 'direction' gives each factor's sign); use more runs or the "
+                       "Spearman view")
+    return out
