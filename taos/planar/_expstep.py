@@ -57,6 +57,7 @@ import numpy as np
 from numba import njit, prange
 
 from . import _avionics_kernels as _av
+from . import dynamics as _dy
 from . import saturation as _lim
 from ._avionics_slots import AV_LSB
 
@@ -385,10 +386,7 @@ def _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, 
                               tab_m, amp, n_per_cycle, dt, x, z, n_settle, n_meas, True, out)
     if st >= 0:
         return st + n_settle
-    for o in range(Cy.shape[0]):
-        out[o, 0] *= 2.0 / n_meas
-        out[o, 1] *= 2.0 / n_meas
-        out[o, 2] *= 1.0 / n_meas
+    _dy.normalise_sums(out, n_meas)
     return -1
 
 

@@ -260,6 +260,16 @@ def sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_
     return z, -1, zmax
 
 
+@njit(cache=True, fastmath=_FM, inline="always")
+def normalise_sums(out, n_meas):
+    """The correlation sums of :func:`sine_steps` over ``n_meas`` steps (whole cycles) into
+    Fourier coefficients in place: out[o] = (2/N sum y sin, 2/N sum y cos, 1/N sum y) [y]."""
+    for o in range(out.shape[0]):
+        out[o, 0] *= 2.0 / n_meas
+        out[o, 1] *= 2.0 / n_meas
+        out[o, 2] *= 1.0 / n_meas
+
+
 @njit(cache=True, fastmath=_FM)
 def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, freq, n_per_cycle,
                     n_settle, n_meas, out):
@@ -285,10 +295,7 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, f
                           n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
     if st >= 0:
         return st + n_settle
-    for o in range(Cy.shape[0]):
-        out[o, 0] *= 2.0 / n_meas
-        out[o, 1] *= 2.0 / n_meas
-        out[o, 2] *= 1.0 / n_meas
+    normalise_sums(out, n_meas)
     return -1
 
 

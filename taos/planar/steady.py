@@ -207,10 +207,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
                           z0, n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
         if st >= 0:
             return st + periods * n_per_cycle
-    for o in range(Cy.shape[0]):
-        out[o, 0] *= 2.0 / n_meas
-        out[o, 1] *= 2.0 / n_meas
-        out[o, 2] *= 1.0 / n_meas
+    _ig.normalise_sums(out, n_meas)
     info[INFO_RESIDUAL] = res
     info[INFO_PERIODS] = periods
     info[INFO_EXTRAPOLATIONS] = cycles
