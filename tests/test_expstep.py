@@ -90,21 +90,14 @@ def test_phi_functions_match_their_recurrences(flight):
             assert np.max(np.abs(hi - ref)) <= 1e-9 * np.max(np.abs(ref))
 
 
-def _engine_exact(args, Cy, amp, f, ts, quantiser_lsb=0.0):
+def _engine_exact(args, Cy, amp, f, ts):
     """Exact engine angle [rad] at times ``ts`` of the linear block driven by b_c u(t), u = amp
-    sin(2 pi f t) (or its staircase rounded to ``quantiser_lsb``), from rest: piecewise exact
-    with the matrix exponential of the augmented system on a fine partition of the staircase."""
+    sin(2 pi f t), from rest: the steady orbit minus the free response that cancels its initial
+    state, expm(A t) x_orbit(0)."""
     A, bc = args[0], args[2]
-    n = A.shape[0]
-    if quantiser_lsb == 0.0:
-        Xc = P.orbit(A, bc, amp, f)
-        out = []
-        for t in ts:
-            xo = np.imag(Xc * np.exp(2j * math.pi * f * t))
-            x0o = np.imag(Xc)
-            out.append(Cy[1] @ (xo - expm(A * t) @ x0o))
-        return np.array(out)
-    raise NotImplementedError
+    Xc = P.orbit(A, bc, amp, f)
+    x0o = np.imag(Xc)
+    return np.array([Cy[1] @ (np.imag(Xc * np.exp(2j * math.pi * f * t)) - expm(A * t) @ x0o) for t in ts])
 
 
 def test_linear_block_fourth_order_against_exact_solution(flight):

@@ -283,7 +283,6 @@ def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, 
     (``tab_m`` <= 0: all); ``n_per_cycle`` a multiple of 4.
     Plant arrays and kernels: :mod:`taos.planar.dynamics`."""
     n = x.shape[0]
-    ny = Cy.shape[0]
     dcs = 0.0
     for j in range(dc.shape[0]):
         dcs += dc[j]
@@ -310,14 +309,7 @@ def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, 
         ph = wdt * (k % n_per_cycle)
         s0 = math.sin(ph)
         if meas:
-            c0 = math.cos(ph)
-            for o in range(ny):
-                s = 0.0
-                for i in range(n):
-                    s += Cy[o, i] * x[i]
-                out[o, 0] += s * s0
-                out[o, 1] += s * c0
-                out[o, 2] += s
+            _dy.accumulate_sums(out, Cy, x, s0, math.cos(ph))
         r0 = amp * s0
         rm = amp * math.sin(ph + 0.5 * wdt)
         r1 = amp * math.sin(ph + wdt)

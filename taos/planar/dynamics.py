@@ -231,9 +231,7 @@ def sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_
     k1, k2, k3, k4, xt : (n,) float64; r0, rm, r1 : (n_r,) float64
         Scratch (:func:`work_buffers`).
     """
-    n = x.shape[0]
     nr = Br.shape[1]
-    ny = Cy.shape[0]
     wdt = 2.0 * math.pi / n_per_cycle
     zmax = abs(z)
     for k in range(nsteps):
@@ -244,20 +242,26 @@ def sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_
             rm[j] = amp * math.sin(ph + 0.5 * wdt)
             r1[j] = amp * math.sin(ph + wdt)
         if meas:
-            c0 = math.cos(ph)
-            for o in range(ny):
-                s = 0.0
-                for i in range(n):
-                    s += Cy[o, i] * x[i]
-                out[o, 0] += s * s0
-                out[o, 1] += s * c0
-                out[o, 2] += s
+            accumulate_sums(out, Cy, x, s0, math.cos(ph))
         z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
                             k1, k2, k3, k4, xt)
         zmax = max(zmax, abs(z))
         if not _finite(x, z):
             return z, k + 1, zmax
     return z, -1, zmax
+
+
+@njit(cache=True, fastmath=_FM, inline="always")
+def accumulate_sums(out, Cy, x, s0, c0):
+    """Add one step's correlation terms of y = Cy x (``x`` (n,) [x]) with the command's sin
+    ``s0`` and cos ``c0`` at that step into ``out`` (n_y, 3): (y s0, y c0, y) [y]."""
+    for o in range(Cy.shape[0]):
+        s = 0.0
+        for i in range(x.shape[0]):
+            s += Cy[o, i] * x[i]
+        out[o, 0] += s * s0
+        out[o, 1] += s * c0
+        out[o, 2] += s
 
 
 @njit(cache=True, fastmath=_FM, inline="always")
