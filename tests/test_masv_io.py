@@ -3,6 +3,7 @@ the ``masv freqresp`` JSON contract, and a config round trip through a modal fil
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -134,7 +135,10 @@ def test_plots_save_png(tmp_path):
     s = build_system(load_config(RIGID))
     f = np.logspace(-1, 1.5, 30)
     fr = an.frequency_response(s, f)
-    save(plot_gain_grid(fr, kind="piston"), tmp_path / "grid.png")
+    # the grid of engine 1's two actuators (2 x 2 panels, coupling included): the same drawing code
+    # as the whole 8 x 8 grid at a sixteenth of its matplotlib cost
+    two = dataclasses.replace(fr, actuators=fr.actuators[:2], piston=fr.piston[:, :2, :2], engine=fr.engine[:, :2, :2])
+    save(plot_gain_grid(two, kind="piston"), tmp_path / "grid.png")
     model = s.config.engines[0].model
     save(plot_actuator_vs_simplex(fr, "actuator_1_pitch", linear_freqresp(model, f, "pitch")), tmp_path / "one.png")
     save(plot_coupling_matrix(an.coupling(s, n_freq=20)), tmp_path / "c.svg")

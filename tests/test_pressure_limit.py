@@ -26,7 +26,7 @@ from scipy.optimize import brentq
 from taos.model import load_model
 from taos.planar.actuator import actuator_state_space
 from taos.planar.avionics import Avionics
-from taos.planar.saturation import apply_valve_pressure, limit_rows_for_actuator, pack_limits
+from taos.planar.saturation import limit_rows_for_actuator, pack_limits
 
 from .conftest import MODELS
 
@@ -43,32 +43,22 @@ def act():
                                pressure_feedback_gain_m_per_s_Pa=0.0, pressure_feedback_time_constant_s=0.0)
 
 
-def _actuator_steady(act, force_N, xc_of_xp, t_end=0.3, dt=1e-5):
+def _actuator_steady(act, force_N, xc_gain, xc_offset=0.0, t_end=0.3, dt=1e-5):
     """Integrate the actuator alone (linear state space + the packed limits) against a constant
-    load force ``force_N`` [N], the command ``x_c = xc_of_xp(x_p)`` [m] held over each step
-    (classical RK4); return the final piston rate [m/s] and load pressure [Pa]."""
+    load force ``force_N`` [N], the command ``x_c = xc_gain x_p + xc_offset`` [m] held over each
+    step (classical RK4, compiled: tests/_actuator_rk4.py); return the final piston rate [m/s]
+    and load pressure [Pa]."""
+    from ._actuator_rk4 import rk4_actuator
+
     ss = actuator_state_space(act)
     rows, _ = limit_rows_for_actuator(act)
     R = act.moment_arm_m
     lim = pack_limits(act.max_rate_m_per_s, act.loop_gain_per_s * R, act.supply_pressure_Pa, 0.0, 0.0, 0.0, rows,
                       p_relief=act.relief_pressure_Pa,
                       k_relief_per_area=act.relief_flow_coefficient_m3_per_s_Pa / act.piston_area_m2)
-    A, bx, bf = ss.A, ss.B[:, 0], ss.B[:, 1]
+    A, bx, bf = (np.ascontiguousarray(a, dtype=float) for a in (ss.A, ss.B[:, 0], ss.B[:, 1]))
     ixp, ivp, ip = ss.state_index("x_p_m"), ss.state_index("v_p_m_s"), ss.state_index("p_load_Pa")
-
-    def f(x, xc):
-        dx = A @ x + bx * xc + bf * force_N
-        apply_valve_pressure(lim, x, 0, xc / R, dx)
-        return dx
-
-    x = np.zeros(len(ss.states))
-    for _ in range(int(t_end / dt)):
-        xc = xc_of_xp(x[ixp])
-        k1 = f(x, xc)
-        k2 = f(x + 0.5 * dt * k1, xc)
-        k3 = f(x + 0.5 * dt * k2, xc)
-        k4 = f(x + dt * k3, xc)
-        x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    x = rk4_actuator(A, bx, bf, lim, R, float(force_N), ixp, float(xc_gain), float(xc_offset), dt, int(t_end / dt))
     return x[ivp], x[ip]
 
 
@@ -84,7 +74,7 @@ def test_static_load_flow_curve_is_the_square_root_law(act, sign, load):
     aps = act.piston_area_m2 * act.supply_pressure_Pa
     vnl, bp = act.max_rate_m_per_s, act.piston_damping_Ns_per_m
     F = sign * load * aps
-    v, p = _actuator_steady(act, F, lambda xp: sign * 10.0)
+    v, p = _actuator_steady(act, F, xc_gain=0.0, xc_offset=sign * 10.0)
     ref = sign * brentq(lambda w: w - vnl * math.sqrt(1.0 - (load * aps + bp * w) / aps), 0.0, 2.0 * vnl)
     assert v == pytest.approx(ref, rel=2e-3)
     assert p * act.piston_area_m2 == pytest.approx(F + bp * v, rel=1e-3, abs=1e-6 * aps)
@@ -101,7 +91,7 @@ def test_relief_valve_static_curve(act, sign, over):
     A, kr, pr, bp = (act.piston_area_m2, act.relief_flow_coefficient_m3_per_s_Pa, act.relief_pressure_Pa,
                      act.piston_damping_Ns_per_m)
     F = sign * over * A * act.supply_pressure_Pa
-    v, p = _actuator_steady(act, F, lambda xp: xp)
+    v, p = _actuator_steady(act, F, xc_gain=1.0)
     # analytic: |P| = P_r + A |v| / K_r and A |P| = |F| - B_p |v|
     w = brentq(lambda w: A * (pr + A * w / kr) - (abs(F) - bp * w), 0.0, 10.0)
     assert v == pytest.approx(-sign * w, rel=2e-3)

@@ -86,17 +86,25 @@ def test_greenrun_h5_holds_the_run_and_the_responses(report):
         assert h5["freqresp/yaw/sine_dwell/piston"].shape == (2, 5)
 
 
-def test_report_opens_offline_with_the_3d_view_drawn(report, tmp_path):
+@pytest.fixture(scope="module")
+def page_image(report, tmp_path_factory):
+    """The report page opened once offline in a 1200 x 2400 px window, for the tests that look at
+    it (the page's layout depends on the window's width only: no height-relative sizes, the 3-D
+    view's frame 620 px high, so its top 1300 rows are what a 1200 x 1300 window shows)."""
     out, _ = report
-    img = screenshot((out / "index.html").as_uri(), tmp_path / "report.png", budget_ms=4000, offline=True,
-                     size=(1200, 1300))
+    return screenshot((out / "index.html").as_uri(), tmp_path_factory.mktemp("shot") / "report.png", budget_ms=4000,
+                      offline=True, size=(1200, 2400))
+
+
+def test_report_opens_offline_with_the_3d_view_drawn(page_image):
+    img = page_image[:1300]  # a 1200 x 1300 window
     assert (img < 200).any(axis=2)[:250].mean() > 0.01  # title and summary text drawn
     # the 3-D view follows the summary table: a solid nozzle-coloured blob in the lower part
     rows = (engine_mask(img[600:]).sum(axis=1) >= 60).sum()
     assert rows >= 80, f"3-D view (engine) not drawn inside the report ({rows} nozzle rows)"
 
 
-def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypatch):
+def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypatch, short_profile):
     import taos.report.analysis as rep
     import taos.report.html as page
     from taos.errors import InputError
@@ -121,28 +129,29 @@ def test_failed_greenrun_leaves_the_previous_report_untouched(tmp_path, monkeypa
     monkeypatch.setattr(page, "_png", lambda fig: (plt.close(fig), "data:,")[1])  # (speed only)
     monkeypatch.setattr(taos.viewer, "offline_html", lambda *a, **k: "<html></html>")
     with pytest.raises(InputError):  # an output place that cannot be written: exit 2
-        rep.greenrun(HOTFIRE, out=out)
+        rep.greenrun(HOTFIRE, short_profile, out=out)  # (the short profile: the write fails the same way)
     assert (out / "index.html").read_text() == "previous"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml", "gr"]  # no temp folder left
     r = run_cli("greenrun", bad, "--out", tmp_path / "new", cwd=ROOT)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "new").exists()
 
 
-def test_greenrun_with_the_3d_engine(tmp_path):
-    """taos greenrun --engine taos: the report is built from the 3-D model and says so."""
+def test_greenrun_with_the_3d_engine(tmp_path, short_profile):
+    """taos greenrun --engine taos: the report is built from the 3-D model and says so (the short
+    two-axis profile: what is checked is which engine made the report, not the long run)."""
     import json as _json
 
     from taos.report import greenrun
 
     out = tmp_path / "gr"
-    res = greenrun(MODELS / "rs25_hotfire.toml", engine="taos", out=out)
+    res = greenrun(MODELS / "rs25_hotfire.toml", short_profile, engine="taos", out=out)
     s = _json.loads((out / "summary.json").read_text())
     assert res.engine == "taos" and res.summary()["engine_model"] == "taos"
     assert s["engine_model"] == "taos"
     assert "taos engine model" in (out / "index.html").read_text()
 
 
-def test_report_shows_figures_of_merit_and_spec_mask_result(report, hotfire, tmp_path):
+def test_report_shows_figures_of_merit_and_spec_mask_result(report, hotfire, page_image):
     """Figures of merit (issue 17 point 3) and the spec-mask verdict in summary.json, the page and
     on the plots; the merit figures checked against independent references."""
     out, _ = report
@@ -175,8 +184,7 @@ def test_report_shows_figures_of_merit_and_spec_mask_result(report, hotfire, tmp
     page = (out / "index.html").read_text()
     assert 'id="figures-of-merit"' in page and 'id="spec-mask"' in page and "PASS" in page
     assert f"{e['peak_gain_db']:+.2f} dB at {e['peak_freq_hz']:.2f} Hz" in page
-    img = screenshot((out / "index.html").as_uri(), tmp_path / "merit.png", budget_ms=4000, offline=True,
-                     size=(1200, 2400))
+    img = page_image
     below_view = img[1100:]                      # the sections after the 3-D view
     green = (below_view[..., 0] < 80) & (below_view[..., 1] > 100) & (below_view[..., 2] < 90)  # PASS in green (#1a7f37)
     dark = (below_view < 120).all(axis=2)
@@ -284,6 +292,15 @@ amplitude = "0.4 deg"
 frequency = "3 Hz"
 cycles = 8
 """
+
+
+@pytest.fixture(scope="module")
+def short_profile(tmp_path_factory):
+    """:data:`SHORT_PROFILE` as a file outside the tests' own ``tmp_path``."""
+    p = tmp_path_factory.mktemp("profile") / "short.toml"
+    p.write_text(SHORT_PROFILE)
+    return p
+
 
 LIBRARY_PROBE = """
 import json, math, sys
