@@ -112,14 +112,8 @@ def test_one_axis_of_a_mixed_record(mixed, axis, method):
 
 @pytest.mark.slow
 def test_greenrun_uses_a_mixed_record(mixed, tmp_path):
-    """(The short two-axis profile: what is checked is what the report says of the record.)"""
-    from .test_report import SHORT_PROFILE
-
-    prof = tmp_path / "short.toml"
-    prof.write_text(SHORT_PROFILE)
     out = tmp_path / "gr"
-    r = run_cli("greenrun", MODELS / "rs25_hotfire.toml", "--profile", prof, "--data", mixed, "--out", out,
-                "--quiet")
+    r = run_cli("greenrun", MODELS / "rs25_hotfire.toml", "--data", mixed, "--out", out, "--quiet")
     assert r.returncode == 0, r.stderr
     s = json.loads((out / "summary.json").read_text())["test_data"]["axes"]
     assert s["pitch"]["excitation"]["kind"] == "dwell" and s["yaw"]["excitation"]["kind"] == "sweep"

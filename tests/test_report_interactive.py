@@ -13,7 +13,7 @@ import h5py
 import numpy as np
 import pytest
 
-from tests.conftest import MODELS, run_cli
+from tests.conftest import MODELS
 from tests.test_report import SHORT_PROFILE as PROFILE
 from tests.test_viewer import CHROMIUM_FLAGS, chromium
 
@@ -51,13 +51,16 @@ POINT = 20
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
+    """``taos greenrun`` run in this process (these tests read the page it writes, not the
+    process: tests/test_report.py runs the console script)."""
+    from taos.cli import main
+
     tmp = tmp_path_factory.mktemp("interactive")
     prof = tmp / "short.toml"
     prof.write_text(PROFILE)
     out = tmp / "report"
-    r = run_cli("greenrun", MODELS / "rs25_hotfire.toml", "--profile", prof, "--out", out,
-                "--data", MODELS / "data" / "greenrun_hotfire_synthetic.csv", "--quiet")
-    assert r.returncode == 0, r.stderr
+    assert main([str(a) for a in ("greenrun", MODELS / "rs25_hotfire.toml", "--profile", prof, "--out", out,
+                                  "--data", MODELS / "data" / "greenrun_hotfire_synthetic.csv", "--quiet")]) == 0
     return out
 
 
