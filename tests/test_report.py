@@ -318,7 +318,7 @@ print(json.dumps({"summary": s, "drew": drew, "fields": fields}))
 """
 
 
-def test_greenrun_library_call_gives_the_cli_summary_and_never_draws(tmp_path):
+def test_greenrun_library_call_gives_the_cli_summary_and_never_draws(tmp_path, monkeypatch):
     """taos.greenrun(...) as a library call: the same numbers as ``taos greenrun``'s summary.json
     for the same inputs (every key, only the timestamp differs), the result's fields agree with
     the summary, its ``write`` gives the same summary.json, and the analysis draws nothing
@@ -326,10 +326,14 @@ def test_greenrun_library_call_gives_the_cli_summary_and_never_draws(tmp_path):
     import subprocess
     import sys
 
+    from taos.cli import main
+
     prof = tmp_path / "short.toml"
     prof.write_text(SHORT_PROFILE)
-    r = run_cli("greenrun", "rs25_hotfire", "--profile", prof, "--out", tmp_path / "cli", "--quiet")
-    assert r.returncode == 0, r.stderr
+    # the command line's run in this process (its console script's process: the report fixture);
+    # the library call below in a fresh one, where nothing else has imported a drawing module
+    monkeypatch.chdir(ROOT)
+    assert main(["greenrun", "rs25_hotfire", "--profile", str(prof), "--out", str(tmp_path / "cli"), "--quiet"]) == 0
     cli = json.loads((tmp_path / "cli" / "summary.json").read_text())
     p = subprocess.run([sys.executable, "-c", LIBRARY_PROBE, str(prof), str(tmp_path / "lib")], capture_output=True,
                        text=True, cwd=ROOT, timeout=600)
