@@ -10,6 +10,8 @@ the user's changed (content hash before and after), except those a case names in
 
 from __future__ import annotations
 
+import copy
+import functools
 import math
 import os
 import socket
@@ -54,23 +56,37 @@ def write(work: Path, name: str, content: str | bytes) -> Path:
     return p
 
 
-def model_copy(work: Path, name: str = "m.toml", edit: Callable | None = None) -> Path:
-    """The ambient model (actuator set inlined, stiffness file absolute), edited through tomlkit."""
+@functools.cache
+def parsed_toml(text: str):
+    """``text`` parsed by tomlkit once (pure-Python parsing is most of a case's cost); callers
+    edit a deep copy."""
     import tomlkit
 
-    doc = tomlkit.parse(model_text())
+    return tomlkit.parse(text)
+
+
+def edited_toml(text: str, edit: Callable | None) -> str:
+    """``text`` (TOML) edited through tomlkit: a fresh copy of the parsed document per call."""
+    import tomlkit
+
+    doc = copy.deepcopy(parsed_toml(text))
     if edit is not None:
         edit(doc)
-    return write(work, name, tomlkit.dumps(doc))
+    return tomlkit.dumps(doc)
+
+
+_model_text = functools.cache(model_text)   # the shipped files it reads are checked unchanged by every case
+
+
+def model_copy(work: Path, name: str = "m.toml", edit: Callable | None = None) -> Path:
+    """The ambient model (actuator set inlined, stiffness file absolute), edited through tomlkit."""
+    return write(work, name, edited_toml(_model_text(), edit))
 
 
 def flight_copy(work: Path, edit: Callable) -> Path:
     """The shipped flight file (its TVC model path made absolute), edited through tomlkit."""
-    import tomlkit
-
-    doc = tomlkit.parse(FLIGHT.read_text().replace('"../rs25_flight.toml"', f'"{MODELS}/rs25_flight.toml"'))
-    edit(doc)
-    return write(work, "f.toml", tomlkit.dumps(doc))
+    text = FLIGHT.read_text().replace('"../rs25_flight.toml"', f'"{MODELS}/rs25_flight.toml"')
+    return write(work, "f.toml", edited_toml(text, edit))
 
 
 def setting(section: str, key: str, value) -> Callable:

@@ -11,21 +11,17 @@ from typing import Callable
 
 from taos.bounds import ASCENT_BOUNDS, CAMPAIGN_BOUNDS
 
-from .hostile_cases import AMBIENT, ASCENT, MODELS, Case, write
+from .hostile_cases import AMBIENT, ASCENT, MODELS, Case, edited_toml, write
 
 CAMPAIGN = MODELS / "montecarlo" / "post_separation.toml"
 
 
 def _toml_copy(work: Path, src: Path, name: str, edit: Callable, paths: dict) -> Path:
     """``src`` with its relative paths (``paths``: text -> absolute) made absolute, edited through tomlkit."""
-    import tomlkit
-
     text = src.read_text()
     for a, b in paths.items():
         text = text.replace(a, b)
-    doc = tomlkit.parse(text)
-    edit(doc)
-    return write(work, name, tomlkit.dumps(doc))
+    return write(work, name, edited_toml(text, edit))
 
 
 def campaign_copy(work: Path, edit: Callable) -> Path:

@@ -191,19 +191,34 @@ def test_freqresp_option_fuzz(freq, amp, axis, capsys):
         one_line_exit_2(rc, out.err)
 
 
+@pytest.fixture(scope="module")
+def short_inputs(tmp_path_factory):
+    """(a 0.3 s pitch step profile, the first 2048 samples of the shipped ambient record with its
+    header): the option fuzz below is about --dt and --nperseg, so a valid tiny step or a short
+    segment costs a short run instead of the 3.5 s step and the 33 s record."""
+    d = tmp_path_factory.mktemp("short")
+    prof = d / "step_short.toml"
+    prof.write_text('name = "Pitch step, 0.4 deg, short"\ntype = "step"\namplitude = "0.4 deg"\n'
+                    'start = "0.05 s"\nhold = "0.25 s"\n')
+    lines = (ROOT / "models" / "data" / "greenrun_ambient_synthetic.csv").read_text().splitlines(keepends=True)
+    head = next(i for i, ln in enumerate(lines) if not ln.startswith("#"))   # the column names
+    rec = d / "record_short.csv"
+    rec.write_text("".join(lines[:head + 1 + 2048]))
+    return prof, rec
+
+
 @pytest.mark.slow
 @FUZZ
 @given(dt=option_text, nperseg=st.one_of(st.integers(-10, 10 ** 9).map(str), st.text(max_size=5)))
-def test_step_and_segment_option_fuzz(dt, nperseg, tmp_path_factory, capsys):
+def test_step_and_segment_option_fuzz(dt, nperseg, short_inputs, tmp_path_factory, capsys):
+    prof, rec = short_inputs
     tmp = tmp_path_factory.mktemp("o")
-    rc = main(["simulate", str(AMBIENT), "--profile", str(ROOT / "models" / "profiles" / "step_pitch.toml"),
-               "--out", str(tmp / "r.h5"), "--dt", dt])
+    rc = main(["simulate", str(AMBIENT), "--profile", str(prof), "--out", str(tmp / "r.h5"), "--dt", dt])
     err = capsys.readouterr().err
     if rc != 0:
         one_line_exit_2(rc, err)
         assert not (tmp / "r.h5").exists()
-    rc = main(["estimate", str(ROOT / "models" / "data" / "greenrun_ambient_synthetic.csv"), "--method", "h1",
-               "--nperseg", nperseg, "--json", str(tmp / "e.json")])
+    rc = main(["estimate", str(rec), "--method", "h1", "--nperseg", nperseg, "--json", str(tmp / "e.json")])
     err = capsys.readouterr().err
     if rc != 0:
         one_line_exit_2(rc, err)

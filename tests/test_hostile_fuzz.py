@@ -216,21 +216,30 @@ def test_a_signal_at_any_moment_is_one_line_and_its_status(signum, delay, tmp_pa
     ends with 130 and SIGTERM with 143, one line, no traceback, no output file. (Before the
     package's first line runs, the interpreter's own start-up, 20-150 ms on a loaded machine, is
     Python's: a signal then is the interpreter's default.)"""
-    out = tmp_path / "fr.json"
-    # about 11 s of 3-D dwells on a quiet machine with the kernels compiled (the planar dwells on
-    # the exponential integrator take under 2 s and ended inside the 2 s and 4 s delays: those
-    # cases skipped; a signal then arrives during the interpreter's own shutdown)
-    proc = subprocess.Popen([sys.executable, "-m", "taos", "freqresp", str(AMBIENT), "--engine", "taos",
-                             "--freq-hz", "0.003,0.005,0.01,0.02", "--amplitude-deg", "0.1,0.2,0.4",
-                             "--json", str(out)],
+    out = tmp_path / "sweep.json"
+    # a long job of many short compiled-kernel calls: a signal is acted on when the running numba
+    # call returns, so the job's calls must be short for every delay to be answered at once (the
+    # 3-D dwells, about 11 s in one kernel call, made each case wait for the whole job). 400 sweep
+    # points of the describing-function LCO prediction on a 2 x 2 grid: one dwell call of about
+    # 20 ms and 0.1 s of Python a point, about 40 s on a quiet machine (longer under load),
+    # so the run is still going at the longest delay
+    proc = subprocess.Popen([sys.executable, "-m", "taos", "sweep", str(AMBIENT),
+                             "--set", "structure.load_stiffness=80000 lbf/in:160000 lbf/in", "--samples", "400",
+                             "--metric", "lco", "--flight", str(FLIGHT), "--amplitudes-deg", "0.05,0.2",
+                             "--freq-hz", "0.3,1", "--no-progress", "--json", str(out)],
                             cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    _wait_for_handlers(proc)
-    time.sleep(delay)
-    if proc.poll() is not None or out.exists():
-        proc.wait(120)
-        pytest.skip("the run ended before the signal")
-    proc.send_signal(signum)
-    rc = proc.wait(120)
+    try:
+        _wait_for_handlers(proc)
+        time.sleep(delay)
+        if proc.poll() is not None or out.exists():
+            proc.wait(120)
+            pytest.skip("the run ended before the signal")
+        proc.send_signal(signum)
+        rc = proc.wait(120)
+    finally:
+        if proc.poll() is None:   # never answered: do not leave the run behind
+            proc.kill()
+            proc.wait(60)
     err = proc.stderr.read()
     lines = [ln for ln in err.splitlines() if ln.strip()]
     assert rc == 128 + signum, err
