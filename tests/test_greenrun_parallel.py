@@ -163,3 +163,18 @@ def test_a_nan_lane_in_the_greenrun_writes_nothing(hot, tmp_path):
         assert not out.exists()
         assert list(tmp_path.iterdir()) == []
     assert len(msgs) == 1
+
+
+def test_verdict_step_reruns_in_parallel_are_the_serial_ones():
+    """The ambient model fails the mask's step (overshoot): its three single removals' step runs
+    go to the threads; the verdict is the serial one."""
+    from taos.report.analysis import DEFAULT_SPEC
+    from taos.report.spec import load_spec
+    from taos.report.verdict import spec_verdict
+
+    amb, mask = load_model("rs25_ambient"), load_spec(DEFAULT_SPEC)
+    v1, v2 = (spec_verdict(amb, mask, threads=n) for n in (1, 2))
+    steps = [c for c in v1.checks if c.basis == "step"]
+    assert steps and not all(c.passed for c in steps)
+    assert {"friction", "load_stiffness", "avionics"} <= set(next(c for c in steps if not c.passed).removed)
+    assert v1.to_dict() == v2.to_dict()

@@ -277,7 +277,7 @@ def _spec_results(model, mask) -> dict:
     return {ax: check_spec(model, mask, ax) for ax in AXES}
 
 
-def _verdict(model, mask, prof, measured, info, dt_s) -> Verdict | None:
+def _verdict(model, mask, prof, measured, info, dt_s, threads=None) -> Verdict | None:
     """The mask on every basis with causes (:func:`taos.report.verdict.spec_verdict`): dwells at
     the profile's amplitudes, the measured record, the step figures ``info`` already holds."""
     if mask is None:
@@ -286,7 +286,7 @@ def _verdict(model, mask, prof, measured, info, dt_s) -> Verdict | None:
 
     segs = {ax: [(s.frequency_hz, s.amplitude_rad) for _, s in dwell_segments(getattr(prof, ax))] for ax in AXES}
     steps = {ax: m["step"] for ax, m in info["figures_of_merit"].items() if "step" in m}
-    return spec_verdict(model, mask, segments=segs, measured=measured, step_figures=steps, dt_s=dt_s)
+    return spec_verdict(model, mask, segments=segs, measured=measured, step_figures=steps, dt_s=dt_s, threads=threads)
 
 
 def _measured_responses(data) -> dict:
@@ -449,7 +449,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
         verdict = None
         if mask is not None:   # part of the dwell step: the mask's dwells and the causes' re-runs
             bar.set_postfix_str("spec verdict")
-            verdict = _verdict(model, mask, prof, measured, info, dt_s)
+            verdict = _verdict(model, mask, prof, measured, info, dt_s, threads)
         bar.update()
 
         result = GreenRunResult(
