@@ -11,15 +11,16 @@ machine load hits them alike; median and best wall time, and the process CPU tim
   every call (as before this branch), the memo's share;
 * the two-axis time-domain run alone (``taos.planar.simulate.simulate``), ``threads`` 1 and 2;
 * the peer: ``scipy.integrate.solve_ivp`` (LSODA, rtol ``--rtol``, atol 1e-12, max_step 2e-3 s)
-  on the same plant matrices, friction law and avionics (``bench_simplex.py``'s peer, no
-  actuator limits), one axis after the other, over the first ``--peer-s`` seconds of the same
-  profile, beside our run over that slice; the peer's largest engine-angle difference from
-  our run is printed (the two integrate the same equations).
+  on the same equations (plant matrices, friction law kernel, the avionics' pure-Python
+  original, the actuator limits), one axis after the other, over the first ``--peer-s``
+  seconds of the same profile (default 1 s: the peer needs about 110 s of wall time per
+  simulated second under load, so the whole 34 s profile would take about an hour), beside
+  our run over that slice; the peer's largest engine-angle difference from our run is printed.
 
 Every parallel result is checked equal to the serial one (the summary without its time stamp,
 the run's arrays) before any figure is printed.
 
-    PYTHONPATH=. .venv/bin/python benchmarks/bench_greenrun_parallel.py [--reps 5] [--peer-s 4]
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_greenrun_parallel.py [--reps 5] [--peer-s 1]
 """
 
 from __future__ import annotations
@@ -57,28 +58,34 @@ class _NoMemo(dict):
 
 
 def peer_lsoda(model, profile, T: float, t_eval: np.ndarray, rtol: float) -> tuple[float, np.ndarray]:
-    """solve_ivp LSODA of each axis' planar model (no limits) over [0, T]; (wall [s], engine
-    angle (2, n) [rad] at ``t_eval``)."""
+    """solve_ivp LSODA of each axis' planar model over [0, T], one axis after the other: the
+    state equations of :mod:`taos.planar.dynamics` (the same plant matrices, friction law kernel,
+    avionics as pure Python, the actuator limits' compiled function) with the exact command;
+    (wall [s], engine angle (2, n) [rad] at ``t_eval``)."""
     from scipy.integrate import solve_ivp
 
     from taos.planar import avionics as av
+    from taos.planar import saturation as lim_laws
+    from taos.planar.simulate import _with_spool_output, kernel_args
     from taos.planar.simplex import simplex_plant
-    from taos.planar.simulate import kernel_args
 
     rates, apply = model.friction.entry.rates, av.apply.py_func
     fp, avp = model.friction.pack(), model.avionics.pack()
     out = []
     t0 = time.perf_counter()
     for i, ax in enumerate(("pitch", "yaw")):
-        plant = simplex_plant(model, ax)
-        A, Br, bc, bf, cc, dc, cw, ca, _lim = kernel_args(plant, model)
+        plant = _with_spool_output(simplex_plant(model, ax))
+        A, Br, bc, bf, cc, dc, cw, ca, lim = kernel_args(plant, model)
         Cth = plant.ss.C[plant.ss.output_index("theta_rad")]
 
-        def rhs(t, s, i=i, A=A, bc=bc, bf=bf, cw=cw, ca=ca):
+        def rhs(t, s, i=i, A=A, Br=Br, bc=bc, bf=bf, cc=cc, dc=dc, cw=cw, ca=ca, lim=lim):
             x, z = s[:-1], s[-1]
-            u = apply(float(profile(np.array([t]))[i, 0]), avp)
+            r = profile(np.array([t]))[i]
+            u = apply(float(cc @ x + dc @ r), avp)
             dz, tf = rates(cw @ x, z, ca @ x, fp)
-            return np.append(A @ x + bc * u + bf * tf, dz)
+            dx = A @ x + Br @ r + bc * u + bf * tf
+            lim_laws.apply(lim, x, u, dx)
+            return np.append(dx, dz)
 
         sol = solve_ivp(rhs, (0.0, T), np.zeros(A.shape[0] + 1), method="LSODA", t_eval=t_eval, rtol=rtol,
                         atol=1e-12, max_step=2e-3)
@@ -86,22 +93,14 @@ def peer_lsoda(model, profile, T: float, t_eval: np.ndarray, rtol: float) -> tup
     return time.perf_counter() - t0, np.vstack(out)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--reps", type=int, default=5)
-    ap.add_argument("--peer-s", type=float, default=4.0, help="simulated seconds of the LSODA peer")
-    ap.add_argument("--rtol", type=float, default=1e-4)
-    a = ap.parse_args()
-
+def bench_greenrun(model, prof, reps: int) -> None:
+    """The Green Run (both engines) and the two-axis run, serial against parallel, interleaved."""
     import numba
 
     import taos.taos3d.simulate as t3
-    from taos.model import load_model
     from taos.planar.simulate import TimeHistory, simulate
-    from taos.report.analysis import DEFAULT_PROFILE, _profile_of, greenrun
+    from taos.report.analysis import greenrun
 
-    model = load_model(MODEL)
-    prof = _profile_of(DEFAULT_PROFILE)[0]
     memo = t3._LINEARISED
 
     def gr(engine, n, memoised=True):
@@ -125,7 +124,7 @@ def main():
     walls = {k: [] for k in cases}
     cpus = {k: [] for k in cases}
     results = {}
-    for _ in range(a.reps):
+    for _ in range(reps):
         for k, fn in cases.items():
             results[k], w, c = timed(fn)
             walls[k].append(w)
@@ -140,42 +139,64 @@ def main():
         assert np.array_equal(getattr(ths[0], name), getattr(ths[1], name)), name
 
     print(f"# Green Run on both cores ({os.cpu_count()} cores, numba threads {numba.get_num_threads()}, "
-          f"threading layer {numba.threading_layer()}); {a.reps} interleaved reps")
+          f"threading layer {numba.threading_layer()}); {reps} interleaved reps; parallel results == serial")
     print(f"# uptime: {os.popen('uptime').read().strip()}")
-    print("| case | median wall [s] | best wall [s] | median CPU [s] |")
-    print("|---|---|---|---|")
+    print("| case | median wall [s] | best wall [s] | median CPU [s] | CPU / wall |")
+    print("|---|---|---|---|---|")
     for k in cases:
-        print(f"| {k} | {statistics.median(walls[k]):.3f} | {min(walls[k]):.3f} | {statistics.median(cpus[k]):.3f} |")
+        mw, mc = statistics.median(walls[k]), statistics.median(cpus[k])
+        print(f"| {k} | {mw:.3f} | {min(walls[k]):.3f} | {mc:.3f} | {mc / mw:.2f} |")
     med = {k: statistics.median(v) for k, v in walls.items()}
     print()
     for label, s, p in (("greenrun simplex", "greenrun simplex, threads=1 (serial)", "greenrun simplex, threads=2"),
                         ("greenrun taos", "greenrun taos (3-D), threads=1 (serial)", "greenrun taos (3-D), threads=2"),
-                        ("greenrun taos vs before", "greenrun taos (3-D), serial, linearised every call (before)",
+                        ("greenrun taos, before / now", "greenrun taos (3-D), serial, linearised every call (before)",
                          "greenrun taos (3-D), threads=2"),
                         ("two-axis run", "two-axis run alone, threads=1", "two-axis run alone, threads=2")):
-        print(f"{label}: serial / parallel = {med[s] / med[p]:.2f}x (median wall)")
+        print(f"{label}: {med[s] / med[p]:.2f}x (median wall, {s} / {p})")
 
-    # the peer over a slice of the same profile
-    T = a.peer_s
+
+def bench_peer(model, prof, T: float, rtol: float, reps: int) -> None:
+    """The first ``T`` s of the two-axis run: ours (threads 1 and 2) against the LSODA peer."""
+    from taos.planar.simulate import simulate
+
     ours = {}
     for n in (1, 2):
         best = math.inf
-        for _ in range(a.reps):
+        for _ in range(reps):
             th, w, _ = timed(lambda n=n: simulate(model, prof, duration_s=T, record_every=1, threads=n))
             best = min(best, w)
         ours[n] = (best, th)
     th = ours[1][1]
     t_eval = th.t_s[::10]
-    wall_peer, eng_peer = peer_lsoda(model, prof, T, t_eval, a.rtol)
+    wall_peer, eng_peer = peer_lsoda(model, prof, T, t_eval, rtol)
     diff = np.degrees(np.max(np.abs(eng_peer - th.engine_rad[:, ::10])))
-    print(f"\n# peer: first {T:g} s of the two-axis profile, both axes, uptime {os.popen('uptime').read().strip()}")
+    print(f"\n# peer: first {T:g} s of the two-axis profile, both axes; uptime {os.popen('uptime').read().strip()}")
     print("| run | wall [s] | x real time |")
     print("|---|---|---|")
-    print(f"| solve_ivp LSODA rtol={a.rtol:g}, one axis after the other | {wall_peer:.3f} | {T / wall_peer:.2f} |")
+    print(f"| solve_ivp LSODA rtol={rtol:g}, one axis after the other | {wall_peer:.3f} | {T / wall_peer:.3f} |")
     for n in (1, 2):
-        print(f"| taos RK4 kernel dt=2e-4 s, threads={n} (best of {a.reps}) | {ours[n][0]:.4f} | {T / ours[n][0]:.0f} |")
+        print(f"| taos RK4 kernel dt=2e-4 s, threads={n} (best of {reps}) | {ours[n][0]:.4f} | {T / ours[n][0]:.0f} |")
     print(f"\npeer / ours: {wall_peer / ours[1][0]:.0f}x (serial), {wall_peer / ours[2][0]:.0f}x (threads=2); "
           f"largest engine-angle difference {diff:.2e} deg")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--peer-s", type=float, default=1.0, help="simulated seconds of the LSODA peer")
+    ap.add_argument("--rtol", type=float, default=1e-4)
+    ap.add_argument("--peer-only", action="store_true", help="only the slice and its peer")
+    a = ap.parse_args()
+
+    from taos.model import load_model
+    from taos.report.analysis import DEFAULT_PROFILE, _profile_of
+
+    model = load_model(MODEL)
+    prof = _profile_of(DEFAULT_PROFILE)[0]
+    if not a.peer_only:
+        bench_greenrun(model, prof, a.reps)
+    bench_peer(model, prof, a.peer_s, a.rtol, a.reps)
 
 
 if __name__ == "__main__":
