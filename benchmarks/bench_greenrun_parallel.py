@@ -14,7 +14,7 @@ machine load hits them alike; median and best wall time, and the process CPU tim
   on the same equations (plant matrices, friction law kernel, the avionics' pure-Python
   original, the actuator limits), one axis after the other, over the first ``--peer-s``
   seconds of the same profile (default 1 s: the peer needs about 110 s of wall time per
-  simulated second under load, so the whole 34 s profile would take about an hour), beside
+  simulated second under load, so the whole 33 s run would take up to an hour), beside
   our run over that slice; the peer's largest engine-angle difference from our run is printed.
 
 Every parallel result is checked equal to the serial one (the summary without its time stamp,
