@@ -97,17 +97,14 @@ def test_two_axis_run_in_parallel_is_the_serial_run_bit_for_bit(hot):
     assert a.provenance == b.provenance
 
 
-def test_greenrun_step_figures_and_run_in_parallel_are_the_serial_ones(runs):
+def test_greenrun_in_parallel_is_the_serial_run_step_figures_and_summary(runs):
+    """One test per engine (the module fixture computed once per engine, also under xdist)."""
     engine, serial, par = runs
     fs, fp = serial.figures_of_merit, par.figures_of_merit
     assert set(fs) == {"pitch", "yaw"} and all("step" in fs[ax] for ax in fs)
     assert fs == fp
     for name in TimeHistory.ARRAYS + TimeHistory.OPTIONAL_ARRAYS:
         assert np.array_equal(getattr(serial.time_history, name), getattr(par.time_history, name)), name
-
-
-def test_greenrun_summary_in_parallel_is_the_serial_one(runs):
-    engine, serial, par = runs
     s, p = _summary(serial), _summary(par)
     assert s["engine_model"] == engine
     assert s == p
