@@ -290,7 +290,7 @@ def taos_freqresp_family(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitudes
                               min_steps_per_cycle=min_steps_per_cycle)[axis]
 
 
-def taos_freqresp_axes(tm: TaosModel, grids, cross: bool = False, *, dt_max_s: float = DEFAULT_DT_S,
+def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = False, *, dt_max_s: float = DEFAULT_DT_S,
                        settle_cycles: int = 2, measure_cycles: int = 2, settle_s: float | None = None,
                        min_steps_per_cycle: int = 64) -> dict[str, list[FrequencyResponse]]:
     """:func:`taos_freqresp_family` of several axes, ``grids`` = {axis: (freq_hz [Hz],
@@ -314,6 +314,8 @@ def taos_freqresp_axes(tm: TaosModel, grids, cross: bool = False, *, dt_max_s: f
         freqs = np.zeros((A.size, 2))
         freqs[:, i] = F
         parts.append((axis, f, a, i, A, amps, freqs, F))
+    if not parts:
+        return {}
     res = _dwell(tm, np.vstack([p[5] for p in parts]), np.vstack([p[6] for p in parts]),
                  np.concatenate([p[7] for p in parts]), dt_max_s, settle_cycles, measure_cycles, settle_s,
                  min_steps_per_cycle, groups=[p[4].size for p in parts])
