@@ -135,7 +135,7 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
     return z, tf, u
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, nogil=True)  # nogil: independent runs in threads (taos.planar._parallel)
 def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, z0, r, dt,
                       rec_every, y_out, aux_out):
     """Integrate over the input samples ``r`` taken every ``dt``.
@@ -165,6 +165,9 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
         Receives (T_f [N m], z [rad], u [rad]) (columns ``AUX_*``).
 
     Returns -1 on success or the index of the step whose state became non-finite.
+
+    Runs without the GIL: independent calls in threads of one process run on all cores, each
+    with the same numbers as alone (:mod:`taos.planar._parallel`).
     """
     n = x0.shape[0]
     x = x0.copy()

@@ -178,9 +178,27 @@ def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
             **more}
 
 
+def _axis_arrays(model: TvcModel, axis: str, cmd: np.ndarray, dt_s: float, record_every: int) -> dict:
+    """One axis' run (its own planar model) driven by the command samples ``cmd`` (n + 1,)
+    [rad]: {array name: recorded samples} (:class:`TimeHistory` names)."""
+    from .dynamics import AUX_TF, AUX_U, AUX_Z
+
+    plant = _with_spool_output(simplex_plant(model, axis))
+    y, aux = integrate_plant(plant, model, cmd[:, None], dt_s, record_every)
+    o = plant.ss.output_index
+    return {"load_pressure_Pa": y[:, o("p_load_Pa")], "spool_flow_m_s": y[:, o("q_m_s")],
+            "supply_pressure_Pa": np.full(y.shape[0], model.actuator.supply_pressure_Pa),
+            "command_rad": cmd[::record_every], "command_avionics_rad": aux[:, AUX_U],
+            "piston_m": y[:, o("x_p_m")], "engine_rad": y[:, o("theta_rad")],
+            "friction_torque_Nm": aux[:, AUX_TF], "friction_state_rad": aux[:, AUX_Z],
+            "load_force_N": y[:, o("load_force_N")]}
+
+
 def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
-             duration_s: float | None = None, progress: bool = False) -> TimeHistory:
-    """Run ``profile`` through the simplex model (each axis its own planar model).
+             duration_s: float | None = None, progress: bool = False, threads: int | None = None) -> TimeHistory:
+    """Run ``profile`` through the simplex model (each axis its own planar model; the axes are
+    independent runs, in parallel on ``threads`` threads with the numbers of a serial run,
+    :mod:`taos.planar._parallel`).
 
     Parameters
     ----------
@@ -194,34 +212,29 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
         Simulated time [s]; default the profile's duration plus 1 s.
     progress : bool
         Show a progress bar per axis.
+    threads : int, optional
+        Threads for the axes (1: one after the other); default numba's thread count
+        (``NUMBA_NUM_THREADS``, default the number of cores). The results do not depend on it.
     """
+    from ._parallel import run_tasks
+
     T = (profile.duration_s + 1.0) if duration_s is None else duration_s
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
     cmd = np.atleast_2d(profile(t))
     axes = ("pitch", "yaw") if is_two_axis(profile) else ("pitch",)
-    out = {k: [] for k in TimeHistory.ARRAYS + TimeHistory.OPTIONAL_ARRAYS}
-    it = axes
+    bar = None
     if progress:
         from tqdm import tqdm
-        it = tqdm(axes, desc="simplex", unit="axis")
-    from .dynamics import AUX_TF, AUX_U, AUX_Z
-
-    for i, ax in enumerate(it):
-        plant = _with_spool_output(simplex_plant(model, ax))
-        y, aux = integrate_plant(plant, model, cmd[i][:, None], dt_s, record_every)
-        o = plant.ss.output_index
-        out["load_pressure_Pa"].append(y[:, o("p_load_Pa")])
-        out["spool_flow_m_s"].append(y[:, o("q_m_s")])
-        out["supply_pressure_Pa"].append(np.full(y.shape[0], model.actuator.supply_pressure_Pa))
-        out["command_rad"].append(cmd[i][::record_every])
-        out["command_avionics_rad"].append(aux[:, AUX_U])
-        out["piston_m"].append(y[:, o("x_p_m")])
-        out["engine_rad"].append(y[:, o("theta_rad")])
-        out["friction_torque_Nm"].append(aux[:, AUX_TF])
-        out["friction_state_rad"].append(aux[:, AUX_Z])
-        out["load_force_N"].append(y[:, o("load_force_N")])
+        bar = tqdm(total=len(axes), desc="simplex", unit="axis")
+    try:
+        runs = run_tasks([lambda i=i, ax=ax: _axis_arrays(model, ax, cmd[i], dt_s, record_every)
+                          for i, ax in enumerate(axes)], threads, done=None if bar is None else lambda i: bar.update())
+    finally:
+        if bar is not None:
+            bar.close()
     solver = SolverSettings(dt_s=dt_s, record_every=record_every)
     prov = provenance(model, solver, engine="simplex", profile=getattr(profile, "name", type(profile).__name__))
+    names = TimeHistory.ARRAYS + TimeHistory.OPTIONAL_ARRAYS
     return TimeHistory(t_s=t[::record_every], axes=axes, moment_arm_m=model.actuator.moment_arm_m,
-                       provenance=prov, **{k: np.vstack(v) for k, v in out.items()})
+                       provenance=prov, **{k: np.vstack([r[k] for r in runs]) for k in names})

@@ -277,7 +277,7 @@ def _spec_results(model, mask) -> dict:
     return {ax: check_spec(model, mask, ax) for ax in AXES}
 
 
-def _verdict(model, mask, prof, measured, info, dt_s) -> Verdict | None:
+def _verdict(model, mask, prof, measured, info, dt_s, threads=None) -> Verdict | None:
     """The mask on every basis with causes (:func:`taos.report.verdict.spec_verdict`): dwells at
     the profile's amplitudes, the measured record, the step figures ``info`` already holds."""
     if mask is None:
@@ -286,7 +286,7 @@ def _verdict(model, mask, prof, measured, info, dt_s) -> Verdict | None:
 
     segs = {ax: [(s.frequency_hz, s.amplitude_rad) for _, s in dwell_segments(getattr(prof, ax))] for ax in AXES}
     steps = {ax: m["step"] for ax, m in info["figures_of_merit"].items() if "step" in m}
-    return spec_verdict(model, mask, segments=segs, measured=measured, step_figures=steps, dt_s=dt_s)
+    return spec_verdict(model, mask, segments=segs, measured=measured, step_figures=steps, dt_s=dt_s, threads=threads)
 
 
 def _measured_responses(data) -> dict:
@@ -307,7 +307,8 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
              engine: str = "simplex", friction: str | None = None, out: str | Path | None = None,
              dt_s: float | None = None, spec: SpecMask | str | Path | None = DEFAULT_SPEC,
              data: TestData | str | Path | None = None, allow_unstable: bool = False,
-             progress: bool = False, view_angle_scale: float = 5.0, view_fps: float = 100.0) -> GreenRunResult:
+             progress: bool = False, view_angle_scale: float = 5.0, view_fps: float = 100.0,
+             threads: int | None = None) -> GreenRunResult:
     """The Green Run analysis of ``model`` (see the module docstring); with ``out``, also the
     report folder (:meth:`GreenRunResult.write`).
 
@@ -348,15 +349,22 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
         tqdm progress bar on standard error.
     view_angle_scale, view_fps : float
         The embedded 3-D view's angle exaggeration [-] and keyframe rate [1/s] (with ``out``).
+    threads : int, optional
+        Threads for the independent runs (the model's step figures beside the two-axis run, the
+        run's axes, the step figures' runs; :mod:`taos.planar._parallel`); default numba's
+        thread count (``NUMBA_NUM_THREADS``, default the number of cores); 1: one after the
+        other. The results are the same bits on any count.
     """
     from tqdm import tqdm
 
     from taos.linear import notch_hz
     from taos.model import TvcModel, load_model
     from taos.planar import envelope as run_checks
+    from taos.planar._parallel import run_tasks, thread_count
     from taos.results import check_output_folder, input_provenance
 
     # bad input fails here, before any progress output: one line, nothing written
+    threads = thread_count(threads)
     if out is not None:
         check_output_folder(Path(out), OUTPUTS)
     if isinstance(model, TvcModel):
@@ -376,21 +384,23 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     mask = _spec_mask(spec)
     specs = _spec_results(model, mask)
     measured = _measured_responses(data) if data is not None else None
-    info = model_summary(model)
     if engine == "taos":
         from taos.taos3d import simulate_taos, taos_freqresp
+        from taos.taos3d.simulate import taos_freqresp_axes
         run_sim = lambda: simulate_taos(tm, prof, dt_s=dt_s)  # noqa: E731
         lin_fr = lambda f, ax: taos_freqresp(tm, f, None, ax)  # noqa: E731
 
-        def dwell_fr_of(amps, freqs, ax):
-            frs = [taos_freqresp(tm, freqs, a, ax) for a in amps]
-            return np.array([fr.piston for fr in frs]), np.array([fr.engine for fr in frs])
+        def dwell_fr_all(grids):   # every axis' dwells in one parallel call
+            frs = taos_freqresp_axes(tm, {ax: (freqs, amps) for ax, (amps, freqs) in grids.items()})
+            return {ax: (np.array([fr.piston for fr in f]), np.array([fr.engine for fr in f])) for ax, f in frs.items()}
     else:
         from taos.planar.freqresp import linear_freqresp, sine_dwell_grid
         from taos.planar.simulate import simulate
-        run_sim = lambda: simulate(model, prof, dt_s=dt_s)  # noqa: E731
+        run_sim = lambda: simulate(model, prof, dt_s=dt_s, threads=threads)  # noqa: E731
         lin_fr = lambda f, ax: linear_freqresp(model, f, ax)  # noqa: E731
-        dwell_fr_of = lambda amps, freqs, ax: sine_dwell_grid(model, amps, freqs, ax, dt_max_s=dt_s)  # noqa: E731
+
+        def dwell_fr_all(grids):   # one parallel call per axis
+            return {ax: sine_dwell_grid(model, amps, freqs, ax, dt_max_s=dt_s) for ax, (amps, freqs) in grids.items()}
     from taos.planar.freqresp import FrequencyResponse
     from taos.planar.simplex import load_resonance_from_notch
 
@@ -398,7 +408,8 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     bar = tqdm(total=len(steps), desc="greenrun", unit="step", file=sys.stderr, disable=not progress)
     try:
         bar.set_postfix_str("simulate")
-        th = run_sim()
+        # the model's figures (their step runs) beside the run: independent, on the threads
+        info, th = run_tasks([lambda: model_summary(model, threads=threads), run_sim], threads)
         if not allow_unstable:
             run_checks.check_envelope(th, model)
         if ppath is not None:
@@ -420,22 +431,25 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
         bar.update()
 
         bar.set_postfix_str("sine dwell")
-        dwell = {}
+        grids = {}
         for ax in AXES:
             segs = dwell_segments(getattr(prof, ax))
-            amps = sorted({s.amplitude_rad for _, s in segs})
-            freqs = sorted({s.frequency_hz for _, s in segs})
-            if not segs:
+            if segs:
+                grids[ax] = (sorted({s.amplitude_rad for _, s in segs}), sorted({s.frequency_hz for _, s in segs}))
+        got = dwell_fr_all(grids) if grids else {}
+        dwell = {}
+        for ax in AXES:
+            if ax not in grids:
                 dwell[ax] = ()
                 continue
-            p, e = dwell_fr_of(amps, freqs, ax)
+            (amps, freqs), (p, e) = grids[ax], got[ax]
             dwell[ax] = tuple(FrequencyResponse(np.array(freqs), p[i], e[i], a, ax, friction_model=model.friction.name)
                               for i, a in enumerate(amps))
         run = {ax: tuple(frs) for ax, frs in run_responses(th, prof, model.actuator.moment_arm_m).items()}
         verdict = None
         if mask is not None:   # part of the dwell step: the mask's dwells and the causes' re-runs
             bar.set_postfix_str("spec verdict")
-            verdict = _verdict(model, mask, prof, measured, info, dt_s)
+            verdict = _verdict(model, mask, prof, measured, info, dt_s, threads)
         bar.update()
 
         result = GreenRunResult(

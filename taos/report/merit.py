@@ -197,34 +197,74 @@ def step_response_figures(model: TvcModel, axis: str = "pitch", step_amplitude_r
     return rise, over
 
 
-def step_merit(model: TvcModel, axis: str = "pitch", *, step_amplitude_rad: float = math.radians(0.5),
-               hysteresis_amplitude_rad: float = math.radians(0.2), ramp_rate_rad_s: float = math.radians(0.05),
-               threshold_tol_rad: float = math.radians(0.002), dt_s: float = 2e-4) -> StepMerit:
-    """Step, threshold and hysteresis figures of ``axis`` by simulation (module docstring)."""
-    from ..profiles import MultiRamp
-    from ..planar.simulate import simulate
-
-    rise, over = step_response_figures(model, axis, step_amplitude_rad, dt_s=dt_s)
-
+def _threshold_rad(model: TvcModel, axis: str, step_amplitude_rad: float, threshold_tol_rad: float,
+                   dt_s: float) -> float:
+    """The threshold [rad] (module docstring) by bisection: a chain of step runs, each after the
+    one before (nan when even ``step_amplitude_rad`` does not move the engine half way)."""
     def moves(a):
         _, e = _engine_step(model, axis, a, hold=1.0, dt_s=dt_s)
         return float(np.mean(e[-200:])) >= 0.5 * a
 
     lo, hi = 0.0, step_amplitude_rad
     if not moves(hi):
-        lo = hi = math.nan
-    else:
-        while hi - lo > threshold_tol_rad:
-            mid = 0.5 * (lo + hi)
-            lo, hi = (lo, mid) if moves(mid) else (mid, hi)
-    A = hysteresis_amplitude_rad
+        return math.nan
+    while hi - lo > threshold_tol_rad:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if moves(mid) else (mid, hi)
+    return hi
+
+
+def _hysteresis_run(model: TvcModel, axis: str, amplitude_rad: float, ramp_rate_rad_s: float,
+                    dt_s: float) -> tuple[float, float, float]:
+    """The slow triangle (module docstring): the engine angle [rad] at zero command on the way
+    down and on the way up, and the one left at its end."""
+    from ..profiles import MultiRamp
+    from ..planar.simulate import simulate
+
+    A = amplitude_rad
     prof = MultiRamp((A, -A, A, 0.0), ramp_rate_rad_s, hold_s=0.2)
     h = simulate(_axis_model(model, axis), prof, dt_s=dt_s, record_every=5, duration_s=prof.duration_s)
     e, tk = h.engine_rad[0], h.t_s
     t_down0 = A / ramp_rate_rad_s + 0.2 + A / ramp_rate_rad_s        # command passes 0 going down
     t_up0 = t_down0 + A / ramp_rate_rad_s + 0.2 + A / ramp_rate_rad_s  # and going up again
-    e_down = float(np.interp(t_down0, tk, e))
-    e_up = float(np.interp(t_up0, tk, e))
-    null = float(e[-1])
-    return StepMerit(axis, math.degrees(step_amplitude_rad), rise, over, math.degrees(hi),
-                     math.degrees(e_down - e_up), math.degrees(null), math.degrees(A), model.friction.name)
+    return float(np.interp(t_down0, tk, e)), float(np.interp(t_up0, tk, e)), float(e[-1])
+
+
+def step_merits(model: TvcModel, axes=("pitch", "yaw"), *, step_amplitude_rad: float = math.radians(0.5),
+                hysteresis_amplitude_rad: float = math.radians(0.2), ramp_rate_rad_s: float = math.radians(0.05),
+                threshold_tol_rad: float = math.radians(0.002), dt_s: float = 2e-4,
+                threads: int | None = None) -> dict[str, StepMerit]:
+    """{axis: :func:`step_merit`} of every axis in ``axes``, their independent runs (per axis the
+    step, the threshold's bisection chain and the hysteresis triangle) spread over ``threads``
+    threads (:func:`taos.planar._parallel.run_tasks`; default numba's thread count, 1: one after
+    the other) with the numbers of a serial run."""
+    from ..planar._parallel import run_tasks
+
+    tasks, cost = [], []
+    for ax in axes:   # task order = the serial order (its first failure is the one raised)
+        tasks += [lambda ax=ax: step_response_figures(model, ax, step_amplitude_rad, dt_s=dt_s),
+                  lambda ax=ax: _threshold_rad(model, ax, step_amplitude_rad, threshold_tol_rad, dt_s),
+                  lambda ax=ax: _hysteresis_run(model, ax, hysteresis_amplitude_rad, ramp_rate_rad_s, dt_s)]
+        # their costs in simulated seconds (the longest start first): one 1.7 s step; ~9 bisection
+        # steps of 1.2 s; the triangle's ramps over 6 A and its 4 holds of 0.2 s
+        cost += [1.7, 1.2 * (1 + math.log2(max(step_amplitude_rad / threshold_tol_rad, 1.0))),
+                 6 * hysteresis_amplitude_rad / ramp_rate_rad_s + 0.8]
+    res = run_tasks(tasks, threads, start_order=sorted(range(len(tasks)), key=lambda i: -cost[i]))
+    out = {}
+    for k, ax in enumerate(axes):
+        (rise, over), hi, (e_down, e_up, null) = res[3 * k: 3 * k + 3]
+        out[ax] = StepMerit(ax, math.degrees(step_amplitude_rad), rise, over, math.degrees(hi),
+                            math.degrees(e_down - e_up), math.degrees(null), math.degrees(hysteresis_amplitude_rad),
+                            model.friction.name)
+    return out
+
+
+def step_merit(model: TvcModel, axis: str = "pitch", *, step_amplitude_rad: float = math.radians(0.5),
+               hysteresis_amplitude_rad: float = math.radians(0.2), ramp_rate_rad_s: float = math.radians(0.05),
+               threshold_tol_rad: float = math.radians(0.002), dt_s: float = 2e-4,
+               threads: int | None = None) -> StepMerit:
+    """Step, threshold and hysteresis figures of ``axis`` by simulation (module docstring); its
+    independent runs on ``threads`` threads (:func:`step_merits`)."""
+    return step_merits(model, (axis,), step_amplitude_rad=step_amplitude_rad,
+                       hysteresis_amplitude_rad=hysteresis_amplitude_rad, ramp_rate_rad_s=ramp_rate_rad_s,
+                       threshold_tol_rad=threshold_tol_rad, dt_s=dt_s, threads=threads)[axis]

@@ -31,24 +31,24 @@ if TYPE_CHECKING:  # imported when a summary is made, not when this module is
 AXES = ("pitch", "yaw")
 
 
-def figures_of_merit(model: TvcModel, axes=AXES, steps: bool = True) -> dict:
+def figures_of_merit(model: TvcModel, axes=AXES, steps: bool = True, threads: int | None = None) -> dict:
     """``{axis: FrequencyMerit.to_dict() (+ "step": StepMerit.to_dict())}`` (:mod:`taos.report.merit`):
     frequency figures from the linear response, and (``steps``) the step, threshold and hysteresis
-    figures by simulation (a second or two per axis)."""
-    from .merit import frequency_merit, step_merit
+    figures by simulation (a second or two per axis; every axis' runs spread over ``threads``
+    threads, :func:`taos.report.merit.step_merits`, the same numbers on any count)."""
+    from .merit import frequency_merit, step_merits
 
-    out = {}
-    for ax in axes:
-        d = frequency_merit(model, ax).to_dict()
-        if steps:
-            d["step"] = step_merit(model, ax).to_dict()
-        out[ax] = d
+    out = {ax: frequency_merit(model, ax).to_dict() for ax in axes}
+    if steps:
+        for ax, m in step_merits(model, tuple(axes), threads=threads).items():
+            out[ax]["step"] = m.to_dict()
     return out
 
 
-def model_summary(model: TvcModel, steps: bool = True) -> dict:
+def model_summary(model: TvcModel, steps: bool = True, threads: int | None = None) -> dict:
     """Parameters in SI and derived figures (the ``taos info --json`` document without its
-    ``provenance``), with the figures of merit (``steps=False``: the linear ones only)."""
+    ``provenance``), with the figures of merit (``steps=False``: the linear ones only;
+    ``threads``: for the step figures' runs, :func:`figures_of_merit`)."""
     from dataclasses import asdict
 
     import numpy as np
@@ -74,7 +74,7 @@ def model_summary(model: TvcModel, steps: bool = True) -> dict:
         "load_stiffness_rotational_Nm_per_rad": model.structure.load_stiffness_N_per_m * model.actuator.moment_arm_m ** 2,
         "stall_force_N": model.actuator.stall_force_N,
         "avionics_lsb_deg": math.degrees(av.lsb_rad),
-        "figures_of_merit": figures_of_merit(model, steps=steps),
+        "figures_of_merit": figures_of_merit(model, steps=steps, threads=threads),
         "servo": {ax: servo_figures(model, ax).to_dict() for ax in AXES},
         "linear_modes": [{"freq_hz": float(abs(x) / (2 * math.pi)),
                           "damping_ratio": float(-x.real / abs(x)) if abs(x) > 0 else 1.0} for x in p],

@@ -280,15 +280,16 @@ def _measured_checks(model, mask, m: MeasuredResponse) -> list[SpecCheck]:
     return out
 
 
-def _step_values(model, axis, reqs, dt_s) -> dict:
-    """The step figures the requirements name, simulated on ``model``."""
+def _step_values(model, axis, reqs, dt_s, threads=None) -> dict:
+    """The step figures the requirements name, simulated on ``model`` (the step figures' runs on
+    ``threads`` threads, :func:`taos.report.merit.step_merit`)."""
     from .merit import step_merit, step_response_figures
 
     amp = reqs[0].amplitude_rad
     if {r.figure for r in reqs} <= {"rise_time_s", "overshoot_pct"}:
         rise, over = step_response_figures(model, axis, amp, dt_s=dt_s)
         return {"rise_time_s": rise, "overshoot_pct": over}
-    return step_merit(model, axis, step_amplitude_rad=amp, dt_s=dt_s).to_dict()
+    return step_merit(model, axis, step_amplitude_rad=amp, dt_s=dt_s, threads=threads).to_dict()
 
 
 def _step_check(axis, reqs, values) -> SpecCheck:
@@ -297,11 +298,11 @@ def _step_check(axis, reqs, values) -> SpecCheck:
                                  *r.bounds) for r in reqs))
 
 
-def _reevaluate(model, checks: list[SpecCheck], mask, dt_s) -> list[bool]:
+def _reevaluate(model, checks: list[SpecCheck], mask, dt_s, threads=None) -> list[bool]:
     """Whether each check (one basis and axis) passes on ``model``."""
     c0 = checks[0]
     if c0.basis == "step":
-        return [_step_check(c0.axis, mask.steps, _step_values(model, c0.axis, mask.steps, dt_s)).passed]
+        return [_step_check(c0.axis, mask.steps, _step_values(model, c0.axis, mask.steps, dt_s, threads)).passed]
     amps = None if c0.basis == "linear" else [c.amplitude_rad for c in checks]
     r = _responses(model, c0.axis, [c.freq_hz for c in checks], amps, dt_s)
     out = []
@@ -319,9 +320,15 @@ def _bounds_like(c: SpecCheck, h: complex, ref: float) -> tuple[Bound, ...]:
     return _freq_bounds(SpecPoint(c.response, c.freq_hz, q.get("gain_db"), q.get("phase_deg")), h, ref)
 
 
-def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s: float) -> list[SpecCheck]:
+def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s: float,
+              threads: int | None = None) -> list[SpecCheck]:
     """``checks`` with the cause of each failing one (module docstring); passing ones unchanged.
-    Each basis and axis is re-evaluated once per removal, on its failing points only."""
+    Each basis and axis is re-evaluated once per removal, on its failing points only. A failing
+    step's three single removals are independent runs, on ``threads`` threads
+    (:func:`taos.planar._parallel.run_tasks`, the serial run's numbers); a dwell basis' removals
+    are one parallel batch each, one after the other."""
+    from taos.planar._parallel import run_tasks
+
     out = list(checks)
     groups: dict[tuple[str, str], list[int]] = {}
     for i, c in enumerate(checks):
@@ -336,14 +343,23 @@ def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s
             for j, ok in enumerate(own):
                 removed[j]["model_dwell"] = ok
             todo = [j for j in todo if not own[j]]
-        for variant in CAUSES + ("servo",):
+        variants = CAUSES + ("servo",)
+        if basis == "step" and todo:   # the single removals' step runs at once
+            sub = [group[j] for j in todo]
+            got = run_tasks([lambda c=c: _reevaluate(remove_causes(model, (c,)), sub, mask, dt_s, threads)
+                             for c in CAUSES], threads)
+            for c, oks in zip(CAUSES, got):
+                for j, ok in zip(todo, oks):
+                    removed[j][c] = ok
+            variants = ("servo",)
+        for variant in variants:
             if variant == "servo":   # only where no single removal passed
                 todo = [j for j in todo if not any(removed[j].get(c) for c in CAUSES)]
             if not todo:
                 break
             mv = remove_causes(model, CAUSES if variant == "servo" else (variant,))
             sub = [dataclasses.replace(group[j], basis="dwell") if basis == "measured" else group[j] for j in todo]
-            for j, ok in zip(todo, _reevaluate(mv, sub, mask, dt_s)):
+            for j, ok in zip(todo, _reevaluate(mv, sub, mask, dt_s, threads)):
                 removed[j][variant] = ok
         for j, i in enumerate(idx):
             rem = removed[j]
@@ -439,14 +455,16 @@ def _and(items: Sequence[str]) -> str:
 
 def spec_verdict(model: TvcModel, mask: SpecMask, *, segments: Mapping[str, Sequence[tuple[float, float]]] | None = None,
                  measured: Mapping[str, MeasuredResponse] | None = None, step_figures: Mapping[str, dict] | None = None,
-                 dt_s: float = 2e-4, axes: Sequence[str] = AXES, attribute_causes: bool = True) -> Verdict:
+                 dt_s: float = 2e-4, axes: Sequence[str] = AXES, attribute_causes: bool = True,
+                 threads: int | None = None) -> Verdict:
     """``model`` against ``mask`` on every basis (module docstring), with causes.
 
     ``segments``: per axis the profile's dwell segments as (frequency [Hz], amplitude [rad])
     (none: no dwell basis); ``measured``: per axis a measured record's responses (none: no
     measured basis); ``step_figures``: per axis the step figures already simulated
     (``StepMerit.to_dict()``, reused when their amplitude is the mask's); ``dt_s``: the
-    integration step [s] of dwells and steps."""
+    integration step [s] of dwells and steps; ``threads``: for the independent step runs
+    (:func:`attribute`; the same numbers on any count)."""
     checks: list[SpecCheck] = []
     for ax in axes:
         checks += _freq_checks(model, mask, ax, "linear", None, dt_s)
@@ -463,8 +481,8 @@ def spec_verdict(model: TvcModel, mask: SpecMask, *, segments: Mapping[str, Sequ
             have = (step_figures or {}).get(ax)
             amp_deg = math.degrees(mask.steps[0].amplitude_rad)
             if have is None or not math.isclose(have.get("step_amplitude_deg", math.nan), amp_deg, rel_tol=1e-9):
-                have = _step_values(model, ax, mask.steps, dt_s)
+                have = _step_values(model, ax, mask.steps, dt_s, threads)
             checks.append(_step_check(ax, mask.steps, have))
     if attribute_causes:
-        checks = attribute(model, checks, mask, dt_s)
+        checks = attribute(model, checks, mask, dt_s, threads)
     return Verdict(model.name, mask.name, mask.source, tuple(checks))

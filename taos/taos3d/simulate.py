@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -180,10 +181,30 @@ def _state_from_tangent(pk: Packed, y: np.ndarray) -> np.ndarray:
     return x
 
 
+#: the linearisation of each model object (models are frozen: one linearisation serves every
+#: axis, frequency and notch search of that object; entries go with their model)
+_LINEARISED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def linear_state_space(tm: TaosModel) -> StateSpace:
     """Linearisation about rest with friction off (T = 0, bearing free): states (dp, dr, v,
     actuators) in tangent coordinates; inputs ``command_pitch_rad``, ``command_yaw_rad``
-    (after the avionics, unity here); outputs x_p and theta per axis."""
+    (after the avionics, unity here); outputs x_p and theta per axis.
+
+    Computed once per model object (a frozen :class:`TaosModel`; its matrices read-only), so the
+    responses of both axes and the notch searches (:func:`taos_freqresp`, tens of calls) share
+    one linearisation and its balancing: the same numbers as a fresh one every call."""
+    ss = _LINEARISED.get(tm)
+    if ss is None:
+        ss = _linearise(tm)
+        for a in (ss.A, ss.B, ss.C, ss.D):
+            a.flags.writeable = False
+        _LINEARISED[tm] = ss
+    return ss
+
+
+def _linearise(tm: TaosModel) -> StateSpace:
+    """:func:`linear_state_space`, computed (central differences of the compiled right-hand side)."""
     pk = pack(tm, ideal_avionics=True)
     n = pk.n_state - 1
     aux = np.empty(_dy.N_AUX)
@@ -264,31 +285,60 @@ def taos_freqresp_family(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitudes
     [Hz], all dwells in one parallel call (as :func:`taos_freqresp`, whose single-amplitude
     result is the family's row bit for bit: each dwell is independent). Arguments checked as
     :func:`taos_freqresp`'s."""
-    if amplitudes_rad is None:
-        from ..errors import InputError
-        raise InputError("argument", "amplitudes_rad", "dwell amplitudes in rad (taos_freqresp gives the linear "
-                         "response)", got="None")
-    f, a = _args.check_dwell_args(tm, freq_hz, amplitudes_rad, axis, "amplitudes_rad", dt_max_s, settle_cycles,
-                                  measure_cycles, settle_s, min_steps_per_cycle)
-    i = AXES.index(axis)
-    o = 1 - i if cross else i
+    return taos_freqresp_axes(tm, {axis: (freq_hz, amplitudes_rad)}, cross, dt_max_s=dt_max_s,
+                              settle_cycles=settle_cycles, measure_cycles=measure_cycles, settle_s=settle_s,
+                              min_steps_per_cycle=min_steps_per_cycle)[axis]
+
+
+def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = False, *, dt_max_s: float = DEFAULT_DT_S,
+                       settle_cycles: int = 2, measure_cycles: int = 2, settle_s: float | None = None,
+                       min_steps_per_cycle: int = 64) -> dict[str, list[FrequencyResponse]]:
+    """:func:`taos_freqresp_family` of several axes, ``grids`` = {axis: (freq_hz [Hz],
+    amplitudes_rad [rad])}, with the dwells of every axis in ONE parallel call (both cores busy
+    to the end; each dwell independent, so every row is the family's, bit for bit). Every
+    axis' arguments are checked (as :func:`taos_freqresp`'s, the step budget per axis) before
+    any dwell runs; an unstable dwell raises for the first in (axis, amplitude, frequency) order."""
+    from ..errors import InputError
+
+    parts = []
+    for axis, (freq_hz, amplitudes_rad) in grids.items():
+        if amplitudes_rad is None:
+            raise InputError("argument", "amplitudes_rad", "dwell amplitudes in rad (taos_freqresp gives the linear "
+                             "response)", got="None")
+        f, a = _args.check_dwell_args(tm, freq_hz, amplitudes_rad, axis, "amplitudes_rad", dt_max_s, settle_cycles,
+                                      measure_cycles, settle_s, min_steps_per_cycle)
+        i = AXES.index(axis)
+        A, F = (g.ravel() for g in np.meshgrid(a, f, indexing="ij"))
+        amps = np.zeros((A.size, 2))
+        amps[:, i] = A
+        freqs = np.zeros((A.size, 2))
+        freqs[:, i] = F
+        parts.append((axis, f, a, i, A, amps, freqs, F))
+    if not parts:
+        return {}
+    res = _dwell(tm, np.vstack([p[5] for p in parts]), np.vstack([p[6] for p in parts]),
+                 np.concatenate([p[7] for p in parts]), dt_max_s, settle_cycles, measure_cycles, settle_s,
+                 min_steps_per_cycle, groups=[p[4].size for p in parts])
     R = tm.base.actuator.moment_arm_m
-    label = f"{axis}->{AXES[o]}" if cross else axis
-    A, F = (g.ravel() for g in np.meshgrid(a, f, indexing="ij"))
-    amps = np.zeros((A.size, 2))
-    amps[:, i] = A
-    freqs = np.zeros((A.size, 2))
-    freqs[:, i] = F
-    res = _dwell(tm, amps, freqs, F, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle)
-    h = ((res[:, :, 0] + 1j * res[:, :, 1]) / A[:, None]).reshape(a.size, f.size, 4)
-    return [FrequencyResponse(f, h[k, :, o] / R, h[k, :, 2 + o], float(ak), label, engine_model="taos",
-                              friction_model=tm.base.friction.name,
-                              provenance={"model_sha256": tm.base.sha256, "method": "sine-dwell (taos)",
-                                          "dt_max_s": dt_max_s, "friction_scale": tm.friction_scale})
-            for k, ak in enumerate(a)]
+    out, k0 = {}, 0
+    for axis, f, a, i, A, _, _, _ in parts:
+        o = 1 - i if cross else i
+        label = f"{axis}->{AXES[o]}" if cross else axis
+        h = ((res[k0:k0 + A.size, :, 0] + 1j * res[k0:k0 + A.size, :, 1]) / A[:, None]).reshape(a.size, f.size, 4)
+        k0 += A.size
+        out[axis] = [FrequencyResponse(f, h[k, :, o] / R, h[k, :, 2 + o], float(ak), label, engine_model="taos",
+                                       friction_model=tm.base.friction.name,
+                                       provenance={"model_sha256": tm.base.sha256, "method": "sine-dwell (taos)",
+                                                   "dt_max_s": dt_max_s, "friction_scale": tm.friction_scale})
+                     for k, ak in enumerate(a)]
+    return out
 
 
-def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle):
+def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle,
+           groups=None):
+    """The dwells of rows ``amps``, ``freqs`` (n, 2) [rad, Hz] measured at ``fmeas`` (n,) [Hz], in
+    one parallel call: (n, 4, 3) correlation coefficients in row order. The step budget is
+    checked on the whole grid, or on each group of consecutive rows of sizes ``groups``."""
     pk = pack(tm)
     ts = settle_time_s(tm.base, "pitch") if settle_s is None else settle_s
     fmeas = np.asarray(fmeas, float)
@@ -296,7 +346,9 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     dts = 1.0 / (fmeas * npc)
     nset = (np.maximum(settle_cycles, np.ceil(ts * fmeas)) * npc).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
-    _args.check_dwell_steps(int(np.sum(nset + nmeas)))   # before any work, as the command line's budget
+    bounds = np.cumsum([0] + list(groups if groups is not None else [fmeas.size]))
+    for g0, g1 in zip(bounds[:-1], bounds[1:]):   # before any work, as the command line's budget
+        _args.check_dwell_steps(int(np.sum(nset[g0:g1] + nmeas[g0:g1])))
     perm = deal_by_cost(nset + nmeas)   # results put back in input order below
     amps, freqs = np.ascontiguousarray(np.asarray(amps, float)[perm]), np.ascontiguousarray(np.asarray(freqs, float)[perm])
     fmeas, dts, nset, nmeas = fmeas[perm], dts[perm], nset[perm], nmeas[perm]
