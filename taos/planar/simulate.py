@@ -179,7 +179,7 @@ def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
 
 
 def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
-             duration_s: float | None = None, progress: bool = False) -> TimeHistory:
+             duration_s: float | None = None, progress: bool = False, integrator: str = "rk4") -> TimeHistory:
     """Run ``profile`` through the simplex model (each axis its own planar model).
 
     Parameters
@@ -194,7 +194,14 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
         Simulated time [s]; default the profile's duration plus 1 s.
     progress : bool
         Show a progress bar per axis.
+    integrator : str
+        ``"rk4"`` (the fixed-step kernel at ``dt_s``) or ``"exp"`` (ETDRK4 with the step
+        chosen by the friction loop and the records, the command sampled every ``dt_s``:
+        :mod:`taos.planar._exptime`; it runs RK4 where it does not apply and says why in the
+        provenance's ``exp``).
     """
+    if integrator not in ("rk4", "exp"):
+        raise ValueError(f"integrator: 'rk4' or 'exp', got {integrator!r}")
     T = (profile.duration_s + 1.0) if duration_s is None else duration_s
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
@@ -207,9 +214,15 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
         it = tqdm(axes, desc="simplex", unit="axis")
     from .dynamics import AUX_TF, AUX_U, AUX_Z
 
+    exp_how: list[dict] = []
     for i, ax in enumerate(it):
         plant = _with_spool_output(simplex_plant(model, ax))
-        y, aux = integrate_plant(plant, model, cmd[i][:, None], dt_s, record_every)
+        if integrator == "exp":
+            from ._exptime import breakpoints, integrate_plant_exp
+            y, aux, how = integrate_plant_exp(plant, model, cmd[i], dt_s, record_every, breakpoints(profile, i))
+            exp_how.append(how)
+        else:
+            y, aux = integrate_plant(plant, model, cmd[i][:, None], dt_s, record_every)
         o = plant.ss.output_index
         out["load_pressure_Pa"].append(y[:, o("p_load_Pa")])
         out["spool_flow_m_s"].append(y[:, o("q_m_s")])
@@ -221,7 +234,9 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
         out["friction_torque_Nm"].append(aux[:, AUX_TF])
         out["friction_state_rad"].append(aux[:, AUX_Z])
         out["load_force_N"].append(y[:, o("load_force_N")])
-    solver = SolverSettings(dt_s=dt_s, record_every=record_every)
-    prov = provenance(model, solver, engine="simplex", profile=getattr(profile, "name", type(profile).__name__))
+    exp = any(h["method"] == "etdrk4" for h in exp_how)
+    solver = SolverSettings(method="etdrk4" if exp else SolverSettings.method, dt_s=dt_s, record_every=record_every)
+    prov = provenance(model, solver, engine="simplex", profile=getattr(profile, "name", type(profile).__name__),
+                      **({"exp": {ax: h for ax, h in zip(axes, exp_how)}} if exp_how else {}))
     return TimeHistory(t_s=t[::record_every], axes=axes, moment_arm_m=model.actuator.moment_arm_m,
                        provenance=prov, **{k: np.vstack(v) for k, v in out.items()})
