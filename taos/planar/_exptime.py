@@ -61,7 +61,11 @@ PLAN_DT_S = 1e-3
 #: what bounds a run's steps (:class:`RunPlan`): the friction loop's rate, the supply-pressure
 #: law's, H_MAX_S (the measurement's sampling), the friction law's explicit-step rule, a
 #: breakpoint of the command, the record interval
-SET_BY = ("friction", "pressure", "sampling", "friction step rule", "breakpoints", "record")
+SET_BY = ("friction", "pressure", "sampling", "friction step rule", "breakpoints", "record", "reversals")
+#: step near a reversal of the linear orbit's engine rate or valve flow [s], within
+#: REVERSAL_SPAN planning samples of it (module docstring)
+REVERSAL_STEP_S = 2.5e-4
+REVERSAL_SPAN = 2
 
 
 @njit(cache=True, fastmath=_FM)
@@ -227,6 +231,11 @@ def point_rates(fid, fp, w, ta, z, cwbf, cabf, out):
             out[k] = max(out[k], _pl._friction_rate(fid, fp, zero, ta[k:k + 1], z[k:k + 1], cwbf, cabf))
 
 
+def _reversals(v: np.ndarray) -> np.ndarray:
+    """True at the samples k of ``v`` where v changes sign between k and k + 1."""
+    return np.append(np.signbit(v[:-1]) != np.signbit(v[1:]), False)
+
+
 def breakpoints(profile, axis: int = 0) -> np.ndarray | None:
     """Times [s] where the ``axis``-th command of ``profile`` (:mod:`taos.profiles`) is not
     smooth (step edges, ramp corners, segment ends, record samples); None for a profile type
@@ -272,16 +281,17 @@ class RunPlan:
 
 
 def plan_run(args, model, inertia_kgm2: float, r: np.ndarray, dt_s: float, record_every: int,
-             breaks: np.ndarray | None) -> RunPlan | str:
+             breaks: np.ndarray | None, max_step_s: float = math.inf, avp: np.ndarray | None = None) -> RunPlan | str:
     """The :class:`RunPlan` of an exponential run of the samples ``r`` (n,) [r] every ``dt_s``
     [s] with records every ``record_every`` samples (module docstring), or the reason it does
     not apply (a str). ``args``: :func:`taos.planar.simulate.kernel_args`; ``breaks``
-    (:func:`breakpoints`) [s]."""
+    (:func:`breakpoints`) [s]; ``max_step_s`` [s] a further bound on the step (the
+    step-refinement studies); ``avp`` the packed avionics (default the model's)."""
     from ..errors import InputError
     from . import saturation as _lim
 
     A, Br, bc, bf, cc, dc, cw, ca, lim = args
-    stair = model.avionics.pack()[AV_LSB] > 0.0
+    stair = (model.avionics.pack() if avp is None else avp)[AV_LSB] > 0.0
     if np.any(cc != 0.0) or Br.shape[1] != 1:
         return "the command depends on the state or on several inputs"
     if not stair and breaks is None:
@@ -305,6 +315,7 @@ def plan_run(args, model, inertia_kgm2: float, r: np.ndarray, dt_s: float, recor
     point_rates(fid, fp, w, ta, np.ascontiguousarray(z), float(cw @ bf), float(ca @ bf), rho)
     rho[~np.isfinite(z)] = np.inf      # the law diverged on the planning grid: its own rate is faster
     why = np.zeros(w.size, np.int64)               # what bounds each sample: an index into SET_BY
+    rev = _reversals(w)
     if lim.size:
         m = _lim.n_limit_states(lim)
         row = lambda k: lim[_lim.row_start(k, m):_lim.row_start(k + 1, m)]  # noqa: E731
@@ -315,11 +326,12 @@ def plan_run(args, model, inertia_kgm2: float, r: np.ndarray, dt_s: float, recor
             return "the linear orbit reaches the valve's rate limit or the hard stops"
         why[rp > rho] = 1
         rho = np.maximum(rho, rp)
+        rev = rev | _reversals(xs @ row(_lim.ROW_Q))
     # per record interval: the planning samples in it and one either side
     nw = ns // record_every + (ns % record_every > 0)
     rho3 = np.maximum(rho, np.maximum(np.append(rho[1:], rho[-1]), np.insert(rho[:-1], 0, rho[0])))
     rw = np.maximum.reduceat(rho3, np.minimum(np.arange(nw) * record_every // q, rho3.size - 1))
-    hmax = min(_pl.H_MAX_S, record_every * dt_s)
+    hmax = min(_pl.H_MAX_S, record_every * dt_s, max(max_step_s, dt_s))
     jmax = max(1, int(math.floor(hmax / dt_s + 1e-9)))
     for _ in range(60):
         try:
@@ -332,6 +344,14 @@ def plan_run(args, model, inertia_kgm2: float, r: np.ndarray, dt_s: float, recor
     with np.errstate(divide="ignore"):
         jw = np.floor(_pl.KAPPA / (rw * dt_s))
     jw = np.clip(np.nan_to_num(jw, posinf=jmax), 1, jmax).astype(np.int64)
+    # near a reversal of the engine rate or the valve flow (friction |w|, the valve's sgn(q)):
+    # N is only continuous there, the scheme's order drops; the step is REVERSAL_STEP_S
+    if REVERSAL_STEP_S > 0:
+        rv = np.convolve(rev.astype(float), np.ones(2 * REVERSAL_SPAN + 1), "same") > 0
+        near = np.maximum.reduceat(rv, np.minimum(np.arange(nw) * record_every // q, rv.size - 1))
+        jr = max(1, int(round(REVERSAL_STEP_S / dt_s)))
+        why_w = np.where(near & (jw > jr), 6, -1)
+        jw = np.where(near, np.minimum(jw, jr), jw)
     # step boundaries: every record, and the samples either side of each breakpoint
     stops = [np.arange(0, ns + 1, record_every), [ns]]
     if not stair and breaks is not None:
@@ -348,36 +368,51 @@ def plan_run(args, model, inertia_kgm2: float, r: np.ndarray, dt_s: float, recor
     sizes, slot = np.unique(np.diff(pos), return_inverse=True)
     top = 3 if jmax * dt_s < hmax - 1e-12 else (5 if record_every * dt_s <= _pl.H_MAX_S else 2)
     code = np.where(jm == jmax, top, why[np.minimum(s0 // q, why.size - 1)])
+    code = np.where(why_w[s0 // record_every] >= 0, why_w[s0 // record_every], code)
     code = np.where((jm >= L) & (L < jmax), 4, code)       # a segment cut short by a breakpoint
     set_by = SET_BY[int(np.argmax(np.bincount(code, weights=p, minlength=len(SET_BY))))]
     return RunPlan(pos, sizes.astype(np.int64), slot.astype(np.int64).ravel(), float(sizes.max() * dt_s), set_by)
 
 
-def integrate_plant_exp(plant, model, r: np.ndarray, dt_s: float, record_every: int, breaks=None):
+def integrate_plant_exp(plant, model, r: np.ndarray, dt_s: float, record_every: int, breaks=None,
+                        max_step_s: float = math.inf):
     """:func:`taos.planar.simulate.integrate_plant` by ETDRK4 (module docstring) from rest, for
     the one-channel input samples ``r`` (n_steps + 1,) [r] every ``dt_s`` [s]; ``breaks``
-    [s]: :func:`breakpoints`. Returns (y, aux, how): the records as ``integrate_plant``'s and
-    a dict for the provenance (the longest step, what set it, or the fallback's reason: then
-    the RK4 kernel ran)."""
+    [s]: :func:`breakpoints`; ``max_step_s``: :func:`plan_run`. Returns (y, aux, how): the
+    records as ``integrate_plant``'s and a dict for the provenance (the longest step, what
+    set it, or the fallback's reason: then the RK4 kernel ran)."""
+    from .simulate import integrate_plant, kernel_args
+
+    r = np.ascontiguousarray(r, dtype=np.float64)
+    out = run_exp(kernel_args(plant, model), plant.ss.C, model, model.avionics.pack(), plant.inertia_kgm2, r, dt_s,
+                  record_every, breaks, max_step_s)
+    if isinstance(out, str):
+        y, aux = integrate_plant(plant, model, r[:, None], dt_s, record_every)
+        return y, aux, {"method": "rk4-fixed-step", "exp_fallback": out}
+    return out
+
+
+def run_exp(args, Cy, model, avp, inertia_kgm2: float, r, dt_s: float, record_every: int, breaks=None,
+            max_step_s: float = math.inf):
+    """The ETDRK4 run of :func:`integrate_plant_exp` on the kernel arrays ``args``
+    (:func:`taos.planar.simulate.kernel_args`), outputs ``Cy`` (n_y, n), the friction law of
+    ``model`` and the packed avionics ``avp``; returns (y, aux, how), or the reason it does not
+    apply (a str: nothing ran). Raises :class:`taos.errors.SimulationUnstable`."""
     from ..errors import SimulationUnstable
     from . import dynamics as _dy
-    from .simulate import check_friction_step, integrate_plant, kernel_args
 
-    args = kernel_args(plant, model)
-    r = np.ascontiguousarray(r, dtype=np.float64)
-    plan = plan_run(args, model, plant.inertia_kgm2, r, dt_s, record_every, breaks)
+    plan = plan_run(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, avp)
     if isinstance(plan, str):
-        y, aux = integrate_plant(plant, model, r[:, None], dt_s, record_every)
-        return y, aux, {"method": "rk4-fixed-step", "exp_fallback": plan}
-    check_friction_step(model, plant.inertia_kgm2, plan.h_max_s)
+        return plan
+    model.friction.check_step(inertia_kgm2, plan.h_max_s, model.source)
     stack, G, D, ms, _ = _pl.step_tables(args[0], args[2], plan.sizes * dt_s)
     n = r.shape[0] - 1
     nrec = n // record_every + 1
-    y = np.empty((nrec, plant.ss.C.shape[0]))
+    y = np.empty((nrec, Cy.shape[0]))
     aux = np.empty((nrec, _dy.N_AUX))
-    st = profile_steps_exp(*args, np.ascontiguousarray(plant.ss.C), model.friction.entry.rates, model.friction.pack(),
-                           model.avionics.pack(), *stack, G, D, ms, plan.slot, plan.pos, r, dt_s, record_every,
-                           np.zeros(plant.ss.A.shape[0]), 0.0, y, aux)
+    st = profile_steps_exp(*args, np.ascontiguousarray(Cy), model.friction.entry.rates, model.friction.pack(), avp,
+                           *stack, G, D, ms, plan.slot, plan.pos, r, dt_s, record_every, np.zeros(args[0].shape[0]),
+                           0.0, y, aux)
     if st >= 0:
         raise SimulationUnstable(st * dt_s, f"{model.friction.name} friction, ETDRK4 step <= {plan.h_max_s:g} s")
     return y, aux, {"method": "etdrk4", "exp_max_step_s": plan.h_max_s, "exp_step_set_by": plan.set_by,
