@@ -287,6 +287,12 @@ def plan_run(args, model, inertia_kgm2: float, r: np.ndarray, dt_s: float, recor
     not apply (a str). ``args``: :func:`taos.planar.simulate.kernel_args`; ``breaks``
     (:func:`breakpoints`) [s]; ``max_step_s`` [s] a further bound on the step (the
     step-refinement studies); ``avp`` the packed avionics (default the model's)."""
+    with np.errstate(over="ignore", invalid="ignore"):    # an unstable plant: its orbit overflows
+        return _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, avp)
+
+
+def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, avp):
+    """:func:`plan_run`'s work."""
     from ..errors import InputError
     from . import saturation as _lim
 
