@@ -385,20 +385,20 @@ def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, 
     return RunPlan(pos, sizes.astype(np.int64), slot.astype(np.int64).ravel(), float(sizes.max() * dt_s), set_by)
 
 
-def integrate_plant_exp(plant, model, r: np.ndarray, dt_s: float, record_every: int, breaks=None,
+def integrate_plant_exp(plant, model, args, r: np.ndarray, dt_s: float, record_every: int, breaks, fallback,
                         max_step_s: float = math.inf):
     """:func:`taos.planar.simulate.integrate_plant` by ETDRK4 (module docstring) from rest, for
-    the one-channel input samples ``r`` (n_steps + 1,) [r] every ``dt_s`` [s]; ``breaks``
-    [s]: :func:`breakpoints`; ``max_step_s``: :func:`plan_run`. Returns (y, aux, how): the
-    records as ``integrate_plant``'s and a dict for the provenance (the longest step, what
-    set it, or the fallback's reason: then the RK4 kernel ran)."""
-    from .simulate import integrate_plant, kernel_args
-
+    the kernel arrays ``args`` of ``plant`` (:func:`taos.planar.simulate.kernel_args`) and the
+    one-channel input samples ``r`` (n_steps + 1,) [r] every ``dt_s`` [s]; ``breaks`` [s]:
+    :func:`breakpoints`; ``max_step_s``: :func:`plan_run`. Returns (y, aux, how): the records
+    as ``integrate_plant``'s and a dict for the provenance (the longest step, what set most
+    steps); where the scheme does not apply, ``fallback()`` (the RK4 run: (y, aux)) and the
+    reason in ``how``."""
     r = np.ascontiguousarray(r, dtype=np.float64)
-    out = run_exp(kernel_args(plant, model), plant.ss.C, model, model.avionics.pack(), plant.inertia_kgm2, r, dt_s,
-                  record_every, breaks, max_step_s)
+    out = run_exp(args, plant.ss.C, model, model.avionics.pack(), plant.inertia_kgm2, r, dt_s, record_every, breaks,
+                  max_step_s)
     if isinstance(out, str):
-        y, aux = integrate_plant(plant, model, r[:, None], dt_s, record_every)
+        y, aux = fallback()
         return y, aux, {"method": "rk4-fixed-step", "exp_fallback": out}
     return out
 

@@ -218,8 +218,12 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
     for i, ax in enumerate(it):
         plant = _with_spool_output(simplex_plant(model, ax))
         if integrator == "exp":
+            from functools import partial
+
             from ._exptime import breakpoints, integrate_plant_exp
-            y, aux, how = integrate_plant_exp(plant, model, cmd[i], dt_s, record_every, breakpoints(profile, i))
+            y, aux, how = integrate_plant_exp(plant, model, kernel_args(plant, model), cmd[i], dt_s, record_every,
+                                              breakpoints(profile, i),
+                                              partial(integrate_plant, plant, model, cmd[i][:, None], dt_s, record_every))
             exp_how.append(how)
         else:
             y, aux = integrate_plant(plant, model, cmd[i][:, None], dt_s, record_every)
