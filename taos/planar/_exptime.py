@@ -28,12 +28,15 @@ the step is chosen:
   :meth:`taos.friction.FrictionLaw.check_step` accepts it); h <= the record interval
   ``record_every`` dt_s, every record time a step boundary, so the records land on the grid
   t = k dt_s record_every of the RK4 path (same TimeHistory, same contracts; a record is the
-  state at the boundary, and T_f, z and u = avionics(c) there). Within
-  :data:`REVERSAL_SPAN` planning samples of a sign change of the orbit's engine rate or valve
-  flow, h <= :data:`REVERSAL_STEP_S`: the friction law's |w| and the valve's sgn(q) (the
-  supply-pressure law) make N only continuous there, where the scheme's order drops (on the
-  hot-fire Green Run with friction off this brought the error at 2 ms records from 5.1e-5 to
-  1.9e-5 deg for 20 % more steps).
+  state at the boundary, and T_f, z and u = avionics(c) there).
+* **Reversals.** Where the engine rate w = c_w . x or the valve flow q changes sign, N is only
+  continuous (the friction law's |w|, the supply-pressure law's sgn(q)) and the scheme's
+  order drops; with friction the reversals (stick-slip) are not where the linear orbit has
+  them. So a step across which w or q changes sign is retaken sample by sample (step dt_s,
+  the RK4 path's; :data:`RETAKE_REVERSALS`). On the hot-fire Green Run (modified LuGre,
+  records every 2 ms) this took the engine error against RK4 at 2.5e-5 s from 1.3e-4 / 1.7e-4
+  deg (pitch / yaw) to 6.2e-5 / 6.6e-5, below the RK4 kernel's 6.8e-5 / 1.8e-4 at 2e-4 s
+  (``benchmarks/bench_exptime_accuracy.py``).
 * **Where it does not apply** (:func:`plan_run` returns the reason, and
   :func:`integrate_plant_exp` runs the RK4 kernel of :mod:`taos.planar.dynamics` instead):
   a command that depends on the state (c_c != 0: it is then not known in advance), more than
@@ -66,11 +69,10 @@ PLAN_DT_S = 1e-3
 #: what bounds a run's steps (:class:`RunPlan`): the friction loop's rate, the supply-pressure
 #: law's, H_MAX_S (the measurement's sampling), the friction law's explicit-step rule, a
 #: breakpoint of the command, the record interval
-SET_BY = ("friction", "pressure", "sampling", "friction step rule", "breakpoints", "record", "reversals")
-#: step near a reversal of the linear orbit's engine rate or valve flow [s], within
-#: REVERSAL_SPAN planning samples of it (module docstring)
-REVERSAL_STEP_S = 2.5e-4
-REVERSAL_SPAN = 2
+SET_BY = ("friction", "pressure", "sampling", "friction step rule", "breakpoints", "record")
+#: retake a step across which the engine rate or the valve flow changes sign sample by sample
+#: (:func:`profile_steps_exp`)
+RETAKE_REVERSALS = True
 
 
 @njit(cache=True, fastmath=_FM)
@@ -134,7 +136,7 @@ def _at(cs, p):
 
 @njit(cache=True, fastmath=_FM)
 def profile_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, slot,
-                      pos, r, dt, rec_every, x0, z0, y_out, aux_out):
+                      pos, r, dt, rec_every, x0, z0, y_out, aux_out, qrow, one):
     """ETDRK4 steps (:func:`taos.planar._expstep.etdrk4_step`) between the sample positions
     ``pos`` (n_steps + 1,) int64 (pos[0] = 0, every multiple of ``rec_every`` among them) of
     the external input ``r`` (n_samples,) [r] sampled every ``dt`` [s] and linear between
@@ -144,8 +146,10 @@ def profile_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E
     (:func:`taos.planar._expplan.step_tables`). Records at every sample multiple of
     ``rec_every`` as :func:`taos.planar.dynamics.integrate_samples` (``y_out`` = Cy x,
     ``aux_out`` T_f, z, u). From ``x0`` (n,) [x], ``z0`` [rad]. Returns -1 or the sample
-    index at the end of the step whose state became non-finite. Plant arrays: as
-    :mod:`taos.planar.dynamics`."""
+    index at the end of the step whose state became non-finite. A step across which the
+    engine rate cw . x or the valve flow ``qrow`` . x (zeros: none) changes sign is retaken
+    sample by sample with the coefficient set ``one`` (the step dt; -1: not retaken).
+    Plant arrays: as :mod:`taos.planar.dynamics`."""
     n = x0.shape[0]
     dcs = 0.0
     for j in range(dc.shape[0]):
@@ -157,6 +161,7 @@ def profile_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E
     a, b, c, xn, tmp = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     g1 = np.zeros(n)
     g2 = np.zeros(n)
+    xs = np.empty(n)
     cmd = r * dcs
     u0 = _av.apply(cmd[0], avp)
     rec = 0
@@ -181,25 +186,59 @@ def profile_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E
             rec += 1
         if k == nst:
             break
-        o = slot[k]
-        h = (pos[k + 1] - p) * dt
-        H = 0.5 * h
-        M = tab_m[o]
-        pm = p + 0.5 * (pos[k + 1] - p)
-        if stair:
-            um = stair_pwl(G[o], D[o], H, M, cmd, float(p), pm, dt, avp, g1)
-            u1 = stair_pwl(G[o], D[o], H, M, cmd, pm, float(pos[k + 1]), dt, avp, g2)
-        else:
-            u0 = _av.apply(cmd[p], avp)
-            um = _av.apply(_at(cmd, pm), avp)
-            u1 = _av.apply(cmd[pos[k + 1]], avp)
-        z, ok = _ex.etdrk4_step(x, z, r[p], _at(r, pm), r[pos[k + 1]], u0, um, u1, stair, g1, g2, A, Br, bc, bf,
-                                cw, ca, lim, fid, fp, E[o], E2[o], P2[o], F1[o], F2[o], F3[o], h,
-                                Nu, Na, Nb, Nc, a, b, c, xn, tmp)
+        p1 = pos[k + 1]
+        w0 = _dot(cw, x)
+        q0 = _dot(qrow, x)
+        for i in range(n):
+            xs[i] = x[i]
+        zs, us = z, u0
+        z, u1, ok = _step(p, p1, slot[k], x, z, u0, stair, cmd, r, dt, avp, A, Br, bc, bf, cw, ca, lim, fid, fp,
+                          E, E2, P2, F1, F2, F3, G, D, tab_m, g1, g2, Nu, Na, Nb, Nc, a, b, c, xn, tmp)
+        if ok and one >= 0 and p1 - p > 1 and ((w0 < 0.0) != (_dot(cw, x) < 0.0) or (q0 < 0.0) != (_dot(qrow, x) < 0.0)):
+            # the engine rate or the valve flow reversed inside the step: N is only continuous
+            # there; retake the step sample by sample
+            for i in range(n):
+                x[i] = xs[i]
+            z, u1 = zs, us
+            for pp in range(p, p1):
+                z, u1, ok = _step(pp, pp + 1, one, x, z, u1, stair, cmd, r, dt, avp, A, Br, bc, bf, cw, ca, lim, fid,
+                                  fp, E, E2, P2, F1, F2, F3, G, D, tab_m, g1, g2, Nu, Na, Nb, Nc, a, b, c, xn, tmp)
+                if not ok:
+                    return pp + 1
         u0 = u1
         if not ok:
-            return pos[k + 1]
+            return p1
     return -1
+
+
+@njit(cache=True, fastmath=_FM, inline="always")
+def _dot(v, x):
+    s = 0.0
+    for i in range(v.shape[0]):
+        s += v[i] * x[i]
+    return s
+
+
+@njit(cache=True, fastmath=_FM)
+def _step(p, p1, o, x, z, u0, stair, cmd, r, dt, avp, A, Br, bc, bf, cw, ca, lim, fid, fp, E, E2, P2, F1, F2, F3, G, D,
+          tab_m, g1, g2, Nu, Na, Nb, Nc, a, b, c, xn, tmp):
+    """One ETDRK4 step from sample ``p`` to ``p1`` with the coefficient set ``o`` (as
+    :func:`profile_steps_exp`), in place on ``x``; returns (z [rad], u at the end [rad], all
+    finite)."""
+    h = (p1 - p) * dt
+    H = 0.5 * h
+    M = tab_m[o]
+    pm = p + 0.5 * (p1 - p)
+    if stair:
+        um = stair_pwl(G[o], D[o], H, M, cmd, float(p), pm, dt, avp, g1)
+        u1 = stair_pwl(G[o], D[o], H, M, cmd, pm, float(p1), dt, avp, g2)
+    else:
+        u0 = _av.apply(cmd[p], avp)
+        um = _av.apply(_at(cmd, pm), avp)
+        u1 = _av.apply(cmd[p1], avp)
+    z, ok = _ex.etdrk4_step(x, z, r[p], _at(r, pm), r[p1], u0, um, u1, stair, g1, g2, A, Br, bc, bf, cw, ca, lim, fid,
+                            fp, E[o], E2[o], P2[o], F1[o], F2[o], F3[o], h, Nu, Na, Nb, Nc, a, b, c, xn, tmp)
+    return z, u1, ok
 
 
 @njit(cache=True)
@@ -234,11 +273,6 @@ def point_rates(fid, fp, w, ta, z, cwbf, cabf, out):
         if k + 1 < w.shape[0] and (w[k] < 0.0) != (w[k + 1] < 0.0):
             zero = np.zeros(1)
             out[k] = max(out[k], _pl._friction_rate(fid, fp, zero, ta[k:k + 1], z[k:k + 1], cwbf, cabf))
-
-
-def _reversals(v: np.ndarray) -> np.ndarray:
-    """True at the samples k of ``v`` where v changes sign between k and k + 1."""
-    return np.append(np.signbit(v[:-1]) != np.signbit(v[1:]), False)
 
 
 def breakpoints(profile, axis: int = 0) -> np.ndarray | None:
@@ -326,7 +360,6 @@ def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, 
     point_rates(fid, fp, w, ta, np.ascontiguousarray(z), float(cw @ bf), float(ca @ bf), rho)
     rho[~np.isfinite(z)] = np.inf      # the law diverged on the planning grid: its own rate is faster
     why = np.zeros(w.size, np.int64)               # what bounds each sample: an index into SET_BY
-    rev = _reversals(w)
     if lim.size:
         m = _lim.n_limit_states(lim)
         row = lambda k: lim[_lim.row_start(k, m):_lim.row_start(k + 1, m)]  # noqa: E731
@@ -337,7 +370,6 @@ def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, 
             return "the linear orbit reaches the valve's rate limit or the hard stops"
         why[rp > rho] = 1
         rho = np.maximum(rho, rp)
-        rev = rev | _reversals(xs @ row(_lim.ROW_Q))
     # per record interval: the planning samples in it and one either side
     nw = ns // record_every + (ns % record_every > 0)
     rho3 = np.maximum(rho, np.maximum(np.append(rho[1:], rho[-1]), np.insert(rho[:-1], 0, rho[0])))
@@ -355,14 +387,6 @@ def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, 
     with np.errstate(divide="ignore"):
         jw = np.floor(_pl.KAPPA / (rw * dt_s))
     jw = np.clip(np.nan_to_num(jw, posinf=jmax), 1, jmax).astype(np.int64)
-    # near a reversal of the engine rate or the valve flow (friction |w|, the valve's sgn(q)):
-    # N is only continuous there, the scheme's order drops; the step is REVERSAL_STEP_S
-    if REVERSAL_STEP_S > 0:
-        rv = np.convolve(rev.astype(float), np.ones(2 * REVERSAL_SPAN + 1), "same") > 0
-        near = np.maximum.reduceat(rv, np.minimum(np.arange(nw) * record_every // q, rv.size - 1))
-        jr = max(1, int(round(REVERSAL_STEP_S / dt_s)))
-        why_w = np.where(near & (jw > jr), 6, -1)
-        jw = np.where(near, np.minimum(jw, jr), jw)
     # step boundaries: every record, and the samples either side of each breakpoint
     stops = [np.arange(0, ns + 1, record_every), [ns]]
     if not stair and breaks is not None:
@@ -379,7 +403,6 @@ def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, 
     sizes, slot = np.unique(np.diff(pos), return_inverse=True)
     top = 3 if jmax * dt_s < hmax - 1e-12 else (5 if record_every * dt_s <= _pl.H_MAX_S else 2)
     code = np.where(jm == jmax, top, why[np.minimum(s0 // q, why.size - 1)])
-    code = np.where(why_w[s0 // record_every] >= 0, why_w[s0 // record_every], code)
     code = np.where((jm >= L) & (L < jmax), 4, code)       # a segment cut short by a breakpoint
     set_by = SET_BY[int(np.argmax(np.bincount(code, weights=p, minlength=len(SET_BY))))]
     return RunPlan(pos, sizes.astype(np.int64), slot.astype(np.int64).ravel(), float(sizes.max() * dt_s), set_by)
@@ -416,14 +439,23 @@ def run_exp(args, Cy, model, avp, inertia_kgm2: float, r, dt_s: float, record_ev
     if isinstance(plan, str):
         return plan
     model.friction.check_step(inertia_kgm2, plan.h_max_s, model.source)
-    stack, G, D, ms, _ = _pl.step_tables(args[0], args[2], plan.sizes * dt_s)
+    sizes = np.unique(np.append(plan.sizes, 1))          # and one sample: the retaken steps
+    stack, G, D, ms, _ = _pl.step_tables(args[0], args[2], sizes * dt_s)
+    slot = np.searchsorted(sizes, plan.sizes)[plan.slot].astype(np.int64)
+    lim = args[8]
+    qrow = np.zeros(args[0].shape[0])
+    if lim.size:
+        from . import saturation as _lim
+
+        m = _lim.n_limit_states(lim)
+        qrow = np.ascontiguousarray(lim[_lim.row_start(_lim.ROW_Q, m):_lim.row_start(_lim.ROW_Q + 1, m)])
     n = r.shape[0] - 1
     nrec = n // record_every + 1
     y = np.empty((nrec, Cy.shape[0]))
     aux = np.empty((nrec, _dy.N_AUX))
     st = profile_steps_exp(*args, np.ascontiguousarray(Cy), model.friction.entry.rates, model.friction.pack(), avp,
-                           *stack, G, D, ms, plan.slot, plan.pos, r, dt_s, record_every, np.zeros(args[0].shape[0]),
-                           0.0, y, aux)
+                           *stack, G, D, ms, slot, plan.pos, r, dt_s, record_every, np.zeros(args[0].shape[0]),
+                           0.0, y, aux, qrow, int(np.searchsorted(sizes, 1) if RETAKE_REVERSALS else -1))
     if st >= 0:
         raise SimulationUnstable(st * dt_s, f"{model.friction.name} friction, ETDRK4 step <= {plan.h_max_s:g} s")
     return y, aux, {"method": "etdrk4", "exp_max_step_s": plan.h_max_s, "exp_step_set_by": plan.set_by,
