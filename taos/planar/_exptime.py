@@ -387,6 +387,8 @@ def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, 
     with np.errstate(divide="ignore"):
         jw = np.floor(_pl.KAPPA / (rw * dt_s))
     jw = np.clip(np.nan_to_num(jw, posinf=jmax), 1, jmax).astype(np.int64)
+    # jmax halved as often as needed: a handful of distinct steps (each its own coefficients)
+    jw = np.maximum(jmax >> np.ceil(np.log2(jmax / jw)).astype(np.int64), 1)
     # step boundaries: every record, and the samples either side of each breakpoint
     stops = [np.arange(0, ns + 1, record_every), [ns]]
     if not stair and breaks is not None:
