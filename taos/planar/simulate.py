@@ -4,6 +4,8 @@ Fixed-step classical RK4 in the compiled kernel of :mod:`taos.planar.dynamics`. 
 (2e-4 s) resolves the fastest dynamics of the shipped models (oil column ~ 250 Hz,
 servovalve 100 Hz) with a wide RK4 stability margin; halving it changes a 20 s LuGre run by
 less than 1e-4 deg (``tests/test_simplex.py::test_step_refinement_lugre_20s``).
+``simulate(..., integrator="exp")`` runs the exponential integrator of
+:mod:`taos.planar._exptime` instead (the step set by the friction loop and the records).
 """
 
 from __future__ import annotations
