@@ -183,6 +183,9 @@ def cmd_simulate(args) -> int:
     from taos.planar.simulate import simulate
 
     check_output_file(args.out, "--out")
+    if args.engine == "taos" and args.integrator != "rk4":
+        raise InputError("command line", "--integrator", "rk4 with --engine taos (the exponential integrator is the "
+                         "simplex engine's)", got=args.integrator)
     model = model_from_args(args)
     tm = taos_from_args(args, model)
     profile = load_command_source(args.profile)
@@ -193,7 +196,7 @@ def cmd_simulate(args) -> int:
         from taos.taos3d import simulate_taos
         th = simulate_taos(tm, profile, dt_s=dt)
     else:
-        th = simulate(model, profile, dt_s=dt, progress=sys.stderr.isatty())
+        th = simulate(model, profile, dt_s=dt, progress=sys.stderr.isatty(), integrator=args.integrator)
     if not args.allow_unstable:
         run_checks.check_envelope(th, model)
     th.provenance.update(input_provenance(args.profile, "profile", th.provenance))
@@ -252,6 +255,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--friction", help="swap the friction law")
     p.add_argument("--dt", type=float, default=None, help="integration step [s] (default: the engine's own, 2e-4 s "
                    "simplex, 4e-4 s taos)")
+    p.add_argument("--integrator", choices=("rk4", "exp"), default="rk4",
+                   help="simplex engine: rk4 (fixed step --dt, default) or exp (exponential ETDRK4: the linear block "
+                   "and the quantised command exact, the step set by the friction loop and the records, the command "
+                   "sampled every --dt; falls back to rk4 where the limits are reached, said in the provenance)")
     p.add_argument("--allow-unstable", action="store_true",
                    help="run a model whose linear block is unstable, and do not stop at the envelope")
     p.set_defaults(func=cmd_simulate)

@@ -91,6 +91,26 @@ def orbit(A: np.ndarray, b_cmd: np.ndarray, amp: float, freq: float) -> np.ndarr
     return np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, b_cmd) * amp
 
 
+def limits_rate(lim: np.ndarray, uv, theta, q, p):
+    """The supply-pressure law's rate (4 beta / V_t) |q| g'(d) / P_s [1/s] (module docstring)
+    at the peak magnitudes (or samples) of the valve command ``uv`` [m/s], engine angle
+    ``theta`` [rad], valve flow ``q`` [m/s] and load pressure ``p`` [Pa] of a linear orbit
+    (scalars or arrays; 0 without a pressure limit), or None where the orbit reaches the
+    valve's rate limit or the hard stops (packed limits ``lim``:
+    :mod:`taos.planar.saturation`)."""
+    m = _lim.n_limit_states(lim)
+    vmax, ps, thmax = lim[_lim.LIM_VMAX], lim[_lim.LIM_PS], lim[_lim.LIM_THMAX]
+    if vmax > 0 and np.any(uv >= vmax):
+        return None
+    if thmax > 0 and np.any(theta >= thmax):
+        return None
+    if not ps > 0:
+        return np.zeros_like(np.asarray(q, float))
+    d = np.maximum(1.0 - p / ps, lim[_lim.LIM_EPS])
+    flow_in = lim[_lim.row_start(_lim.ROW_FLOW_IN, m):_lim.row_start(_lim.ROW_FLOW_IN + 1, m)]
+    return float(np.max(np.abs(flow_in))) * q / (2.0 * np.sqrt(d) * ps)
+
+
 def dwell_step_s(args, model, amp: float, freq: float, fixed_dt_s: float) -> tuple[float, str]:
     """The ETDRK4 step [s] for one dwell of ``amp`` [r] at ``freq`` [Hz] (module docstring) and
     what set it (``"friction"``, ``"pressure"``, ``"limits"``, ``"sampling"``). ``args``: the
@@ -118,17 +138,12 @@ def dwell_step_s(args, model, amp: float, freq: float, fixed_dt_s: float) -> tup
     if lim.size:
         m = _lim.n_limit_states(lim)
         row = lambda r: lim[_lim.row_start(r, m):_lim.row_start(r + 1, m)]  # noqa: E731
-        vmax, ps, thmax = lim[_lim.LIM_VMAX], lim[_lim.LIM_PS], lim[_lim.LIM_THMAX]
-        if vmax > 0 and np.abs(row(_lim.ROW_UV) @ X + lim[_lim.LIM_KVR] * amp * dc.sum()) >= vmax:
+        rp = limits_rate(lim, np.abs(row(_lim.ROW_UV) @ X + lim[_lim.LIM_KVR] * amp * dc.sum()),
+                         np.abs(row(_lim.ROW_THETA) @ X), np.abs(row(_lim.ROW_Q) @ X), np.abs(row(_lim.ROW_P) @ X))
+        if rp is None:
             return fixed_dt_s, "limits"
-        if thmax > 0 and np.abs(row(_lim.ROW_THETA) @ X) >= thmax:
-            return fixed_dt_s, "limits"
-        if ps > 0:
-            q, p = np.abs(row(_lim.ROW_Q) @ X), np.abs(row(_lim.ROW_P) @ X)
-            d = max(1.0 - p / ps, lim[_lim.LIM_EPS])
-            rp = float(np.max(np.abs(row(_lim.ROW_FLOW_IN)))) * q / (2.0 * math.sqrt(d) * ps)
-            if rp > rho:
-                rho, why = rp, "pressure"
+        if rp > rho:
+            rho, why = rp, "pressure"
     h = KAPPA / rho if rho > 0 else math.inf
     if h >= H_MAX_S:
         return H_MAX_S, "sampling"

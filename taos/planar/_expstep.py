@@ -272,6 +272,55 @@ def _nonlin(x, z, r, u, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, N):
 
 
 @njit(cache=True, fastmath=_FM)
+def etdrk4_step(x, z, r0, rm, r1, u0, um, u1, stair, g1, g2, A, Br, bc, bf, cw, ca, lim, fid, fp, E, E2, P2, F1, F2,
+                F3, dt, Nu, Na, Nb, Nc, a, b, c, xn, tmp):
+    """One ETDRK4 step of length ``dt`` [s] (module docstring, part 3) in place on ``x`` (n,)
+    [x]; returns (z [rad], all finite). ``r0``, ``rm``, ``r1`` [r] and ``u0``, ``um``, ``u1``
+    [rad] the external input and the avionics output at the step's start, middle and end;
+    with ``stair`` the staircase's responses ``g1``, ``g2`` (n,) over the two half steps
+    (:func:`_stair`), otherwise b_c u rides in N; ``E`` .. ``F3``: :func:`etd_coefficients`
+    for ``dt``; ``Nu`` .. ``tmp`` (n,) scratch. Plant arrays: :mod:`taos.planar.dynamics`."""
+    n = x.shape[0]
+    H = 0.5 * dt
+    dzu = _nonlin(x, z, r0, u0, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Nu)
+    for i in range(n):
+        tmp[i] = g1[i]
+    _matvec_add(E2, x, tmp, 1.0)          # tmp = E2 x + g1
+    for i in range(n):
+        a[i] = tmp[i]
+    _matvec_add(P2, Nu, a, 1.0)
+    za = z + H * dzu
+    dza = _nonlin(a, za, rm, um, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Na)
+    for i in range(n):
+        b[i] = tmp[i]
+    _matvec_add(P2, Na, b, 1.0)
+    zb = z + H * dza
+    dzb = _nonlin(b, zb, rm, um, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Nb)
+    for i in range(n):
+        c[i] = g2[i]
+        tmp[i] = 2.0 * Nb[i] - Nu[i]
+    _matvec_add(E2, a, c, 1.0)
+    _matvec_add(P2, tmp, c, 1.0)
+    zc = za + H * (2.0 * dzb - dzu)
+    dzc = _nonlin(c, zc, r1, u1, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Nc)
+    for i in range(n):
+        xn[i] = g2[i]
+        tmp[i] = Na[i] + Nb[i]
+    _matvec_add(E2, g1, xn, 1.0)
+    _matvec_add(E, x, xn, 1.0)
+    _matvec_add(F1, Nu, xn, 1.0)
+    _matvec_add(F2, tmp, xn, 2.0)
+    _matvec_add(F3, Nc, xn, 1.0)
+    ok = True
+    for i in range(n):
+        x[i] = xn[i]
+        ok = ok and math.isfinite(xn[i])
+    z = z + dt * (dzu + 2.0 * dza + 2.0 * dzb + dzc) / 6.0
+    ok = ok and math.isfinite(z)
+    return z, ok
+
+
+@njit(cache=True, fastmath=_FM)
 def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, amp,
                    n_per_cycle, dt, x, z, k0, nsteps, meas, out):
     """``nsteps`` ETDRK4 steps (module docstring) of r = amp sin(2 pi k / n_per_cycle) on every
@@ -319,43 +368,11 @@ def sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, 
         else:
             um = _av.apply(dcs * rm, avp)
             u1 = _av.apply(dcs * r1, avp)
-        dzu = _nonlin(x, z, r0, u0, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Nu)
-        for i in range(n):
-            tmp[i] = g1[i]
-        _matvec_add(E2, x, tmp, 1.0)          # tmp = E2 x + g1
-        for i in range(n):
-            a[i] = tmp[i]
-        _matvec_add(P2, Nu, a, 1.0)
-        za = z + H * dzu
-        dza = _nonlin(a, za, rm, um, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Na)
-        for i in range(n):
-            b[i] = tmp[i]
-        _matvec_add(P2, Na, b, 1.0)
-        zb = z + H * dza
-        dzb = _nonlin(b, zb, rm, um, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Nb)
-        for i in range(n):
-            c[i] = g2[i]
-            tmp[i] = 2.0 * Nb[i] - Nu[i]
-        _matvec_add(E2, a, c, 1.0)
-        _matvec_add(P2, tmp, c, 1.0)
-        zc = za + H * (2.0 * dzb - dzu)
-        dzc = _nonlin(c, zc, r1, u1, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, Nc)
-        for i in range(n):
-            xn[i] = g2[i]
-            tmp[i] = Na[i] + Nb[i]
-        _matvec_add(E2, g1, xn, 1.0)
-        _matvec_add(E, x, xn, 1.0)
-        _matvec_add(F1, Nu, xn, 1.0)
-        _matvec_add(F2, tmp, xn, 2.0)
-        _matvec_add(F3, Nc, xn, 1.0)
-        ok = True
-        for i in range(n):
-            x[i] = xn[i]
-            ok = ok and math.isfinite(xn[i])
-        z = z + dt * (dzu + 2.0 * dza + 2.0 * dzb + dzc) / 6.0
+        z, ok = etdrk4_step(x, z, r0, rm, r1, u0, um, u1, stair, g1, g2, A, Br, bc, bf, cw, ca, lim, fid, fp, E, E2, P2,
+                            F1, F2, F3, dt, Nu, Na, Nb, Nc, a, b, c, xn, tmp)
         u0 = u1
         zmax = max(zmax, abs(z))
-        if not (ok and math.isfinite(z)):
+        if not ok:
             return z, k - k0 + 1, zmax
     return z, -1, zmax
 

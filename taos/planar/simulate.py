@@ -4,6 +4,8 @@ Fixed-step classical RK4 in the compiled kernel of :mod:`taos.planar.dynamics`. 
 (2e-4 s) resolves the fastest dynamics of the shipped models (oil column ~ 250 Hz,
 servovalve 100 Hz) with a wide RK4 stability margin; halving it changes a 20 s LuGre run by
 less than 1e-4 deg (``tests/test_simplex.py::test_step_refinement_lugre_20s``).
+``simulate(..., integrator="exp")`` runs the exponential integrator of
+:mod:`taos.planar._exptime` instead (the step set by the friction loop and the records).
 """
 
 from __future__ import annotations
@@ -178,24 +180,37 @@ def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
             **more}
 
 
-def _axis_arrays(model: TvcModel, axis: str, cmd: np.ndarray, dt_s: float, record_every: int) -> dict:
+def _axis_arrays(model: TvcModel, axis: str, cmd: np.ndarray, dt_s: float, record_every: int,
+                 integrator: str = "rk4", profile: Profile | None = None, index: int = 0) -> tuple[dict, dict | None]:
     """One axis' run (its own planar model) driven by the command samples ``cmd`` (n + 1,)
-    [rad]: {array name: recorded samples} (:class:`TimeHistory` names)."""
+    [rad]: ({array name: recorded samples} (:class:`TimeHistory` names), how the exponential
+    integrator ran (``integrator="exp"``; ``profile`` and its axis ``index`` give its
+    breakpoints) or None)."""
     from .dynamics import AUX_TF, AUX_U, AUX_Z
 
     plant = _with_spool_output(simplex_plant(model, axis))
-    y, aux = integrate_plant(plant, model, cmd[:, None], dt_s, record_every)
+    how = None
+    if integrator == "exp":
+        from functools import partial
+
+        from ._exptime import breakpoints, integrate_plant_exp
+        y, aux, how = integrate_plant_exp(plant, model, kernel_args(plant, model), cmd, dt_s, record_every,
+                                          breakpoints(profile, index),
+                                          partial(integrate_plant, plant, model, cmd[:, None], dt_s, record_every))
+    else:
+        y, aux = integrate_plant(plant, model, cmd[:, None], dt_s, record_every)
     o = plant.ss.output_index
     return {"load_pressure_Pa": y[:, o("p_load_Pa")], "spool_flow_m_s": y[:, o("q_m_s")],
             "supply_pressure_Pa": np.full(y.shape[0], model.actuator.supply_pressure_Pa),
             "command_rad": cmd[::record_every], "command_avionics_rad": aux[:, AUX_U],
             "piston_m": y[:, o("x_p_m")], "engine_rad": y[:, o("theta_rad")],
             "friction_torque_Nm": aux[:, AUX_TF], "friction_state_rad": aux[:, AUX_Z],
-            "load_force_N": y[:, o("load_force_N")]}
+            "load_force_N": y[:, o("load_force_N")]}, how
 
 
 def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
-             duration_s: float | None = None, progress: bool = False, threads: int | None = None) -> TimeHistory:
+             duration_s: float | None = None, progress: bool = False, threads: int | None = None,
+             integrator: str = "rk4") -> TimeHistory:
     """Run ``profile`` through the simplex model (each axis its own planar model; the axes are
     independent runs, in parallel on ``threads`` threads with the numbers of a serial run,
     :mod:`taos.planar._parallel`).
@@ -215,9 +230,16 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
     threads : int, optional
         Threads for the axes (1: one after the other); default numba's thread count
         (``NUMBA_NUM_THREADS``, default the number of cores). The results do not depend on it.
+    integrator : str
+        ``"rk4"`` (the fixed-step kernel at ``dt_s``) or ``"exp"`` (ETDRK4 with the step
+        chosen by the friction loop and the records, the command sampled every ``dt_s``:
+        :mod:`taos.planar._exptime`; it runs RK4 where it does not apply and says why in the
+        provenance's ``exp``).
     """
     from ._parallel import run_tasks
 
+    if integrator not in ("rk4", "exp"):
+        raise ValueError(f"integrator: 'rk4' or 'exp', got {integrator!r}")
     T = (profile.duration_s + 1.0) if duration_s is None else duration_s
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
@@ -228,13 +250,17 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
         from tqdm import tqdm
         bar = tqdm(total=len(axes), desc="simplex", unit="axis")
     try:
-        runs = run_tasks([lambda i=i, ax=ax: _axis_arrays(model, ax, cmd[i], dt_s, record_every)
+        runs = run_tasks([lambda i=i, ax=ax: _axis_arrays(model, ax, cmd[i], dt_s, record_every, integrator,
+                                                          profile, i)
                           for i, ax in enumerate(axes)], threads, done=None if bar is None else lambda i: bar.update())
     finally:
         if bar is not None:
             bar.close()
-    solver = SolverSettings(dt_s=dt_s, record_every=record_every)
-    prov = provenance(model, solver, engine="simplex", profile=getattr(profile, "name", type(profile).__name__))
+    exp_how = [how for _, how in runs if how is not None]
+    exp = any(h["method"] == "etdrk4" for h in exp_how)
+    solver = SolverSettings(method="etdrk4" if exp else SolverSettings.method, dt_s=dt_s, record_every=record_every)
+    prov = provenance(model, solver, engine="simplex", profile=getattr(profile, "name", type(profile).__name__),
+                      **({"exp": {ax: h for ax, h in zip(axes, exp_how)}} if exp_how else {}))
     names = TimeHistory.ARRAYS + TimeHistory.OPTIONAL_ARRAYS
     return TimeHistory(t_s=t[::record_every], axes=axes, moment_arm_m=model.actuator.moment_arm_m,
-                       provenance=prov, **{k: np.vstack([r[k] for r in runs]) for k in names})
+                       provenance=prov, **{k: np.vstack([r[k] for r, _ in runs]) for k in names})
