@@ -7,7 +7,6 @@ the printed summary and a bad value's exit status run the console script in a su
 
 from __future__ import annotations
 
-import json
 import math
 
 import signal
