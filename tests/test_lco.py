@@ -5,7 +5,6 @@ bounding results at ambient (115,000 lbf/in) and hot-fire (205,000 lbf/in) stiff
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
@@ -16,6 +15,7 @@ from taos.flight.lco import analyse_lco
 from taos.model import Structure, load_model
 
 from .conftest import MODELS, run_cli
+from .inprocess import taos_json
 
 #: slow (make check skips these, make test runs them): cycles confirmed in the time domain
 pytestmark = pytest.mark.slow
@@ -102,11 +102,11 @@ def test_larger_command_amplitude_restores_stability(reports, law):
 
 
 def test_cli_lco_json_and_plots(tmp_path):
-    """``taos lco MODEL --flight F --json -`` gives the contract keys; plots are written."""
-    r = run_cli("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "modified-lugre",
-                "--amplitudes-deg", "0.02,0.1,0.5", "--freq-hz", "0.08,0.15,0.3", "--duration", "40", "--json", "-", "--plot", tmp_path / "n.png", "--plot-time", tmp_path / "t.svg")
-    assert r.returncode == 0, r.stderr
-    d = json.loads(r.stdout)
+    """``taos lco MODEL --flight F --json FILE`` gives the contract keys; plots are written (in this
+    process, :mod:`tests.inprocess`); a bad value through the console script: one line, exit 2."""
+    d = taos_json(tmp_path / "lco.json", "lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction",
+                  "modified-lugre", "--amplitudes-deg", "0.02,0.1,0.5", "--freq-hz", "0.08,0.15,0.3", "--duration",
+                  "40", "--plot", tmp_path / "n.png", "--plot-time", tmp_path / "t.svg")
     for k in ("lco", "amplitude_deg", "frequency_hz", "stable", "margin_db", "time_domain"):
         assert k in d
     assert d["lco"] is False and d["amplitude_deg"] is None and d["margin_db"] > 3
@@ -121,14 +121,13 @@ def test_lco_sweep_map_shows_where_the_verdict_flips(tmp_path):
     """Issue 12.2: ``taos lco --sweep`` over the flight loop's integral gain (the calibration
     knob) with the one Green Run friction set: at the old K_i = 0.6 1/s (low-frequency gain margin
     9.5 dB) soft-structure Dahl has no cycle, at the shipped 0.78 1/s (7.2 dB) it has one; the
-    JSON names the flip and the loop margins, and the map is drawn."""
+    JSON names the flip and the loop margins, and the map is drawn (in this process,
+    :mod:`tests.inprocess`); a bad --sweep through the console script: exit 2, nothing on stdout."""
     amps = ",".join(f"{a:.4g}" for a in np.degrees(AMPS))
     freqs = ",".join(f"{f:.4g}" for f in FREQ)
-    r = run_cli("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "dahl",
-                "--sweep", "integral_gain=0.6,0.78", "--amplitudes-deg", amps, "--freq-hz", freqs,
-                "--json", "-", "--plot-map", tmp_path / "map.png")
-    assert r.returncode == 0, r.stderr
-    d = json.loads(r.stdout)["sweep"]
+    d = taos_json(tmp_path / "map.json", "lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "dahl",
+                  "--sweep", "integral_gain=0.6,0.78", "--amplitudes-deg", amps, "--freq-hz", freqs,
+                  "--plot-map", tmp_path / "map.png")["sweep"]
     assert d["lco"] == [False, True]
     assert 0.3 < d["margin_db"][0] < 3.0 and d["margin_db"][1] == 0.0
     assert 0.05 <= d["engine_amplitude_deg"][1] <= 0.2 and 0.1 <= d["frequency_hz"][1] <= 0.2
@@ -157,11 +156,16 @@ def test_smooth_coulomb_converges_to_switching_as_regularisation_shrinks(reports
     err = []
     for veps in (0.06, 0.03, 0.01):
         m = base.replace(friction=dataclasses.replace(base.friction, regularization_velocity_rad_s=veps * DEG))
-        d = analyse_lco(fl, m, amplitudes_rad=AMPS, freq_hz=FREQ, time_domain=False).to_dict()
+        rep = analyse_lco(fl, m, amplitudes_rad=AMPS, freq_hz=FREQ, time_domain=False)
+        d = rep.to_dict()
         assert d["lco"]
         err.append(abs(d["amplitude_deg"] / sw["amplitude_deg"] - 1))
     assert err[0] > err[1] > err[2]
-    td = analyse_lco(fl, base, amplitudes_rad=AMPS, freq_hz=FREQ, duration_s=160.0, window_s=60.0).to_dict()
+    # the last model of the loop is the shipped one (v_eps = 0.01 deg/s): its describing-function
+    # map (on AMPS x FREQ, the costly part: ~7 s at this small v_eps) is the one the time-domain
+    # analysis would make again, so it is reused (analyse_lco's df=)
+    assert m == base
+    td = analyse_lco(fl, base, df=rep.prediction.df, duration_s=160.0, window_s=60.0).to_dict()
     assert abs(td["time_domain"]["engine_amplitude_deg"] / sw["time_domain"]["engine_amplitude_deg"] - 1) < 0.10
 
 

@@ -18,6 +18,7 @@ from taos.flight.vehicle import flight_plant, load_flight
 from taos.model import Structure, load_model
 
 from .conftest import MODELS, run_cli
+from .inprocess import taos_json
 
 DEG = math.pi / 180
 LBF_IN = 4.4482216152605 / 0.0254
@@ -144,20 +145,25 @@ LCO = ("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "da
        "--freq-hz", ",".join(f"{f:.4g}" for f in FREQ), "--sweep", "integral_gain=0.6,0.78")
 
 
+@pytest.fixture(scope="module")
+def map_json(tmp_path_factory):
+    """``taos lco`` LCO's map with no store, the JSON (the reference of both campaign tests below:
+    the same command on the same inputs, run once for the module). The commands whose subject is
+    the map's figures and files run in this process (:mod:`tests.inprocess`); the refusals run the
+    console script."""
+    return taos_json(tmp_path_factory.mktemp("lco_map") / "inproc.json", *LCO)
+
+
 @pytest.mark.slow
-def test_map_as_a_stored_resumable_campaign(tmp_path):
+def test_map_as_a_stored_resumable_campaign(tmp_path, map_json):
     """Issue 26.5: ``--out DIR`` runs the map on the Monte Carlo engine: DIR/map.zarr in the
     campaign store's layout (xarray-readable, one row per point), the same map as in process; a
     second run without --resume is refused (exit 2, nothing written); a point lost (its status
     reset) is run again by --resume and the map comes out the same."""
     import xarray as xr
-    r0 = run_cli(*LCO, "--json", tmp_path / "inproc.json")
-    assert r0.returncode == 0, r0.stderr
     out = tmp_path / "map"
-    r1 = run_cli(*LCO, "--out", out, "--json", tmp_path / "stored.json")
-    assert r1.returncode == 0, r1.stderr
-    a = json.loads((tmp_path / "inproc.json").read_text())["sweep"]
-    b = json.loads((tmp_path / "stored.json").read_text())["sweep"]
+    a = map_json["sweep"]
+    b = taos_json(tmp_path / "stored.json", *LCO, "--out", out)["sweep"]
     assert a == b
     ds = xr.open_zarr(out / "map.zarr", zarr_format=2)
     assert ds.sizes["run"] == 2 and list(ds["status"].values) == [1, 1]
@@ -171,18 +177,13 @@ def test_map_as_a_stored_resumable_campaign(tmp_path):
     assert other.returncode == 2 and "design_sha256" in other.stderr
     xr.Dataset({"status": (("run",), np.array([1, 0], np.int8))}).to_zarr(out / "map.zarr", region={"run": slice(0, 2)},
                                                                          zarr_format=2)
-    r2 = run_cli(*LCO, "--out", out, "--resume", "--json", tmp_path / "resumed.json")
-    assert r2.returncode == 0, r2.stderr
-    assert json.loads((tmp_path / "resumed.json").read_text())["sweep"] == a
+    assert taos_json(tmp_path / "resumed.json", *LCO, "--out", out, "--resume")["sweep"] == a
 
 
 @pytest.mark.slow
-def test_map_on_dask_workers_equals_the_map_in_process(tmp_path):
+def test_map_on_dask_workers_equals_the_map_in_process(tmp_path, map_json):
     """``--workers 2`` (a local Dask cluster, one batch per TVC variant) stores the same map."""
-    r0 = run_cli(*LCO, "--json", tmp_path / "inproc.json")
-    r1 = run_cli(*LCO, "--out", tmp_path / "map", "--workers", "2", "--json", tmp_path / "dask.json")
-    assert r0.returncode == 0 and r1.returncode == 0, r1.stderr
-    assert json.loads((tmp_path / "inproc.json").read_text()) == json.loads((tmp_path / "dask.json").read_text())
+    assert map_json == taos_json(tmp_path / "dask.json", *LCO, "--out", tmp_path / "map", "--workers", "2")
 
 
 def test_map_campaign_options_need_a_sweep_and_a_folder(tmp_path):

@@ -9,6 +9,7 @@ import json
 import pytest
 
 from .conftest import MODELS, run_cli
+from .inprocess import taos_json
 
 FLIGHT = MODELS / "flight" / "core_stage.toml"
 GRID = ("--amplitudes-deg", "0.02,0.05,0.1,0.2,0.5", "--freq-hz", "0.05,0.08,0.12,0.2,0.3")
@@ -38,11 +39,11 @@ def test_coulomb_soft_structure_verdict_in_plain_words_with_vehicle_motion(tmp_p
 
 
 @pytest.mark.slow
-def test_no_cycle_states_which_margin_and_where():
-    r = run_cli("lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "dahl", "--load-stiffness",
-                "205000 lbf/in", *GRID, "--no-time-domain", "--json", "-")
-    assert r.returncode == 0, r.stderr
-    d = json.loads(r.stdout)
+def test_no_cycle_states_which_margin_and_where(tmp_path):
+    """(The JSON's figures and words are the subject: the command runs in this process,
+    :mod:`tests.inprocess`.)"""
+    d = taos_json(tmp_path / "lco.json", "lco", MODELS / "rs25_flight.toml", "--flight", FLIGHT, "--friction", "dahl",
+                  "--load-stiffness", "205000 lbf/in", *GRID, "--no-time-domain")
     v = d["verdict"]
     print(v["text"])
     assert not d["lco"] and v["kind"] == "none"

@@ -6,7 +6,9 @@ with pip into a temporary target folder (offline: ``--no-index``), and runs ``ta
 subprocesses with that folder on ``PYTHONPATH``; the folder goes with the test's temporary
 directory. The plug-in law is smooth Coulomb friction, T = T_c v / sqrt(v^2 + v_eps^2), written
 in the plug-in's own code: its runs must equal the built-in ``coulomb-smooth`` law's (other
-kernels, same physics) to round-off, which is the independent reference.
+kernels, same physics) to round-off, which is the independent reference. The built-in law's
+reference runs need no plug-in: they go through the console script's entry in this process
+(:mod:`tests.inprocess`, no second process start-up).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from pathlib import Path
 import pytest
 
 from .conftest import MODELS, ROOT
+from .inprocess import taos_json, taos_main
 
 LAW = "plugin-smooth-coulomb"
 PKG = "taos_plugin_demo"
@@ -142,36 +145,32 @@ def test_the_installed_plugin_is_listed_and_used_by_info(plugin_path):
     assert r.returncode == 2 and LAW in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
-def test_plugin_law_in_freqresp_equals_the_builtin_law_it_reimplements(plugin_path):
+def test_plugin_law_in_freqresp_equals_the_builtin_law_it_reimplements(plugin_path, tmp_path):
     """Sine dwells (planar integrator, the plug-in's compiled kernel) with the plug-in law against
     the built-in coulomb-smooth law: the same physics in other code, so the same numbers."""
-    out = {}
-    for law in (LAW, "coulomb-smooth"):
-        r = taos_with(plugin_path, "freqresp", MODELS / "rs25_hotfire.toml", "--friction", law,
-                      "--amplitude-deg", "0.1", "--freq-hz", "2,6", "--json", "-")
-        assert r.returncode == 0, r.stderr
-        out[law] = json.loads(r.stdout)
-    a, b = out[LAW], out["coulomb-smooth"]
+    dwells = ("freqresp", MODELS / "rs25_hotfire.toml", "--amplitude-deg", "0.1", "--freq-hz", "2,6")
+    r = taos_with(plugin_path, *dwells, "--friction", LAW, "--json", "-")
+    assert r.returncode == 0, r.stderr
+    a = json.loads(r.stdout)
+    b = taos_json(tmp_path / "builtin.json", *dwells, "--friction", "coulomb-smooth")
     for resp in ("piston", "engine"):
         for k in range(2):
             assert a[resp]["gain_db"][k] == pytest.approx(b[resp]["gain_db"][k], abs=1e-6)
             assert a[resp]["phase_deg"][k] == pytest.approx(b[resp]["phase_deg"][k], abs=1e-5)
     # friction matters here: the frictionless dwell differs (so the agreement is not vacuous)
-    r = taos_with(plugin_path, "freqresp", MODELS / "rs25_hotfire.toml", "--friction", "none",
-                  "--amplitude-deg", "0.1", "--freq-hz", "2,6", "--json", "-")
-    assert abs(json.loads(r.stdout)["engine"]["gain_db"][0] - b["engine"]["gain_db"][0]) > 0.1
+    none = taos_json(tmp_path / "none.json", *dwells, "--friction", "none")
+    assert abs(none["engine"]["gain_db"][0] - b["engine"]["gain_db"][0]) > 0.1
 
 
 @pytest.mark.slow
-def test_plugin_law_in_the_lco_prediction(plugin_path):
+def test_plugin_law_in_the_lco_prediction(plugin_path, tmp_path):
     """``taos lco --friction NAME``: the describing-function map uses the plug-in law's kernel."""
-    res = {}
-    for law in (LAW, "coulomb-smooth"):
-        r = taos_with(plugin_path, "lco", MODELS / "rs25_flight.toml", "--flight", MODELS / "flight" / "core_stage.toml",
-                      "--friction", law, "--no-time-domain", "--amplitudes-deg", "0.03,0.3",
-                      "--freq-hz", "0.1,0.5,1.5", "--json", "-")
-        assert r.returncode == 0, r.stderr
-        res[law] = json.loads(r.stdout)
+    lco = ("lco", MODELS / "rs25_flight.toml", "--flight", MODELS / "flight" / "core_stage.toml", "--no-time-domain",
+           "--amplitudes-deg", "0.03,0.3", "--freq-hz", "0.1,0.5,1.5")
+    r = taos_with(plugin_path, *lco, "--friction", LAW, "--json", "-")
+    assert r.returncode == 0, r.stderr
+    res = {LAW: json.loads(r.stdout), "coulomb-smooth": taos_json(tmp_path / "builtin.json", *lco, "--friction",
+                                                                  "coulomb-smooth")}
     mt = [x["low_gain_margin_db"] for x in res[LAW]["verdict"]["margin_table"]]
     ref = [x["low_gain_margin_db"] for x in res["coulomb-smooth"]["verdict"]["margin_table"]]
     assert mt == pytest.approx(ref, abs=1e-6)
@@ -196,27 +195,30 @@ def test_plugin_law_in_simulate_fit_and_the_3d_model(plugin_path, tmp_path):
     (``freqresp --engine taos``), each against the built-in coulomb-smooth law."""
     prof = tmp_path / "dwell.toml"
     prof.write_text('type = "sine_dwell"\namplitude = "0.2 deg"\nfrequency = "2 Hz"\ncycles = 6\n')
+    from taos.planar.simulate import TimeHistory
     runs = {}
     for law in (LAW, "coulomb-smooth"):
         out = tmp_path / f"{law}.h5"
-        r = taos_with(plugin_path, "simulate", MODELS / "rs25_hotfire.toml", "--friction", law, "--profile", prof,
-                      "--out", out)
-        assert r.returncode == 0, r.stderr
-        from taos.planar.simulate import TimeHistory
+        cmd = ("simulate", MODELS / "rs25_hotfire.toml", "--friction", law, "--profile", prof, "--out", out)
+        if law == LAW:
+            r = taos_with(plugin_path, *cmd)
+            assert r.returncode == 0, r.stderr
+        else:
+            assert taos_main(*cmd) == 0
         runs[law] = TimeHistory.from_hdf5(out).engine_rad
     assert runs[LAW] == pytest.approx(runs["coulomb-smooth"], abs=1e-9)
-    fits = {}
-    for law in (LAW, "coulomb-smooth"):
-        r = taos_with(plugin_path, "fit", MODELS / "data" / "greenrun_hotfire_synthetic.csv", "--model",
-                      MODELS / "rs25_hotfire.toml", "--friction", law, "--free", "coulomb_torque", "--starts", "1",
-                      "--no-correction", "--json", "-")
-        assert r.returncode == 0, r.stderr
-        fits[law] = json.loads(r.stdout)["parameters"]["coulomb_torque"]["value"]
+    fit = ("fit", MODELS / "data" / "greenrun_hotfire_synthetic.csv", "--model", MODELS / "rs25_hotfire.toml",
+           "--free", "coulomb_torque", "--starts", "1", "--no-correction")
+    r = taos_with(plugin_path, *fit, "--friction", LAW, "--json", "-")
+    assert r.returncode == 0, r.stderr
+    fits = {LAW: json.loads(r.stdout),
+            "coulomb-smooth": taos_json(tmp_path / "fit.json", *fit, "--friction", "coulomb-smooth")}
+    fits = {law: d["parameters"]["coulomb_torque"]["value"] for law, d in fits.items()}
     assert fits[LAW] == pytest.approx(fits["coulomb-smooth"], rel=1e-6)
-    three = {}
-    for law in (LAW, "coulomb-smooth"):
-        r = taos_with(plugin_path, "freqresp", MODELS / "rs25_hotfire.toml", "--engine", "taos", "--friction", law,
-                      "--amplitude-deg", "0.2", "--freq-hz", "3", "--json", "-")
-        assert r.returncode == 0, r.stderr
-        three[law] = json.loads(r.stdout)["engine"]["gain_db"][0]
+    dwell3 = ("freqresp", MODELS / "rs25_hotfire.toml", "--engine", "taos", "--amplitude-deg", "0.2", "--freq-hz", "3")
+    r = taos_with(plugin_path, *dwell3, "--friction", LAW, "--json", "-")
+    assert r.returncode == 0, r.stderr
+    three = {LAW: json.loads(r.stdout)["engine"]["gain_db"][0],
+             "coulomb-smooth": taos_json(tmp_path / "three.json", *dwell3, "--friction", "coulomb-smooth")["engine"]
+             ["gain_db"][0]}
     assert three[LAW] == pytest.approx(three["coulomb-smooth"], abs=1e-4)

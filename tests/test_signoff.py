@@ -15,6 +15,7 @@ import math
 import pytest
 
 from tests.conftest import MODELS, run_cli
+from tests.inprocess import taos_json
 
 REQ = MODELS / "specs" / "flight_signoff_notional.toml"
 GRID = ("--amplitudes-deg", "0.03,0.1,0.3", "--freq-hz", "0.05,0.08,0.12,0.18,0.27,0.4")
@@ -23,12 +24,14 @@ LCO = ("lco", "rs25_flight", "--flight", "core_stage", *GRID, "--no-time-domain"
 
 @pytest.fixture(scope="module")
 def nominal(tmp_path_factory):
+    """The plain ``taos lco`` JSON (its figures are the reference: run in this process,
+    :mod:`tests.inprocess`) and the sign-off run by the console script (its printed verdict is
+    checked), with its JSON, folder and completed process."""
     tmp = tmp_path_factory.mktemp("signoff")
-    r = run_cli(*LCO, "--json", tmp / "lco.json")
-    assert r.returncode == 0, r.stderr
+    lco = taos_json(tmp / "lco.json", *LCO)
     r2 = run_cli(*LCO, "--requirements", REQ, "--signoff", tmp / "so", "--json", tmp / "so.json")
     assert r2.returncode == 0, r2.stderr
-    return json.loads((tmp / "lco.json").read_text()), json.loads((tmp / "so.json").read_text()), tmp / "so", r2
+    return lco, json.loads((tmp / "so.json").read_text()), tmp / "so", r2
 
 
 def _checks(case) -> dict:
@@ -80,10 +83,8 @@ def test_signoff_folder_holds_the_json_and_a_page_that_works_offline(nominal):
 
 @pytest.mark.slow
 def test_signoff_over_dispersions_fails_the_soft_load_path_and_passes_the_stiff_one(tmp_path):
-    r = run_cli(*LCO, "--requirements", REQ, "--sweep", "load_stiffness=60000 lbf/in,205000 lbf/in",
-                "--json", tmp_path / "so.json")
-    assert r.returncode == 0, r.stderr
-    s = json.loads((tmp_path / "so.json").read_text())["signoff"]
+    s = taos_json(tmp_path / "so.json", *LCO, "--requirements", REQ, "--sweep",
+                  "load_stiffness=60000 lbf/in,205000 lbf/in")["signoff"]
     soft, stiff = s["cases"]
     assert soft["parameters"]["load_stiffness_N_per_m"] == pytest.approx(60000 * 4.4482216152605 / 0.0254)
     assert not soft["pass"] and stiff["pass"] and s["pass"] is False
@@ -134,20 +135,16 @@ def test_bad_requirements_and_options_stop_before_any_work(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_loop_unstable_at_the_largest_amplitude_is_not_called_cycle_free():
+def test_a_loop_unstable_at_the_largest_amplitude_is_not_called_cycle_free(tmp_path):
     """Soft load path (60000 lbf/in): on a map up to 0.3 deg the loop with the TVC is unstable at
     every amplitude, so the verdict says the motion grows beyond the map (it used to read "no
     limit cycle expected"); the map extended to 3 deg finds the cycle above 0.3 deg, and the
     time-domain run (another method) oscillates near it."""
     soft = ("--load-stiffness", "60000 lbf/in")
-    r = run_cli(*LCO, *soft, "--json", "-")
-    assert r.returncode == 0, r.stderr
-    v = json.loads(r.stdout)["verdict"]
+    v = taos_json(tmp_path / "map.json", *LCO, *soft)["verdict"]
     assert v["kind"] == "grows-beyond-map" and "motion grows beyond it" in v["text"]
-    r = run_cli("lco", "rs25_flight", "--flight", "core_stage", "--amplitudes-deg", "0.03,0.1,0.3,1,3",
-                "--freq-hz", GRID[3], "--duration", "100", *soft, "--json", "-")
-    assert r.returncode == 0, r.stderr
-    d = json.loads(r.stdout)
+    d = taos_json(tmp_path / "extended.json", "lco", "rs25_flight", "--flight", "core_stage",
+                  "--amplitudes-deg", "0.03,0.1,0.3,1,3", "--freq-hz", GRID[3], "--duration", "100", *soft)
     assert d["verdict"]["kind"] == "limit-cycle" and d["amplitude_deg"] > 0.3
     td = d["time_domain"]
     assert td["lco"] and td["amplitude_deg"] == pytest.approx(d["amplitude_deg"], rel=0.25)

@@ -1,6 +1,9 @@
-"""``taos sweep``: driven as a user would (the console script in a subprocess), the figures
-checked against independent references, the design, unstable variants, resume after an
-interruption, and bad input (one line, exit 2, nothing written)."""
+"""``taos sweep``: the figures checked against independent references, the design, unstable
+variants, resume after an interruption, and bad input (one line, exit 2, nothing written).
+
+Where a test is about the figures and files, the command runs through the console script's entry
+in this process (:mod:`tests.inprocess`: no second process start-up per call); the Ctrl-C,
+the printed summary and a bad value's exit status run the console script in a subprocess."""
 
 from __future__ import annotations
 
@@ -18,6 +21,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import MODELS, inline_actuator_set, run_cli
+from tests.inprocess import taos_json
 
 AMBIENT = MODELS / "rs25_ambient.toml"
 FLIGHT_MODEL = MODELS / "rs25_flight.toml"
@@ -28,10 +32,8 @@ STIFFNESS_LBF_IN = (80_000, 115_000, 150_000, 205_000)
 
 
 def sweep_json(tmp_path: Path, *args, name="s.json") -> dict:
-    out = tmp_path / name
-    r = run_cli("sweep", *args, "--json", out)
-    assert r.returncode == 0, r.stderr
-    return json.loads(out.read_text())
+    """``taos sweep ARGS --json tmp_path/name`` (in this process): exit 0, the JSON."""
+    return taos_json(tmp_path / name, "sweep", *args)
 
 
 def _si(text: str) -> float:
@@ -182,6 +184,8 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
     assert p.returncode == 130 and "Traceback" not in err, err
     done = _store_done(out / "sweep.zarr")
     assert 3 <= done < 24
+    # the resume is a new process, as a user's would be (the store's inputs hash is of the files a
+    # fresh process reads; a resume inside this test process would also count fewer of them)
     r = run_cli(*args, "--out", out, "--resume", "--json", tmp_path / "resumed.json")
     assert r.returncode == 0, r.stderr
     resumed = json.loads((tmp_path / "resumed.json").read_text())
@@ -222,9 +226,8 @@ def test_time_domain_verdict_equals_taos_lco_on_each_point(tmp_path):
     soft, stiff = (p["metrics"] for p in d["points"])
     assert soft["lco_confirmed"] is True and stiff["lco_confirmed"] is False
     for point, k in ((soft, "115000 lbf/in"), (stiff, "205000 lbf/in")):
-        r = run_cli("lco", FLIGHT_MODEL, "--flight", FLIGHT, "--load-stiffness", k, *grid, "--json", "-")
-        assert r.returncode == 0, r.stderr
-        lco = json.loads(r.stdout)
+        lco = taos_json(tmp_path / f"lco_{k.split()[0]}.json", "lco", FLIGHT_MODEL, "--flight", FLIGHT,
+                        "--load-stiffness", k, *grid)
         assert point["lco_confirmed"] is lco["verdict"]["lco"]
         assert point["lco"] is lco["lco"]
         td = lco["time_domain"]
