@@ -86,6 +86,13 @@ def check_unit_text(unit: str, source: str, field: str, expected: str = "a unit 
     return unit.strip()
 
 
+def cache_folder() -> Path:
+    """The folder of taos's own caches (``$XDG_CACHE_HOME/taos``, default ``~/.cache/taos``):
+    derived tables, never an input of a run."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "taos"
+
+
 @functools.cache
 def _cache_file() -> Path | None:
     """The (unit, kind) table's file: keyed by the installed pint's location, size and time."""
@@ -96,11 +103,10 @@ def _cache_file() -> Path | None:
         st = os.stat(spec.origin)
     except Exception:
         return None
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     key = f"{spec.origin}:{st.st_size}:{st.st_mtime_ns}"
     import hashlib
 
-    return Path(base) / "taos" / f"units-{hashlib.sha256(key.encode()).hexdigest()[:16]}.json"
+    return cache_folder() / f"units-{hashlib.sha256(key.encode()).hexdigest()[:16]}.json"
 
 
 @functools.cache

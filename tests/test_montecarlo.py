@@ -395,3 +395,29 @@ def test_lockstep_kernel_matches_the_per_segment_dense_path(dispersed_runs):
         got = h.signal("command_rad", c.axis)
         assert np.max(np.abs(ref)) > 1e-4  # the kick moved it
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+
+
+def test_the_inputs_hash_does_not_depend_on_what_the_process_loaded_before(tmp_path):
+    """A fresh process's first model load also reads taos's own units cache
+    (``~/.cache/taos/units-*.json``); that cache is not an input, so a store written by a ``taos``
+    process resumes from a process that had already loaded a model (the recorded inputs of the
+    first and the second load in one fresh process are the same files)."""
+    import subprocess
+    import sys
+
+    code = ("import json, sys; from taos.montecarlo.inputs import recording, digest; "
+            "from taos.model import load_model\n"
+            "out = []\n"
+            "for _ in range(2):\n"
+            "    with recording() as f:\n"
+            "        load_model(sys.argv[1])\n"
+            "    out.append(digest(f, 's')[1])\n"
+            "print(json.dumps(out))")
+    env = {**__import__("os").environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    r = subprocess.run([sys.executable, "-c", code, str(ROOT / "models" / "rs25_ambient.toml")],
+                       capture_output=True, text=True, env=env, timeout=120, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    first, second = json.loads(r.stdout)
+    assert (tmp_path / "cache" / "taos").is_dir()     # the first load did write and read the cache
+    assert first == second and first, (first, second)
+    assert all("cache" not in Path(t["file"]).parts for t in first)

@@ -4,7 +4,7 @@ The campaign's inputs are loaded once, on the client, inside :func:`recording`: 
 hook (PEP 578, event ``open``) notes every file opened by this thread while it is active, so
 files named by other files (the flight file an ascent names, the parameter sets and stiffness
 file a model names, ...) are counted without each loader having to declare them. Python code,
-compiled caches and files of installed packages other than taos's own shipped data are left out.
+compiled caches, taos's own cache folder (:func:`taos.units.cache_folder`) and files of installed packages other than taos's own shipped data are left out.
 :func:`digest` hashes the contents (not the paths: a moved project with the same files resumes)
 together with the settings that shape the runs.
 """
@@ -48,8 +48,11 @@ def _is_input(path: str) -> bool:
     if p.suffix in _CODE_SUFFIXES or "__pycache__" in p.parts or not p.is_file():
         return False
     import taos
+    from taos.units import cache_folder
     own = Path(taos.__file__).resolve().parent
     rp = p.resolve()
+    if cache_folder().resolve() in rp.parents:
+        return False  # taos's own caches (the units table, read by the first model load of a process)
     if own in rp.parents:
         return True  # shipped data of an installed taos
     return not any(Path(pre).resolve() in rp.parents for pre in {sys.prefix, sys.base_prefix})
