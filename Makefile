@@ -73,14 +73,15 @@ $(DOCS_STAMP): $(STAMP)
 # tests/test_docs.py checks what that build's runs wrote (TAOS_TEST_DOCS_STATUS names the file
 # the build's exit status goes to; without it, as in `make check` or plain pytest, the tests run
 # the commands themselves). Two pytest processes (pytest-xdist; the tests share no output
-# folder or port), the slowest test modules first (tests/_ordering.py).
+# folder or port), the slowest test modules first (tests/_ordering.py); a worker that runs out
+# of tests takes half of the other's queue (--dist worksteal), so neither idles at the end.
 DOCS_STATUS := $(CURDIR)/docs/_build/sphinx.status
 SPHINX := MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
 test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 	@rm -rf docs/_build docs/_generated; mkdir -p docs/_build; \
 	  ( $(SPHINX) >docs/_build/sphinx.log 2>&1; echo $$? >$(DOCS_STATUS).tmp; mv $(DOCS_STATUS).tmp $(DOCS_STATUS) ) & \
 	  docs=$$!; \
-	  TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --durations=25 tests; \
+	  TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal --durations=25 tests; \
 	  rc=$$?; if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; \
 	  wait $$docs; drc=$$(cat $(DOCS_STATUS) 2>/dev/null || echo 1); \
 	  if [ "$$drc" = 0 ]; then echo "Documentation: docs/_build/html/index.html"; \
@@ -92,7 +93,7 @@ test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 # live viewer), on two processes (pytest-xdist), without the documentation build. Under 3 minutes
 # on 2 cores once the kernel cache is warm (after a source change the warm-up adds about one).
 check: $(PYC) $(WARM) browser
-	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 -m "not slow" tests; rc=$$?; \
+	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal -m "not slow" tests; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
 
 # the verification suite (tests/verification) and its table docs/verification.md

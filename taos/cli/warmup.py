@@ -35,7 +35,7 @@ import argparse
 import ast
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
@@ -158,10 +158,10 @@ def _resolve(mod: str, level: int, here: str, is_pkg: bool) -> str:
 class _Module:
     path: Path
     imports_numba: bool = False
-    jit_calls: set[str] | None = None        # names called or used as decorators
-    decorators: set[str] | None = None       # names used as decorators
-    modules: set[str] | None = None          # taos modules it imports whole (``import taos.x``)
-    names: dict[str, tuple[str, str]] | None = None   # local name -> (module, name) it imports
+    jit_calls: set[str] = field(default_factory=set)      # names called
+    decorators: set[str] = field(default_factory=set)     # names used as decorators
+    modules: set[str] = field(default_factory=set)        # taos modules imported whole (``import taos.x``)
+    names: dict[str, tuple[str, str]] = field(default_factory=dict)   # local name -> (module, name) imported
 
 
 def _outside_functions(tree: ast.Module):
@@ -179,7 +179,7 @@ def _scan(path: Path, root: Path) -> tuple[str, _Module]:
     name = _module_name(path, root)
     is_pkg = path.name == "__init__.py"
     tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
-    m = _Module(path, jit_calls=set(), decorators=set(), modules=set(), names={})
+    m = _Module(path)
     top = root.name
     module_level = {id(n) for n in _outside_functions(tree)}
     for node in ast.walk(tree):
@@ -232,7 +232,7 @@ def kernel_sources(root: Path = PACKAGE_DIR) -> list[Path]:
             mod = mod.rpartition(".")[0]
         return mod or None
 
-    def definer(mod: str, name: str, seen: frozenset = frozenset()) -> set[str]:
+    def definer(mod: str, name: str, seen: frozenset[tuple[str, str]] = frozenset()) -> set[str]:
         """The module ``name`` comes from, through re-exports (``mod.name`` may be a module)."""
         if f"{mod}.{name}" in mods:
             return {f"{mod}.{name}"}
