@@ -18,7 +18,7 @@ from taos.cli import warmup
 
 ROOT = Path(__file__).resolve().parents[1]
 TAOS = ROOT / "taos"
-NUMBA_IMPORT = re.compile(r"^\s*(import numba\b|from numba\b)", re.M)
+NUMBA_IMPORT = re.compile(r"^\s*(import numba(\.\w+)*(\s+as\s+\w+)?\s*(#.*)?$|from numba(\.\w+)* import )", re.M)
 
 
 @pytest.fixture(scope="module")
