@@ -70,20 +70,27 @@ $(DOCS_STAMP): $(STAMP)
 # The documentation is built (sphinx -W: no warnings) at the same time as the tests, in the
 # background (its output in docs/_build/sphinx.log, shown if it fails; a failed build fails
 # `make test`), so both cores stay busy. The user guide's commands run once, in the docs build:
-# tests/test_docs.py checks what that build's runs wrote (TAOS_TEST_DOCS_STATUS names the file
-# the build's exit status goes to; without it, as in `make check` or plain pytest, the tests run
-# the commands themselves). Two pytest processes (pytest-xdist; the tests share no output
-# folder or port), the slowest test modules first (tests/_ordering.py); a worker that runs out
-# of tests takes half of the other's queue (--dist worksteal), so neither idles at the end.
+# right after it, still in the background, tests/test_docs.py checks what that build's runs
+# wrote (TAOS_TEST_DOCS_STATUS names the file holding the build's exit status; without it, as
+# in `make check` or plain pytest, or after a failed build, those tests run the commands
+# themselves); the main run leaves that file out. Two pytest processes (pytest-xdist; the tests
+# share no output folder or port); a worker that runs out of tests takes half of the other's
+# queue (--dist worksteal: no worker idles while a long test runs on the other at the end;
+# benchmarks/sim_test_order.py).
 DOCS_STATUS := $(CURDIR)/docs/_build/sphinx.status
 SPHINX := MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
 test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 	@rm -rf docs/_build docs/_generated; mkdir -p docs/_build; \
-	  ( $(SPHINX) >docs/_build/sphinx.log 2>&1; echo $$? >$(DOCS_STATUS).tmp; mv $(DOCS_STATUS).tmp $(DOCS_STATUS) ) & \
+	  ( $(SPHINX) >docs/_build/sphinx.log 2>&1; echo $$? >$(DOCS_STATUS).tmp; mv $(DOCS_STATUS).tmp $(DOCS_STATUS); \
+	    TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(BIN)/python -m pytest -q -p no:cacheprovider tests/test_docs.py \
+	      >docs/_build/test_docs.log 2>&1; echo $$? >docs/_build/test_docs.status ) & \
 	  docs=$$!; \
-	  TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal --durations=25 tests; \
+	  $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal --durations=25 --ignore=tests/test_docs.py tests; \
 	  rc=$$?; if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; \
 	  wait $$docs; drc=$$(cat $(DOCS_STATUS) 2>/dev/null || echo 1); \
+	  trc=$$(cat docs/_build/test_docs.status 2>/dev/null || echo 1); \
+	  echo "tests/test_docs.py (after the docs build):"; tail -n 40 docs/_build/test_docs.log; \
+	  if [ "$$trc" != 0 ] && [ $$rc -eq 0 ]; then rc=1; fi; \
 	  if [ "$$drc" = 0 ]; then echo "Documentation: docs/_build/html/index.html"; \
 	  else cat docs/_build/sphinx.log; echo "make test: the documentation build failed (exit $$drc)"; \
 	    [ $$rc -ne 0 ] || rc=1; fi; exit $$rc

@@ -40,7 +40,3 @@ def inline_actuator_set(text: str, path: Path = MODELS / "rs25_ambient.toml") ->
     doc = tomlkit.parse(text)
     inline_actuator_parameter_set(doc, path, str(path))
     return tomlkit.dumps(doc)
-
-
-# the order tests run in (slowest modules first; tests/_ordering.py)
-from ._ordering import pytest_collection_modifyitems  # noqa: E402,F401

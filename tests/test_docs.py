@@ -6,8 +6,8 @@ every key the code reads and the shipped files use. (``make docs`` builds the si
 The guide's commands and Python examples run once per ``make test``: in its documentation build,
 which runs them (``taosdocs.guide.run_step``/``run_python``, as here) while the tests run and
 records each result in ``docs/_generated/records``. Under ``make test`` (``TAOS_TEST_DOCS_STATUS``
-names the file the build's exit status goes to) these tests wait for that build and check the
-same assertions on what it ran and wrote, when it succeeded and recorded every current command;
+names the file the build's exit status goes to; make test runs this file right after that
+build, and the tests wait for the file in any case) these tests check the same assertions on what it ran and wrote, when it succeeded and recorded every current command;
 otherwise (``make check``, plain pytest, a failed or stale build) they run the commands here."""
 
 from __future__ import annotations
