@@ -21,19 +21,30 @@ $(STAMP): pyproject.toml setup.py
 	touch $(STAMP)
 
 # numba's on-disk cache keys each kernel on its own file only: a kernel that inlines code from
-# another file (the friction laws' bearing steps, the 3-D step) keeps its old machine code when
-# only that other file changes. So after any source change `make test` drops the whole kernel
-# cache and warms it again (about a minute); a fresh clone has no cache to drop.
-KERNEL_SOURCES := $(shell find taos -name '*.py' -not -path '*/__pycache__/*')
+# another file (the friction laws' bearing steps, the 3-D step) or reads its constants keeps its
+# old machine code when only that other file changes. So when a file whose code numba compiles
+# changes, `make test` drops the whole kernel cache and warms it again, in two processes at once
+# (each compiles its own share of the kernels; about a minute on 2 cores); a fresh clone has no
+# cache to drop. Those files (KERNEL_SOURCES): the modules that import numba or declare kernels
+# and the modules they take names from (`python3 taos/cli/warmup.py --sources`, static; checked
+# against the loaded kernels by tests/test_kernel_sources.py). Other changes (the report, the
+# CLI, ...) keep the cache.
+KERNEL_SOURCES := $(shell $(PYTHON) taos/cli/warmup.py --sources)
+TAOS_SOURCES := $(shell find taos -name '*.py' -not -path '*/__pycache__/*')
+PYC  := $(VENV)/.pyc
 WARM := $(VENV)/.warm
-# It also compiles the Python bytecode (.pyc) of taos and the venv's packages: where
-# PYTHONDONTWRITEBYTECODE is set nothing writes it otherwise, and every `taos` process then
+# The Python bytecode (.pyc) of taos and the venv's packages, after any change under taos/:
+# where PYTHONDONTWRITEBYTECODE is set nothing writes it otherwise, and every `taos` process then
 # compiles ~600 modules from source (about 1 s of start-up a process; benchmarks/RESULTS.md).
-$(WARM): $(STAMP) $(KERNEL_SOURCES)
-	find taos -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+$(PYC): $(STAMP) $(TAOS_SOURCES)
 	$(BIN)/python -m compileall -q -j 2 taos >/dev/null
 	-$(BIN)/python -m compileall -q -j 2 $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])') >/dev/null
-	$(BIN)/python -m taos.cli.warmup
+	touch $(PYC)
+
+$(WARM): $(STAMP) $(KERNEL_SOURCES) taos/cli/warmup.py | $(PYC)
+	find taos -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+	$(BIN)/python -m taos.cli.warmup --part 1/2 & one=$$!; \
+	  $(BIN)/python -m taos.cli.warmup --part 2/2; two=$$?; wait $$one && exit $$two
 	touch $(WARM)
 
 demo: $(STAMP)
@@ -47,20 +58,49 @@ browser:
 	    (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) ; \
 	  else echo "chromium missing: run 'sudo apt-get install chromium' for the browser tests"; fi; }
 
+# The documentation site (Sphinx, warnings are errors): runs the user guide's commands on the
+# shipped models for its pictures, so it takes a few minutes. Output: docs/_build/html.
+DOCS_STAMP := $(VENV)/.docs-installed
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[docs]' 2>/dev/null || \
+	  $(BIN)/python -m pip install --quiet -e '.[docs]'
+	touch $(DOCS_STAMP)
+
 # pytest exits 5 when it collects no tests; treat that as success, anything else as is.
-# the documentation is built (sphinx -W: no warnings) as part of the tests. Two pytest processes
-# (pytest-xdist; the tests share no output folder or port): the whole suite took 5 min on 2 cores
-# (other work on the machine, load ~3) against 18 min in one process (load ~4-5).
-test: $(WARM) browser docs
-	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --durations=25 tests; rc=$$?; \
-	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
+# The documentation is built (sphinx -W: no warnings) at the same time as the tests, in the
+# background (its output in docs/_build/sphinx.log, shown if it fails; a failed build fails
+# `make test`), so both cores stay busy. The user guide's commands run once, in the docs build:
+# right after it, still in the background, tests/test_docs.py checks what that build's runs
+# wrote (TAOS_TEST_DOCS_STATUS names the file holding the build's exit status; without it, as
+# in `make check` or plain pytest, or after a failed build, those tests run the commands
+# themselves); the main run leaves that file out. Two pytest processes (pytest-xdist; the tests
+# share no output folder or port); a worker that runs out of tests takes half of the other's
+# queue (--dist worksteal: no worker idles while a long test runs on the other at the end;
+# benchmarks/sim_test_order.py).
+DOCS_STATUS := $(CURDIR)/docs/_build/sphinx.status
+SPHINX := MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
+test: $(PYC) $(WARM) browser $(DOCS_STAMP)
+	@rm -rf docs/_build docs/_generated; mkdir -p docs/_build; \
+	  ( $(SPHINX) >docs/_build/sphinx.log 2>&1; echo $$? >$(DOCS_STATUS).tmp; mv $(DOCS_STATUS).tmp $(DOCS_STATUS); \
+	    TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(BIN)/python -m pytest -q -p no:cacheprovider tests/test_docs.py \
+	      >docs/_build/test_docs.log 2>&1; echo $$? >docs/_build/test_docs.status ) & \
+	  docs=$$!; \
+	  $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal --durations=25 --ignore=tests/test_docs.py tests; \
+	  rc=$$?; if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; \
+	  wait $$docs; drc=$$(cat $(DOCS_STATUS) 2>/dev/null || echo 1); \
+	  trc=$$(cat docs/_build/test_docs.status 2>/dev/null || echo 1); \
+	  echo "tests/test_docs.py (after the docs build):"; tail -n 40 docs/_build/test_docs.log; \
+	  if [ "$$trc" != 0 ] && [ $$rc -eq 0 ]; then rc=1; fi; \
+	  if [ "$$drc" = 0 ]; then echo "Documentation: docs/_build/html/index.html"; \
+	  else cat docs/_build/sphinx.log; echo "make test: the documentation build failed (exit $$drc)"; \
+	    [ $$rc -ne 0 ] || rc=1; fi; exit $$rc
 
 # The fast loop while developing: every test except those marked slow (the end-to-end runs: the
 # Green Run report, Monte Carlo campaigns, the installed wheel, time-domain limit cycles, the
 # live viewer), on two processes (pytest-xdist), without the documentation build. Under 3 minutes
 # on 2 cores once the kernel cache is warm (after a source change the warm-up adds about one).
-check: $(WARM) browser
-	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 -m "not slow" tests; rc=$$?; \
+check: $(PYC) $(WARM) browser
+	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal -m "not slow" tests; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
 
 # the verification suite (tests/verification) and its table docs/verification.md
@@ -70,17 +110,9 @@ verification: $(STAMP)
 bench: $(STAMP)
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done
 
-# The documentation site (Sphinx, warnings are errors): runs the user guide's commands on the
-# shipped models for its pictures, so it takes a few minutes. Output: docs/_build/html.
-DOCS_STAMP := $(VENV)/.docs-installed
-$(DOCS_STAMP): $(STAMP)
-	$(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[docs]' 2>/dev/null || \
-	  $(BIN)/python -m pip install --quiet -e '.[docs]'
-	touch $(DOCS_STAMP)
-
 docs: $(DOCS_STAMP)
 	rm -rf docs/_build docs/_generated
-	MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
+	$(SPHINX)
 	@echo "Documentation: docs/_build/html/index.html"
 
 clean:

@@ -1,12 +1,21 @@
 """The documentation's generated parts stay true: every user-guide command runs on the shipped
 models and writes what the guide says it writes, the Python examples run, the CLI reference
 covers every subcommand and option of the parsers, and the model-file key reference covers
-every key the code reads and the shipped files use. (``make docs`` builds the site with -W.)"""
+every key the code reads and the shipped files use. (``make docs`` builds the site with -W.)
+
+The guide's commands and Python examples run once per ``make test``: in its documentation build,
+which runs them (``taosdocs.guide.run_step``/``run_python``, as here) while the tests run and
+records each result in ``docs/_generated/records``. Under ``make test`` (``TAOS_TEST_DOCS_STATUS``
+names the file the build's exit status goes to; make test runs this file right after that
+build, and the tests wait for the file in any case) these tests check the same assertions on what it ran and wrote, when it succeeded and recorded every current command;
+otherwise (``make check``, plain pytest, a failed or stale build) they run the commands here."""
 
 from __future__ import annotations
 
+import os
 import re
 import sys
+import time
 import tomllib
 from pathlib import Path
 
@@ -24,7 +33,12 @@ LAYOUT_RE = re.compile(r"```\{taos-output-layout\}\s+(\S+)\s+(\S+)")
 
 
 def _pages():
-    return [p for p in DOCS.rglob("*.md") if "_generated" not in p.parts and "_build" not in p.parts]
+    """The docs' markdown pages (not the build's output: it may be changing while this runs)."""
+    out = []
+    for folder, subs, files in os.walk(DOCS):
+        subs[:] = sorted(d for d in subs if d not in ("_generated", "_build"))
+        out += [Path(folder, f) for f in sorted(files) if f.endswith(".md")]
+    return out
 
 
 def test_every_guide_command_is_shown_and_every_shown_command_exists():
@@ -36,15 +50,50 @@ def test_every_guide_command_is_shown_and_every_shown_command_exists():
             assert m.group(2) in step.outputs or m.group(2).startswith("out/"), m.group(0)
 
 
+DOCS_STATUS_ENV = "TAOS_TEST_DOCS_STATUS"
+DOCS_WAIT_S = 1800.0
+
+
+def _docs_build_records():
+    """The records folder of this ``make test``'s documentation build, once it has finished
+    successfully and recorded every current guide command and Python example; else None."""
+    status = os.environ.get(DOCS_STATUS_ENV)
+    if not status:
+        return None
+    status, t0 = Path(status), time.monotonic()
+    while not status.is_file() and time.monotonic() - t0 < DOCS_WAIT_S:
+        time.sleep(1.0)
+    if not status.is_file() or status.read_text().strip() != "0":
+        return None
+    records, work = DOCS / "_generated" / "records", DOCS / "_generated" / "work"
+    if any(guide.read_step_record(s, records, work) is None for s in guide.STEPS):
+        return None
+    if any(guide.python_record_error(code, records) == "not run by the docs build"
+           for _, code in guide.python_examples(DOCS)):
+        return None
+    return records
+
+
 @pytest.fixture(scope="module")
-def workdir(tmp_path_factory):
+def docs_records():
+    return _docs_build_records()
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory, docs_records):
+    if docs_records is not None:
+        return DOCS / "_generated" / "work"
     return guide.prepare_workdir(tmp_path_factory.mktemp("guide"))
 
 
 @pytest.mark.parametrize("step", guide.STEPS, ids=[s.id for s in guide.STEPS])
-def test_guide_command_runs_on_shipped_models(step, workdir):
-    """Steps run in guide order (``view`` reads the run ``simulate`` wrote)."""
-    res = guide.run_step(step, workdir)
+def test_guide_command_runs_on_shipped_models(step, workdir, docs_records):
+    """Steps run in guide order (``view`` reads the run ``simulate`` wrote); under ``make test``
+    the docs build ran them (its result, its outputs and pictures as they are now)."""
+    if docs_records is not None:
+        res = guide.read_step_record(step, docs_records, workdir)
+    else:
+        res = guide.run_step(step, workdir)
     assert res.exit_code == 0, res.stderr[-2000:]
     assert not res.missing
     for f in res.figures:
@@ -56,11 +105,14 @@ def test_guide_command_runs_on_shipped_models(step, workdir):
         assert res.stdout.strip()
 
 
-def test_python_examples_run(workdir):
+def test_python_examples_run(workdir, docs_records):
     examples = guide.python_examples(DOCS)
     assert len(examples) >= 3
     for page, code in examples:
-        guide.run_python(code, workdir)
+        if docs_records is not None:
+            assert guide.python_record_error(code, docs_records) is None, page   # ran there without an exception
+        else:
+            guide.run_python(code, workdir)
     assert (workdir / "out" / "flight_loop_nichols.png").is_file()
 
 

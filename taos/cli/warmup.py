@@ -3,40 +3,294 @@
 The integrator kernels take tens of seconds to compile on a cold cache and are cached on disk
 after their first use. ``make demo`` does not warm up: the Green Run compiles just the
 kernels it uses. ``make test`` warms every kernel first, so that no test pays a compile.
+
+``--part K/N`` compiles the K-th of N disjoint shares of the kernels, so that ``make`` runs the
+shares at the same time on several cores (``make`` runs ``--part 1/2`` and ``--part 2/2``).
+The steps are grouped so that no two shares write the same cache file with different
+signatures: numba's cache (``numba.core.caching.IndexDataCacheFile``) is safe against two
+processes saving the SAME key (each writes its index and data through a temporary file and
+``os.replace``; both write the same key and equivalent machine code), but two processes saving
+DIFFERENT signatures of one kernel at once can leave an index entry naming the other
+signature's data file. A step that calls a non-inlined cached kernel of another step compiles
+that callee too, so the steps sharing such callees form one group and a group is never split:
+
+* ``planar``: the planar simulation, the dwells (ETDRK4 and RK4), the shooting kernels and the
+  verdict map's confirmation share ``planar.dynamics`` (``integrate_samples``, ``sine_steps``,
+  ``saturation.apply``) and ``planar._expstep``;
+* ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` and ``taos3d._bearing``;
+* ``friction``: every built-in law's C callbacks (``friction.registry.load_all``).
+
+Between groups the only shared callees are ``planar._avionics_kernels.apply`` and the model's
+friction law's C callbacks, which every group calls with the same signature (float64 and
+C-contiguous float64 arrays), so a simultaneous save writes the same key with the same code.
+
+``--sources`` prints the source files whose code numba compiles (:func:`kernel_sources`; plain
+Python, imports nothing from taos: the Makefile runs it with any ``python3``) — the files whose
+change makes ``make`` drop the kernel cache and warm it again.
 """
 
 from __future__ import annotations
 
+import argparse
+import ast
 import math
 import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+PACKAGE_DIR = Path(__file__).resolve().parents[1]
+
+#: the names whose call or decoration makes numba compile the function (``kernel`` is
+#: :func:`taos.friction._builtin.kernel`, a cached ``cfunc``; it is counted only when imported
+#: from a module that imports numba, see :func:`kernel_sources`)
+JIT_NAMES = frozenset({"njit", "jit", "cfunc", "vectorize", "guvectorize", "stencil", "generated_jit",
+                       "overload", "register_jitable"})
 
 
-def main() -> None:
-    from taos.planar.freqresp import sine_dwell_grid
+# -- the steps ---------------------------------------------------------------------------------
+def _model():
     from taos.model import load_model
-    from taos.profiles import SineDwell
-    from taos.planar.simulate import simulate
+    return load_model("rs25_hotfire")
 
-    t0 = time.perf_counter()
-    model = load_model("rs25_hotfire")
-    simulate(model, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
-    sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1)
-    # the exponential (ETDRK4) and RK4 dwell kernels, settled and shooting (both integrators'
-    # shooting kernel compile together: minutes on a loaded machine if a test paid for it)
-    sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1,
-                    integrator="rk4")
-    sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1,
-                    method="shoot", max_cycles=1)
-    model.friction.response([0.0, 0.1], 1e-3)
+
+def _dwell(**kw) -> None:
+    from taos.planar.freqresp import sine_dwell_grid
+    sine_dwell_grid(_model(), [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1, **kw)
+
+
+def _simulate() -> None:
+    from taos.planar.simulate import simulate
+    from taos.profiles import SineDwell
+    simulate(_model(), SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
+
+
+def _simulate_exp() -> None:
+    from taos.planar.simulate import simulate
+    from taos.profiles import SineDwell
+    simulate(_model(), SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01, integrator="exp")
+
+
+def _shoot() -> None:
+    # both integrators' shooting kernel compile together (minutes on a loaded machine if a test
+    # paid for it)
+    _dwell(method="shoot", max_cycles=1)
+
+
+def _friction() -> None:
     from taos.friction.registry import load_all
+    _model().friction.response([0.0, 0.1], 1e-3)
     load_all()   # every built-in law's kernels (a command loads only its own law's)
+
+
+def _lco_confirm() -> None:
     from taos.flight.lco_confirm import compile_kernel
-    compile_kernel(model)   # the verdict map's confirmation runs (taos lco --sweep)
-    from taos.taos3d import simulate_taos, taos_freqresp, taos_model
-    tm = taos_model(model)
-    simulate_taos(tm, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
-    taos_freqresp(tm, [10.0], math.radians(0.4))
-    print(f"taos: numba kernels compiled and cached in {time.perf_counter() - t0:.0f} s")
+    compile_kernel(_model())   # the verdict map's confirmation runs (taos lco --sweep)
+
+
+def _taos_model() -> None:
+    from taos.taos3d import taos_model
+    taos_model(_model())
+
+
+def _simulate_taos() -> None:
+    from taos.profiles import SineDwell
+    from taos.taos3d import simulate_taos, taos_model
+    simulate_taos(taos_model(_model()), SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
+
+
+def _taos_freqresp() -> None:
+    from taos.taos3d import taos_freqresp, taos_model
+    taos_freqresp(taos_model(_model()), [10.0], math.radians(0.4))
+
+
+@dataclass(frozen=True)
+class Step:
+    """One warm-up step: ``run`` compiles its kernels; ``group`` the steps sharing non-inlined
+    cached callees (never split between shares); ``cost_s`` its compile time on a quiet
+    2-core machine [s] (for balancing the shares)."""
+
+    name: str
+    group: str
+    run: Callable[[], None]
+    cost_s: float
+
+
+STEPS: tuple[Step, ...] = (
+    Step("simulate", "planar", _simulate, 8.0),
+    Step("simulate exponential", "planar", _simulate_exp, 14.0),
+    Step("dwell exponential", "planar", _dwell, 20.0),
+    Step("dwell rk4", "planar", lambda: _dwell(integrator="rk4"), 15.0),
+    Step("shoot", "planar", _shoot, 28.0),
+    Step("lco confirmation", "planar", _lco_confirm, 2.0),
+    Step("friction laws", "friction", _friction, 5.5),
+    Step("3-D model", "3d", _taos_model, 8.5),
+    Step("3-D simulate", "3d", _simulate_taos, 25.0),
+    Step("3-D frequency response", "3d", _taos_freqresp, 29.0),
+)
+
+
+def shares(n: int, steps: tuple[Step, ...] = STEPS) -> list[list[Step]]:
+    """The steps in ``n`` shares of about equal cost: whole groups, the costliest first onto the
+    least loaded share (longest-processing-time rule); steps keep their order within a share."""
+    groups: dict[str, list[Step]] = {}
+    for s in steps:
+        groups.setdefault(s.group, []).append(s)
+    load = [0.0] * n
+    out: list[list[Step]] = [[] for _ in range(n)]
+    for g in sorted(groups.values(), key=lambda g: -sum(s.cost_s for s in g)):
+        k = load.index(min(load))
+        out[k].extend(g)
+        load[k] += sum(s.cost_s for s in g)
+    return out
+
+
+# -- the kernel sources ------------------------------------------------------------------------
+def _module_name(path: Path, root: Path) -> str:
+    parts = list(path.relative_to(root.parent).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _resolve(mod: str, level: int, here: str, is_pkg: bool) -> str:
+    if level == 0:
+        return mod
+    base = here.split(".") if is_pkg else here.split(".")[:-1]
+    base = base[: len(base) - (level - 1)]
+    return ".".join(base + ([mod] if mod else []))
+
+
+@dataclass
+class _Module:
+    path: Path
+    imports_numba: bool = False
+    jit_calls: set[str] = field(default_factory=set)      # names called
+    decorators: set[str] = field(default_factory=set)     # names used as decorators
+    modules: set[str] = field(default_factory=set)        # taos modules imported whole (``import taos.x``)
+    names: dict[str, tuple[str, str]] = field(default_factory=dict)   # local name -> (module, name) imported
+
+
+def _outside_functions(tree: ast.Module):
+    """The nodes of ``tree`` not inside a function (a kernel cannot import; an import inside a
+    function is the Python around the kernels)."""
+    stack = list(tree.body)
+    while stack:
+        node = stack.pop()
+        yield node
+        if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+            stack.extend(ast.iter_child_nodes(node))
+
+
+def _scan(path: Path, root: Path) -> tuple[str, _Module]:
+    name = _module_name(path, root)
+    is_pkg = path.name == "__init__.py"
+    tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+    m = _Module(path)
+    top = root.name
+    module_level = {id(n) for n in _outside_functions(tree)}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.split(".")[0] == "numba":
+                    m.imports_numba = True
+                elif a.name.split(".")[0] == top and id(node) in module_level:
+                    m.modules.add(a.name)
+        elif isinstance(node, ast.ImportFrom):
+            mod = _resolve(node.module or "", node.level, name, is_pkg)
+            if mod.split(".")[0] == "numba":
+                m.imports_numba = True
+            elif mod.split(".")[0] == top and id(node) in module_level:
+                for a in node.names:
+                    m.names[a.asname or a.name] = (mod, a.name)
+        elif isinstance(node, ast.Call):
+            f = node.func
+            m.jit_calls.add(f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", ""))
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            for d in node.decorator_list:
+                f = d.func if isinstance(d, ast.Call) else d
+                m.decorators.add(f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", ""))
+    return name, m
+
+
+def kernel_sources(root: Path = PACKAGE_DIR) -> list[Path]:
+    """The source files under ``root`` (the taos package) whose code numba compiles, sorted.
+
+    numba's on-disk cache checks only the file of the kernel it compiled; a kernel that inlines
+    or calls code from another file, or reads its constants, keeps its old machine code when
+    only that other file changes. So the set is: every module that imports numba (anywhere,
+    even inside a function), every module that declares kernels with a decorator imported from
+    such a module (the friction laws' ``@kernel``), and for each module declaring kernels, every
+    taos module it imports from (a module or a name of it: a callee, a constant, a packed-slot
+    index), each name followed to the module that defines it. Static (``ast``): imports nothing.
+    """
+    root = Path(root)
+    mods = dict(_scan(p, root) for p in sorted(root.rglob("*.py")) if "__pycache__" not in p.parts)
+    numba_mods = {n for n, m in mods.items() if m.imports_numba}
+
+    def declares(n: str) -> bool:
+        m = mods[n]
+        if m.imports_numba and (m.jit_calls | m.decorators) & JIT_NAMES:
+            return True
+        return any(local in m.decorators and src in numba_mods for local, (src, _) in m.names.items())
+
+    def module_of(mod: str) -> str | None:
+        while mod and mod not in mods:
+            mod = mod.rpartition(".")[0]
+        return mod or None
+
+    def definer(mod: str, name: str, seen: frozenset[tuple[str, str]] = frozenset()) -> set[str]:
+        """The module ``name`` comes from, through re-exports (``mod.name`` may be a module)."""
+        if f"{mod}.{name}" in mods:
+            return {f"{mod}.{name}"}
+        m = module_of(mod)
+        if m is None or (m, name) in seen:
+            return set()
+        src = mods[m].names.get(name)
+        if src is None:
+            return {m}
+        return {m} | definer(*src, seen=seen | {(m, name)})
+
+    kernel_mods = {n for n in mods if declares(n)}
+    out = set(numba_mods) | kernel_mods
+    for n in kernel_mods:
+        m = mods[n]
+        out |= {mod for mod in m.modules if mod in mods}
+        for src in m.names.values():
+            out |= definer(*src)
+    return sorted(mods[n].path for n in out)
+
+
+# -- command line ------------------------------------------------------------------------------
+def _part(text: str) -> tuple[int, int]:
+    try:
+        k, n = (int(v) for v in text.split("/"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected K/N (e.g. 1/2), got {text!r}") from None
+    if not 1 <= k <= n <= len(STEPS):
+        raise argparse.ArgumentTypeError(f"expected 1 <= K <= N <= {len(STEPS)}, got {text!r}")
+    return k, n
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(prog="python -m taos.cli.warmup", description=__doc__.splitlines()[0])
+    ap.add_argument("--part", type=_part, default=(1, 1), metavar="K/N",
+                    help="compile the K-th of N disjoint shares of the kernels (default 1/1: all)")
+    ap.add_argument("--sources", action="store_true",
+                    help="print the source files whose code numba compiles, relative to the working folder")
+    args = ap.parse_args(argv)
+    if args.sources:
+        cwd = Path.cwd()
+        for p in kernel_sources():
+            print(p.relative_to(cwd) if p.is_relative_to(cwd) else p)
+        return
+    k, n = args.part
+    t0 = time.perf_counter()
+    for step in shares(n)[k - 1]:
+        t1 = time.perf_counter()
+        step.run()
+        print(f"taos warm-up {k}/{n}: {step.name} {time.perf_counter() - t1:.1f} s", flush=True)
+    print(f"taos: numba kernels ({k}/{n}) compiled and cached in {time.perf_counter() - t0:.0f} s")
 
 
 if __name__ == "__main__":

@@ -67,6 +67,7 @@ class TaosStep(_MarkdownDirective):
         srcdir = Path(app.srcdir)
         work = srcdir / GEN / "work"
         res = guide.run_step(step, work)
+        guide.write_step_record(res, srcdir / GEN / "records")   # for tests/test_docs.py under make test
         self.env.note_dependency(str(Path(guide.__file__)))
         if res.exit_code != 0 or res.missing:
             raise self.error(f"guide step {step_id!r} ({step.command}) exited {res.exit_code}, missing "
@@ -140,6 +141,7 @@ class TaosOutputLayout(_MarkdownDirective):
             if step is None:
                 raise self.error(f"taos-output-layout: no guide step {step_id!r}")
             res = guide.run_step(step, work)
+            guide.write_step_record(res, Path(self.env.app.srcdir) / GEN / "records")
             if res.exit_code != 0 or not path.exists():
                 raise self.error(f"guide step {step_id!r} did not write {rel}: {res.stderr.strip()[-300:]}")
         text = layouts.h5_layout(path) if path.suffix == ".h5" else layouts.json_layout(path)
@@ -158,10 +160,13 @@ class TaosPython(_MarkdownDirective):
         code = "\n".join(self.content)
         work = guide.prepare_workdir(Path(self.env.app.srcdir) / GEN / "work")
         (work / "out").mkdir(exist_ok=True)
+        records = Path(self.env.app.srcdir) / GEN / "records"
         try:
             printed = guide.run_python(code, work)
         except Exception as e:  # a failing example stops the build
+            guide.write_python_record(self.env.docname, code, f"{type(e).__name__}: {e}", records)
             raise self.error(f"python example failed: {type(e).__name__}: {e}") from None
+        guide.write_python_record(self.env.docname, code, None, records)
         md = [f"```python\n{code}\n```\n"]
         if printed.strip():
             md.append(f"```text\n{printed.rstrip()}\n```\n")

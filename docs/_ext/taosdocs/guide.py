@@ -223,3 +223,54 @@ def python_examples(docs_dir: Path) -> list[tuple[str, str]]:
         for m in PY_EXAMPLE.finditer(md.read_text(encoding="utf-8")):
             out.append((md.relative_to(docs_dir).as_posix(), m.group(2)))
     return out
+
+
+# -- what the docs build ran, for the tests of the same `make test` (tests/test_docs.py) -------
+def _record_path(records: Path, kind: str, key: str) -> Path:
+    return Path(records) / f"{kind}_{re.sub(r'[^A-Za-z0-9_.-]', '_', key)}.json"
+
+
+def write_step_record(res: StepResult, records: Path) -> None:
+    """Save what :func:`run_step` returned (exit code, printed text, pictures relative to the
+    work folder) as ``records/step_ID.json``."""
+    import json
+    Path(records).mkdir(parents=True, exist_ok=True)
+    rec = {"id": res.step.id, "command": res.step.command, "exit_code": res.exit_code, "stdout": res.stdout,
+           "stderr": res.stderr[-4000:], "figures": [f.relative_to(res.workdir).as_posix() for f in res.figures]}
+    _record_path(records, "step", res.step.id).write_text(json.dumps(rec), encoding="utf-8")
+
+
+def read_step_record(step: Step, records: Path, workdir: Path) -> StepResult | None:
+    """The :class:`StepResult` the docs build saved for ``step`` (its outputs and pictures read
+    from ``workdir`` now), or None when it has no record of this very command."""
+    import json
+    p = _record_path(records, "step", step.id)
+    if not p.is_file():
+        return None
+    rec = json.loads(p.read_text(encoding="utf-8"))
+    if rec["command"] != step.command:
+        return None
+    return StepResult(step, rec["exit_code"], rec["stdout"], rec["stderr"], Path(workdir),
+                      [Path(workdir) / f for f in rec["figures"]])
+
+
+def write_python_record(page: str, code: str, error: str | None, records: Path) -> None:
+    """Save that the Python example ``code`` of ``page`` ran (``error`` None) or how it failed."""
+    import hashlib
+    import json
+    Path(records).mkdir(parents=True, exist_ok=True)
+    key = hashlib.sha256(code.strip().encode()).hexdigest()[:16]
+    rec = {"page": page, "code": code, "error": error}
+    _record_path(records, "python", key).write_text(json.dumps(rec), encoding="utf-8")
+
+
+def python_record_error(code: str, records: Path) -> str | None:
+    """How the docs build's run of the Python example ``code`` ended: None (no exception), the
+    exception's text, or ``"not run by the docs build"``."""
+    import hashlib
+    import json
+    p = _record_path(records, "python", hashlib.sha256(code.strip().encode()).hexdigest()[:16])
+    if not p.is_file():
+        return "not run by the docs build"
+    rec = json.loads(p.read_text(encoding="utf-8"))
+    return rec["error"] if rec["code"].strip() == code.strip() else "not run by the docs build"
