@@ -71,6 +71,17 @@ def _simulate_exp() -> None:
     simulate(_model(), SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01, integrator="exp")
 
 
+def _ascent_lanes() -> None:
+    # the lockstep lane kernel of ascents and Monte Carlo batches (one compile for every law:
+    # the friction rates are a first-class function argument)
+    from taos.flight.ascent import load_ascent
+    from taos.flight.ascent_sim import simulate_ascent
+    from taos.model import load_model
+    asc = load_ascent("ascent")
+    simulate_ascent(asc, load_model(asc.tvc_model), axes=("yaw",), start_s=0.0, end_s=0.1, dt_s=1e-3,
+                    record_interval_s=0.01)
+
+
 def _shoot() -> None:
     # both integrators' shooting kernel compile together (minutes on a loaded machine if a test
     # paid for it)
@@ -117,16 +128,17 @@ class Step:
 
 
 STEPS: tuple[Step, ...] = (
-    Step("simulate", "planar", _simulate, 8.0),
-    Step("simulate exponential", "planar", _simulate_exp, 14.0),
-    Step("dwell exponential", "planar", _dwell, 20.0),
-    Step("dwell rk4", "planar", lambda: _dwell(integrator="rk4"), 15.0),
-    Step("shoot", "planar", _shoot, 28.0),
-    Step("lco confirmation", "planar", _lco_confirm, 2.0),
-    Step("friction laws", "friction", _friction, 5.5),
-    Step("3-D model", "3d", _taos_model, 8.5),
-    Step("3-D simulate", "3d", _simulate_taos, 25.0),
-    Step("3-D frequency response", "3d", _taos_freqresp, 29.0),
+    Step("simulate", "planar", _simulate, 7.6),
+    Step("simulate exponential", "planar", _simulate_exp, 12.2),
+    Step("dwell exponential", "planar", _dwell, 8.3),
+    Step("dwell rk4", "planar", lambda: _dwell(integrator="rk4"), 12.1),
+    Step("shoot", "planar", _shoot, 22.7),
+    Step("lco confirmation", "planar", _lco_confirm, 1.6),
+    Step("friction laws", "friction", _friction, 4.7),
+    Step("ascent lanes", "lanes", _ascent_lanes, 16.3),
+    Step("3-D model", "3d", _taos_model, 10.5),
+    Step("3-D simulate", "3d", _simulate_taos, 23.9),
+    Step("3-D frequency response", "3d", _taos_freqresp, 25.6),
 )
 
 
