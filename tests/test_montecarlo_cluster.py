@@ -215,27 +215,30 @@ def test_killing_a_worker_loses_no_run(reference, tmp_path):
     assert stats(out) == stats(reference)
 
 
-def test_killed_client_resumes_to_the_same_store(isolated, reference, tmp_path):
+def test_killed_client_resumes_to_the_same_store(reference, tmp_path):
     """The client (the taos process) killed with SIGKILL mid-campaign: --resume on the same
-    folder runs only what is missing and ends with the same store and statistics. (On the
-    module's loopback cluster: a client's death leaves the scheduler and workers running, which
-    is the case here, so the test needs no cluster of its own.)"""
-    addr, _ = isolated
+    folder runs only what is missing and ends with the same store and statistics. (On a cluster
+    of its own: the killed client's tasks keep the workers busy until the scheduler drops them,
+    which held a shared cluster's teardown for 40 s.)"""
+    addr, sched, workers = start_cluster(tmp_path, [])
     out = tmp_path / "resume"
-    p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
-                          "--batch", "2", "--out", str(out), "--no-progress"],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.time() + 180
-    while _stored(out) < 5 and time.time() < deadline and p.poll() is None:
-        time.sleep(0.05)
-    p.kill()
-    p.wait()
-    done = _stored(out)
-    assert 0 < done < RUNS + 1
-    assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
-                 "--no-progress"]) == 2  # without --resume: refused
-    assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
-                 "--resume", "--no-progress"]) == 0
+    try:
+        p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
+                              "--batch", "2", "--out", str(out), "--no-progress"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.time() + 180
+        while _stored(out) < 5 and time.time() < deadline and p.poll() is None:
+            time.sleep(0.05)
+        p.kill()
+        p.wait()
+        done = _stored(out)
+        assert 0 < done < RUNS + 1
+        assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
+                     "--no-progress"]) == 2  # without --resume: refused
+        assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
+                     "--resume", "--no-progress"]) == 0
+    finally:
+        stop_cluster([*workers, sched])
     same_store(out, reference)
     assert stats(out) == stats(reference)
     executed = json.loads((out / "summary.json").read_text())["timing"]["runs_executed"]
