@@ -212,3 +212,15 @@ def test_cli_refuses_exp_with_the_3d_engine(tmp_path, capsys):
     assert main(["simulate", str(MODELS / "rs25_ambient.toml"), "--profile", str(MODELS / "profiles" / "step_pitch.toml"),
                  "--out", str(out), "--engine", "taos", "--integrator", "exp"]) == 2
     assert "--integrator" in capsys.readouterr().err and not out.exists()
+
+
+def test_two_axis_exp_run_on_two_threads_equals_the_serial_run(hotfire):
+    """The axes of an exponential two-axis run in parallel (the kernel runs without the GIL) give
+    the serial run's numbers bit for bit."""
+    prof = TwoAxis(SineDwell(0.2 * DEG, 2.0, 4), MultiRamp((0.1 * DEG, -0.1 * DEG, 0.0), 0.5 * DEG, 0.5))
+    one = simulate(hotfire, prof, integrator="exp", threads=1)
+    two = simulate(hotfire, prof, integrator="exp", threads=2)
+    assert one.provenance["solver"]["method"] == "etdrk4"
+    for k in ("engine_rad", "piston_m", "load_pressure_Pa", "friction_torque_Nm", "friction_state_rad",
+              "command_avionics_rad"):
+        assert np.array_equal(getattr(one, k), getattr(two, k)), k

@@ -134,7 +134,7 @@ def _at(cs, p):
     return cs[i] + (p - i) * (cs[i + 1] - cs[i])
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, nogil=True)
 def profile_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, slot,
                       pos, r, dt, rec_every, x0, z0, y_out, aux_out, qrow, one):
     """ETDRK4 steps (:func:`taos.planar._expstep.etdrk4_step`) between the sample positions
