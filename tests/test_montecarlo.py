@@ -150,7 +150,7 @@ def test_failed_and_diverged_runs_are_counted_and_stored_in_their_rows(failing):
     assert f["lco_runs"] == 5 and f["value"] == 1.0
     assert f["all_runs_low"] == pytest.approx(5 / 12) and f["all_runs_high"] == pytest.approx(1.0)
     assert sorted(x["status"] for x in s["failures"]) == ["diverged"] * 5 + ["failed"] * 2
-    ds = open_store(out / "campaign.zarr")
+    ds = open_store(out / "campaign.zarr", dask=False)
     st = ds["status"].values
     assert list(ds["run"].values) == list(range(12))
     # each run in its own row: the same campaign flown one run a batch (each run alone in the
@@ -159,7 +159,7 @@ def test_failed_and_diverged_runs_are_counted_and_stored_in_their_rows(failing):
     # kernel's rounding; the counts above are the physics)
     alone = out.parent / "alone"
     run_campaign(load_campaign(FAILING), alone, runs=12, workers=0, batch=1)
-    ds1 = open_store(alone / "campaign.zarr")
+    ds1 = open_store(alone / "campaign.zarr", dask=False)
     assert list(ds1["status"].values) == list(st)
     assert list(ds1["error"].values) == list(ds["error"].values)
     np.testing.assert_array_equal(ds1["amplitude_deg"].values, ds["amplitude_deg"].values)
@@ -309,7 +309,7 @@ def test_flight_sensitivity_designs_run_through_the_campaign_engine(tmp_path):
         summary = json.loads((out / "summary.json").read_text())
         s = summary["sensitivity"]
         assert s["method"] == method and s["runs"] == rows
-        ds = open_store(out / "campaign.zarr")
+        ds = open_store(out / "campaign.zarr", dask=False)
         assert ds.sizes["run"] == rows and set(ds["seed"].values) == {c.seed}
         if s["indices"] is not None:
             assert {r["parameter"] for r in s["indices"]} == {d.name for d in c.dispersions}
