@@ -78,14 +78,18 @@ $(DOCS_STAMP): $(STAMP)
 # queue (--dist worksteal: no worker idles while a long test runs on the other at the end;
 # benchmarks/sim_test_order.py).
 DOCS_STATUS := $(CURDIR)/docs/_build/sphinx.status
+# pytest rewrites every test module's asserts when it imports it, and caches the result in
+# tests/__pycache__ only where bytecode may be written: with PYTHONDONTWRITEBYTECODE set, each
+# pytest process parsed and rewrote ~130 test modules again (8.6 -> 4.1 CPU-s a collection).
+PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -q -p no:cacheprovider
 SPHINX := MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
 test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 	@rm -rf docs/_build docs/_generated; mkdir -p docs/_build; \
 	  ( $(SPHINX) >docs/_build/sphinx.log 2>&1; echo $$? >$(DOCS_STATUS).tmp; mv $(DOCS_STATUS).tmp $(DOCS_STATUS); \
-	    TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(BIN)/python -m pytest -q -p no:cacheprovider tests/test_docs.py \
+	    TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(PYTEST) tests/test_docs.py \
 	      >docs/_build/test_docs.log 2>&1; echo $$? >docs/_build/test_docs.status ) & \
 	  docs=$$!; \
-	  $(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal --durations=25 --ignore=tests/test_docs.py tests; \
+	  $(PYTEST) -n 2 --dist worksteal --durations=25 --ignore=tests/test_docs.py tests; \
 	  rc=$$?; if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; \
 	  wait $$docs; drc=$$(cat $(DOCS_STATUS) 2>/dev/null || echo 1); \
 	  trc=$$(cat docs/_build/test_docs.status 2>/dev/null || echo 1); \
@@ -100,7 +104,7 @@ test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 # live viewer), on two processes (pytest-xdist), without the documentation build. Under 3 minutes
 # on 2 cores once the kernel cache is warm (after a source change the warm-up adds about one).
 check: $(PYC) $(WARM) browser
-	@$(BIN)/python -m pytest -q -p no:cacheprovider -n 2 --dist worksteal -m "not slow" tests; rc=$$?; \
+	@$(PYTEST) -n 2 --dist worksteal -m "not slow" tests; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
 
 # the verification suite (tests/verification) and its table docs/verification.md
