@@ -210,6 +210,7 @@ def write_comparison(cmp, out_dir, json_path: str | None = None):
 
     from taos.identify.compare import comparison_curves
     from taos.plotting import fit as pf
+    from taos.plotting._common import freeze_layout
     from taos.results import output_provenance, write_output_folder
 
     curves = comparison_curves(cmp)
@@ -218,6 +219,7 @@ def write_comparison(cmp, out_dir, json_path: str | None = None):
         def write(p):
             fig = make(curves)
             try:
+                freeze_layout(fig)   # one draw on save
                 fig.savefig(p, dpi=120, format="png")
             finally:
                 plt.close(fig)

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._common import LENGTH_UNITS, finish_bode_axes, legend_once, wrapped_title  # (sets the Agg backend)
+from ._common import LENGTH_UNITS, finish_bode_axes, legend_once, use_grid_layout, wrapped_title  # (sets the Agg backend)
 from ..errors import InputError
 from ..linear import gain_db, phase_deg, phase_deg_continuous, sampled_notch_hz
 
@@ -53,7 +53,8 @@ def reference_response(responses):
 
 
 def new_bode_figure(title: str | None = None, piston_label: str = "x_p / (R θ_c)"):
-    fig, ax = plt.subplots(2, 2, figsize=(11, 7), sharex=True, constrained_layout=True)
+    fig, ax = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    use_grid_layout(fig, ax)
     ax[0, 0].set_title("command → piston")
     ax[0, 1].set_title("command → engine angle")
     ax[0, 0].set_ylabel(f"gain [dB]  ({piston_label})")

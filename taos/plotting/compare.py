@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from . import bode
-from ._common import legend_once, wrapped_title
+from ._common import legend_once, use_grid_layout, wrapped_title
 from ..linear import sampled_notch_hz
 from .timehist import units
 
@@ -75,7 +75,8 @@ def plot_compare_timehist(runs, axis: str = "pitch", length_unit: str = "in", an
                           t_range_s=None, title: str | None = None):
     """Overlay piston, engine angle and friction torque of ``axis`` for runs {label: TimeHistory}."""
     m_per, rad_per, tname, nm_per = units(length_unit, angle_unit)
-    fig, ax = plt.subplots(3, 1, figsize=(11, 7), sharex=True, constrained_layout=True)
+    fig, ax = plt.subplots(3, 1, figsize=(11, 7), sharex=True)
+    use_grid_layout(fig, ax)
     for k, (label, th) in enumerate(runs.items()):
         c = COLOURS[k % len(COLOURS)]
         i = th.axes.index(axis)

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ._common import finish_bode_axes, wrapped_title  # (importing _common also sets the Agg backend)
+from ._common import finish_bode_axes, use_grid_layout, wrapped_title  # (importing _common also sets the Agg backend)
 from ..linear import gain_db as _db
 from ..linear import phase_deg, phase_deg_continuous
 from ..units import from_si
@@ -39,7 +39,8 @@ def plot_fit(result, linear: dict, title: str | None = None):
     (:func:`taos.identify.fit.fitted_linear_curves`)."""
     has_e = any(e is not None for e in result.fitted_engine)
     ncol = 2 if has_e else 1
-    fig, ax = plt.subplots(3, ncol, figsize=(6 * ncol + 1, 9), sharex=True, squeeze=False, constrained_layout=True)
+    fig, ax = plt.subplots(3, ncol, figsize=(6 * ncol + 1, 9), sharex=True, squeeze=False)
+    use_grid_layout(fig, ax)
     R = result.model.actuator.moment_arm_m
     for k, ax_name in enumerate(sorted(linear)):
         lin = linear[ax_name]
@@ -101,7 +102,8 @@ def plot_fit(result, linear: dict, title: str | None = None):
 def plot_compare_side_by_side(curves):
     """Command -> piston gain and phase (in/deg), condition A left, B right (paper fig. 2);
     ``curves`` from :func:`taos.identify.compare.comparison_curves`."""
-    fig, ax = plt.subplots(2, 2, figsize=(12, 7), sharex=True, constrained_layout=True)
+    fig, ax = plt.subplots(2, 2, figsize=(12, 7), sharex=True)
+    use_grid_layout(fig, ax)
     for k, cc in enumerate(curves):
         axis = cc.axis
         R = cc.moment_arm_m
@@ -134,7 +136,8 @@ def plot_compare_side_by_side(curves):
 def plot_compare_overlay(curves):
     """Both conditions on one Bode layout: piston (in/deg) and engine, gain and phase;
     ``curves`` from :func:`taos.identify.compare.comparison_curves`."""
-    fig, ax = plt.subplots(2, 2, figsize=(12, 7), sharex=True, constrained_layout=True)
+    fig, ax = plt.subplots(2, 2, figsize=(12, 7), sharex=True)
+    use_grid_layout(fig, ax)
     for k, cc in enumerate(curves):
         c = COLOURS[k]
         axis = cc.axis

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._common import LENGTH_UNITS, wrapped_title
+from ._common import LENGTH_UNITS, use_grid_layout, wrapped_title
 from ..errors import InputError
 from ..units import ureg
 
@@ -68,7 +68,8 @@ def plot_timehistory(th, length_unit: str = "in", angle_unit: str = "deg", *, t_
             raise InputError("plot", "axes", f"axes of the run ({', '.join(th.axes)})", got=repr(n))
     t = np.asarray(th.t_s)
     w = _window(t, t_range_s)
-    fig, ax = plt.subplots(4, 1, figsize=(11, 9), sharex=True, constrained_layout=True)
+    fig, ax = plt.subplots(4, 1, figsize=(11, 9), sharex=True)
+    use_grid_layout(fig, ax)
     for n in names:
         i = th.axes.index(n)
         c = AXIS_COLOURS.get(n, None)

