@@ -98,8 +98,15 @@ class TvcSlave(Fmi2Slave):
         self._hold = 0
         self._block = TvcBlock(model, engine=cfg["engine"], dt_s=self._dt, allow_unstable=cfg["allow_unstable"])
         _ALIVE.append(self._block)
-        self._out = self._block.outputs
+        #: the block's outputs after the last step (None before the first: the outputs' getters
+        #: then ask the block, which computes its values at rest when first asked; an instance
+        #: made only for its model description, as pythonfmu's builder makes one, never loads
+        #: the compiled kernels)
+        self._out = None
         self._register()
+        #: value reference -> getter / setter of every Real (the fast path of get_real, set_real)
+        self._real_get = {vr: v.getter for vr, v in self.vars.items() if isinstance(v, Real)}
+        self._real_set = {vr: v.setter for vr, v in self.vars.items() if isinstance(v, Real) and v.setter is not None}
 
     # -- variables ------------------------------------------------------------------------
     def _register(self) -> None:
@@ -110,7 +117,7 @@ class TvcSlave(Fmi2Slave):
         for name in BlockOutputs.signal_names():
             self.register_variable(_Real(name, fmi_unit(name), causality=Fmi2Causality.output,
                                          variability=Fmi2Variability.continuous,
-                                         getter=lambda n=name: getattr(self._out, n)))
+                                         getter=lambda n=name: getattr(self._out or self._block.outputs, n)))
         fixed = {"causality": Fmi2Causality.parameter, "variability": Fmi2Variability.fixed}
         self.register_variable(_Real("internal_step_s", "s", description="the kernel's fixed step", **fixed,
                                      getter=lambda: self._dt, setter=lambda v: setattr(self, "_dt", float(v))))
@@ -149,6 +156,26 @@ class TvcSlave(Fmi2Slave):
         return root
 
     # -- FMI calls ------------------------------------------------------------------------
+    def get_real(self, vrs: list) -> list:
+        """pythonfmu's ``get_real`` (every value as a float), through a value-reference map
+        instead of a type check per variable (a host reads every output at every step); a value
+        reference that is not a Real goes to pythonfmu's, which refuses it."""
+        get = self._real_get
+        try:
+            return [float(get[vr]()) for vr in vrs]
+        except KeyError:
+            return super().get_real(vrs)
+
+    def set_real(self, vrs: list, values: list) -> None:
+        """pythonfmu's ``set_real`` through the value-reference map (as :meth:`get_real`)."""
+        put = self._real_set
+        for vr, value in zip(vrs, values):
+            f = put.get(vr)
+            if f is None:   # not a Real, or one without a setter: pythonfmu's error
+                super().set_real([vr], [value])
+            else:
+                f(value)
+
     def _fail(self, err: Exception) -> None:
         """Log ``err`` (status error) and raise it: pythonfmu's binary returns ``fmi2Fatal``."""
         self.log(str(err), Fmi2Status.error)
