@@ -19,6 +19,7 @@ to return ``fmi2Error`` from Python).
 from __future__ import annotations
 
 import json
+from operator import attrgetter
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement
 
@@ -107,6 +108,10 @@ class TvcSlave(Fmi2Slave):
         #: value reference -> getter / setter of every Real (the fast path of get_real, set_real)
         self._real_get = {vr: v.getter for vr, v in self.vars.items() if isinstance(v, Real)}
         self._real_set = {vr: v.setter for vr, v in self.vars.items() if isinstance(v, Real) and v.setter is not None}
+        #: every output's value reference, in the outputs' order (what a host records at each step)
+        names = {v.name: vr for vr, v in self.vars.items()}
+        self._output_vrs = [names[n] for n in BlockOutputs.signal_names()]
+        self._output_values = attrgetter(*BlockOutputs.signal_names())
 
     # -- variables ------------------------------------------------------------------------
     def _register(self) -> None:
@@ -160,6 +165,8 @@ class TvcSlave(Fmi2Slave):
         """pythonfmu's ``get_real`` (every value as a float), through a value-reference map
         instead of a type check per variable (a host reads every output at every step); a value
         reference that is not a Real goes to pythonfmu's, which refuses it."""
+        if vrs == self._output_vrs:   # every output, in order: read at once (floats already)
+            return list(self._output_values(self._out or self._block.outputs))
         get = self._real_get
         try:
             return [float(get[vr]()) for vr in vrs]
