@@ -97,12 +97,12 @@ class TvcSlave(Fmi2Slave):
         self._par = dict(model_parameters(model))
         self._dt = float(cfg["dt_s"])
         self._hold = 0
-        self._block = TvcBlock(model, engine=cfg["engine"], dt_s=self._dt, allow_unstable=cfg["allow_unstable"])
-        _ALIVE.append(self._block)
-        #: the block's outputs after the last step (None before the first: the outputs' getters
-        #: then ask the block, which computes its values at rest when first asked; an instance
-        #: made only for its model description, as pythonfmu's builder makes one, never loads
-        #: the compiled kernels)
+        #: the block, built when initialisation ends from the parameters then (the model was
+        #: checked, with every check of the block, when the FMU was built; its SHA-256 above)
+        self._block: TvcBlock | None = None
+        #: the block's outputs since initialisation ended (None before: the outputs' getters then
+        #: read :meth:`_rest_outputs`). An instance made only for its model description, as
+        #: pythonfmu's builder makes one, builds no block and loads no compiled kernel.
         self._out = None
         self._register()
         #: value reference -> getter / setter of every Real (the fast path of get_real, set_real)
@@ -122,7 +122,7 @@ class TvcSlave(Fmi2Slave):
         for name in BlockOutputs.signal_names():
             self.register_variable(_Real(name, fmi_unit(name), causality=Fmi2Causality.output,
                                          variability=Fmi2Variability.continuous,
-                                         getter=lambda n=name: getattr(self._out or self._block.outputs, n)))
+                                         getter=lambda n=name: getattr(self._out or self._rest_outputs(), n)))
         fixed = {"causality": Fmi2Causality.parameter, "variability": Fmi2Variability.fixed}
         self.register_variable(_Real("internal_step_s", "s", description="the kernel's fixed step", **fixed,
                                      getter=lambda: self._dt, setter=lambda v: setattr(self, "_dt", float(v))))
@@ -166,7 +166,7 @@ class TvcSlave(Fmi2Slave):
         instead of a type check per variable (a host reads every output at every step); a value
         reference that is not a Real goes to pythonfmu's, which refuses it."""
         if vrs == self._output_vrs:   # every output, in order: read at once (floats already)
-            return list(self._output_values(self._out or self._block.outputs))
+            return list(self._output_values(self._out or self._rest_outputs()))
         get = self._real_get
         try:
             return [float(get[vr]()) for vr in vrs]
@@ -182,6 +182,16 @@ class TvcSlave(Fmi2Slave):
                 super().set_real([vr], [value])
             else:
                 f(value)
+
+    def _rest_outputs(self) -> BlockOutputs:
+        """The outputs before initialisation ends: the model file's block (the build's internal
+        step and hold) at rest, built when first asked for."""
+        if self._block is None:
+            cfg = self._cfg
+            self._block = TvcBlock(self._model, engine=cfg["engine"], dt_s=float(cfg["dt_s"]),
+                                   allow_unstable=cfg["allow_unstable"])
+            _ALIVE.append(self._block)
+        return self._block.outputs
 
     def _fail(self, err: Exception) -> None:
         """Log ``err`` (status error) and raise it: pythonfmu's binary returns ``fmi2Fatal``."""
