@@ -223,7 +223,8 @@ class TvcBlock:
         self._out = out = _outputs(self._k * self.dt_s, end)
         if not self.allow_unstable:
             hs, fl = HARD_STOP_RAD, self._force_limit_N
-            if not (abs(end[_TH_P]) <= hs and abs(end[_TH_Y]) <= hs and abs(end[_FL_P]) <= fl and abs(end[_FL_Y]) <= fl):
+            if not (abs(end[_TH_P]) <= hs and abs(end[_TH_Y]) <= hs and
+                    abs(end[_FL_P]) <= fl and abs(end[_FL_Y]) <= fl):
                 self._check_envelope(out)   # beyond (or NaN): raises, naming the signal
         return out
 
