@@ -14,6 +14,11 @@ default step dt):
   FMPy step: ``set_real`` of the two inputs, ``do_step``, ``get_real`` of the 17 outputs (without
   the binary and FMPy themselves), simplex, ``ramp``.
 
+With ``--fmu SECONDS``: also the FMU (built as ``taos fmu`` builds it) run by FMPy over that much
+of the profile at h = dt, ``command_hold`` 1, in a child process as tests/test_fmu.py runs it
+(:func:`tests.test_fmu.fmpy_in_child`): the child's wall time of ``simulate_fmu`` and its CPU
+time (start-up included: imports, instantiation, kernel loading).
+
 A digest of every output at every step of one more run (SHA-256 of the values, untimed) and the
 last pitch engine angle are printed, so that runs before and after a change can be compared bit
 for bit.
@@ -107,10 +112,35 @@ def slave_row(model_path: Path, c: np.ndarray, dt: float, repeat: int, tmp: Path
     return best / n * 1e6, vals, digest(rec)
 
 
+def fmu_row(prof, seconds: float, dt: float = 2e-4) -> None:
+    """The FMU in FMPy over ``seconds`` of ``prof`` at h = dt (ramp), in a child process."""
+    import resource
+    import tempfile
+
+    from taos.cosim import build_fmu
+    from tests.test_fmu import fmpy_in_child, profile_input
+
+    with tempfile.TemporaryDirectory(prefix="bench_cosim_fmu_") as tmp:
+        fmu = build_fmu(ROOT / "models" / "rs25_hotfire.toml", Path(tmp) / "tvc.fmu").path
+        sig = profile_input(prof, dt, seconds + dt)
+        cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        res, _, err, wall = fmpy_in_child(fmu, tmp, sig, stop_time=float(sig["time"][-1]), step_size=dt,
+                                          output_interval=dt, start_values={"command_hold": 1})
+        cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if err:
+        raise SystemExit(f"FMPy: {err}")
+    cpu = (cpu1.ru_utime - cpu0.ru_utime) + (cpu1.ru_stime - cpu0.ru_stime)
+    n = res.size - 1
+    print(f"FMU in FMPy, {seconds:g} s at h = dt ({n} steps): simulate_fmu {wall:.2f} s wall "
+          f"({wall / n * 1e6:.1f} us/step); child CPU {cpu:.2f} s; digest {digest(res.tolist())}")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=20000, help="communication steps a run (default 20000)")
     ap.add_argument("--repeat", type=int, default=5, help="runs per row, the best kept (default 5)")
+    ap.add_argument("--fmu", type=float, default=0.0, metavar="SECONDS",
+                    help="also run the FMU in FMPy over this much of the profile (default: not run)")
     args = ap.parse_args(argv)
     print("uptime:", subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip())
     print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores; hot fire, Green Run two-axis samples, "
@@ -128,6 +158,8 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory(prefix="bench_cosim_") as tmp:
         us, vals, h = slave_row(ROOT / "models" / "rs25_hotfire.toml", c, 2e-4, args.repeat, Path(tmp))
     print(f"{'TvcSlave set_real + do_step + get_real, ramp':44s} {us:8.2f}  {h}  {vals[0]!r}")
+    if args.fmu > 0:
+        fmu_row(prof, args.fmu)
     return 0
 
 
