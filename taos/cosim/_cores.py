@@ -20,7 +20,9 @@ small. The command samples, the kernel's output arrays and its argument list are
 chunk length and reused; the kernel is called through its compiled entry point
 (:func:`compiled_entry`), and the friction law's compiled functions are passed as
 :class:`FunctionAddress` objects (numba's wrapper-address protocol: the same function pointer,
-found without the signature comparison numba makes for a ``cfunc`` at every call).
+found without the signature comparison numba makes for a ``cfunc`` at every call). The simplex
+core loads the friction law's compiled functions and its kernel at its first chunk, not when
+built (a block built for its checks alone, as ``taos fmu`` builds one, loads no kernel).
 
 Engine rate of the 3-D model: the engine angles are the pitch/yaw components of the rotation
 vector r = log(R) (:mod:`taos.taos3d.model`), so their rates are those components of
