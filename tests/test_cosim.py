@@ -136,6 +136,27 @@ def test_bad_steps_and_commands_are_refused_in_one_line(hotfire, bad, message):
     assert b.time_s == 0.0   # nothing advanced
 
 
+def test_refused_steps_between_good_ones_change_nothing(hotfire):
+    """The block checks a step size once and reuses the count while the size repeats: a refused
+    size or command between good steps changes nothing (the run equals one without them), and
+    commands given as numpy floats or ints step exactly as the same values as floats."""
+    dt = 2e-4
+    cmds = [(0.3 * DEG, -0.2 * DEG), (0.1 * DEG, 0.25 * DEG)] * 15
+    ref = TvcBlock(hotfire, hold="ramp")
+    ref.reset()
+    want = [ref.step(2 * dt, p, y) for p, y in cmds]
+    b = TvcBlock(hotfire, hold="ramp")
+    b.reset()
+    got = []
+    for k, (p, y) in enumerate(cmds):
+        for bad in ((1.5 * dt, p, y), (float("nan"), p, y), (2 * dt, float("inf"), y), (2 * dt, p, 11 * DEG)):
+            with pytest.raises(InputError):
+                b.step(*bad)
+        got.append(b.step(2 * dt, np.float64(p), y) if k % 2 else b.step(2 * dt, p, y))
+    assert got == want
+    assert b.step(2 * dt, 0, np.int64(0)) == ref.step(2 * dt, 0.0, 0.0)
+
+
 @pytest.mark.parametrize("kw, message", [(dict(engine="mujoco"), "simplex or taos"),
                                          (dict(hold="cubic"), "hold or ramp"), (dict(dt_s=0.05), "at most")])
 def test_bad_block_settings_are_refused_before_any_step(hotfire, kw, message):

@@ -28,10 +28,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..bounds import HARD_STOP_RAD, LOAD_FORCE_FACTOR, check_command_angle
+from ..bounds import GIMBAL_RANGE_RAD, HARD_STOP_RAD, LOAD_FORCE_FACTOR, check_command_angle
 from ..errors import EnvelopeExceeded, InputError
 from ..model import TvcModel
-from ._cores import AXES, EndValues, PlanarCore, TaosCore
+from ._cores import AXES, SIGNALS, PlanarCore, TaosCore
 from ._options import HOLDS
 
 #: a communication step counts as a whole multiple of the internal step within this fraction of it
@@ -81,15 +81,22 @@ class BlockOutputs:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
-def _outputs(t: float, e: EndValues) -> BlockOutputs:
-    kw = {"time_s": t}
-    for name in ("engine_rad", "engine_rate_rad_s", "piston_m", "load_force_N", "load_pressure_Pa",
-                 "friction_torque_Nm", "command_avionics_rad"):
-        for i, ax in enumerate(AXES):
-            kw[f"{ax}_{name}"] = getattr(e, name)[i]
-    for i, c in enumerate("xyz"):
-        kw[f"thrust_direction_{c}"] = e.thrust_direction[i]
-    return BlockOutputs(**kw)
+assert BlockOutputs.signal_names() == SIGNALS   # the cores return the outputs in this order
+_FIELDS = ("time_s",) + SIGNALS
+#: positions in SIGNALS of the engine angles and load forces (the envelope)
+_TH_P, _TH_Y, _FL_P, _FL_Y = (SIGNALS.index(k) for k in ("pitch_engine_rad", "yaw_engine_rad", "pitch_load_force_N",
+                                                         "yaw_load_force_N"))
+_new = object.__new__
+
+
+def _outputs(t: float, values: tuple) -> BlockOutputs:
+    """The outputs at ``t`` [s] of the core's end values (:data:`taos.cosim._cores.SIGNALS`).
+    Built as the frozen dataclass's own ``__init__`` would (its instance dictionary: every
+    field set, nothing else), without its one ``object.__setattr__`` call per field: one of
+    these per communication step."""
+    out = _new(BlockOutputs)
+    out.__dict__.update(zip(_FIELDS, (t, *values)))
+    return out
 
 
 class TvcBlock:
@@ -132,17 +139,30 @@ class TvcBlock:
         self.model, self.engine, self.dt_s, self.hold = model, engine, dt, hold
         self.allow_unstable = allow_unstable
         self._stall_N = model.actuator.stall_force_N
-        self.reset()
+        self._ramp = hold == "ramp"
+        #: the envelope's load-force bound [N] (:meth:`_check_envelope`)
+        self._force_limit_N = LOAD_FORCE_FACTOR * self._stall_N
+        #: the last communication step [s] given and its internal steps (:meth:`substeps`)
+        self._last_step: tuple = (None, 0)
+        #: the ramp fractions k / n, k = 0..n (n + 1, 1) of the last ramp of n > 1 steps
+        self._frac = np.zeros((2, 1))
+        self._restart(0.0, 0.0)
 
     # -- state ----------------------------------------------------------------------------
     def reset(self, pitch_command_rad: float = 0.0, yaw_command_rad: float = 0.0) -> BlockOutputs:
         """Back to rest at time 0 with the given commands [rad] (the start of a ``ramp``);
         returns the outputs there."""
+        self._restart(pitch_command_rad, yaw_command_rad)
+        return self.outputs
+
+    def _restart(self, pitch_command_rad: float, yaw_command_rad: float) -> None:
+        """Rest at time 0 with the given commands; the outputs there computed when first asked
+        for (:attr:`outputs`: a block built only for its checks, as ``taos fmu`` builds one,
+        never loads the compiled kernels)."""
         self._core.reset()
         self._k = 0
         self._cmd = self._checked(pitch_command_rad, yaw_command_rad)
-        self._out = _outputs(0.0, self._core.advance(np.array([self._cmd]), self.dt_s, 0.0))
-        return self._out
+        self._out = None
 
     @property
     def time_s(self) -> float:
@@ -152,6 +172,10 @@ class TvcBlock:
     @property
     def outputs(self) -> BlockOutputs:
         """The outputs at :attr:`time_s`."""
+        if self._out is None:   # at rest at time 0 (_restart): the kernels' values there
+            r = self._core.samples(0)
+            r[0, 0], r[0, 1] = self._cmd
+            self._out = _outputs(0.0, self._core.advance(0, 0.0))
         return self._out
 
     # -- stepping -------------------------------------------------------------------------
@@ -170,26 +194,47 @@ class TvcBlock:
     def step(self, dt_s: float, pitch_command_rad: float, yaw_command_rad: float) -> BlockOutputs:
         """Advance by the communication step ``dt_s`` [s] with the FCS engine-angle commands
         [rad] (before the avionics; held or ramped over the step, :attr:`hold`); returns the
-        outputs at the end of the step."""
-        n = self.substeps(dt_s)
-        cmd = self._checked(pitch_command_rad, yaw_command_rad)
-        r = np.empty((n + 1, 2))
-        if self.hold == "ramp":
-            frac = np.arange(n + 1)[:, None] / n
-            r[:] = np.asarray(self._cmd) + frac * (np.asarray(cmd) - np.asarray(self._cmd))
-            r[0], r[-1] = self._cmd, cmd   # the end points exactly
+        outputs at the end of the step (a refused step or command changes nothing)."""
+        last, n = self._last_step
+        if dt_s != last:   # a step checked once (NaN never equals: always checked and refused)
+            n = self.substeps(dt_s)
+            self._last_step = (dt_s, n)
+        p1, y1 = cmd = self._checked(pitch_command_rad, yaw_command_rad)
+        core = self._core
+        r = core.samples(n)
+        if self._ramp:
+            p0, y0 = self._cmd
+            if n > 1:
+                frac = self._frac
+                if frac.shape[0] != n + 1:
+                    frac = self._frac = np.arange(n + 1)[:, None] / n
+                np.multiply(frac, (p1 - p0, y1 - y0), out=r)   # c0 + k / n (c1 - c0), as taos simulate's
+                r += (p0, y0)                                   # linear interpolation of its samples
+            r[0, 0], r[0, 1] = p0, y0   # the end points exactly
+            r[n, 0], r[n, 1] = p1, y1
+        elif n == 1:
+            r[0, 0], r[0, 1] = r[1, 0], r[1, 1] = cmd
         else:
-            r[:] = cmd
-        t0 = self.time_s
-        end = self._core.advance(r, self.dt_s, t0)
-        self._k += n
+            r[:, 0], r[:, 1] = cmd
+        k0 = self._k
+        end = core.advance(n, k0 * self.dt_s)
+        self._k = k0 + n
         self._cmd = cmd
-        self._out = _outputs(self.time_s, end)
-        self._check_envelope(self._out)
-        return self._out
+        self._out = out = _outputs(self._k * self.dt_s, end)
+        if not self.allow_unstable:
+            hs, fl = HARD_STOP_RAD, self._force_limit_N
+            if not (abs(end[_TH_P]) <= hs and abs(end[_TH_Y]) <= hs and
+                    abs(end[_FL_P]) <= fl and abs(end[_FL_Y]) <= fl):
+                self._check_envelope(out)   # beyond (or NaN): raises, naming the signal
+        return out
 
     # -- checks ---------------------------------------------------------------------------
     def _checked(self, pitch: float, yaw: float) -> tuple[float, float]:
+        """The commands as floats [rad], refused unless numbers within the gimbal range
+        (:func:`taos.bounds.check_command_angle`; two floats within +-GIMBAL_RANGE_RAD pass at once)."""
+        if type(pitch) is float and type(yaw) is float and -GIMBAL_RANGE_RAD <= pitch <= GIMBAL_RANGE_RAD \
+                and -GIMBAL_RANGE_RAD <= yaw <= GIMBAL_RANGE_RAD:
+            return (pitch, yaw)
         out = []
         for ax, v in zip(AXES, (pitch, yaw)):
             try:
@@ -210,7 +255,7 @@ class TvcBlock:
                 raise EnvelopeExceeded(o.time_s, f"{ax} engine angle {math.degrees(th):.4g} deg beyond the hard "
                                        f"stops +-{math.degrees(HARD_STOP_RAD):.3g} deg",
                                        "a command too fast or too large for the actuator's flow and force")
-            if not abs(fl) <= LOAD_FORCE_FACTOR * self._stall_N:
+            if not abs(fl) <= self._force_limit_N:
                 raise EnvelopeExceeded(o.time_s, f"{ax} load force {fl:.4g} N beyond {LOAD_FORCE_FACTOR:g} x the "
                                        f"stall force A P_s = {self._stall_N:.4g} N",
                                        "a command too fast or too large for the actuator")

@@ -19,6 +19,7 @@ to return ``fmi2Error`` from Python).
 from __future__ import annotations
 
 import json
+from operator import attrgetter
 from pathlib import Path
 from xml.etree.ElementTree import Element, SubElement
 
@@ -96,10 +97,21 @@ class TvcSlave(Fmi2Slave):
         self._par = dict(model_parameters(model))
         self._dt = float(cfg["dt_s"])
         self._hold = 0
-        self._block = TvcBlock(model, engine=cfg["engine"], dt_s=self._dt, allow_unstable=cfg["allow_unstable"])
-        _ALIVE.append(self._block)
-        self._out = self._block.outputs
+        #: the block, built when initialisation ends from the parameters then (the model was
+        #: checked, with every check of the block, when the FMU was built; its SHA-256 above)
+        self._block: TvcBlock | None = None
+        #: the block's outputs since initialisation ended (None before: the outputs' getters then
+        #: read :meth:`_rest_outputs`). An instance made only for its model description, as
+        #: pythonfmu's builder makes one, builds no block and loads no compiled kernel.
+        self._out = None
         self._register()
+        #: value reference -> getter / setter of every Real (the fast path of get_real, set_real)
+        self._real_get = {vr: v.getter for vr, v in self.vars.items() if isinstance(v, Real)}
+        self._real_set = {vr: v.setter for vr, v in self.vars.items() if isinstance(v, Real) and v.setter is not None}
+        #: every output's value reference, in the outputs' order (what a host records at each step)
+        names = {v.name: vr for vr, v in self.vars.items()}
+        self._output_vrs = [names[n] for n in BlockOutputs.signal_names()]
+        self._output_values = attrgetter(*BlockOutputs.signal_names())
 
     # -- variables ------------------------------------------------------------------------
     def _register(self) -> None:
@@ -110,7 +122,7 @@ class TvcSlave(Fmi2Slave):
         for name in BlockOutputs.signal_names():
             self.register_variable(_Real(name, fmi_unit(name), causality=Fmi2Causality.output,
                                          variability=Fmi2Variability.continuous,
-                                         getter=lambda n=name: getattr(self._out, n)))
+                                         getter=lambda n=name: getattr(self._out or self._rest_outputs(), n)))
         fixed = {"causality": Fmi2Causality.parameter, "variability": Fmi2Variability.fixed}
         self.register_variable(_Real("internal_step_s", "s", description="the kernel's fixed step", **fixed,
                                      getter=lambda: self._dt, setter=lambda v: setattr(self, "_dt", float(v))))
@@ -149,6 +161,38 @@ class TvcSlave(Fmi2Slave):
         return root
 
     # -- FMI calls ------------------------------------------------------------------------
+    def get_real(self, vrs: list) -> list:
+        """pythonfmu's ``get_real`` (every value as a float), through a value-reference map
+        instead of a type check per variable (a host reads every output at every step); a value
+        reference that is not a Real goes to pythonfmu's, which refuses it."""
+        if vrs == self._output_vrs:   # every output, in order: read at once (floats already)
+            return list(self._output_values(self._out or self._rest_outputs()))
+        get = self._real_get
+        try:
+            return [float(get[vr]()) for vr in vrs]
+        except KeyError:
+            return super().get_real(vrs)
+
+    def set_real(self, vrs: list, values: list) -> None:
+        """pythonfmu's ``set_real`` through the value-reference map (as :meth:`get_real`)."""
+        put = self._real_set
+        for vr, value in zip(vrs, values):
+            f = put.get(vr)
+            if f is None:   # not a Real, or one without a setter: pythonfmu's error
+                super().set_real([vr], [value])
+            else:
+                f(value)
+
+    def _rest_outputs(self) -> BlockOutputs:
+        """The outputs before initialisation ends: the model file's block (the build's internal
+        step and hold) at rest, built when first asked for."""
+        if self._block is None:
+            cfg = self._cfg
+            self._block = TvcBlock(self._model, engine=cfg["engine"], dt_s=float(cfg["dt_s"]),
+                                   allow_unstable=cfg["allow_unstable"])
+            _ALIVE.append(self._block)
+        return self._block.outputs
+
     def _fail(self, err: Exception) -> None:
         """Log ``err`` (status error) and raise it: pythonfmu's binary returns ``fmi2Fatal``."""
         self.log(str(err), Fmi2Status.error)
