@@ -180,6 +180,14 @@ def _env():
     return e
 
 
+def _as_from_a_terminal() -> None:
+    """(preexec_fn) SIGINT and SIGTERM at their default in the child, as a terminal starts a
+    command: a test run itself started with SIGINT ignored (a background job of a shell without
+    job control) would hand that on, and the package leaves an ignored SIGINT ignored at start-up."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 @pytest.mark.parametrize("where", ["taos", "taos.cli", "taos.cli.basic"])
 def test_a_signal_during_start_up_is_one_line_and_its_status(signum, where):
@@ -187,7 +195,8 @@ def test_a_signal_during_start_up_is_one_line_and_its_status(signum, where):
     right after importing ``where`` (the package's first line, the CLI, a command module)."""
     code = (f"import os, sys; sys.argv[0] = 'taos'; import {where}; os.kill(os.getpid(), {int(signum)}); "
             "import time; time.sleep(30)")
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=120)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=120,
+                       preexec_fn=_as_from_a_terminal)
     lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     assert r.returncode == 128 + signum, r.stderr
     assert len(lines) == 1 and "Traceback" not in r.stderr and "start-up" in lines[0], r.stderr
@@ -227,7 +236,8 @@ def test_a_signal_at_any_moment_is_one_line_and_its_status(signum, delay, tmp_pa
                              "--set", "structure.load_stiffness=80000 lbf/in:160000 lbf/in", "--samples", "400",
                              "--metric", "lco", "--flight", str(FLIGHT), "--amplitudes-deg", "0.05,0.2",
                              "--freq-hz", "0.3,1", "--no-progress", "--json", str(out)],
-                            cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=tmp_path, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_as_from_a_terminal)
     try:
         _wait_for_handlers(proc)
         time.sleep(delay)
@@ -249,7 +259,8 @@ def test_a_signal_at_any_moment_is_one_line_and_its_status(signum, delay, tmp_pa
 
 def test_startup_handlers_are_not_installed_for_a_library_user():
     code = "import signal, taos, taos.cli; print(signal.getsignal(signal.SIGINT) is signal.default_int_handler)"
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=120)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=120,
+                       preexec_fn=_as_from_a_terminal)
     assert r.stdout.strip() == "True", r.stderr
 
 
