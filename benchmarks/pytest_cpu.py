@@ -1,0 +1,45 @@
+"""A pytest plugin: CPU seconds of each test (setup + call + teardown), its own process and the
+children it waited for, written one line a test to ``$TAOS_TEST_CPU_DIR/cpu-<pid>.tsv``.
+
+Where `make test`'s CPU goes, test by test, in the run as it is (two xdist workers beside the
+docs build); wall durations there are inflated by whatever the other core does, CPU is not:
+
+    TAOS_TEST_CPU_DIR=/tmp/cpu make test PYTEST="PYTHONDONTWRITEBYTECODE= .venv/bin/python -m pytest \
+        -q -p no:cacheprovider -p benchmarks.pytest_cpu"
+    cat /tmp/cpu/cpu-*.tsv | sort -t$'\\t' -k2 -rn | head -40
+
+A child that is never waited for (a killed process's orphan, a Dask worker of a cluster left to
+another test) is not counted."""
+
+from __future__ import annotations
+
+import os
+import resource
+from pathlib import Path
+
+import pytest
+
+
+def _cpu_s() -> float:
+    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    out = os.environ.get("TAOS_TEST_CPU_DIR")
+    t0 = _cpu_s()
+    yield
+    if out:
+        Path(out).mkdir(parents=True, exist_ok=True)
+        with open(Path(out) / f"cpu-{os.getpid()}.tsv", "a") as f:
+            f.write(f"{item.nodeid}\t{_cpu_s() - t0:.3f}\n")
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_sessionfinish(session):
+    """The session's own CPU outside the tests (collection, start-up): one line ``<session>``."""
+    out = os.environ.get("TAOS_TEST_CPU_DIR")
+    if out and Path(out).is_dir():
+        with open(Path(out) / f"cpu-{os.getpid()}.tsv", "a") as f:
+            f.write(f"<session {os.getpid()}>\t{_cpu_s():.3f}\n")
