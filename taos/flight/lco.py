@@ -146,21 +146,22 @@ def predict_lco(flight: FlightModel, df: DescribingFunctionMap, axis: str | None
     G = l0db[None, :] + gain_db(N)
     E = _wrap180(l0ph[None, :] + np.degrees(np.angle(N)) + 180.0)
     found: list[tuple[float, float]] = []
-    for i in range(n_grid - 1):
-        for j in range(n_grid - 1):
-            g = G[i:i + 2, j:j + 2]
-            e = E[i:i + 2, j:j + 2]
-            if g.min() > 0 or g.max() < 0 or e.min() > 0 or e.max() < 0 or np.abs(e).max() > 90:
-                continue
-            x0 = np.array([0.5 * (la[i] + la[i + 1]), 0.5 * (lf[j] + lf[j + 1])])
-            sol = scipy.optimize.root(lambda x: nichols(*x), x0, method="hybr", options={"xtol": 1e-10})
-            x = sol.x if sol.success else x0
-            if not (la[0] - 1e-9 <= x[0] <= la[-1] + 1e-9 and lf[0] - 1e-9 <= x[1] <= lf[-1] + 1e-9):
-                x = x0
-            if np.abs(nichols(*x)).max() > 0.5:
-                x = x0
-            if all(abs(x[0] - a) > 0.05 or abs(x[1] - b) > 0.05 for a, b in found):
-                found.append((float(x[0]), float(x[1])))
+    # the grid cells whose corners bracket both 0 dB and -180 deg (phase error within 90 deg),
+    # in row-major order (amplitude, then frequency); each one starts a root search
+    g4 = np.stack((G[:-1, :-1], G[1:, :-1], G[:-1, 1:], G[1:, 1:]))
+    e4 = np.stack((E[:-1, :-1], E[1:, :-1], E[:-1, 1:], E[1:, 1:]))
+    skip = ((g4.min(0) > 0) | (g4.max(0) < 0) | (e4.min(0) > 0) | (e4.max(0) < 0)
+            | (np.abs(e4).max(0) > 90))
+    for i, j in zip(*np.nonzero(~skip)):
+        x0 = np.array([0.5 * (la[i] + la[i + 1]), 0.5 * (lf[j] + lf[j + 1])])
+        sol = scipy.optimize.root(lambda x: nichols(*x), x0, method="hybr", options={"xtol": 1e-10})
+        x = sol.x if sol.success else x0
+        if not (la[0] - 1e-9 <= x[0] <= la[-1] + 1e-9 and lf[0] - 1e-9 <= x[1] <= lf[-1] + 1e-9):
+            x = x0
+        if np.abs(nichols(*x)).max() > 0.5:
+            x = x0
+        if all(abs(x[0] - a) > 0.05 or abs(x[1] - b) > 0.05 for a, b in found):
+            found.append((float(x[0]), float(x[1])))
     cycles = []
     for lA, lF in sorted(found):
         Ar, fr = math.exp(lA), math.exp(lF)
