@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import resource
+import time
 from pathlib import Path
 
 import pytest
@@ -28,12 +29,12 @@ def _cpu_s() -> float:
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item, nextitem):
     out = os.environ.get("TAOS_TEST_CPU_DIR")
-    t0 = _cpu_s()
+    t0, w0 = _cpu_s(), time.time()
     yield
     if out:
         Path(out).mkdir(parents=True, exist_ok=True)
         with open(Path(out) / f"cpu-{os.getpid()}.tsv", "a") as f:
-            f.write(f"{item.nodeid}\t{_cpu_s() - t0:.3f}\n")
+            f.write(f"{item.nodeid}\t{_cpu_s() - t0:.3f}\t{w0:.2f}\t{time.time():.2f}\n")
 
 
 @pytest.hookimpl(trylast=True)
