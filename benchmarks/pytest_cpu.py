@@ -1,5 +1,6 @@
 """A pytest plugin: CPU seconds of each test (setup + call + teardown) in its own process and the
-children it waited for, with its wall start and end (Unix time), one line a test to ``$TAOS_TEST_CPU_DIR/cpu-<pid>.tsv``.
+children it waited for, with its wall start and end (Unix time), one line a test to
+``$TAOS_TEST_CPU_DIR/cpu-<pid>.tsv``.
 
 Where `make test`'s CPU goes, test by test, in the run as it is (two xdist workers beside the
 docs build); wall durations there are inflated by whatever the other core does, CPU is not:
