@@ -75,7 +75,8 @@ $(DOCS_STAMP): $(STAMP)
 # in `make check` or plain pytest, or after a failed build, those tests run the commands
 # themselves); the main run leaves that file out. Two pytest processes (pytest-xdist; the tests
 # share no output folder or port); a worker that runs out of tests takes half of the other's
-# queue (--dist worksteal: no worker idles while a long test runs on the other at the end;
+# queue (--dist worksteal: no worker idles while a long test runs on the other at the end; both cuts
+# fall between test modules where they can, tests/_xdist_modules.py, so no module fixture is built twice;
 # benchmarks/sim_test_order.py).
 DOCS_STATUS := $(CURDIR)/docs/_build/sphinx.status
 # pytest rewrites every test module's asserts when it imports it, and caches the result in

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from tests._xdist_modules import pytest_xdist_make_scheduler  # noqa: F401  (a hook: worksteal cuts between modules)
+
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
 
