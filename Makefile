@@ -69,11 +69,12 @@ $(DOCS_STAMP): $(STAMP)
 # pytest exits 5 when it collects no tests; treat that as success, anything else as is.
 # The documentation is built (sphinx -W: no warnings) at the same time as the tests, in the
 # background (its output in docs/_build/sphinx.log, shown if it fails; a failed build fails
-# `make test`), so both cores stay busy. The user guide's commands run once, in the docs build:
-# right after it, still in the background, tests/test_docs.py checks what that build's runs
-# wrote (TAOS_TEST_DOCS_STATUS names the file holding the build's exit status; without it, as
-# in `make check` or plain pytest, or after a failed build, those tests run the commands
-# themselves); the main run leaves that file out. Two pytest processes (pytest-xdist; the tests
+# `make test`), so both cores stay busy. The user guide's commands and the gallery's examples
+# run once, in the docs build: right after it, still in the background, tests/test_docs.py and
+# tests/test_examples.py check what that build's runs wrote (TAOS_TEST_DOCS_STATUS names the
+# file holding the build's exit status; without it, as in `make check` or plain pytest, or
+# after a failed build, those tests run the commands and examples themselves); the main run
+# leaves those two files out. Two pytest processes (pytest-xdist; the tests
 # share no output folder or port); a worker that runs out of tests takes half of the other's
 # queue (--dist worksteal: no worker idles while a long test runs on the other at the end; both cuts
 # fall between test modules where they can, tests/_xdist_modules.py, so no module fixture is built twice;
@@ -87,14 +88,14 @@ SPHINX := MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs
 test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 	@rm -rf docs/_build docs/_generated; mkdir -p docs/_build; \
 	  ( $(SPHINX) >docs/_build/sphinx.log 2>&1; echo $$? >$(DOCS_STATUS).tmp; mv $(DOCS_STATUS).tmp $(DOCS_STATUS); \
-	    TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(PYTEST) tests/test_docs.py \
+	    TAOS_TEST_DOCS_STATUS=$(DOCS_STATUS) $(PYTEST) tests/test_docs.py tests/test_examples.py \
 	      >docs/_build/test_docs.log 2>&1; echo $$? >docs/_build/test_docs.status ) & \
 	  docs=$$!; \
-	  $(PYTEST) -n 2 --dist worksteal --durations=25 --ignore=tests/test_docs.py tests; \
+	  $(PYTEST) -n 2 --dist worksteal --durations=25 --ignore=tests/test_docs.py --ignore=tests/test_examples.py tests; \
 	  rc=$$?; if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; \
 	  wait $$docs; drc=$$(cat $(DOCS_STATUS) 2>/dev/null || echo 1); \
 	  trc=$$(cat docs/_build/test_docs.status 2>/dev/null || echo 1); \
-	  echo "tests/test_docs.py (after the docs build):"; tail -n 40 docs/_build/test_docs.log; \
+	  echo "tests/test_docs.py tests/test_examples.py (after the docs build):"; tail -n 40 docs/_build/test_docs.log; \
 	  if [ "$$trc" != 0 ] && [ $$rc -eq 0 ]; then rc=1; fi; \
 	  if [ "$$drc" = 0 ]; then echo "Documentation: docs/_build/html/index.html"; \
 	  else cat docs/_build/sphinx.log; echo "make test: the documentation build failed (exit $$drc)"; \

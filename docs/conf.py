@@ -56,8 +56,12 @@ html_theme_options = {"description": "TVC gimbal and actuator simulation", "page
                       "sidebar_width": "240px"}
 
 # The examples gallery (sphinx-gallery): every examples/plot_*.py is run by the build (an error
-# stops it) and shown with its output and pictures in docs/gallery (generated, not in git);
-# tests/test_examples.py runs the same scripts.
+# stops it) and shown with its output and pictures in docs/gallery (generated, not in git), every
+# build (run_stale_examples: also an example unchanged since the last build's docs/gallery, whose
+# output the code may have changed). The hook taosdocs.gallery.reset_example, before and after
+# each example, removes the friction laws it registered and records its run for
+# tests/test_examples.py (which, under make test, checks that record instead of running the
+# script again; see there).
 sphinx_gallery_conf = {
     "examples_dirs": str(ROOT / "examples"),
     "gallery_dirs": str(HERE / "gallery"),
@@ -70,4 +74,7 @@ sphinx_gallery_conf = {
     "matplotlib_animations": False,
     "image_scrapers": ("matplotlib",),
     "within_subsection_order": "FileNameSortKey",
+    "run_stale_examples": True,
+    "reset_modules": ("matplotlib", "taosdocs.gallery.reset_example"),
+    "reset_modules_order": "both",
 }

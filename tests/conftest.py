@@ -26,6 +26,27 @@ def hotfire():
     return load_model(MODELS / "rs25_hotfire.toml")
 
 
+#: under ``make test``, the file its documentation build writes its exit status to (Makefile)
+DOCS_STATUS_ENV = "TAOS_TEST_DOCS_STATUS"
+DOCS_WAIT_S = 1800.0
+
+
+def docs_build_succeeded() -> bool:
+    """Under ``make test`` (:data:`DOCS_STATUS_ENV` set): whether its documentation build
+    finished with exit status 0, waiting up to :data:`DOCS_WAIT_S` s for it to finish; False
+    without that variable (``make check``, plain pytest)."""
+    import os
+    import time
+
+    status = os.environ.get(DOCS_STATUS_ENV)
+    if not status:
+        return False
+    status, t0 = Path(status), time.monotonic()
+    while not status.is_file() and time.monotonic() - t0 < DOCS_WAIT_S:
+        time.sleep(1.0)
+    return status.is_file() and status.read_text().strip() == "0"
+
+
 def run_cli(*args, prog="taos", cwd=ROOT):
     """Run the console script in a subprocess; returns CompletedProcess (text)."""
     exe = Path(sys.executable).parent / prog

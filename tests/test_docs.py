@@ -15,7 +15,6 @@ from __future__ import annotations
 import os
 import re
 import sys
-import time
 import tomllib
 from pathlib import Path
 
@@ -27,6 +26,8 @@ sys.path.insert(0, str(DOCS / "_ext"))
 
 from taosdocs import guide, reference  # noqa: E402
 from taosdocs.docstrings import escape_docstring  # noqa: E402
+
+from .conftest import docs_build_succeeded  # noqa: E402
 
 STEP_RE = re.compile(r"```\{taos-step\}\s+(\S+)")
 LAYOUT_RE = re.compile(r"```\{taos-output-layout\}\s+(\S+)\s+(\S+)")
@@ -50,20 +51,10 @@ def test_every_guide_command_is_shown_and_every_shown_command_exists():
             assert m.group(2) in step.outputs or m.group(2).startswith("out/"), m.group(0)
 
 
-DOCS_STATUS_ENV = "TAOS_TEST_DOCS_STATUS"
-DOCS_WAIT_S = 1800.0
-
-
 def _docs_build_records():
     """The records folder of this ``make test``'s documentation build, once it has finished
     successfully and recorded every current guide command and Python example; else None."""
-    status = os.environ.get(DOCS_STATUS_ENV)
-    if not status:
-        return None
-    status, t0 = Path(status), time.monotonic()
-    while not status.is_file() and time.monotonic() - t0 < DOCS_WAIT_S:
-        time.sleep(1.0)
-    if not status.is_file() or status.read_text().strip() != "0":
+    if not docs_build_succeeded():
         return None
     records, work = DOCS / "_generated" / "records", DOCS / "_generated" / "work"
     if any(guide.read_step_record(s, records, work) is None for s in guide.STEPS):
