@@ -49,7 +49,6 @@ from taos.linear import StateSpace
 from taos.stability import LoopMargins, loop_margins
 from taos.model import TvcModel, read_toml
 from taos.shipped import resolve
-from taos.planar.saturation import embed_limits
 from taos.planar.simplex import LurePlant, simplex_limits, simplex_state_space
 
 #: vehicle + FCS block signals
@@ -384,6 +383,8 @@ def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None, 
     Outputs: the simplex outputs, then :data:`VF_OUTPUTS`. States: the simplex states, then
     the vehicle + FCS states. ``parts``: :meth:`PlantParts.of` of the same ``model``, ``axis``
     and FCS filter when already built (the same plant, without rebuilding them)."""
+    from taos.planar.saturation import embed_limits   # a numba module: imported by a run, not a file load
+
     axis = axis or flight.axis
     parts = parts or PlantParts.of(flight, model, axis)
     tv = parts.tvc
