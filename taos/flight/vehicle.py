@@ -272,7 +272,8 @@ def fcs_filter_tf(fcs: FlightControl) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fcs_filter_ss(fcs: FlightControl) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(A, B, C, D) of :func:`fcs_filter_tf` in controller canonical form (SI, states in [s^k]).
+    """(A, B, C, D) of :func:`fcs_filter_tf` in controller canonical form (time in s; the
+    filter's input and output are the FCS command in rad).
 
     With num (padded with leading zeros to den's length) and den both divided by den[0]: A's
     first row is -den[1:] with ones on its subdiagonal, B = e_1, C = num[1:] - num[0] den[1:],
