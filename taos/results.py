@@ -38,7 +38,6 @@ import subprocess
 import tempfile
 from contextlib import contextmanager
 from functools import cache
-from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Mapping
 
@@ -55,6 +54,8 @@ _TMP_RE = re.compile(r"^\..+\.(\d+)\.[0-9a-f]{32}\.taos\.tmp$")  # .NAME.PID.TOK
 def package_version() -> str:
     """taos's own version: the installed distribution's (``taos-tvc``) metadata, else
     ``taos.__version__`` (a source tree on the path, not installed)."""
+    from importlib import metadata
+
     try:
         return metadata.version("taos-tvc")
     except metadata.PackageNotFoundError:

@@ -4,13 +4,14 @@ Lur'e plant against the loop margins."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 import pytest
 
 from taos.errors import InputError
-from taos.flight.vehicle import fcs_filter_tf, flight_plant, load_flight, loop_freqresp, margins
+from taos.flight.vehicle import fcs_filter_ss, fcs_filter_tf, flight_plant, load_flight, loop_freqresp, margins
 from taos.planar.freqresp import linear_freqresp
 from taos.model import load_model
 
@@ -35,6 +36,22 @@ def test_loop_equals_closed_form_rigid_body_pid_with_tail_wags_dog():
     # ~7e-4 one percent away)
     f_twd = v.twd_frequency_hz(fl.axis)
     assert abs(loop_freqresp(fl, [f_twd])[0]) < 1e-9 * abs(loop_freqresp(fl, [0.99 * f_twd])[0])
+
+
+def test_fcs_filter_state_space_is_scipy_tf2ss_bit_for_bit():
+    """The written-out controller canonical form equals ``scipy.signal.tf2ss`` exactly (same
+    shapes, same floats) for every filter shape: with or without lag and notch, delays up to the
+    bound, Pade orders 0-6, and the static filter's idle state."""
+    import dataclasses
+
+    import scipy.signal
+
+    base = load_flight(FLIGHT).fcs
+    for lag, notch, delay, order in itertools.product((0.0, 0.05, 10.0), (0.0, 3.0), (0.0, 0.02, 2.0), range(7)):
+        c = dataclasses.replace(base, lag_time_constant_s=lag, notch_frequency_hz=notch, delay_s=delay,
+                                pade_order=order)
+        for got, ref in zip(fcs_filter_ss(c), scipy.signal.tf2ss(*fcs_filter_tf(c)), strict=True):
+            assert got.shape == ref.shape and got.dtype == ref.dtype and np.array_equal(got, ref), (c, got, ref)
 
 
 def test_loop_meets_typical_margins_and_is_conditionally_stable():

@@ -421,3 +421,21 @@ def test_the_inputs_hash_does_not_depend_on_what_the_process_loaded_before(tmp_p
     assert (tmp_path / "cache" / "taos").is_dir()     # the first load did write and read the cache
     assert first == second and first, (first, second)
     assert all("cache" not in Path(t["file"]).parts for t in first)
+
+
+def test_a_fresh_flight_load_records_the_flight_file_only(tmp_path):
+    """The flight loader builds pint's registry on first use (not when its module is imported);
+    :func:`~taos.montecarlo.inputs.recording` builds it before the block, so a fresh process's
+    first flight load records the flight file, not pint's cache or what pint's imports read."""
+    import subprocess
+    import sys
+
+    code = ("import json; from taos.montecarlo.inputs import recording, digest; "
+            "from taos.flight.vehicle import load_flight\n"
+            "with recording() as f:\n"
+            "    load_flight('core_stage')\n"
+            "print(json.dumps([t['file'] for t in digest(f, 's')[1]]))")
+    env = {**__import__("os").environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout) == [str((ROOT / "models" / "flight" / "core_stage.toml").resolve())]

@@ -72,3 +72,28 @@ def test_unit_table_gives_what_pint_gives():
                        "flow_pressure"), ("0.02 s", "time"), ("120 Hz", "frequency")):
         ref = ureg.Quantity(text).to(DIMENSIONS[kind][1]).magnitude
         assert abs(to_si(text, kind, source="t", field="f") - ref) <= 4e-16 * abs(ref)
+
+
+def _imports(code: str, names: tuple[str, ...]) -> list[str]:
+    probe = f"import json, sys\n{code}\nprint(json.dumps([m for m in {names!r} if m in sys.modules]))"
+    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_a_monte_carlo_worker_imports_only_what_a_flight_run_uses():
+    """A Dask worker of a flight campaign imports the task function and its run kind
+    (:func:`taos.montecarlo.engine.run_task`, :class:`taos.montecarlo.run.FlightRuns`): the FCS
+    filter's state space is written out (no scipy.signal, which pulls scipy.stats), and the LCO
+    root finder (scipy.optimize), the describing-function files (h5py), the flight-file units
+    (pint), the fit (casadi) and the plots load where they are used, not with the modules."""
+    heavy = ("scipy.signal", "scipy.stats", "scipy.optimize", "h5py", "pint", "casadi", "matplotlib")
+    assert _imports("import taos.montecarlo.engine, taos.montecarlo.run", heavy) == []
+
+
+def test_the_sweep_client_starts_without_kernels():
+    """``taos sweep`` imports its driver without numba (the package names resolve on first use;
+    numba comes with the first simulation); ``taos lco`` imports the flight loop without
+    scipy.signal."""
+    assert _imports("import taos.montecarlo.sweep", ("numba", "scipy.signal")) == []
+    assert _imports("import taos.flight.lco", ("scipy.signal", "scipy.stats", "h5py", "pint")) == []

@@ -295,3 +295,20 @@ def test_list_metrics_names_every_family():
     assert r.returncode == 0
     for name in ("load_resonance_hz", "phase_margin_deg", "lco", "flight_low_gain_margin_db"):
         assert name in r.stdout
+
+
+def test_a_fresh_sweep_load_records_the_same_inputs_as_a_second(tmp_path):
+    """The sweep's inputs hash does not depend on what the process imported before: the first
+    load of a fresh ``taos sweep`` process (which imports the flight modules, and numba with them,
+    on demand) records the same input files as a second load, the model's and the flight's."""
+    code = ("import json, sys\nfrom taos.montecarlo.sweep import SweepDefinition, load_runs\n"
+            "from taos.montecarlo.sweep_define import make_design, parse_set\n"
+            "d = make_design([parse_set('structure.load_stiffness=115000 lbf/in,205000 lbf/in')])\n"
+            "defn = SweepDefinition(sys.argv[1], d, ('lco',), flight_file=sys.argv[2])\n"
+            "print(json.dumps([[t['file'] for t in load_runs(defn)[1]] for _ in range(2)]))")
+    env = {**__import__("os").environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    r = subprocess.run([sys.executable, "-c", code, str(FLIGHT_MODEL), str(FLIGHT)], capture_output=True, text=True,
+                       env=env, timeout=300)
+    assert r.returncode == 0, r.stderr
+    first, second = json.loads(r.stdout)
+    assert first == second and str(FLIGHT.resolve()) in first and str(FLIGHT_MODEL.resolve()) in first

@@ -4,13 +4,34 @@
 * :mod:`taos.flight.describing` - the TVC describing-function map N(A, w) by sine dwells;
 * :mod:`taos.flight.lco` - harmonic-balance LCO prediction and time-domain confirmation;
 * :mod:`taos.flight.signoff` - the sign-off: stated limits checked over the cases, margin to each.
+
+Names are resolved on first use (PEP 562): a process that needs one module (a Monte Carlo
+worker flying an ascent) imports that module's dependencies only.
 """
 
-from taos.flight.describing import DescribingFunctionMap, describing_function_map
-from taos.flight.lco import LcoPrediction, LcoReport, analyse_lco, predict_lco, simulate_flight
-from taos.flight.signoff import Requirements, SignOff, load_requirements, sign_off
-from taos.flight.vehicle import FlightModel, Margins, load_flight, loop_freqresp, margins
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from taos import lazy_api
+
+if TYPE_CHECKING:
+    from .describing import DescribingFunctionMap, describing_function_map
+    from .lco import LcoPrediction, LcoReport, analyse_lco, predict_lco, simulate_flight
+    from .signoff import Requirements, SignOff, load_requirements, sign_off
+    from .vehicle import FlightModel, Margins, load_flight, loop_freqresp, margins
+
+#: public name -> submodule that defines it
+_WHERE = {
+    "DescribingFunctionMap": "describing", "describing_function_map": "describing", "LcoPrediction": "lco",
+    "LcoReport": "lco", "analyse_lco": "lco", "predict_lco": "lco", "simulate_flight": "lco",
+    "Requirements": "signoff", "SignOff": "signoff", "load_requirements": "signoff", "sign_off": "signoff",
+    "FlightModel": "vehicle", "Margins": "vehicle", "load_flight": "vehicle", "loop_freqresp": "vehicle",
+    "margins": "vehicle",
+}
 
 __all__ = ["DescribingFunctionMap", "describing_function_map", "LcoPrediction", "LcoReport", "analyse_lco",
            "predict_lco", "simulate_flight", "FlightModel", "Margins", "load_flight", "loop_freqresp", "margins",
            "Requirements", "SignOff", "load_requirements", "sign_off"]
+
+__getattr__, __dir__ = lazy_api(__name__, {k: f".{m}" for k, m in _WHERE.items()}, globals())

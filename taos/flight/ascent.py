@@ -44,7 +44,7 @@ from taos.flight.vehicle import FlightModel, load_flight
 from taos.model import read_toml
 from taos.profiles import Multisine, SineSweep
 from taos.shipped import resolve
-from taos.units import Q_, to_si
+from taos.units import to_si
 
 #: trajectory column -> (unit kind for to_si-style checks, SI unit)
 TRAJECTORY_COLUMNS = {
@@ -197,7 +197,7 @@ def _column(t: Mapping, key: str, si_unit: str, src: str) -> np.ndarray:
     if (not isinstance(vals, list) or not vals or len(vals) > MAX_TABLE_ROWS
             or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals)):
         raise InputError(src, f"{fld}.values", f"a list of 1 to {MAX_TABLE_ROWS} numbers", got=repr(vals)[:80])
-    from taos.units import check_unit_text
+    from taos.units import Q_, check_unit_text
 
     check_unit_text(col["unit"], src, f"{fld}.unit", f"a unit convertible to {si_unit}")
     try:
@@ -247,6 +247,8 @@ def _boosters(doc: Mapping, src: str) -> Boosters:
 
 
 def _aero(doc: Mapping, src: str) -> Aero:
+    from taos.units import Q_
+
     a = _table(doc, "aero", src)
     _keys(a, {"reference_area", "normal_force_slope", "center_of_pressure_ahead"}, src, "aero")
     slope = a.get("normal_force_slope")

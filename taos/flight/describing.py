@@ -22,7 +22,6 @@ import json
 import math
 from dataclasses import dataclass, field
 
-import h5py
 import numpy as np
 
 from taos.errors import InputError
@@ -122,6 +121,8 @@ class DescribingFunctionMap:
 
     def to_hdf5(self, path) -> None:
         """Atomically: /amplitude_rad, /freq_hz, /engine, /piston (complex), attributes."""
+        import h5py
+
         def write(tmp):
             with h5py.File(tmp, "w") as h5:
                 for k in ("amplitude_rad", "freq_hz", "engine", "piston"):
@@ -134,6 +135,8 @@ class DescribingFunctionMap:
 
     @classmethod
     def from_hdf5(cls, path) -> "DescribingFunctionMap":
+        import h5py
+
         with h5py.File(path, "r") as h5:
             return cls(amplitude_rad=h5["amplitude_rad"][()], freq_hz=h5["freq_hz"][()], engine=h5["engine"][()],
                        piston=h5["piston"][()], friction_model=str(h5.attrs["friction_model"]),

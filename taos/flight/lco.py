@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.optimize
 
 from taos.planar.avionics import Avionics
 from taos.harmonics import harmonic_amplitudes as _fit
@@ -126,6 +125,8 @@ def _wrap180(x):
 def predict_lco(flight: FlightModel, df: DescribingFunctionMap, axis: str | None = None,
                 n_grid: int = 160) -> LcoPrediction:
     """Solve L0(j w) N(A, w) = -1 over the map (see the module docstring)."""
+    import scipy.optimize
+
     axis = axis or flight.axis
     la = np.linspace(np.log(df.amplitude_rad[0]), np.log(df.amplitude_rad[-1]), n_grid)
     lf = np.linspace(np.log(df.freq_hz[0]), np.log(df.freq_hz[-1]), n_grid)

@@ -43,16 +43,13 @@ from pathlib import Path
 from typing import Mapping
 
 import numpy as np
-import scipy.signal
 
 from taos.errors import InputError
 from taos.linear import StateSpace
 from taos.stability import LoopMargins, loop_margins
 from taos.model import TvcModel, read_toml
 from taos.shipped import resolve
-from taos.planar.saturation import embed_limits
 from taos.planar.simplex import LurePlant, simplex_limits, simplex_state_space
-from taos.units import Q_
 
 #: vehicle + FCS block signals
 VF_INPUTS = ("delta_rad", "delta_rate_rad_s")
@@ -167,6 +164,8 @@ _OPTIONAL = {"aero_instability", "lag_time_constant", "notch_frequency", "notch_
 
 def _value(table: Mapping, key: str, unit: str, check: str, src: str, section: str) -> float:
     """Parse ``table[key]`` (a string with a unit; plain numbers for dimensionless) to SI."""
+    from taos.units import Q_
+
     fld = f"{section}.{key}"
     expected = f"a value with a unit convertible to {unit}"
     v = table[key]
@@ -273,8 +272,24 @@ def fcs_filter_tf(fcs: FlightControl) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fcs_filter_ss(fcs: FlightControl) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(A, B, C, D) of :func:`fcs_filter_tf` in controller canonical form (``scipy.signal.tf2ss``)."""
-    return scipy.signal.tf2ss(*fcs_filter_tf(fcs))
+    """(A, B, C, D) of :func:`fcs_filter_tf` in controller canonical form (time in s; the
+    filter's input and output are the FCS command in rad).
+
+    With num (padded with leading zeros to den's length) and den both divided by den[0]: A's
+    first row is -den[1:] with ones on its subdiagonal, B = e_1, C = num[1:] - num[0] den[1:],
+    D = num[0]; a static filter (no lag, notch or delay) keeps one idle state. This is
+    ``scipy.signal.tf2ss`` bit for bit (``tests/test_flight.py``), written out so that a flight
+    run does not import scipy.signal (about half a second of every Monte Carlo worker's start-up).
+    scipy's trim of numerator coefficients below 1e-14 never applies: num[0] / den[0] is
+    +-1 or +-1 / lag time constant (the Pade and notch leading coefficients cancel)."""
+    num, den = fcs_filter_tf(fcs)
+    num, den = num / den[0], den / den[0]
+    num = np.concatenate([np.zeros(len(den) - len(num)), num])
+    n = len(den) - 1
+    if n == 0:
+        return np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)), num.reshape(1, 1)
+    A = np.vstack([-den[None, 1:], np.eye(n - 1, n)])
+    return A, np.eye(n, 1), (num[1:] - num[0] * den[1:])[None, :], num[:1].reshape(1, 1)
 
 
 def vehicle_fcs_state_space(flight: FlightModel, axis: str | None = None, *,
@@ -369,6 +384,8 @@ def flight_plant(flight: FlightModel, model: TvcModel, axis: str | None = None, 
     Outputs: the simplex outputs, then :data:`VF_OUTPUTS`. States: the simplex states, then
     the vehicle + FCS states. ``parts``: :meth:`PlantParts.of` of the same ``model``, ``axis``
     and FCS filter when already built (the same plant, without rebuilding them)."""
+    from taos.planar.saturation import embed_limits   # a numba module: imported by a run, not a file load
+
     axis = axis or flight.axis
     parts = parts or PlantParts.of(flight, model, axis)
     tv = parts.tvc

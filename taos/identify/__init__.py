@@ -7,12 +7,31 @@
 * :mod:`taos.identify.fit` - least-squares fits with standard errors;
 * :mod:`taos.identify.compare` - two model fits side by side;
 * :mod:`taos.identify.series` - a series of records fitted one by one, with trends.
+
+Names are resolved on first use (PEP 562): a module taking one table from a submodule
+(:data:`taos.identify.surrogate.PARAMETERS`) does not import the fit and the estimators.
 """
 
-from taos.identify.compare import Comparison, compare_models
-from taos.identify.data import TestData, load_test_data
-from taos.identify.estimation import MeasuredResponse, estimate
-from taos.identify.fit import FitResult, fit_frequency_response
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from taos import lazy_api
+
+if TYPE_CHECKING:
+    from .compare import Comparison, compare_models
+    from .data import TestData, load_test_data
+    from .estimation import MeasuredResponse, estimate
+    from .fit import FitResult, fit_frequency_response
+
+#: public name -> submodule that defines it
+_WHERE = {
+    "Comparison": "compare", "compare_models": "compare", "TestData": "data", "load_test_data": "data",
+    "MeasuredResponse": "estimation", "estimate": "estimation", "FitResult": "fit",
+    "fit_frequency_response": "fit",
+}
 
 __all__ = ["Comparison", "compare_models", "TestData", "load_test_data", "MeasuredResponse", "estimate",
            "FitResult", "fit_frequency_response"]
+
+__getattr__, __dir__ = lazy_api(__name__, {k: f".{m}" for k, m in _WHERE.items()}, globals())

@@ -50,7 +50,6 @@ import numpy as np
 from taos.errors import InputError
 from taos.bounds import MAX_DATA_SAMPLES, MAX_RESAMPLE_FACTOR
 from taos.results import atomic_write
-from taos.units import Q_
 
 AXES = ("pitch", "yaw")
 #: canonical signal name -> (unit kind, SI unit, example unit)
@@ -136,6 +135,8 @@ class TestData:
     def to_csv(self, path, digits: int = 8, piston_unit: str = "in", angle_unit: str = "deg") -> None:
         """Write this record as CSV with a TOML-comment header and ``signal [unit]`` columns
         (atomically)."""
+        from taos.units import Q_
+
         pf = float(Q_(1.0, "m").to(piston_unit).magnitude)
         af = float(Q_(1.0, "rad").to(angle_unit).magnitude)
         cols, names = [self.t_s], ["time [s]"]
@@ -179,7 +180,7 @@ def _toml_value(v) -> str:
 def unit_factor(unit: str, signal: str, source: str, column: str) -> float:
     """SI factor of ``unit`` for ``signal`` (e.g. 'deg' for an angle -> pi/180)."""
     kind, si, example = SIGNALS[signal]
-    from taos.units import check_unit_text
+    from taos.units import Q_, check_unit_text
 
     check_unit_text(unit, source, column, f"a {kind} unit like {example}")
     try:

@@ -32,7 +32,12 @@ def _audit(event: str, args) -> None:
 
 @contextmanager
 def recording() -> Iterator[set[str]]:
-    """Within the block, the set of files this thread opens (absolute paths)."""
+    """Within the block, the set of files this thread opens (absolute paths). pint's unit
+    registry is built first: the flight and ascent loaders ask for it on first use, and its
+    start-up reads (pint's own cache, the system files its imports probe) are not inputs."""
+    from taos.units import _registry
+
+    _registry()
     if not _HOOK["installed"]:
         sys.addaudithook(_audit)
         _HOOK["installed"] = True

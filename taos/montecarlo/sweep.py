@@ -167,15 +167,15 @@ def check_metrics(names: tuple[str, ...], flight_file: str | None) -> None:
 def load_runs(defn: SweepDefinition) -> tuple[SweepRuns, list[dict], dict]:
     """The run kind with every variant built and checked here, the table of input files, and
     the base model's provenance."""
+    from taos.flight.vehicle import load_flight
     from taos.model import load_model
     from taos.montecarlo.inputs import digest, recording
 
     check_metrics(defn.metrics, defn.flight_file)
-    with recording() as files:
+    with recording() as files:   # the modules imported before it: an import reads files that are not inputs
         base = load_model(defn.model_file, friction=defn.friction)
         lco = None
         if defn.flight_file is not None:
-            from taos.flight.vehicle import load_flight
             flight = load_flight(defn.flight_file)
             lco = LcoSettings(flight, defn.avionics,
                               None if defn.amplitudes_deg is None else tuple(map(math.radians, defn.amplitudes_deg)),

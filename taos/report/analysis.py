@@ -364,7 +364,6 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     from taos.results import check_output_folder, input_provenance
 
     # bad input fails here, before any progress output: one line, nothing written
-    threads = thread_count(threads)
     if out is not None:
         check_output_folder(Path(out), OUTPUTS)
     if isinstance(model, TvcModel):
@@ -384,6 +383,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     mask = _spec_mask(spec)
     specs = _spec_results(model, mask)
     measured = _measured_responses(data) if data is not None else None
+    threads = thread_count(threads)   # when None numba's count: numba imported once the inputs are good
     if engine == "taos":
         from taos.taos3d import simulate_taos, taos_freqresp
         from taos.taos3d.simulate import taos_freqresp_axes
