@@ -18,7 +18,7 @@ import pytest
 
 from taos.errors import InputError, SimulationUnstable
 from taos.model import load_model
-from taos.planar._parallel import run_tasks, thread_count
+from taos.planar._parallel import run_each, run_tasks, thread_count
 from taos.planar.simulate import TimeHistory, simulate
 from taos.profiles import Step, TwoAxis
 from taos.report.analysis import DEFAULT_PROFILE, _profile_of, greenrun
@@ -74,6 +74,26 @@ def test_the_first_failure_in_task_order_is_raised_as_the_serial_run_would():
         with pytest.raises(SimulationUnstable) as e:
             run_tasks([late, early], threads=n)
         assert e.value.time_s == 2.0 and "task 0" in str(e.value)
+
+
+def test_run_each_calls_every_item_once_the_costliest_first():
+    """A batch's items (the dwells): every item once; two threads start the two costliest
+    first (they take the items costliest first, one at a time); one thread goes in item order."""
+    cost = [3, 9, 1, 7, 5]
+    for n in (1, 2):
+        seen, lock = [], threading.Lock()
+
+        def call(b):
+            with lock:
+                seen.append(b)
+            time.sleep(0.01 * cost[b])
+
+        run_each(call, cost, threads=n)
+        assert sorted(seen) == list(range(5))
+        if n == 1:
+            assert seen == [0, 1, 2, 3, 4]
+        else:
+            assert set(seen[:2]) == {1, 3}
 
 
 def test_thread_count_default_and_bad_values():

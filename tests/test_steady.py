@@ -112,6 +112,43 @@ def test_taos_family_equals_single_amplitude_calls(hotfire):
         assert one.amplitude_rad == fam[k].amplitude_rad
 
 
+@pytest.mark.parametrize("kw", [{"integrator": "rk4"}, {"method": "shoot", "max_cycles": 2},
+                                {"method": "shoot", "max_cycles": 2, "integrator": "rk4"}])
+def test_dwell_batches_on_one_and_two_threads_are_bit_identical(hotfire, kw):
+    """The RK4 and shooting dwell batches (one dwell a task on the threads, the longest first)
+    give the same bits on one thread as on two (the ETDRK4 one: tests/test_expstep.py)."""
+    import numba
+    nt = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = sine_dwell_points(hotfire, AMPS, FREQ, settle_s=0.2, **kw)
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = sine_dwell_points(hotfire, AMPS, FREQ, settle_s=0.2, **kw)
+    finally:
+        numba.set_num_threads(nt)
+    assert np.array_equal(one.engine, two.engine) and np.array_equal(one.piston, two.piston)
+    if one.method == "shoot":
+        for q in ("residual", "periods", "converged"):
+            assert np.array_equal(getattr(one, q), getattr(two, q))
+
+
+def test_taos_dwells_on_one_and_two_threads_are_bit_identical(hotfire):
+    """The 3-D model's dwell batch (one dwell a task on the threads): one thread's bits on two."""
+    import numba
+    from taos.taos3d import taos_freqresp_family, taos_model
+    tm = taos_model(hotfire)
+    nt = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = taos_freqresp_family(tm, [2.0, 5.0], [0.1 * DEG, 0.3 * DEG], settle_s=0.2)
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = taos_freqresp_family(tm, [2.0, 5.0], [0.1 * DEG, 0.3 * DEG], settle_s=0.2)
+    finally:
+        numba.set_num_threads(nt)
+    for a, b in zip(one, two):
+        assert np.array_equal(a.engine, b.engine) and np.array_equal(a.piston, b.piston)
+
+
 def test_lco_map_makes_one_describing_function_per_tvc_variant(monkeypatch):
     """The describing function depends on the TVC only: a verdict map over a TVC parameter and a
     flight-loop gain makes one map per TVC value (2, not 4), and every point equals the

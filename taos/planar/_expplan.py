@@ -175,9 +175,13 @@ def step_tables(A: np.ndarray, bc: np.ndarray, dts: np.ndarray):
 
 def run_dwells(args, Cy, kern, amps, freqs, npc, n_settle, n_meas, out, status):
     """ETDRK4 dwells (:func:`taos.planar._expstep.dwell_batch`) for ``npc`` steps a cycle each
-    (coefficients from :func:`step_tables`)."""
+    (coefficients from :func:`step_tables`), one per task on the threads, the longest first
+    (:func:`taos.planar._parallel.run_each`)."""
+    from ._parallel import run_each
+
     stack, G, D, ms, idx = step_tables(args[0], args[2], 1.0 / (freqs * npc))
-    _ex.dwell_batch(*args, Cy, *kern, *stack, G, D, ms, idx, idx, amps, freqs, npc, n_settle, n_meas, out, status)
+    run_each(lambda b: _ex.dwell_batch(*args, Cy, *kern, *stack, G, D, ms, idx, idx, amps, freqs, npc, n_settle,
+                                       n_meas, out, status, b, b + 1), n_settle + n_meas)
 
 
 def exp_steps_per_cycle(args, model, inertia_kgm2: float, amps, freqs, fixed_dt_s: float,

@@ -54,7 +54,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from . import _avionics_kernels as _av
 from . import dynamics as _dy
@@ -399,16 +399,17 @@ def _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, 
     return -1
 
 
-@njit(cache=True, parallel=True, fastmath=_FM)
+@njit(cache=True, nogil=True, fastmath=_FM)
 def dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, offs,
-                tab, amps, freqs, n_per_cycle, n_settle, n_meas, out, status):
-    """Independent ETDRK4 sine dwells in parallel (each as :func:`_dwell_one`). Dwell b uses
+                tab, amps, freqs, n_per_cycle, n_settle, n_meas, out, status, b0, b1):
+    """Independent ETDRK4 sine dwells b0 <= b < b1, one after the other without the GIL (each as
+    :func:`_dwell_one`; the callers run slices on threads: :func:`taos.planar._parallel.run_each`). Dwell b uses
     the step coefficients ``E[offs[b]]`` .. ``F3[offs[b]]`` ((k, n, n) stacks, one per
     distinct step) and the command table ``G[tab[b]]``, ``D[tab[b]]`` ((k, M + 1, n), the
     first ``tab_m[tab[b]]`` + 1 rows: each step's table has its own size); the
     rest per entry as :func:`taos.planar.dynamics.sine_dwell_batch`. A dwell's result does not
     depend on the other dwells (bit for bit)."""
-    for b in prange(amps.shape[0]):
+    for b in range(b0, b1):
         o = offs[b]
         t = tab[b]
         status[b] = _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E[o], E2[o], P2[o], F1[o],

@@ -20,7 +20,10 @@ flag per outermost call, seen by the nested calls through a context variable).
 The thread count: ``threads`` given, else numba's (``NUMBA_NUM_THREADS``, default the number of
 cores), so ``NUMBA_NUM_THREADS=1`` makes every command serial. Only kernels that are not
 ``parallel=True`` go to the threads: numba's default (workqueue) threading layer does not
-allow two parallel kernels to start at once.
+allow two parallel kernels to start at once. The package has no ``parallel=True`` kernel: a
+batch of independent dwells is a serial ``nogil`` kernel over a range of dwells, called once
+per dwell on the threads (:func:`run_each`), which also spares numba's parallel lowering at
+compile time.
 """
 
 from __future__ import annotations
@@ -105,3 +108,14 @@ def run_tasks(tasks: Sequence[Callable[[], T]], threads: int | None = None,
             _CANCEL.reset(token)
     ex.shutdown(wait=True)
     return out
+
+
+def run_each(call: Callable[[int], object], cost: Sequence[float], threads: int | None = None) -> None:
+    """``call(b)`` for every b in ``range(len(cost))`` (a kernel computing item b of a batch into
+    arrays of its own, e.g. ``status[b]``, ``out[b]``: nothing returned), on ``threads`` threads
+    by :func:`run_tasks` (failures and interrupts as there). The threads take the items costliest
+    first (``cost`` in any unit, e.g. steps; ties in item order), one at a time, so that the
+    long items do not end up on one thread; one thread calls them in item order."""
+    n = len(cost)
+    order = sorted(range(n), key=lambda b: -float(cost[b]))
+    run_tasks([lambda b=b: call(b) for b in range(n)], threads, start_order=order)

@@ -48,7 +48,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from . import _avionics_kernels as _av
 from . import saturation as _lim
@@ -306,15 +306,16 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, f
     return -1
 
 
-@njit(cache=True, parallel=True, fastmath=_FM)
+@njit(cache=True, nogil=True, fastmath=_FM)
 def sine_dwell_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps, freqs, n_per_cycle,
-                     n_settle, n_meas, out, status):
-    """Independent sine dwells in parallel: :func:`_sine_dwell_one` for every entry b of
-    ``amps`` (n_b,) [r] and ``freqs`` (n_b,) [Hz], with ``n_per_cycle``, ``n_settle``,
+                     n_settle, n_meas, out, status, b0, b1):
+    """Independent sine dwells b0 <= b < b1, one after the other without the GIL (the callers
+    run slices on threads: :func:`taos.planar._parallel.run_each`): :func:`_sine_dwell_one` for
+    entry b of ``amps`` (n_b,) [r] and ``freqs`` (n_b,) [Hz], with ``n_per_cycle``, ``n_settle``,
     ``n_meas`` (n_b,) int, into ``out[b]`` (n_b, n_y, 3) and ``status[b]`` (n_b,) int (-1 or
     the failing step); plant arrays, ``Cy``, ``fid``, ``fp``, ``avp`` as
     :func:`integrate_samples`."""
-    for b in prange(amps.shape[0]):
+    for b in range(b0, b1):
         status[b] = _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amps[b], freqs[b],
                                     n_per_cycle[b], n_settle[b], n_meas[b], out[b])
 

@@ -36,6 +36,7 @@ from ..errors import SimulationUnstable
 from ..linear import gain_db, phase_deg_continuous
 from ..model import TvcModel
 from .simplex import simplex_plant, simplex_state_space
+from ._parallel import run_each
 from .simulate import DEFAULT_DT_S, check_friction_step, kernel_args
 
 
@@ -165,18 +166,6 @@ def settle_time_s(model: TvcModel, axis: str = "pitch", decades: float = 4.0) ->
     return decades * math.log(10) / sigma
 
 
-def deal_by_cost(cost) -> np.ndarray:
-    """Order for a parallel batch of independent jobs with expected ``cost`` (any unit): numba's
-    threads take contiguous blocks of a ``prange``, so the jobs are sorted by cost and dealt
-    round-robin to the threads (thread j gets the j-th, (j+k)-th, ... costliest). Returns the
-    permutation ``perm``; results come back in input order with ``np.argsort(perm)``."""
-    import numba
-
-    k = max(numba.get_num_threads(), 1)
-    by_cost = np.argsort(-np.asarray(cost, float), kind="stable")
-    return np.concatenate([by_cost[j::k] for j in range(k)])
-
-
 #: how a sine dwell reaches the periodic orbit it measures (``taos freqresp --steady``)
 STEADY_METHODS = ("settle", "shoot")
 #: how a dwell is integrated: exponential Runge-Kutta (:mod:`taos.planar._expstep`) or
@@ -204,7 +193,8 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
                       settle_s: float | None = None, min_steps_per_cycle: int = 64, method: str = "settle",
                       tol: float = 1e-4, k_rre: int = 4, max_cycles: int = 8, integrator: str = "exp") -> DwellPoints:
     """Sine dwells at paired points (``amplitudes_rad`` [rad], ``freq_hz`` [Hz], equal
-    lengths), all in one parallel call of the compiled kernel; each dwell is independent, so a
+    lengths), all in one parallel batch (one compiled call per dwell on the threads, the longest
+    first: :func:`taos.planar._parallel.run_each`); each dwell is independent, so a
     point's result does not depend on the other points (bit for bit).
 
     ``method="settle"``: from rest through at least ``settle_cycles`` cycles and ``settle_s``
@@ -231,8 +221,9 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
         dt_max_s = DEFAULT_DT_S
     if measure_cycles is None:
         measure_cycles = 2 if method == "settle" else 1
-    A = np.atleast_1d(np.asarray(amplitudes_rad, float))
-    F = np.atleast_1d(np.asarray(freq_hz, float))
+    # own copies (writable, C order: the kernels' compiled signature, whatever the caller passed)
+    A = np.array(amplitudes_rad, float, ndmin=1)
+    F = np.array(freq_hz, float, ndmin=1)
     plant = simplex_plant(model, axis)
     check_friction_step(model, plant.inertia_kgm2, dt_max_s)
     ts = settle_time_s(model, axis) if settle_s is None else settle_s
@@ -248,8 +239,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     o = plant.ss.output_index
     Cy = np.ascontiguousarray(plant.ss.C[[o("x_p_m"), o("theta_rad")]])
     kern = (model.friction.entry.rates, model.friction.pack(), model.avionics.pack())
-    perm = deal_by_cost(nbud * npc + nmeas)   # each dwell is independent; results are put back
-    A, F, npc, nbud, nmeas = A[perm], F[perm], npc[perm], nbud[perm], nmeas[perm]
+    cost = nbud * npc + nmeas   # steps: each dwell is one task, the longest first (run_each)
     out = np.zeros((A.size, 2, 3))
     status = np.full(A.size, -1, np.int64)
     extra = {}
@@ -260,7 +250,8 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     elif method == "settle":
         from . import dynamics as _ig
 
-        _ig.sine_dwell_batch(*args, Cy, *kern, A, F, npc, nbud * npc, nmeas, out, status)
+        nset = nbud * npc
+        run_each(lambda b: _ig.sine_dwell_batch(*args, Cy, *kern, A, F, npc, nset, nmeas, out, status, b, b + 1), cost)
     else:
         from . import steady
 
@@ -282,20 +273,19 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
             tabs = ((z3,) * 6, np.zeros((1, 2, n)), np.zeros((1, 2, n)), np.ones(1, np.int64),
                     np.zeros(A.size, np.int64))
         stack, G, D, ms, idx = tabs
-        steady.shoot_batch(*args, Cy, *kern, *stack, G, D, ms, idx, use_exp, A, F, npc, nbud, nmeas, y0, scale, nz,
-                           tol, k_rre, max_cycles, out, info, status)
+        run_each(lambda b: steady.shoot_batch(*args, Cy, *kern, *stack, G, D, ms, idx, use_exp, A, F, npc, nbud, nmeas,
+                                              y0, scale, nz, tol, k_rre, max_cycles, out, info, status, b, b + 1), cost)
         extra = {"residual": info[:, steady.INFO_RESIDUAL], "periods": info[:, steady.INFO_PERIODS].astype(np.int64),
                  "converged": info[:, steady.INFO_CONVERGED] > 0.5}
     bad = np.flatnonzero(status >= 0)
-    if bad.size:
-        b = bad[np.argmin(perm[bad])]
+    if bad.size:   # the first failing dwell in input order
+        b = bad[0]
         raise SimulationUnstable(status[b] / (F[b] * npc[b]),
                                  f"sine dwell {math.degrees(A[b]):.3g} deg at {F[b]:.3g} Hz")
     # fundamental: y ~ a sin + b cos  ->  complex gain (a + j b) / A relative to A sin
-    back = np.argsort(perm)
-    h = ((out[:, :, 0] + 1j * out[:, :, 1]) / A[:, None])[back]
+    h = (out[:, :, 0] + 1j * out[:, :, 1]) / A[:, None]
     R = model.actuator.moment_arm_m
-    return DwellPoints(h[:, 0] / R, h[:, 1], method, **{q: v[back] for q, v in extra.items()})
+    return DwellPoints(h[:, 0] / R, h[:, 1], method, **extra)
 
 
 def sine_dwell_grid(model: TvcModel, amplitudes_rad: np.typing.ArrayLike, freq_hz: np.typing.ArrayLike,

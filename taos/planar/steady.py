@@ -44,7 +44,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from . import _expstep as _ex
 from . import dynamics as _ig
@@ -215,17 +215,19 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
     return -1
 
 
-@njit(cache=True, parallel=True, fastmath=_FM)
+@njit(cache=True, nogil=True, fastmath=_FM)
 def shoot_batch(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D, tab_m, idx, use_exp,
-                amps, freqs, n_per_cycle, n_budget, n_meas, y0, scale, nz, tol, k_rre, max_cycles, out, info, status):
-    """Independent shooting dwells in parallel: :func:`_shoot_one` for every entry b of ``amps``
+                amps, freqs, n_per_cycle, n_budget, n_meas, y0, scale, nz, tol, k_rre, max_cycles, out, info, status,
+                b0, b1):
+    """Independent shooting dwells b0 <= b < b1, one after the other without the GIL (the callers
+    run slices on threads: :func:`taos.planar._parallel.run_each`): :func:`_shoot_one` for entry b of ``amps``
     (n_b,) [r] and ``freqs`` (n_b,) [Hz] with its ``n_per_cycle``, ``n_budget``, ``n_meas``
     (n_b,), start ``y0`` and scales ``scale`` (n_b, n + 1), into ``out[b]`` (n_b, n_y, 3),
     ``info[b]`` (n_b, len(INFO)) and ``status[b]`` (n_b,) int; the rest as :func:`_shoot_one`.
     With ``use_exp`` the periods are ETDRK4 steps with the coefficient stacks ``E`` .. ``D``,
     ``tab_m`` at ``idx[b]`` (as :func:`taos.planar._expstep.dwell_batch`), else RK4 steps (the
     stacks unused)."""
-    for b in prange(amps.shape[0]):
+    for b in range(b0, b1):
         i = idx[b]
         ex = (E[i], E2[i], P2[i], F1[i], F2[i], F3[i], G[i], D[i], tab_m[i])
         status[b] = _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amps[b], freqs[b],

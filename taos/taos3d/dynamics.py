@@ -92,7 +92,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..planar import _avionics_kernels as _av
 from ..planar import saturation as _lim
@@ -710,12 +710,13 @@ def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out,
     return -1
 
 
-@njit(cache=True, parallel=True, fastmath=_FM, error_model="numpy")
-def dwell_batch(P, fid, fp, avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out, status):
-    """Independent two-axis dwells in parallel: :func:`_dwell_one` for every row b of ``amps``
+@njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
+def dwell_batch(P, fid, fp, avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out, status, b0, b1):
+    """Independent two-axis dwells b0 <= b < b1, one after the other without the GIL (the caller
+    runs slices on threads: :func:`taos.planar._parallel.run_each`): :func:`_dwell_one` for row b of ``amps``
     (n, 2) [rad] and ``freqs`` (n, 2) [Hz], with ``fmeas`` (n,) [Hz], ``dts`` (n,) [s],
     ``nset``, ``nmeas`` (n,) int, into ``out[b]`` (n, 4, 3) and ``status[b]`` (n,) int
     (-1 or the failing step); ``P``, ``fid``, ``fp``, ``avp``, ``x0`` as :func:`_dwell_one`."""
-    for b in prange(amps.shape[0]):
+    for b in range(b0, b1):
         status[b] = _dwell_one(P, fid, fp, avp, x0, amps[b], freqs[b], fmeas[b], dts[b], nset[b],
                                nmeas[b], out[b])

@@ -21,7 +21,8 @@ import numpy as np
 
 from ..planar.actuator import actuator_state_space
 from ..errors import SimulationUnstable
-from ..planar.freqresp import FrequencyResponse, deal_by_cost, settle_time_s
+from ..planar._parallel import run_each
+from ..planar.freqresp import FrequencyResponse, settle_time_s
 from ..linear import StateSpace
 from ..profiles import Profile, is_two_axis
 from ..planar.simulate import SolverSettings, TimeHistory, provenance
@@ -341,7 +342,7 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     checked on the whole grid, or on each group of consecutive rows of sizes ``groups``."""
     pk = pack(tm)
     ts = settle_time_s(tm.base, "pitch") if settle_s is None else settle_s
-    fmeas = np.asarray(fmeas, float)
+    fmeas = np.array(fmeas, float)   # own copies (writable, C order: the kernel's compiled signature)
     npc = np.maximum(np.ceil(1.0 / (fmeas * dt_max_s)), min_steps_per_cycle).astype(np.int64)
     dts = 1.0 / (fmeas * npc)
     nset = (np.maximum(settle_cycles, np.ceil(ts * fmeas)) * npc).astype(np.int64)
@@ -349,17 +350,17 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     bounds = np.cumsum([0] + list(groups if groups is not None else [fmeas.size]))
     for g0, g1 in zip(bounds[:-1], bounds[1:]):   # before any work, as the command line's budget
         _args.check_dwell_steps(int(np.sum(nset[g0:g1] + nmeas[g0:g1])))
-    perm = deal_by_cost(nset + nmeas)   # results put back in input order below
-    amps, freqs = np.ascontiguousarray(np.asarray(amps, float)[perm]), np.ascontiguousarray(np.asarray(freqs, float)[perm])
-    fmeas, dts, nset, nmeas = fmeas[perm], dts[perm], nset[perm], nmeas[perm]
+    amps, freqs = np.array(amps, float), np.array(freqs, float)
     out = np.zeros((fmeas.size, 4, 3))
     status = np.full(fmeas.size, -1, np.int64)
-    _dy.dwell_batch(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), amps, freqs, fmeas, dts, nset, nmeas, out, status)
+    x0 = rest_state(pk)
+    # one task per dwell on the threads, the longest (most steps) first
+    run_each(lambda b: _dy.dwell_batch(pk.P, pk.fid, pk.fp, pk.avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out,
+                                       status, b, b + 1), nset + nmeas)
     bad = np.flatnonzero(status >= 0)
-    if bad.size:
-        b = bad[np.argmin(perm[bad])]
+    if bad.size:   # the first failing dwell in row order
+        b = bad[0]
         raise SimulationUnstable(status[b] * dts[b], f"TAOS sine dwell at {fmeas[b]:.3g} Hz")
-    out = out[np.argsort(perm)]
     return out
 
 
