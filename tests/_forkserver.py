@@ -255,23 +255,26 @@ class _Zygote:
 
         umask = os.umask(0o022)
         os.umask(umask)
-        req = {"argv": argv, "cwd": os.path.abspath(cwd), "umask": umask, "env": {k: os.environ[k] for k in ALLOWED_ENV if k in os.environ}}
+        req = {"argv": argv, "cwd": os.path.abspath(cwd), "umask": umask,
+               "env": {k: os.environ[k] for k in ALLOWED_ENV if k in os.environ}}
         mine, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         out_r, out_w = os.pipe()
         err_r, err_w = os.pipe()
+        first = b""
         try:
             socket.send_fds(self.ctl, [json.dumps(req).encode()], [theirs.fileno(), 0, out_w, err_w])
             first = mine.recv(4096)
         except OSError:
-            first = b""
+            pass
         finally:
             for f in (out_w, err_w):
                 os.close(f)
             theirs.close()
+            if not first:
+                for f in (out_r, err_r):
+                    os.close(f)
+                mine.close()
         if not first:
-            for f in (out_r, err_r):
-                os.close(f)
-            mine.close()
             raise _NotStarted("the fork server did not start the command")
         endtime = None if timeout is None else time.monotonic() + timeout
         chunks = {out_r: [], err_r: []}
@@ -283,8 +286,8 @@ class _Zygote:
                 while sel.get_map():
                     left = None if endtime is None else endtime - time.monotonic()
                     if left is not None and left < 0:
-                        raise subprocess.TimeoutExpired(argv, timeout, output=b"".join(chunks[out_r]) if chunks[out_r] else None,
-                                                        stderr=b"".join(chunks[err_r]) if chunks[err_r] else None)
+                        so_far = [b"".join(chunks[f]) if chunks[f] else None for f in (out_r, err_r)]
+                        raise subprocess.TimeoutExpired(argv, timeout, output=so_far[0], stderr=so_far[1])
                     for key, _ in sel.select(left):
                         data = os.read(key.fd, 32768)
                         if not data:
@@ -317,14 +320,20 @@ class _Zygote:
         return subprocess.CompletedProcess(argv, rc, text[0], text[1])
 
 
-def _interpreter(script: str) -> str:
-    """The interpreter of a console script's ``#!`` line (the zygote's: the same as a new process)."""
-    with open(script, "rb") as f:
-        line = f.readline().decode()
-    return line[2:].strip() if line.startswith("#!") and " " not in line[2:].strip() else sys.executable
+def _interpreter(script: str) -> str | None:
+    """The interpreter of a console script's ``#!`` line (the zygote's, as its new process's), or
+    ``None`` if the line is not a bare path to a Python (a shell trampoline: a real process)."""
+    try:
+        with open(script, "rb") as f:
+            line = f.readline().decode()
+    except (OSError, UnicodeDecodeError):
+        return None
+    path = line[2:].strip()
+    ok = line.startswith("#!") and path and " " not in path and os.path.basename(path).startswith("python")
+    return path if ok else None
 
 
-_zygote: _Zygote | None = None
+_zygote: _Zygote | None | bool = None   # False: it could not start
 _pid = None
 #: this process's count of forked commands ("forked") and of real processes, by reason
 STATS: dict[str, int] = {}
@@ -340,11 +349,12 @@ def eligible(script: str, cwd) -> str | None:
         return f"not a taos/masv console script: {script}"
     if not os.path.isdir(cwd):
         return f"no folder {cwd}"   # subprocess.run raises its error
-    if _zygote is not None and _pid == os.getpid():
+    if _zygote and _pid == os.getpid():
         env = {k: v for k, v in os.environ.items() if k not in ALLOWED_ENV}
         if env != {k: v for k, v in _zygote.env.items() if k not in ALLOWED_ENV}:
             return "environment differs from the fork server's"
-    if any(os.path.exists(os.path.join(d, _NUMBA_CONFIG)) for d in (cwd, _zygote.cwd if _zygote else os.getcwd())):
+    start = _zygote.cwd if _zygote and _pid == os.getpid() else os.getcwd()   # where the zygote imports
+    if any(os.path.exists(os.path.join(d, _NUMBA_CONFIG)) for d in (cwd, start)):
         return f"{_NUMBA_CONFIG} in the working folder"
     return None
 
@@ -354,8 +364,12 @@ def zygote(script: str) -> _Zygote | None:
     ``script``; it runs any Python script with the same interpreter), or ``None`` if it is gone."""
     global _zygote, _pid
     if _zygote is None or _pid != os.getpid():
-        _zygote, _pid = _Zygote(script), os.getpid()
-    return _zygote if _zygote.alive() else None
+        _pid = os.getpid()
+        try:
+            _zygote = _Zygote(script) if _interpreter(script) else False
+        except OSError:
+            _zygote = False   # not again in this process: its commands run as real processes
+    return _zygote if _zygote and _zygote.alive() else None
 
 
 def run(argv: list[str], cwd, timeout: float = 300):
@@ -365,6 +379,8 @@ def run(argv: list[str], cwd, timeout: float = 300):
 
     argv = [str(a) for a in argv]
     why = eligible(argv[0], cwd)
+    if why is None and _interpreter(argv[0]) is None:
+        why = "not a Python console script"
     if why is None and ((z := zygote(argv[0])) is None or z.interpreter != _interpreter(argv[0])):
         why = "the fork server is gone" if z is None else "another interpreter"
     if why is None:
@@ -381,7 +397,7 @@ def run(argv: list[str], cwd, timeout: float = 300):
 def shutdown() -> None:
     """End this process's zygote (pytest's session end, and ``atexit``)."""
     global _zygote
-    if _zygote is not None and _pid == os.getpid():
+    if _zygote and _pid == os.getpid():
         _zygote.close()
     _zygote = None
     if STATS and os.environ.get("TAOS_TEST_FORKSERVER_STATS"):   # a file to append the counts to
