@@ -126,7 +126,7 @@ def _serve(ctl_fd: int, base_signals: dict) -> dict:
                 os.write(conn, json.dumps({"pid": pid}).encode())
             elif fd in by_pidfd:   # a child ended: reap it, report its status
                 pid, conn = by_pidfd[fd]
-                got, status = os.waitpid(pid, os.WNOHANG)
+                got, status, usage = os.wait4(pid, os.WNOHANG)
                 if got == 0:   # a stale event: this pidfd's number was reused in this round
                     continue
                 del by_pidfd[fd]
@@ -136,7 +136,8 @@ def _serve(ctl_fd: int, base_signals: dict) -> dict:
                     del by_conn[conn]
                     poll.unregister(conn)
                     try:
-                        os.write(conn, json.dumps({"returncode": os.waitstatus_to_exitcode(status)}).encode())
+                        os.write(conn, json.dumps({"returncode": os.waitstatus_to_exitcode(status),
+                                                   "cpu_s": usage.ru_utime + usage.ru_stime}).encode())
                     except OSError:
                         pass
                     os.close(conn)
@@ -313,7 +314,9 @@ class _Zygote:
             for f in chunks:
                 os.close(f)
         mine.close()
-        rc = json.loads(status)["returncode"]
+        status = json.loads(status)
+        rc = status["returncode"]
+        STATS["child_cpu_s"] = STATS.get("child_cpu_s", 0.0) + status["cpu_s"]
         probe = io.TextIOWrapper(io.BytesIO())   # what subprocess.Popen(text=True) decodes with
         text = [b"".join(chunks[f]).decode(probe.encoding, probe.errors).replace("\r\n", "\n").replace("\r", "\n")
                 for f in (out_r, err_r)]
@@ -335,8 +338,10 @@ def _interpreter(script: str) -> str | None:
 
 _zygote: _Zygote | None | bool = None   # False: it could not start
 _pid = None
-#: this process's count of forked commands ("forked") and of real processes, by reason
-STATS: dict[str, int] = {}
+#: this process's count of forked commands ("forked") and of real processes, by reason, and the
+#: forked children's CPU seconds ("child_cpu_s": the zygote waits for them, not this process;
+#: ``benchmarks/pytest_cpu.py`` adds them to each test's figure)
+STATS: dict[str, float] = {}
 
 
 def eligible(script: str, cwd) -> str | None:
@@ -395,7 +400,8 @@ def run(argv: list[str], cwd, timeout: float = 300):
 
 
 def shutdown() -> None:
-    """End this process's zygote (pytest's session end, and ``atexit``)."""
+    """End this process's zygote (at pytest's session end; a zygote whose caller ends without
+    this ends by itself, its control socket closed)."""
     global _zygote
     if _zygote and _pid == os.getpid():
         _zygote.close()
@@ -403,6 +409,7 @@ def shutdown() -> None:
     if STATS and os.environ.get("TAOS_TEST_FORKSERVER_STATS"):   # a file to append the counts to
         with open(os.environ["TAOS_TEST_FORKSERVER_STATS"], "a") as f:
             f.write(f"{os.getpid()} {STATS}\n")
+    STATS.pop("child_cpu_s", None)   # the ended zygote's children now count in this process's RUSAGE_CHILDREN
 
 
 if __name__ == "__main__":
