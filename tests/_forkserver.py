@@ -23,11 +23,13 @@ capture_output=True, text=True, timeout=...)`` gives: exit status (``-N`` for a 
 texts decoded as ``subprocess`` decodes them, :class:`subprocess.TimeoutExpired` (the child
 killed, the output so far attached) on a timeout; an exception in the caller kills the child.
 
-What a forked child cannot reproduce, :func:`eligible` refuses, and the caller runs a real
-process: an environment that differs from the zygote's in any key outside :data:`ALLOWED_ENV`
-(numba's and other modules' import-time reads of the environment must match), a working folder
-with a ``.numba_config.yaml`` (numba reads it at import), ``TAOS_TEST_NO_FORKSERVER=1`` (the
-whole suite the old way). Known, accepted differences: ``os.getppid()`` is the zygote, the
+The child's environment is the caller's: a key outside :data:`ALLOWED_ENV` that differs from
+the zygote's start (the preloaded modules read some at import: ``OMP_NUM_THREADS``, ``NUMBA_*``;
+a Dask cluster in the test process sets several) restarts the zygote (:func:`env_change`, at
+most :data:`MAX_RESTARTS` times, then real processes). What a forked child cannot reproduce,
+:func:`eligible` refuses, and the caller runs a real process: a working folder with a
+``.numba_config.yaml`` (numba reads it at import), a script other than ``taos``/``masv`` or not
+a ``#!python`` script, ``TAOS_TEST_NO_FORKSERVER=1`` (the whole suite the old way). Known, accepted differences: ``os.getppid()`` is the zygote, the
 string hash seed is the zygote's (one valid seed, shared by the children), ``sys.orig_argv`` and
 ``sys.excepthook`` are the zygote's, and modules the zygote imported (the command modules,
 numpy, scipy, numba, pint, h5py) are already in ``sys.modules`` (no ``taos`` code reads that
@@ -317,6 +319,7 @@ class _Zygote:
         status = json.loads(status)
         rc = status["returncode"]
         STATS["child_cpu_s"] = STATS.get("child_cpu_s", 0.0) + status["cpu_s"]
+        STATS["forked_cpu_s"] = STATS.get("forked_cpu_s", 0.0) + status["cpu_s"]
         probe = io.TextIOWrapper(io.BytesIO())   # what subprocess.Popen(text=True) decodes with
         text = [b"".join(chunks[f]).decode(probe.encoding, probe.errors).replace("\r\n", "\n").replace("\r", "\n")
                 for f in (out_r, err_r)]
@@ -339,8 +342,8 @@ def _interpreter(script: str) -> str | None:
 _zygote: _Zygote | None | bool = None   # False: it could not start
 _pid = None
 #: this process's count of forked commands ("forked") and of real processes, by reason, and the
-#: forked children's CPU seconds ("child_cpu_s": the zygote waits for them, not this process;
-#: ``benchmarks/pytest_cpu.py`` adds them to each test's figure)
+#: forked children's CPU seconds ("child_cpu_s": the running zygote's, which waits for them, not
+#: this process; ``benchmarks/pytest_cpu.py`` adds them to each test's figure; "forked_cpu_s": all)
 STATS: dict[str, float] = {}
 
 
@@ -354,14 +357,25 @@ def eligible(script: str, cwd) -> str | None:
         return f"not a taos/masv console script: {script}"
     if not os.path.isdir(cwd):
         return f"no folder {cwd}"   # subprocess.run raises its error
-    if _zygote and _pid == os.getpid():
-        env = {k: v for k, v in os.environ.items() if k not in ALLOWED_ENV}
-        if env != {k: v for k, v in _zygote.env.items() if k not in ALLOWED_ENV}:
-            return "environment differs from the fork server's"
     start = _zygote.cwd if _zygote and _pid == os.getpid() else os.getcwd()   # where the zygote imports
     if any(os.path.exists(os.path.join(d, _NUMBA_CONFIG)) for d in (cwd, start)):
         return f"{_NUMBA_CONFIG} in the working folder"
     return None
+
+
+def env_change() -> list[str]:
+    """The environment keys (outside :data:`ALLOWED_ENV`) in which this process's environment now
+    differs from its zygote's start: a zygote restart (the preloaded modules read some of them at
+    import: ``OMP_NUM_THREADS``, ``NUMBA_*``, ...), e.g. after a Dask cluster in this process set
+    its workers' ``OMP_NUM_THREADS``, ``MALLOC_TRIM_THRESHOLD_``, ``PYTHONHASHSEED`` here."""
+    if not (_zygote and _pid == os.getpid()):
+        return []
+    old, new = _zygote.env, os.environ
+    return sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k) and k not in ALLOWED_ENV)
+
+
+#: zygote restarts allowed per process after an environment change (then: real processes)
+MAX_RESTARTS = 4
 
 
 def zygote(script: str) -> _Zygote | None:
@@ -386,6 +400,13 @@ def run(argv: list[str], cwd, timeout: float = 300):
     why = eligible(argv[0], cwd)
     if why is None and _interpreter(argv[0]) is None:
         why = "not a Python console script"
+    if why is None and (keys := env_change()):
+        if STATS.get("restarts", 0) >= MAX_RESTARTS:
+            why = "environment differs from the fork server's (restarts used up)"
+        else:   # a new zygote for the new environment, as a new process would see it
+            STATS["restarts"] = STATS.get("restarts", 0) + 1
+            STATS["restarted for " + ", ".join(keys)] = STATS.get("restarted for " + ", ".join(keys), 0) + 1
+            shutdown(final=False)
     if why is None and ((z := zygote(argv[0])) is None or z.interpreter != _interpreter(argv[0])):
         why = "the fork server is gone" if z is None else "another interpreter"
     if why is None:
@@ -399,17 +420,18 @@ def run(argv: list[str], cwd, timeout: float = 300):
     return subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)
 
 
-def shutdown() -> None:
-    """End this process's zygote (at pytest's session end; a zygote whose caller ends without
-    this ends by itself, its control socket closed)."""
+def shutdown(final: bool = True) -> None:
+    """End this process's zygote (``final``: at pytest's session end, which appends :data:`STATS`
+    to the file ``$TAOS_TEST_FORKSERVER_STATS`` if set). A zygote whose caller ends without this
+    ends by itself, its control socket closed."""
     global _zygote
     if _zygote and _pid == os.getpid():
         _zygote.close()
     _zygote = None
-    if STATS and os.environ.get("TAOS_TEST_FORKSERVER_STATS"):   # a file to append the counts to
+    STATS.pop("child_cpu_s", None)   # the ended zygote's children now count in this process's RUSAGE_CHILDREN
+    if final and STATS and os.environ.get("TAOS_TEST_FORKSERVER_STATS"):
         with open(os.environ["TAOS_TEST_FORKSERVER_STATS"], "a") as f:
             f.write(f"{os.getpid()} {STATS}\n")
-    STATS.pop("child_cpu_s", None)   # the ended zygote's children now count in this process's RUSAGE_CHILDREN
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ from tests.conftest import MODELS
 TAOS = str(Path(sys.executable).parent / "taos")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def zygote():
     z = _forkserver.zygote(TAOS)
     assert z is not None, "the fork server did not start"
@@ -148,13 +148,27 @@ def test_what_the_fork_server_refuses_runs_as_a_real_process(monkeypatch, tmp_pa
     assert "console script" in _forkserver.eligible(sys.executable, tmp_path)
     (tmp_path / ".numba_config.yaml").write_text("")
     assert ".numba_config.yaml" in _forkserver.eligible(TAOS, tmp_path)
-    monkeypatch.setenv("PYTEST_CURRENT_TEST", "another")          # the allowed key: set in the child
-    assert _forkserver.eligible(TAOS, os.getcwd()) is None
-    monkeypatch.setenv("NUMBA_OPT", "0")                          # read by numba at import
-    assert "environment" in _forkserver.eligible(TAOS, os.getcwd())
-    monkeypatch.delenv("NUMBA_OPT")
     monkeypatch.setenv("TAOS_TEST_NO_FORKSERVER", "1")
     assert "TAOS_TEST_NO_FORKSERVER" in _forkserver.eligible(TAOS, os.getcwd())
+
+
+def test_a_changed_environment_restarts_the_fork_server(zygote, monkeypatch, tmp_path):
+    """A key outside the allowed one (read at import by the preloaded modules, as numba reads
+    ``NUMBA_OPT``) starts a zygote with the new environment; the allowed key is set in the child."""
+    exe = script(tmp_path / "bin", "import os\nprint(os.environ.get('NUMBA_OPT'), os.environ['PYTEST_CURRENT_TEST'])\n")
+    first = _forkserver.zygote(TAOS)
+    monkeypatch.setenv("PYTEST_CURRENT_TEST", "another")
+    assert _forkserver.env_change() == []
+    monkeypatch.setenv("NUMBA_OPT", "0")
+    assert _forkserver.env_change() == ["NUMBA_OPT"]
+    restarts = _forkserver.STATS.get("restarts", 0)
+    a = _forkserver.run([exe], tmp_path)
+    same(a, subprocess.run([exe], capture_output=True, text=True, cwd=tmp_path, timeout=300))
+    assert a.stdout == "0 another\n"
+    assert _forkserver.STATS["restarts"] == restarts + 1 and _forkserver.zygote(TAOS) is not first
+    assert first.proc.returncode == 0   # the old zygote ended
+    monkeypatch.undo()
+    _forkserver.shutdown(final=False)   # the next command starts one with the test process's environment
 
 
 def test_the_fork_server_ends_with_its_caller_and_leaves_no_child(tmp_path):
