@@ -48,7 +48,7 @@ import sys
 
 #: environment keys a request may differ in from the zygote's start (set in the child);
 #: none is read by taos or the preloaded modules at import
-ALLOWED_ENV = frozenset({"PYTEST_CURRENT_TEST"})
+ALLOWED_ENV = frozenset({"PYTEST_CURRENT_TEST", "TAOS_TEST_NO_FORKSERVER"})
 
 #: modules the zygote imports after the command modules (their import-time reads reviewed:
 #: the environment, guarded; numba also ``.numba_config.yaml`` in the working folder, guarded)

@@ -143,6 +143,7 @@ def test_a_timeout_kills_the_command_as_subprocess_run_does(zygote, tmp_path):
 
 
 def test_what_the_fork_server_refuses_runs_as_a_real_process(monkeypatch, tmp_path):
+    monkeypatch.delenv("TAOS_TEST_NO_FORKSERVER", raising=False)
     assert _forkserver.eligible(TAOS, tmp_path) is None
     assert "masv" not in str(_forkserver.eligible(str(Path(TAOS).with_name("masv")), tmp_path))
     assert "console script" in _forkserver.eligible(sys.executable, tmp_path)
@@ -156,6 +157,7 @@ def test_a_changed_environment_restarts_the_fork_server(zygote, monkeypatch, tmp
     """A key outside the allowed one (read at import by the preloaded modules, as numba reads
     ``NUMBA_OPT``) starts a zygote with the new environment; the allowed key is set in the child."""
     exe = script(tmp_path / "bin", "import os\nprint(os.environ.get('NUMBA_OPT'), os.environ['PYTEST_CURRENT_TEST'])\n")
+    monkeypatch.delenv("TAOS_TEST_NO_FORKSERVER", raising=False)   # (the suite run the old way)
     first = _forkserver.zygote(TAOS)
     monkeypatch.setenv("PYTEST_CURRENT_TEST", "another")
     assert _forkserver.env_change() == []
