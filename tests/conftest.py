@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from tests import _forkserver
 from tests._xdist_modules import pytest_xdist_make_scheduler  # noqa: F401  (a hook: worksteal cuts between modules)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -47,10 +47,20 @@ def docs_build_succeeded() -> bool:
     return status.is_file() and status.read_text().strip() == "0"
 
 
-def run_cli(*args, prog="taos", cwd=ROOT):
-    """Run the console script in a subprocess; returns CompletedProcess (text)."""
+def run_cli(*args, prog="taos", cwd=ROOT, timeout=300):
+    """Run the console script as a new process; returns ``subprocess.run``'s CompletedProcess
+    (text; ``subprocess.TimeoutExpired`` after ``timeout`` s). A ``taos`` or ``masv`` command runs
+    in a child forked from this test process's fork server (:mod:`tests._forkserver`: the imports
+    paid once), which starts it as its new process would start; anything the fork server cannot
+    reproduce exactly, and every command with ``TAOS_TEST_NO_FORKSERVER=1``, runs as a real
+    process."""
     exe = Path(sys.executable).parent / prog
-    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=300)
+    return _forkserver.run([str(exe), *map(str, args)], cwd, timeout)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """The fork server ends with its test process (each xdist worker has its own)."""
+    _forkserver.shutdown()
 
 
 def inline_actuator_set(text: str, path: Path = MODELS / "rs25_ambient.toml") -> str:

@@ -1,0 +1,459 @@
+"""A fork server ("zygote") for the test suite's console-script runs (:func:`tests.conftest.run_cli`).
+
+A new ``taos`` process pays 0.5-1.5 CPU-s of interpreter start, imports (numpy, scipy, numba,
+pint, h5py) and numba's first kernel load before any work. The zygote pays them once per pytest
+process (per xdist worker): it is started as an ordinary child (``python tests/_forkserver.py``,
+a clean interpreter, not a fork of pytest), imports what the commands import, then forks one
+child per command. The child does what the console script does in a new process:
+
+* ``sys.argv = [script, *args]``, ``sys.path[0]`` the script's folder (as ``python script``
+  sets it), ``chdir(cwd)``, the caller's umask, standard input the caller's (what
+  ``subprocess.run`` hands on), standard output and error two pipes read by the caller;
+* every signal at the disposition the zygote had before its imports (the interpreter's own),
+  then ``taos._startup_signals()`` again for a ``taos``/``masv`` script: the handlers a new
+  ``taos`` process has when it starts (the one-line Ctrl-C / SIGTERM message names the script);
+* the script's source run as ``__main__`` at the top level of this file, so that an uncaught
+  ``SystemExit`` or exception ends the interpreter as in a new process (exit status, traceback,
+  ``atexit``, the final flush and its exit status 120); the traceback is printed without this
+  file's frame (a ``sys.excepthook`` in the child only);
+* numpy's global random state reseeded from the OS (Python's ``random`` reseeds itself at fork);
+* the zygote's own objects frozen (``gc.freeze``) before it forks: the child's collections and
+  its exit skip them (without it the exit of a child costs ~0.6 CPU-s more than a new process's).
+
+The caller (:func:`run`) gets a :class:`subprocess.CompletedProcess` as ``subprocess.run(...,
+capture_output=True, text=True, timeout=...)`` gives: exit status (``-N`` for a signal), the two
+texts decoded as ``subprocess`` decodes them, :class:`subprocess.TimeoutExpired` (the child
+killed, the output so far attached) on a timeout; an exception in the caller kills the child.
+
+The child's environment is the caller's: a key outside :data:`ALLOWED_ENV` that differs from
+the zygote's start (the preloaded modules read some at import: ``OMP_NUM_THREADS``, ``NUMBA_*``;
+a Dask cluster in the test process sets several) restarts the zygote (:func:`env_change`, at
+most :data:`MAX_RESTARTS` times, then real processes). What a forked child cannot reproduce,
+:func:`eligible` refuses, and the caller runs a real process: a working folder with a
+``.numba_config.yaml`` (numba reads it at import), a script other than ``taos``/``masv`` or not
+a ``#!python`` script, ``TAOS_TEST_NO_FORKSERVER=1`` (the whole suite the old way).
+
+Known, accepted differences: ``os.getppid()`` is the zygote; the string hash seed is the
+zygote's (one valid seed, shared by its children); ``sys.orig_argv`` and ``sys.excepthook`` are
+the zygote's; the modules the zygote imported (the command modules, numpy, scipy.linalg, numba,
+pint, h5py) are already in ``sys.modules`` (no ``taos`` code reads that except for casadi, which
+the zygote does not import; none of them adds a warnings filter, a signal handler, a thread or
+an environment key at import: ``tests/test_forkserver.py`` compares that state).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+#: environment keys a request may differ in from the zygote's start (set in the child);
+#: none is read by taos or the preloaded modules at import
+ALLOWED_ENV = frozenset({"PYTEST_CURRENT_TEST", "TAOS_TEST_NO_FORKSERVER"})
+
+#: modules the zygote imports after the command modules (their import-time reads reviewed:
+#: the environment, guarded; numba also ``.numba_config.yaml`` in the working folder, guarded)
+#: (none of these adds a warnings filter at import: ``scipy.signal`` and ``scipy.optimize``, which
+#: import ``scipy.special`` and its filters, are left out)
+PRELOAD = ("numpy", "scipy.linalg", "numba", "pint", "h5py", "tomlkit",
+           "taos.model", "taos.units", "taos.planar.freqresp", "taos.planar.simulate", "taos.results")
+
+_NUMBA_CONFIG = ".numba_config.yaml"
+
+
+# --------------------------------------------------------------------------------------------
+# the zygote (this file run as a script)
+# --------------------------------------------------------------------------------------------
+
+def _preload() -> None:
+    """Import what the commands import and load one cached kernel (numba's CPU target context)."""
+    import importlib
+
+    import taos.cli
+
+    taos.cli.build_parser()
+    for name in PRELOAD:
+        try:
+            importlib.import_module(name)
+        except Exception:  # an optional dependency missing: the command imports it (or fails) itself
+            pass
+    try:  # numba's CPU target context, set up by a process's first kernel load (~0.3-0.5 s)
+        from numba.core.registry import cpu_target
+        cpu_target.target_context.refresh()
+    except Exception:
+        pass
+
+
+def _serve(ctl_fd: int, base_signals: dict) -> dict:
+    """Fork a child per request; returns the request in the child only (never in the zygote)."""
+    import json
+    import select
+    import signal
+    import socket
+
+    ctl = socket.socket(fileno=ctl_fd)
+    poll = select.poll()
+    poll.register(ctl_fd, select.POLLIN)
+    by_pidfd: dict[int, list] = {}   # pidfd -> [pid, conn fd or None]
+    by_conn: dict[int, int] = {}     # conn fd -> pidfd
+    while True:
+        for fd, ev in poll.poll():
+            if fd == ctl_fd:
+                try:
+                    msg, fds, _, _ = socket.recv_fds(ctl, 1 << 20, 4)
+                except OSError:
+                    msg, fds = b"", []
+                if not msg:   # the test process closed its end or ended: no orphan left behind
+                    for pid, _ in by_pidfd.values():
+                        os.kill(pid, signal.SIGKILL)
+                    os._exit(0)
+                req = json.loads(msg)
+                conn, fin, fout, ferr = fds
+                sys.stdout.flush()
+                sys.stderr.flush()
+                pid = os.fork()
+                if pid == 0:
+                    ctl.close()
+                    for f in (conn, *by_pidfd, *by_conn):
+                        os.close(f)
+                    for f, target in ((fin, 0), (fout, 1), (ferr, 2)):
+                        os.dup2(f, target)
+                        os.close(f)
+                    for s, h in base_signals.items():
+                        if signal.getsignal(s) is not h:
+                            signal.signal(s, h)
+                    return req
+                for f in (fin, fout, ferr):
+                    os.close(f)
+                pidfd = os.pidfd_open(pid)
+                os.set_blocking(conn, False)
+                by_pidfd[pidfd] = [pid, conn]
+                by_conn[conn] = pidfd
+                poll.register(pidfd, select.POLLIN)
+                poll.register(conn, select.POLLIN)
+                os.write(conn, json.dumps({"pid": pid}).encode())
+            elif fd in by_pidfd:   # a child ended: reap it, report its status
+                pid, conn = by_pidfd[fd]
+                got, status, usage = os.wait4(pid, os.WNOHANG)
+                if got == 0:   # a stale event: this pidfd's number was reused in this round
+                    continue
+                del by_pidfd[fd]
+                poll.unregister(fd)
+                os.close(fd)
+                if conn is not None:
+                    del by_conn[conn]
+                    poll.unregister(conn)
+                    try:
+                        os.write(conn, json.dumps({"returncode": os.waitstatus_to_exitcode(status),
+                                                   "cpu_s": usage.ru_utime + usage.ru_stime}).encode())
+                    except OSError:
+                        pass
+                    os.close(conn)
+            elif fd in by_conn:    # "kill", or the caller gone (it raised): kill, as subprocess.run does
+                pidfd = by_conn[fd]
+                try:
+                    data = os.read(fd, 64)
+                except BlockingIOError:   # a stale event: this number was reused in this round
+                    continue
+                except OSError:
+                    data = b""
+                os.kill(by_pidfd[pidfd][0], signal.SIGKILL)   # not reaped yet: the pid is still this child
+                if not data:
+                    del by_conn[fd]
+                    poll.unregister(fd)
+                    os.close(fd)
+                    by_pidfd[pidfd][1] = None
+
+
+def _child(req: dict) -> dict:
+    """Set the child up as the console script's new process (the part after the fork)."""
+    os.chdir(req["cwd"])
+    os.umask(req["umask"])
+    for k in ALLOWED_ENV:
+        if k in req["env"]:
+            os.environ[k] = req["env"][k]
+        else:
+            os.environ.pop(k, None)
+    script = req["argv"][0]
+    sys.argv = list(req["argv"])
+    sys.path[0] = os.path.dirname(os.path.realpath(script))
+    if os.path.basename(script) in ("taos", "masv"):
+        import taos
+        taos._startup_signals()
+    if "numpy.random" in sys.modules:
+        sys.modules["numpy.random"].seed()
+    with open(script, "rb") as f:
+        source = f.read()
+    import builtins
+    import importlib.machinery
+    import types
+
+    main = types.ModuleType("__main__")
+    main.__dict__.update(__file__=script, __cached__=None, __package__=None, __spec__=None,
+                         __loader__=importlib.machinery.SourceFileLoader("__main__", script),
+                         __builtins__=builtins, __annotations__={})
+    sys.modules["__main__"] = main
+    here = __file__
+
+    def excepthook(etype, value, tb, _default=sys.__excepthook__):
+        while tb is not None and tb.tb_frame.f_code.co_filename == here:
+            tb = tb.tb_next
+        if isinstance(value, BaseException):
+            value.__traceback__ = tb
+        _default(etype, value, tb)
+
+    sys.excepthook = excepthook
+    return {"code": compile(source, script, "exec"), "globals": main.__dict__}
+
+
+# --------------------------------------------------------------------------------------------
+# the caller (the test process)
+# --------------------------------------------------------------------------------------------
+
+class _NotStarted(Exception):
+    """The zygote is gone before it forked the command's child (the caller runs a real process)."""
+
+
+class _Zygote:
+    """One zygote process and its control socket; :meth:`run` is ``subprocess.run`` through it."""
+
+    def __init__(self, script: str):
+        import socket
+        import subprocess
+
+        self.script = script
+        self.interpreter = _interpreter(script)
+        self.env = dict(os.environ)
+        self.cwd = os.getcwd()
+        self.ctl, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        self.proc = subprocess.Popen([self.interpreter, os.path.abspath(__file__), str(theirs.fileno()), script],
+                                     pass_fds=[theirs.fileno()], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        theirs.close()
+        os.set_blocking(self.proc.stdout.fileno(), False)
+        self.log = b""
+
+    def alive(self) -> bool:
+        self._drain()
+        return self.proc.poll() is None
+
+    def _drain(self) -> None:
+        try:
+            while chunk := self.proc.stdout.read(65536):
+                self.log += chunk
+        except (OSError, ValueError):
+            pass
+
+    def close(self) -> None:
+        self.ctl.close()
+        try:
+            self.proc.wait(timeout=10)
+        except Exception:
+            self.proc.kill()
+            self.proc.wait()
+        self._drain()
+        self.proc.stdout.close()
+
+    def run(self, argv: list[str], cwd, timeout: float):
+        """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)``."""
+        import io
+        import json
+        import selectors
+        import socket
+        import subprocess
+        import time
+
+        umask = os.umask(0o022)
+        os.umask(umask)
+        req = {"argv": argv, "cwd": os.path.abspath(cwd), "umask": umask,
+               "env": {k: os.environ[k] for k in ALLOWED_ENV if k in os.environ}}
+        mine, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        out_r, out_w = os.pipe()
+        err_r, err_w = os.pipe()
+        first = b""
+        try:
+            socket.send_fds(self.ctl, [json.dumps(req).encode()], [theirs.fileno(), 0, out_w, err_w])
+            first = mine.recv(4096)
+        except OSError:
+            pass
+        finally:
+            for f in (out_w, err_w):
+                os.close(f)
+            theirs.close()
+            if not first:
+                for f in (out_r, err_r):
+                    os.close(f)
+                mine.close()
+        if not first:
+            raise _NotStarted("the fork server did not start the command")
+        endtime = None if timeout is None else time.monotonic() + timeout
+        chunks = {out_r: [], err_r: []}
+        done = False
+        try:
+            with selectors.PollSelector() as sel:
+                for f in chunks:
+                    sel.register(f, selectors.EVENT_READ)
+                while sel.get_map():
+                    left = None if endtime is None else endtime - time.monotonic()
+                    if left is not None and left < 0:
+                        so_far = [b"".join(chunks[f]) if chunks[f] else None for f in (out_r, err_r)]
+                        raise subprocess.TimeoutExpired(argv, timeout, output=so_far[0], stderr=so_far[1])
+                    for key, _ in sel.select(left):
+                        data = os.read(key.fd, 32768)
+                        if not data:
+                            sel.unregister(key.fd)
+                        chunks[key.fd].append(data)
+            if endtime is not None:
+                mine.settimeout(max(endtime - time.monotonic(), 0.0))
+            try:
+                status = mine.recv(4096)
+            except socket.timeout:
+                raise subprocess.TimeoutExpired(argv, timeout) from None
+            if not status:
+                raise ChildProcessError("the fork server ended")
+            done = True
+        except subprocess.TimeoutExpired:
+            mine.settimeout(None)
+            mine.send(b"kill")
+            mine.recv(4096)   # its status, once reaped
+            raise
+        finally:
+            if not done:
+                mine.close()   # the zygote kills the child when this end closes
+            for f in chunks:
+                os.close(f)
+        mine.close()
+        status = json.loads(status)
+        rc = status["returncode"]
+        STATS["child_cpu_s"] = STATS.get("child_cpu_s", 0.0) + status["cpu_s"]
+        STATS["forked_cpu_s"] = STATS.get("forked_cpu_s", 0.0) + status["cpu_s"]
+        probe = io.TextIOWrapper(io.BytesIO())   # what subprocess.Popen(text=True) decodes with
+        text = [b"".join(chunks[f]).decode(probe.encoding, probe.errors).replace("\r\n", "\n").replace("\r", "\n")
+                for f in (out_r, err_r)]
+        return subprocess.CompletedProcess(argv, rc, text[0], text[1])
+
+
+def _interpreter(script: str) -> str | None:
+    """The interpreter of a console script's ``#!`` line (the zygote's, as its new process's), or
+    ``None`` if the line is not a bare path to a Python (a shell trampoline: a real process)."""
+    try:
+        with open(script, "rb") as f:
+            line = f.readline().decode()
+    except (OSError, UnicodeDecodeError):
+        return None
+    path = line[2:].strip()
+    ok = line.startswith("#!") and path and " " not in path and os.path.basename(path).startswith("python")
+    return path if ok else None
+
+
+_zygote: _Zygote | None | bool = None   # False: it could not start
+_pid = None
+#: this process's count of forked commands ("forked") and of real processes, by reason, and the
+#: forked children's CPU seconds ("child_cpu_s": the running zygote's, which waits for them, not
+#: this process; ``benchmarks/pytest_cpu.py`` adds them to each test's figure; "forked_cpu_s": all)
+STATS: dict[str, float] = {}
+
+
+def eligible(script: str, cwd) -> str | None:
+    """Why a run of ``script`` in ``cwd`` must be a real process (``None``: the zygote may run it)."""
+    if os.environ.get("TAOS_TEST_NO_FORKSERVER") == "1":
+        return "TAOS_TEST_NO_FORKSERVER=1"
+    if not hasattr(os, "pidfd_open") or not hasattr(os, "fork"):
+        return "no fork/pidfd_open on this system"
+    if os.path.basename(script) not in ("taos", "masv") or not os.access(script, os.X_OK):
+        return f"not a taos/masv console script: {script}"
+    if not os.path.isdir(cwd):
+        return f"no folder {cwd}"   # subprocess.run raises its error
+    start = _zygote.cwd if _zygote and _pid == os.getpid() else os.getcwd()   # where the zygote imports
+    if any(os.path.exists(os.path.join(d, _NUMBA_CONFIG)) for d in (cwd, start)):
+        return f"{_NUMBA_CONFIG} in the working folder"
+    return None
+
+
+def env_change() -> list[str]:
+    """The environment keys (outside :data:`ALLOWED_ENV`) in which this process's environment now
+    differs from its zygote's start: a zygote restart (the preloaded modules read some of them at
+    import: ``OMP_NUM_THREADS``, ``NUMBA_*``, ...), e.g. after a Dask cluster in this process set
+    its workers' ``OMP_NUM_THREADS``, ``MALLOC_TRIM_THRESHOLD_``, ``PYTHONHASHSEED`` here."""
+    if not (_zygote and _pid == os.getpid()):
+        return []
+    old, new = _zygote.env, os.environ
+    return sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k) and k not in ALLOWED_ENV)
+
+
+#: zygote restarts allowed per process after an environment change (then: real processes)
+MAX_RESTARTS = 4
+
+
+def zygote(script: str) -> _Zygote | None:
+    """This process's zygote (started on first use, preloading for the console script
+    ``script``; it runs any Python script with the same interpreter), or ``None`` if it is gone."""
+    global _zygote, _pid
+    if _zygote is None or _pid != os.getpid():
+        _pid = os.getpid()
+        try:
+            _zygote = _Zygote(script) if _interpreter(script) else False
+        except OSError:
+            _zygote = False   # not again in this process: its commands run as real processes
+    return _zygote if _zygote and _zygote.alive() else None
+
+
+def run(argv: list[str], cwd, timeout: float = 300):
+    """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)`` through
+    this process's zygote, or a real process when :func:`eligible` refuses or the zygote is gone."""
+    import subprocess
+
+    argv = [str(a) for a in argv]
+    why = eligible(argv[0], cwd)
+    if why is None and _interpreter(argv[0]) is None:
+        why = "not a Python console script"
+    if why is None and (keys := env_change()):
+        if STATS.get("restarts", 0) >= MAX_RESTARTS:
+            why = "environment differs from the fork server's (restarts used up)"
+        else:   # a new zygote for the new environment, as a new process would see it
+            STATS["restarts"] = STATS.get("restarts", 0) + 1
+            STATS["restarted for " + ", ".join(keys)] = STATS.get("restarted for " + ", ".join(keys), 0) + 1
+            shutdown(final=False)
+    if why is None and ((z := zygote(argv[0])) is None or z.interpreter != _interpreter(argv[0])):
+        why = "the fork server is gone" if z is None else "another interpreter"
+    if why is None:
+        try:
+            result = z.run(argv, cwd, timeout)
+            STATS["forked"] = STATS.get("forked", 0) + 1
+            return result
+        except _NotStarted:
+            why = "the fork server is gone"
+    STATS[why] = STATS.get(why, 0) + 1
+    return subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)
+
+
+def shutdown(final: bool = True) -> None:
+    """End this process's zygote (``final``: at pytest's session end, which appends :data:`STATS`
+    to the file ``$TAOS_TEST_FORKSERVER_STATS`` if set). A zygote whose caller ends without this
+    ends by itself, its control socket closed."""
+    global _zygote
+    if _zygote and _pid == os.getpid():
+        _zygote.close()
+    _zygote = None
+    STATS.pop("child_cpu_s", None)   # the ended zygote's children now count in this process's RUSAGE_CHILDREN
+    if final and STATS and os.environ.get("TAOS_TEST_FORKSERVER_STATS"):
+        with open(os.environ["TAOS_TEST_FORKSERVER_STATS"], "a") as f:
+            f.write(f"{os.getpid()} {STATS}\n")
+
+
+if __name__ == "__main__":
+    # sys.path[0] is this file's folder: make it the console script's, as its new process has it
+    _ctl_fd, _script = int(sys.argv[1]), sys.argv[2]
+    sys.path[0] = os.path.dirname(os.path.realpath(_script))
+    sys.argv = [_script]
+    import signal as _signal
+
+    _base = {s: _signal.getsignal(s) for s in _signal.valid_signals()
+             if s not in (_signal.SIGKILL, _signal.SIGSTOP) and _signal.getsignal(s) is not None}
+    _preload()
+    _signal.signal(_signal.SIGINT, _signal.SIG_IGN)   # a Ctrl-C ends pytest, whose end ends the zygote
+    import gc as _gc
+
+    _gc.collect()
+    _gc.freeze()   # the children's collections (and their exit's) skip the zygote's objects: ~0.6 CPU-s less each
+    _run = _child(_serve(_ctl_fd, _base))
+    del _ctl_fd, _script, _signal, _base, _gc
+    exec(_run["code"], _run["globals"])
