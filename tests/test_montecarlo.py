@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shutil
 import socket
 import threading
@@ -413,7 +414,7 @@ def test_the_inputs_hash_does_not_depend_on_what_the_process_loaded_before(tmp_p
             "        load_model(sys.argv[1])\n"
             "    out.append(digest(f, 's')[1])\n"
             "print(json.dumps(out))")
-    env = {**__import__("os").environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
     r = subprocess.run([sys.executable, "-c", code, str(ROOT / "models" / "rs25_ambient.toml")],
                        capture_output=True, text=True, env=env, timeout=120, cwd=ROOT)
     assert r.returncode == 0, r.stderr
@@ -435,7 +436,7 @@ def test_a_fresh_flight_load_records_the_flight_file_only(tmp_path):
             "with recording() as f:\n"
             "    load_flight('core_stage')\n"
             "print(json.dumps([t['file'] for t in digest(f, 's')[1]]))")
-    env = {**__import__("os").environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout) == [str((ROOT / "models" / "flight" / "core_stage.toml").resolve())]

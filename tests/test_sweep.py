@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 import math
-
+import os
 import signal
 import subprocess
 import sys
@@ -306,7 +306,7 @@ def test_a_fresh_sweep_load_records_the_same_inputs_as_a_second(tmp_path):
             "d = make_design([parse_set('structure.load_stiffness=115000 lbf/in,205000 lbf/in')])\n"
             "defn = SweepDefinition(sys.argv[1], d, ('lco',), flight_file=sys.argv[2])\n"
             "print(json.dumps([[t['file'] for t in load_runs(defn)[1]] for _ in range(2)]))")
-    env = {**__import__("os").environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache")}
     r = subprocess.run([sys.executable, "-c", code, str(FLIGHT_MODEL), str(FLIGHT)], capture_output=True, text=True,
                        env=env, timeout=300)
     assert r.returncode == 0, r.stderr
