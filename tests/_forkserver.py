@@ -24,6 +24,13 @@ The caller (:func:`run`) gets a :class:`subprocess.CompletedProcess` as ``subpro
 capture_output=True, text=True, timeout=...)`` gives: exit status (``-N`` for a signal), the two
 texts decoded as ``subprocess`` decodes them, :class:`subprocess.TimeoutExpired` (the child
 killed, the output so far attached) on a timeout; an exception in the caller kills the child.
+:func:`popen` gives a :class:`Child`, what ``subprocess.Popen(..., stdout=PIPE, stderr=PIPE,
+text=True)`` gives (pid, streams, poll, wait, signals) for a test that talks to a running command.
+
+``python -c CODE ARGS`` with the zygote's interpreter runs the same way (the zygote of the
+``taos`` script beside that interpreter): ``sys.argv = ['-c', *ARGS]``, ``sys.path[0] = ''``, the
+code compiled as ``<string>`` in a ``__main__`` without ``__file__``, the interpreter's own signal
+handlers (a console script's start-up handlers are not installed).
 
 The child's environment is the caller's: a key outside :data:`ALLOWED_ENV` that differs from
 the zygote's start (the preloaded modules read some at import: ``OMP_NUM_THREADS``, ``NUMBA_*``;
@@ -173,24 +180,31 @@ def _child(req: dict) -> dict:
             os.environ[k] = req["env"][k]
         else:
             os.environ.pop(k, None)
-    script = req["argv"][0]
-    sys.argv = list(req["argv"])
-    sys.path[0] = os.path.dirname(os.path.realpath(script))
-    if os.path.basename(script) in ("taos", "masv"):
-        import taos
-        taos._startup_signals()
-    if "numpy.random" in sys.modules:
-        sys.modules["numpy.random"].seed()
-    with open(script, "rb") as f:
-        source = f.read()
     import builtins
     import importlib.machinery
     import types
 
     main = types.ModuleType("__main__")
-    main.__dict__.update(__file__=script, __cached__=None, __package__=None, __spec__=None,
-                         __loader__=importlib.machinery.SourceFileLoader("__main__", script),
-                         __builtins__=builtins, __annotations__={})
+    if _code_mode(req["argv"]):   # python -c CODE ARGS: argv ['-c', ARGS], sys.path[0] '' (the cwd)
+        sys.argv = ["-c", *req["argv"][3:]]
+        sys.path[0] = ""
+        source, script = req["argv"][2], "<string>"
+        main.__dict__.update(__package__=None, __spec__=None, __loader__=importlib.machinery.BuiltinImporter,
+                             __builtins__=builtins, __annotations__={})
+    else:
+        script = req["argv"][0]
+        sys.argv = list(req["argv"])
+        sys.path[0] = os.path.dirname(os.path.realpath(script))
+        if os.path.basename(script) in ("taos", "masv"):
+            import taos
+            taos._startup_signals()
+        with open(script, "rb") as f:
+            source = f.read()
+        main.__dict__.update(__file__=script, __cached__=None, __package__=None, __spec__=None,
+                             __loader__=importlib.machinery.SourceFileLoader("__main__", script),
+                             __builtins__=builtins, __annotations__={})
+    if "numpy.random" in sys.modules:
+        sys.modules["numpy.random"].seed()
     sys.modules["__main__"] = main
     here = __file__
 
@@ -252,14 +266,10 @@ class _Zygote:
         self._drain()
         self.proc.stdout.close()
 
-    def run(self, argv: list[str], cwd, timeout: float):
-        """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)``."""
-        import io
+    def _start(self, argv: list[str], cwd):
+        """Fork ``argv``'s child in ``cwd``: (control socket, stdout and stderr read ends, pid)."""
         import json
-        import selectors
         import socket
-        import subprocess
-        import time
 
         umask = os.umask(0o022)
         os.umask(umask)
@@ -284,6 +294,22 @@ class _Zygote:
                 mine.close()
         if not first:
             raise _NotStarted("the fork server did not start the command")
+        return mine, out_r, err_r, json.loads(first)["pid"]
+
+    def popen(self, argv: list[str], cwd) -> "Child":
+        """``subprocess.Popen(argv, cwd=cwd, stdout=PIPE, stderr=PIPE, text=True)``."""
+        return Child(argv, *self._start(argv, cwd))
+
+    def run(self, argv: list[str], cwd, timeout: float):
+        """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)``."""
+        import io
+        import json
+        import selectors
+        import socket
+        import subprocess
+        import time
+
+        mine, out_r, err_r, _ = self._start(argv, cwd)
         endtime = None if timeout is None else time.monotonic() + timeout
         chunks = {out_r: [], err_r: []}
         done = False
@@ -329,6 +355,77 @@ class _Zygote:
         text = [b"".join(chunks[f]).decode(probe.encoding, probe.errors).replace("\r\n", "\n").replace("\r", "\n")
                 for f in (out_r, err_r)]
         return subprocess.CompletedProcess(argv, rc, text[0], text[1])
+
+
+class Child:
+    """A child forked by the zygote as :class:`subprocess.Popen` (``stdout=PIPE, stderr=PIPE,
+    text=True``) presents its process: ``args``, ``pid``, ``stdout`` and ``stderr`` (text streams,
+    decoded as ``Popen`` decodes them), ``returncode``, :meth:`poll`, :meth:`wait` (its timeout
+    raising :class:`subprocess.TimeoutExpired`), :meth:`send_signal`, :meth:`terminate`,
+    :meth:`kill`. The zygote reaps the child and reports its status on the control socket; a
+    signal is sent only while that status has not come (the pid is still the child's)."""
+
+    def __init__(self, args, ctl, out_r: int, err_r: int, pid: int):
+        self.args, self.pid, self.returncode, self._ctl = args, pid, None, ctl
+        self.stdout = open(out_r, "r")   # locale encoding, universal newlines: Popen's text mode
+        self.stderr = open(err_r, "r")
+
+    def _status(self, msg: bytes) -> int:
+        import json
+
+        if not msg:
+            raise ChildProcessError("the fork server ended")
+        st = json.loads(msg)
+        self.returncode = st["returncode"]
+        STATS["child_cpu_s"] = STATS.get("child_cpu_s", 0.0) + st["cpu_s"]
+        STATS["forked_cpu_s"] = STATS.get("forked_cpu_s", 0.0) + st["cpu_s"]
+        self._ctl.close()
+        return self.returncode
+
+    def poll(self) -> int | None:
+        import socket
+
+        if self.returncode is None:
+            try:
+                msg = self._ctl.recv(4096, socket.MSG_DONTWAIT)
+            except (BlockingIOError, socket.timeout):
+                return None
+            self._status(msg)
+        return self.returncode
+
+    def wait(self, timeout: float | None = None) -> int:
+        import socket
+        import subprocess
+
+        if self.returncode is None:
+            self._ctl.settimeout(timeout)
+            try:
+                msg = self._ctl.recv(4096)
+            except socket.timeout:
+                raise subprocess.TimeoutExpired(self.args, timeout) from None
+            finally:
+                self._ctl.settimeout(None)
+            self._status(msg)
+        return self.returncode
+
+    def send_signal(self, sig: int) -> None:
+        if self.poll() is None:
+            os.kill(self.pid, sig)
+
+    def terminate(self) -> None:
+        self.send_signal(15)
+
+    def kill(self) -> None:
+        self.send_signal(9)
+
+    def __del__(self):
+        if self.returncode is None:   # the zygote kills a child whose control socket closes
+            self._ctl.close()
+
+
+def _code_mode(argv: list[str]) -> bool:
+    """``argv`` is ``[python, "-c", code, *args]``."""
+    return len(argv) >= 3 and argv[1] == "-c"
 
 
 def _interpreter(script: str) -> str | None:
@@ -396,15 +493,18 @@ def zygote(script: str) -> _Zygote | None:
     return _zygote if _zygote and _zygote.alive() else None
 
 
-def run(argv: list[str], cwd, timeout: float = 300):
-    """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)`` through
-    this process's zygote, or a real process when :func:`eligible` refuses or the zygote is gone."""
-    import subprocess
-
-    argv = [str(a) for a in argv]
-    why = eligible(argv[0], cwd)
-    if why is None and _interpreter(argv[0]) is None:
+def _zygote_for(argv: list[str], cwd):
+    """(this process's zygote for ``argv``, None) or (None, why ``argv`` must be a real process).
+    ``python -c CODE ARGS`` (:func:`_code_mode`) runs in the zygote of the ``taos`` script beside
+    that Python, when that Python is the zygote's interpreter."""
+    code = _code_mode(argv)
+    script = os.path.join(os.path.dirname(argv[0]), "taos") if code else argv[0]
+    why, z = eligible(script, cwd), None
+    interp = _interpreter(script) if why is None else None
+    if why is None and interp is None:
         why = "not a Python console script"
+    if why is None and code and os.path.realpath(argv[0]) != os.path.realpath(interp):
+        why = "another interpreter"
     if why is None and (keys := env_change()):
         if STATS.get("restarts", 0) >= MAX_RESTARTS:
             why = "environment differs from the fork server's (restarts used up)"
@@ -412,9 +512,20 @@ def run(argv: list[str], cwd, timeout: float = 300):
             STATS["restarts"] = STATS.get("restarts", 0) + 1
             STATS["restarted for " + ", ".join(keys)] = STATS.get("restarted for " + ", ".join(keys), 0) + 1
             shutdown(final=False)
-    if why is None and ((z := zygote(argv[0])) is None or z.interpreter != _interpreter(argv[0])):
+    if why is None and ((z := zygote(script)) is None or z.interpreter != interp):
         why = "the fork server is gone" if z is None else "another interpreter"
-    if why is None:
+    return (z, None) if why is None else (None, why)
+
+
+def run(argv: list[str], cwd, timeout: float = 300):
+    """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)`` through
+    this process's zygote (a console script, or ``python -c CODE ARGS``), or a real process when
+    :func:`eligible` refuses or the zygote is gone."""
+    import subprocess
+
+    argv = [str(a) for a in argv]
+    z, why = _zygote_for(argv, cwd)
+    if z is not None:
         try:
             result = z.run(argv, cwd, timeout)
             STATS["forked"] = STATS.get("forked", 0) + 1
@@ -423,6 +534,24 @@ def run(argv: list[str], cwd, timeout: float = 300):
             why = "the fork server is gone"
     STATS[why] = STATS.get(why, 0) + 1
     return subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)
+
+
+def popen(argv: list[str], cwd):
+    """``subprocess.Popen(argv, cwd=cwd, stdout=PIPE, stderr=PIPE, text=True)`` through this
+    process's zygote (a :class:`Child`), or a real process as :func:`run` decides."""
+    import subprocess
+
+    argv = [str(a) for a in argv]
+    z, why = _zygote_for(argv, cwd)
+    if z is not None:
+        try:
+            child = z.popen(argv, cwd)
+            STATS["forked"] = STATS.get("forked", 0) + 1
+            return child
+        except _NotStarted:
+            why = "the fork server is gone"
+    STATS[why] = STATS.get(why, 0) + 1
+    return subprocess.Popen(argv, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
 def shutdown(final: bool = True) -> None:

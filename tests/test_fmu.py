@@ -31,6 +31,7 @@ from taos.model import load_model  # noqa: E402
 from taos.planar.simulate import simulate  # noqa: E402
 from taos.profiles import Step, TwoAxis, load_profile  # noqa: E402
 
+from . import _forkserver  # noqa: E402
 from .conftest import MODELS, run_cli  # noqa: E402
 
 DEG = math.pi / 180
@@ -68,8 +69,9 @@ os._exit(0)
 
 
 def fmpy_in_child(path, workdir, inputs=None, **kw):
-    """``fmpy.simulate_fmu(path, **kw)`` in a child Python (ended with ``os._exit``); ``inputs``
-    an FMPy input array. Returns (result array or None, log messages [(status, text)], the
+    """``fmpy.simulate_fmu(path, **kw)`` in a child Python (ended with ``os._exit``; forked from the
+    test process's fork server, :mod:`tests._forkserver`, as ``python -c``); ``inputs`` an FMPy
+    input array. Returns (result array or None, log messages [(status, text)], the
     error text or None, the simulation's wall time [s])."""
     workdir = Path(workdir)
     n = len(list(workdir.glob("run*.npy.json")))
@@ -78,7 +80,7 @@ def fmpy_in_child(path, workdir, inputs=None, **kw):
     if inputs is not None:
         np.save(workdir / f"in{n}.npy", inputs)
         arg["input"] = str(workdir / f"in{n}.npy")
-    r = subprocess.run([sys.executable, "-c", _CHILD, json.dumps(arg)], capture_output=True, text=True, timeout=3600)
+    r = _forkserver.run([sys.executable, "-c", _CHILD, json.dumps(arg)], workdir, timeout=3600)
     meta_file = Path(str(out) + ".json")
     assert meta_file.exists(), r.stderr[-2000:]
     meta = json.loads(meta_file.read_text())

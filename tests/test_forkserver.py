@@ -92,7 +92,8 @@ print(json.dumps({
     "warnings": [str(f) for f in warnings.filters],
     "stdio": [[s.encoding, s.errors, s.line_buffering, s.write_through, s.seekable(), s.isatty(), s.fileno(),
                type(s.buffer).__name__] for s in (sys.stdin, sys.stdout, sys.stderr)],
-    "main": [__name__, __file__, sorted(k for k in globals() if k.startswith("__"))],
+    "main": [__name__, globals().get("__file__"), getattr(__loader__, "__name__", type(__loader__).__name__),
+             sorted(k for k in globals() if k.startswith("__"))],
     "process": [os.getpgrp(), os.getsid(0), str(sys.flags), sys.dont_write_bytecode, sys.getrecursionlimit()],
 }))
 '''
@@ -124,6 +125,22 @@ def test_a_command_starts_in_the_state_of_a_new_process(zygote, tmp_path):
     assert set(state["fds"]) <= {"0", "1", "2", "3"}   # 3: the listing's own descriptor
 
 
+def test_python_c_starts_in_the_state_of_a_new_python_c(zygote, tmp_path):
+    """``python -c CODE ARGS`` (the fmpy and slow-write children of test_fmu.py and
+    test_output_safety.py): argv ``['-c', ARGS]``, ``sys.path[0]`` the empty string, the
+    interpreter's own signal handlers (no console script's), no ``__file__``."""
+    argv = [sys.executable, "-c", PROBE, "x", "y"]
+    a, b = zygote.run(argv, tmp_path, 300), subprocess.run(argv, capture_output=True, text=True, cwd=tmp_path)
+    same(a, b)
+    state = json.loads(a.stdout)
+    assert state["argv"] == ["-c", "x", "y"] and state["path"][0] == "" and state["main"][1] is None
+    assert not any("_startup_signals" in h for h in state["signals"].values())
+    assert state["threads"] == ["MainThread"]
+    z, why = _forkserver._zygote_for(argv, tmp_path)
+    assert z is zygote and why is None
+
+
+@pytest.mark.parametrize("mode", ["script", "python -c"])
 @pytest.mark.parametrize("body, code", [
     ("import os\nos.abort()\n", -6),
     ("import os, signal\nos.kill(os.getpid(), signal.SIGKILL)\n", -9),
@@ -131,9 +148,9 @@ def test_a_command_starts_in_the_state_of_a_new_process(zygote, tmp_path):
     ("print('out')\ndef f():\n    raise ValueError('uncaught')\nf()\n", 1),
     ("import sys\nsys.stdout.write('no newline')\nsys.exit(7)\n", 7),
 ], ids=["abort", "killed", "exit-text", "traceback", "exit-7"])
-def test_a_crash_is_reported_as_subprocess_run_reports_it(zygote, tmp_path, body, code):
-    exe = script(tmp_path / "bin", body)
-    a, b = both(zygote, [exe], (tmp_path, tmp_path))
+def test_a_crash_is_reported_as_subprocess_run_reports_it(zygote, tmp_path, body, code, mode):
+    argv = [script(tmp_path / "bin", body)] if mode == "script" else [sys.executable, "-c", body]
+    a, b = both(zygote, argv, (tmp_path, tmp_path))
     same(a, b)
     assert a.returncode == code
 
@@ -150,11 +167,49 @@ def test_a_timeout_kills_the_command_as_subprocess_run_does(zygote, tmp_path):
     assert got[0][2] == b"started\n"
 
 
+#: prints a line, then waits: SIGINT ends it with 130 (its handler), SIGTERM with the default
+WAITER = """
+import signal, sys, time
+signal.signal(signal.SIGINT, lambda s, f: sys.exit(130))
+print("started", sys.argv[1:], flush=True)
+sys.stderr.write("to stderr\\n")
+time.sleep(120)
+"""
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, -15), (signal.SIGINT, 130), (signal.SIGKILL, -9)],
+                         ids=["SIGTERM", "SIGINT", "SIGKILL"])
+def test_a_forked_child_behaves_as_subprocess_popen(zygote, tmp_path, sig, code):
+    """:func:`tests._forkserver.popen` (the slow-write children of test_output_safety.py): a line
+    read as it is printed, ``poll`` None while it runs, ``wait`` with a timeout raising
+    ``TimeoutExpired`` as Popen's, a signal's exit status, the rest of standard error after it."""
+    argv = [sys.executable, "-c", WAITER, "a"]
+    got = []
+    for p in (zygote.popen(argv, tmp_path),
+              subprocess.Popen(argv, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)):
+        line = p.stdout.readline()
+        assert p.poll() is None
+        with pytest.raises(subprocess.TimeoutExpired) as e:
+            p.wait(0.2)
+        p.send_signal(sig)
+        rc = p.wait(60)
+        got.append((line, str(e.value), rc, p.returncode, p.poll(), p.stderr.read(), p.stdout.read(), p.args))
+        p.stdout.close()
+        p.stderr.close()
+    assert got[0] == got[1]
+    assert got[0][:3] == ("started ['a']\n", f"Command '{argv}' timed out after 0.2 seconds", code)
+    assert isinstance(zygote.popen([sys.executable, "-c", "pass"], tmp_path), _forkserver.Child)
+
+
 def test_what_the_fork_server_refuses_runs_as_a_real_process(monkeypatch, tmp_path):
     monkeypatch.delenv("TAOS_TEST_NO_FORKSERVER", raising=False)
     assert _forkserver.eligible(TAOS, tmp_path) is None
     assert "masv" not in str(_forkserver.eligible(str(Path(TAOS).with_name("masv")), tmp_path))
     assert "console script" in _forkserver.eligible(sys.executable, tmp_path)
+    other = "/usr/bin/python3"   # python -c with another interpreter than the zygote's
+    if os.path.exists(other) and os.path.realpath(other) != os.path.realpath(sys.executable):
+        z, why = _forkserver._zygote_for([other, "-c", "pass"], tmp_path)
+        assert z is None and why
     (tmp_path / ".numba_config.yaml").write_text("")
     assert ".numba_config.yaml" in _forkserver.eligible(TAOS, tmp_path)
     monkeypatch.setenv("TAOS_TEST_NO_FORKSERVER", "1")

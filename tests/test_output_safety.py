@@ -19,6 +19,7 @@ import pytest
 
 from taos.cli import main
 
+from . import _forkserver
 from .conftest import inline_actuator_set
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -109,8 +110,10 @@ sys.exit(main(sys.argv[1:]))
 
 
 def _start_slow(args, cwd):
-    return subprocess.Popen([sys.executable, "-c", SLOW, *map(str, args)], cwd=cwd, env=env(),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    """``python -c SLOW ARGS`` in ``cwd``, forked from the test process's fork server
+    (:mod:`tests._forkserver`: a ``subprocess.Popen``-like child; a real process where the fork
+    server cannot run it)."""
+    return _forkserver.popen([sys.executable, "-c", SLOW, *map(str, args)], cwd)
 
 
 def _wait_for_writing(proc, timeout=240):
