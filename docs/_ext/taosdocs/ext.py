@@ -6,7 +6,9 @@
 * ``{taos-cli} taos|masv``: the command-line reference, from the argparse parsers;
 * ``{taos-model-keys}``: the model-file and flight-file keys, from the code's key tables;
 * ``{taos-verification}``: ``docs/verification.md`` (written by the verification suite) when it
-  is there, else a note saying how to make it.
+  is there, else a note saying how to make it;
+* the Python domain's cross-reference look-ups memoised while the pages are written
+  (:mod:`.xrefmemo`).
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from . import guide
 
 from . import layouts
 
-from . import reference
+from . import reference, xrefmemo
 from .docstrings import process_docstring
 
 logger = logging.getLogger(__name__)
@@ -188,4 +190,5 @@ def setup(app):
     app.add_directive("taos-verification", TaosVerification)
     app.add_directive("taos-output-layout", TaosOutputLayout)
     app.add_directive("taos-python", TaosPython)
+    xrefmemo.setup(app)
     return {"parallel_read_safe": False, "version": "1"}
