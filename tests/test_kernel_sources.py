@@ -6,6 +6,7 @@ shares compile every step once, whole groups each."""
 from __future__ import annotations
 
 import ast
+import functools
 import importlib
 import re
 import sys
@@ -42,7 +43,9 @@ def test_the_report_and_the_cli_are_not_kernel_sources(sources):
         assert (ROOT / rel).resolve() not in sources, rel
 
 
-def _top_level_names(path: Path) -> set[str]:
+@functools.cache
+def _top_level_names(path: Path) -> frozenset[str]:
+    """The names a module file assigns or defines at top level (each file parsed once)."""
     names = set()
     for node in ast.parse(path.read_text(encoding="utf-8")).body:
         targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(
@@ -51,7 +54,7 @@ def _top_level_names(path: Path) -> set[str]:
             names |= {n.id for n in ast.walk(t) if isinstance(n, ast.Name)}
         if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
             names.add(node.name)
-    return names
+    return frozenset(names)
 
 
 def _code_names(code: types.CodeType) -> set[str]:
