@@ -199,3 +199,31 @@ def test_settled_dwells_against_long_settled_rk4(flight):
     for h, r in ((e.engine, ref.engine), (e.piston, ref.piston)):
         assert np.max(np.abs(gain_db(h) - gain_db(r))) < 0.03
         assert np.max(np.abs(np.degrees(np.angle(h / r)))) < 0.1
+
+
+@pytest.mark.parametrize("kl_lbf_in", [115000, 205000])
+def test_switching_law_step_is_its_stick_band_rate_not_its_jump(kl_lbf_in):
+    """Karnopp's switching law: inside the stick band |w| < v_s, T_f = t_app + c_stick w (a rate
+    c_stick / J on the planar joint: M = [[T_w c_w.b_f + T_a c_a.b_f, 0], [0, 0]]), outside it
+    T_c sign(w) (no rate); at |w| = v_s the torque jumps, which the law's own explicit-step rule
+    covers. So every dwell's friction step is KAPPA / |c_stick c_w.b_f + c_a.b_f|, on the paper's
+    soft and stiff structures alike, including orbit samples within a quotient's stencil of the
+    band's edge: a central quotient across the jump had made the 0.037-deg 0.5-Hz dwell's step
+    3.3e-7 s on the stiff structure (six million steps a cycle, 80 % of the LCO map's work)."""
+    from taos.model import Structure
+
+    m = load_model(MODELS / "rs25_flight.toml", friction="coulomb-switching")
+    m = m.replace(structure=Structure(kl_lbf_in * 4.4482216152605 / 0.0254))
+    args = kernel_args(simplex_plant(m), m)
+    cw, ca, bf = args[6], args[7], args[3]
+    law = m.friction
+    rate = abs(law.stick_damping_Nms_per_rad * float(cw @ bf) + float(ca @ bf))
+    amps = np.logspace(np.log10(0.01), 0.0, 8) * DEG          # the LCO tests' map (tests/test_lco.py)
+    freqs = np.logspace(np.log10(0.06), np.log10(0.5), 6)
+    steps = np.array([P.dwell_step_s(args, m, a, f, 2e-4)[0] for a in amps for f in freqs])
+    assert np.allclose(steps, P.KAPPA / rate, rtol=1e-9, atol=0)
+    # samples a fraction of the quotient's stencil (1e-7 rad/s) inside and outside the edge
+    fid, fp, vs = law.entry.rates, law.pack(), law.stick_velocity_rad_s
+    for w, want in ((vs - 2e-8, rate), (-vs + 3e-8, rate), (vs + 2e-8, 0.0), (-vs - 6e-8, 0.0)):
+        got = P._friction_rate(fid, fp, np.array([w]), np.zeros(1), np.zeros(1), float(cw @ bf), float(ca @ bf))
+        assert got == pytest.approx(want, rel=1e-6, abs=1e-9 * rate)

@@ -50,26 +50,65 @@ KAPPA = 0.5
 H_MAX_S = 0.01
 #: orbit samples per cycle for the friction-loop rates
 N_ORBIT = 1024
+#: a stencil side whose one half changes the law more than this many times the other holds a
+#: jump (:func:`_jumps`); a smooth law's halves agree to ~1e-3 at these stencils
+JUMP_RATIO = 8.0
+
+
+@njit(cache=True)
+def _law_at(fid, fp, w, z, ta, k, h):
+    """The law's (dz/dt, T_f) with variable ``k`` (0: w, 1: z, 2: t_app) shifted by ``h``."""
+    if k == 0:
+        return fid(w + h, z, ta, fp)
+    if k == 1:
+        return fid(w, z + h, ta, fp)
+    return fid(w, z, ta + h, fp)
+
+
+@njit(cache=True)
+def _jumps(a0, ah, a1):
+    """Whether a change a0 -> a1 over a stencil side, ah its value at the side's middle, is a
+    jump: one half of the side changes more than JUMP_RATIO times the other (a continuous law
+    changes alike over both halves of a stencil this small; a kink into a flat part is flagged
+    too, harmlessly: the other side's quotient is then that regime's own rate)."""
+    d1, d2 = abs(ah - a0), abs(a1 - ah)
+    return max(d1, d2) > JUMP_RATIO * min(d1, d2) and max(d1, d2) > 1e-12 * (abs(a0) + abs(a1))
+
+
+@njit(cache=True)
+def _quotients(fid, fp, w, z, ta, k, d):
+    """(dT_f/dx, d(dz/dt)/dx) along variable ``k`` (:func:`_law_at`) with step ``d``: central
+    quotients, or, where one side of the stencil holds a jump of the law (:func:`_jumps`: the
+    switching law's step at the edge of its stick band), the other side's one-sided quotients.
+    A jump is no rate: the law's own explicit-step rule covers it
+    (:meth:`taos.friction.FrictionLaw.check_step`)."""
+    g0, t0 = _law_at(fid, fp, w, z, ta, k, 0.0)
+    gp, tp = _law_at(fid, fp, w, z, ta, k, d)
+    gm, tm = _law_at(fid, fp, w, z, ta, k, -d)
+    gph, tph = _law_at(fid, fp, w, z, ta, k, 0.5 * d)
+    gmh, tmh = _law_at(fid, fp, w, z, ta, k, -0.5 * d)
+    jp = _jumps(t0, tph, tp) or _jumps(g0, gph, gp)
+    jm = _jumps(t0, tmh, tm) or _jumps(g0, gmh, gm)
+    if jp and not jm:
+        return (t0 - tm) / d, (g0 - gm) / d
+    if jm and not jp:
+        return (tp - t0) / d, (gp - g0) / d
+    return (tp - tm) / (2 * d), (gp - gm) / (2 * d)
 
 
 @njit(cache=True)
 def _friction_rate(fid, fp, w, ta, z, cwbf, cabf):
     """max |lambda(M)| [1/s] (module docstring) over the samples ``w`` [rad/s], ``ta`` [N m],
-    ``z`` [rad] (equal lengths); ``cwbf``, ``cabf`` the products c_w . b_f, c_a . b_f."""
+    ``z`` [rad] (equal lengths); ``cwbf``, ``cabf`` the products c_w . b_f, c_a . b_f. The
+    partial derivatives are central quotients except at a jump of the law (:func:`_quotients`)."""
     rho = 0.0
     for k in range(w.shape[0]):
         dw = max(1e-7, 1e-5 * abs(w[k]))
         dz = max(1e-12, 1e-5 * abs(z[k]))
         da = max(1e-3, 1e-5 * abs(ta[k]))
-        gp, tp = fid(w[k] + dw, z[k], ta[k], fp)
-        gm, tm = fid(w[k] - dw, z[k], ta[k], fp)
-        Tw, gw = (tp - tm) / (2 * dw), (gp - gm) / (2 * dw)
-        gp, tp = fid(w[k], z[k] + dz, ta[k], fp)
-        gm, tm = fid(w[k], z[k] - dz, ta[k], fp)
-        Tz, gz = (tp - tm) / (2 * dz), (gp - gm) / (2 * dz)
-        gp, tp = fid(w[k], z[k], ta[k] + da, fp)
-        gm, tm = fid(w[k], z[k], ta[k] - da, fp)
-        Ta, ga = (tp - tm) / (2 * da), (gp - gm) / (2 * da)
+        Tw, gw = _quotients(fid, fp, w[k], z[k], ta[k], 0, dw)
+        Tz, gz = _quotients(fid, fp, w[k], z[k], ta[k], 1, dz)
+        Ta, ga = _quotients(fid, fp, w[k], z[k], ta[k], 2, da)
         m11 = Tw * cwbf + Ta * cabf
         m21 = gw * cwbf + ga * cabf
         tr = m11 + gz
