@@ -26,7 +26,8 @@ at the reference points)::
 
 where S are the coupled surface DOFs and I all other (interior) DOFs. K_II is symmetric
 positive definite (the interfaces hold every rigid-body motion) and is solved by a sparse
-Cholesky factorisation, K_II = P^T L L^T P (:func:`spd_solve`: CHOLMOD, supernodal, AMD order).
+Cholesky factorisation, P K_II P^T = L L^T (:func:`spd_inverse_form`: CHOLMOD, supernodal,
+AMD order).
 
 References: R. J. Guyan, "Reduction of stiffness and mass matrices", AIAA J. 3(2), 1965;
 Y. Chen, T. A. Davis, W. W. Hager, S. Rajamanickam, "Algorithm 887: CHOLMOD, supernodal sparse
@@ -176,28 +177,36 @@ def rigid_transform(locs: np.ndarray, comp: np.ndarray, ref: Sequence[float]) ->
     return T
 
 
-def spd_solve(A: sp.spmatrix, B: np.ndarray) -> np.ndarray:
-    """X = A^-1 B for a sparse symmetric positive definite A (n, n) and a dense B (n, k).
+def spd_inverse_form(A: sp.spmatrix, B: np.ndarray) -> np.ndarray:
+    """Q = B^T A^-1 B (k, k) for a sparse symmetric positive definite A (n, n) and a dense B (n, k).
 
-    Units: those of B over those of A (here m from N and N/m). Method: sparse Cholesky
-    factorisation P A P^T = L L^T with CHOLMOD (Chen, Davis, Hager, Rajamanickam 2008, ACM TOMS
-    35(3) 22; SuiteSparse as bundled by the cvxopt wheel): approximate minimum degree (AMD)
-    fill-reducing order, supernodal numeric factorisation on dense BLAS blocks (cvxopt's
-    single-threaded OpenBLAS), then forward and back substitution for the k columns. Only the
-    lower triangle of A is read. On the interior blocks of the gimbal halves (18-19k DOFs):
-    about 3x less CPU than SuperLU's LU with a symmetric minimum-degree order and diagonal pivots
-    (the previous method), storing L only (8-11 M entries against 16-22 M in L + U), solutions
-    equal to round-off. Raises ArithmeticError if A is not positive definite.
+    Units: those of B^T B over those of A (here N/m, N/rad, N m/m, N m/rad). Method: sparse
+    Cholesky factorisation P A P^T = L D L^T with CHOLMOD (Chen, Davis, Hager, Rajamanickam 2008,
+    ACM TOMS 35(3) 22; SuiteSparse as bundled by the cvxopt wheel): approximate minimum degree
+    (AMD) fill-reducing order, supernodal numeric factorisation on dense BLAS blocks (cvxopt's
+    single-threaded OpenBLAS; D = I then) or simplicial L D L^T for small matrices (CHOLMOD's
+    choice). Then Q = Z^T D^-1 Z with Z = L^-1 P B: one forward substitution, half the work of
+    solving A X = B. Only the lower triangle of A is read. On the interior blocks of the gimbal
+    halves (18-19k DOFs): about 3x less CPU than SuperLU's LU with a symmetric minimum-degree
+    order and diagonal pivots (the previous method), storing L only (8-11 M entries against
+    16-22 M in L + U), the condensed matrices equal to round-off (benchmarks/bench_condense_lu.py).
+    Raises ArithmeticError if A is not positive definite.
     """
     # imported here: cvxopt is only needed by the FEM rebuild, not at taos start-up
     from cvxopt import cholmod, matrix, spmatrix
     L = sp.tril(A, format="coo")
     M = spmatrix(L.data, L.row.astype(np.int64), L.col.astype(np.int64), A.shape)
     F = cholmod.symbolic(M, uplo="L")
-    cholmod.numeric(M, F)
-    X = matrix(np.asarray(B, float))
-    cholmod.solve(F, X)
-    return np.array(X)
+    try:
+        cholmod.numeric(M, F)
+    except ArithmeticError as e:
+        raise ArithmeticError(f"matrix not positive definite (CHOLMOD stopped at column {e})") from None
+    Z = matrix(np.asarray(B, float))
+    cholmod.solve(F, Z, sys=7)  # P B
+    cholmod.solve(F, Z, sys=4)  # L^-1 P B
+    W = matrix(Z)
+    cholmod.solve(F, W, sys=6)  # D^-1 L^-1 P B
+    return np.array(Z).T @ np.array(W)
 
 
 def guyan_condense(model: ElasticModel, interfaces: Sequence[Interface]) -> np.ndarray:
@@ -229,8 +238,7 @@ def guyan_condense(model: ElasticModel, interfaces: Sequence[Interface]) -> np.n
     TS = Tfull[S]
     KSS = (TS.T @ K[S][:, S] @ TS).toarray()
     KIS_T = (K[interior][:, S] @ TS).toarray()
-    X = spd_solve(K[interior][:, interior], KIS_T)
-    Kc = KSS - KIS_T.T @ X
+    Kc = KSS - spd_inverse_form(K[interior][:, interior], KIS_T)
     return 0.5 * (Kc + Kc.T)
 
 
