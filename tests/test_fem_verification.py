@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from taos.fem import TI_6AL_4V, Interface, assemble_elasticity, cantilever_tube_check, guyan_condense, rigid_body_modes
 from taos.fem.mesh import curved_mesh, tube_mesh
@@ -49,3 +50,26 @@ def test_curved_geometry_gives_exact_tube_volume():
     model = assemble_elasticity(curved_mesh(rm, 8), TI_6AL_4V)
     exact = np.pi * (0.06 ** 2 - 0.03 ** 2) * 0.4
     assert abs(volume(model) / exact - 1) < 2e-3
+
+
+@pytest.mark.parametrize("supernodal", [0, 2])  # CHOLMOD's simplicial L D L^T, and its automatic choice
+def test_sparse_cholesky_inverse_form_matches_a_dense_solve(supernodal):
+    from cvxopt import cholmod
+
+    from taos.fem.elasticity import spd_inverse_form
+    rng = np.random.default_rng(7)
+    n = 300
+    R = sp.random(n, n, density=0.02, random_state=rng)
+    A = (R @ R.T + sp.diags(rng.uniform(1.0, 2.0, n))).tocsr()  # sparse, symmetric positive definite
+    B = rng.standard_normal((n, 5))
+    want = B.T @ np.linalg.solve(A.toarray(), B)
+    saved = dict(cholmod.options)
+    try:
+        cholmod.options["supernodal"] = supernodal
+        got = spd_inverse_form(A, B)
+    finally:
+        cholmod.options.clear()
+        cholmod.options.update(saved)
+    assert np.abs(got - want).max() < 1e-12 * np.abs(want).max()
+    with pytest.raises(ArithmeticError, match="not positive definite"):
+        spd_inverse_form(A - 10.0 * sp.eye(n), B)

@@ -58,6 +58,16 @@ def tube_section(name: str, diameter: float, wall: float, E: float, G: float, rh
     return Section(name, E, G, rho, A, Ib, Ib, 2 * Ib)
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b of two 3-vectors (the products and differences of np.cross, without its overhead)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+# element-matrix index blocks: axial, torsion, and bending (v, rz) and (w, ry) at both ends
+_AXIAL, _TORSION = np.ix_([0, 6], [0, 6]), np.ix_([3, 9], [3, 9])
+_BEND = {(1, 5): np.ix_([1, 5, 7, 11], [1, 5, 7, 11]), (2, 4): np.ix_([2, 4, 8, 10], [2, 4, 8, 10])}
+
+
 def element_matrices(x1: np.ndarray, x2: np.ndarray, sec: Section, up: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray]:
     """Global (12, 12) stiffness [SI] and consistent mass [kg, kg m, kg m^2] of one element.
@@ -67,16 +77,16 @@ def element_matrices(x1: np.ndarray, x2: np.ndarray, sec: Section, up: np.ndarra
     d = x2 - x1
     L = float(np.linalg.norm(d))
     ex = d / L
-    ey = np.cross(up, ex)
+    ey = _cross(up, ex)
     if np.linalg.norm(ey) < 1e-8:
-        ey = np.cross(np.array([0.0, 1.0, 0.0]) if abs(ex[1]) < 0.9 else np.array([1.0, 0.0, 0.0]), ex)
+        ey = _cross(np.array([0.0, 1.0, 0.0]) if abs(ex[1]) < 0.9 else np.array([1.0, 0.0, 0.0]), ex)
     ey /= np.linalg.norm(ey)
-    ez = np.cross(ex, ey)
+    ez = _cross(ex, ey)
     E, G, A, Iy, Iz, J = sec.E_Pa, sec.G_Pa, sec.A_m2, sec.Iy_m4, sec.Iz_m4, sec.J_m4
     k = np.zeros((12, 12))
     ea, gj = E * A / L, G * J / L
-    k[np.ix_([0, 6], [0, 6])] = ea * np.array([[1, -1], [-1, 1]])
-    k[np.ix_([3, 9], [3, 9])] = gj * np.array([[1, -1], [-1, 1]])
+    k[_AXIAL] = ea * np.array([[1, -1], [-1, 1]])
+    k[_TORSION] = gj * np.array([[1, -1], [-1, 1]])
 
     def bend(I, iv, ir, sgn):
         c = E * I / L ** 3
@@ -84,14 +94,14 @@ def element_matrices(x1: np.ndarray, x2: np.ndarray, sec: Section, up: np.ndarra
                            [sgn * 6 * L, 4 * L * L, -sgn * 6 * L, 2 * L * L],
                            [-12, -sgn * 6 * L, 12, -sgn * 6 * L],
                            [sgn * 6 * L, 2 * L * L, -sgn * 6 * L, 4 * L * L]])
-        k[np.ix_([iv, ir, iv + 6, ir + 6], [iv, ir, iv + 6, ir + 6])] += kb
+        k[_BEND[iv, ir]] += kb
 
     bend(Iz, 1, 5, +1)   # v with rz
     bend(Iy, 2, 4, -1)   # w with ry
     mu = sec.rho_kg_m3 * A + sec.extra_mass_kg_per_m
     m = np.zeros((12, 12))
-    m[np.ix_([0, 6], [0, 6])] = mu * L / 6 * np.array([[2, 1], [1, 2]])
-    m[np.ix_([3, 9], [3, 9])] = sec.rho_kg_m3 * (Iy + Iz) * L / 6 * np.array([[2, 1], [1, 2]])
+    m[_AXIAL] = mu * L / 6 * np.array([[2, 1], [1, 2]])
+    m[_TORSION] = sec.rho_kg_m3 * (Iy + Iz) * L / 6 * np.array([[2, 1], [1, 2]])
 
     def bmass(iv, ir, sgn):
         c = mu * L / 420
@@ -99,7 +109,7 @@ def element_matrices(x1: np.ndarray, x2: np.ndarray, sec: Section, up: np.ndarra
                            [sgn * 22 * L, 4 * L * L, sgn * 13 * L, -3 * L * L],
                            [54, sgn * 13 * L, 156, -sgn * 22 * L],
                            [-sgn * 13 * L, -3 * L * L, -sgn * 22 * L, 4 * L * L]])
-        m[np.ix_([iv, ir, iv + 6, ir + 6], [iv, ir, iv + 6, ir + 6])] += mb
+        m[_BEND[iv, ir]] += mb
 
     bmass(1, 5, +1)
     bmass(2, 4, -1)
@@ -117,14 +127,25 @@ class Frame:
     lumped: dict = field(default_factory=dict)     # node -> kg
     names: dict = field(default_factory=dict)      # name -> node
     fixed: set = field(default_factory=set)
+    _xyz: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)), repr=False, compare=False)
 
     def node(self, xyz, tol: float = 1e-6) -> int:
+        """Index of the first node within ``tol`` [m] of ``xyz`` [m]; a new node if none is."""
         p = np.asarray(xyz, float)
-        for i, q in enumerate(self.nodes):
-            if np.linalg.norm(q - p) < tol:
-                return i
+        X = self._coords()
+        hit = np.flatnonzero(np.sqrt(np.sum((X - p) ** 2, axis=1)) < tol)
+        if hit.size:
+            return int(hit[0])
         self.nodes.append(p)
         return len(self.nodes) - 1
+
+    def _coords(self) -> np.ndarray:
+        """(n, 3) array of ``nodes`` [m], extended by the nodes appended since the last call."""
+        k = self._xyz.shape[0]
+        if k != len(self.nodes):
+            new = np.array(self.nodes[k:], float).reshape(-1, 3) if k < len(self.nodes) else None
+            self._xyz = np.vstack([self._xyz, new]) if new is not None else np.array(self.nodes, float).reshape(-1, 3)
+        return self._xyz
 
     def member(self, a: int, b: int, sec: Section, max_element_m: float, up=(1.0, 0.0, 0.0)) -> None:
         """Member from node a to node b split into equal elements <= max_element_m."""
