@@ -52,8 +52,11 @@ def test_curved_geometry_gives_exact_tube_volume():
     assert abs(volume(model) / exact - 1) < 2e-3
 
 
-@pytest.mark.parametrize("supernodal", [0, 2])  # CHOLMOD's simplicial L D L^T, and its automatic choice
-def test_sparse_cholesky_inverse_form_matches_a_dense_solve(supernodal):
+@pytest.mark.parametrize("solver, supernodal", [("superlu", None), ("cholmod", 0), ("cholmod", 2)],
+                         ids=["superlu", "cholmod-simplicial", "cholmod-auto"])
+def test_sparse_inverse_form_matches_a_dense_solve(solver, supernodal):
+    """B^T A^-1 B of both sparse solvers (SuperLU, the default without the optional cvxopt;
+    CHOLMOD's simplicial L D L^T and its automatic choice) against a dense solve."""
     from cvxopt import cholmod
 
     from taos.fem.elasticity import spd_inverse_form
@@ -65,11 +68,36 @@ def test_sparse_cholesky_inverse_form_matches_a_dense_solve(supernodal):
     want = B.T @ np.linalg.solve(A.toarray(), B)
     saved = dict(cholmod.options)
     try:
-        cholmod.options["supernodal"] = supernodal
-        got = spd_inverse_form(A, B)
+        if supernodal is not None:
+            cholmod.options["supernodal"] = supernodal
+        got = spd_inverse_form(A, B, solver)
     finally:
         cholmod.options.clear()
         cholmod.options.update(saved)
     assert np.abs(got - want).max() < 1e-12 * np.abs(want).max()
-    with pytest.raises(ArithmeticError, match="not positive definite"):
-        spd_inverse_form(A - 10.0 * sp.eye(n), B)
+    if solver == "cholmod":
+        with pytest.raises(ArithmeticError, match="not positive definite"):
+            spd_inverse_form(A - 10.0 * sp.eye(n), B, solver)
+
+
+def test_both_sparse_solvers_condense_a_gimbal_half_alike():
+    """The two solvers on a real interior block (the upper gimbal half, thrust condition, on a
+    coarse mesh): the same condensed matrix to round-off; the default is CHOLMOD where cvxopt is
+    installed (the test extra installs it)."""
+    from taos.fem import elasticity as el
+    from taos.fem.gimbal import GimbalGeometry, MeshSpec, half_interfaces, half_model
+
+    g = GimbalGeometry()
+    rm, em = half_model(g, "upper", MeshSpec(0.02, 8))
+    itf = half_interfaces(g, "upper", "thrust", rm)
+    real = el.spd_inverse_form
+    got = {}
+    for solver in el.SPD_SOLVERS:
+        el.spd_inverse_form = lambda A, B, _s=solver: real(A, B, _s)
+        try:
+            got[solver] = el.guyan_condense(em, itf)
+        finally:
+            el.spd_inverse_form = real
+    scale = np.abs(got["superlu"]).max()
+    assert np.abs(got["cholmod"] - got["superlu"]).max() < 1e-10 * scale
+    assert el.spd_solver() == "cholmod"

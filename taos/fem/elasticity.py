@@ -27,7 +27,7 @@ at the reference points)::
 where S are the coupled surface DOFs and I all other (interior) DOFs. K_II is symmetric
 positive definite (the interfaces hold every rigid-body motion) and is solved by a sparse
 Cholesky factorisation, P K_II P^T = L L^T (:func:`spd_inverse_form`: CHOLMOD, supernodal,
-AMD order).
+AMD order, when the optional cvxopt is installed) or SciPy's SuperLU (otherwise).
 
 References: R. J. Guyan, "Reduction of stiffness and mass matrices", AIAA J. 3(2), 1965;
 Y. Chen, T. A. Davis, W. W. Hager, S. Rajamanickam, "Algorithm 887: CHOLMOD, supernodal sparse
@@ -188,21 +188,47 @@ def rigid_transform(locs: np.ndarray, comp: np.ndarray, ref: Sequence[float]) ->
     return T
 
 
-def spd_inverse_form(A: sp.spmatrix, B: np.ndarray) -> np.ndarray:
+#: the sparse solvers of :func:`spd_inverse_form`
+SPD_SOLVERS = ("cholmod", "superlu")
+
+
+def spd_solver() -> str:
+    """The default solver of :func:`spd_inverse_form`: ``"cholmod"`` when the optional ``cvxopt``
+    package (the extra ``fem-fast``; GPL-3.0, as CHOLMOD's supernodal module) is installed, else
+    ``"superlu"`` (SciPy, no further dependency)."""
+    import importlib.util
+
+    return "cholmod" if importlib.util.find_spec("cvxopt") is not None else "superlu"
+
+
+def spd_inverse_form(A: sp.spmatrix, B: np.ndarray, solver: str | None = None) -> np.ndarray:
     """Q = B^T A^-1 B (k, k) for a sparse symmetric positive definite A (n, n) and a dense B (n, k).
 
-    Units: those of B^T B over those of A (here N/m, N/rad, N m/m, N m/rad). Method: sparse
-    Cholesky factorisation P A P^T = L D L^T with CHOLMOD (Chen, Davis, Hager, Rajamanickam 2008,
-    ACM TOMS 35(3) 22; SuiteSparse as bundled by the cvxopt wheel): approximate minimum degree
-    (AMD) fill-reducing order, supernodal numeric factorisation on dense BLAS blocks (cvxopt's
-    single-threaded OpenBLAS; D = I then) or simplicial L D L^T for small matrices (CHOLMOD's
-    choice). Then Q = Z^T D^-1 Z with Z = L^-1 P B: one forward substitution, half the work of
-    solving A X = B. Only the lower triangle of A is read. On the interior blocks of the gimbal
-    halves (18-19k DOFs): about 3x less CPU than SuperLU's LU with a symmetric minimum-degree
-    order and diagonal pivots (the previous method), storing L only (8-11 M entries against
-    16-22 M in L + U), the condensed matrices equal to round-off (benchmarks/bench_condense_lu.py).
-    Raises ArithmeticError if A is not positive definite.
+    Units: those of B^T B over those of A (here N/m, N/rad, N m/m, N m/rad). ``solver`` (default
+    :func:`spd_solver`), equal to round-off (tests/test_fem_verification.py):
+
+    * ``"cholmod"``: sparse Cholesky factorisation P A P^T = L D L^T with CHOLMOD (Chen, Davis,
+      Hager, Rajamanickam 2008, ACM TOMS 35(3) 22; SuiteSparse as bundled by the optional cvxopt
+      wheel): approximate minimum degree (AMD) fill-reducing order, supernodal numeric
+      factorisation on dense BLAS blocks (cvxopt's single-threaded OpenBLAS; D = I then) or
+      simplicial L D L^T for small matrices (CHOLMOD's choice). Then Q = Z^T D^-1 Z with
+      Z = L^-1 P B: one forward substitution, half the work of solving A X = B. Only the lower
+      triangle of A is read. Raises ArithmeticError if A is not positive definite.
+    * ``"superlu"``: SciPy's SuperLU LU with a symmetric fill-reducing order (minimum degree on
+      A + A^T) and diagonal pivots (symmetric mode), Q = B^T (A^-1 B).
+
+    On the interior blocks of the gimbal halves (18-19k DOFs) CHOLMOD takes about a third of
+    SuperLU's CPU and stores L only (8-11 M entries against 16-22 M in L + U)
+    (benchmarks/bench_condense_lu.py).
     """
+    solver = spd_solver() if solver is None else solver
+    if solver == "superlu":
+        from scipy.sparse.linalg import splu
+
+        lu = splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+        return B.T @ lu.solve(B)
+    if solver != "cholmod":
+        raise ValueError(f"solver must be one of {SPD_SOLVERS}, got {solver!r}")
     # imported here: cvxopt is only needed by the FEM rebuild, not at taos start-up
     from cvxopt import cholmod, matrix, spmatrix
     L = sp.tril(A, format="coo")
