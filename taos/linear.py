@@ -355,35 +355,36 @@ def hessenberg_solve(H: np.ndarray, s: np.ndarray, B: np.ndarray) -> np.ndarray:
     cur[0] += s
     rc = np.empty((m, F), complex)   # and its right-hand side
     rc[:] = B[0][:, None]
-    for k in range(n - 1):
-        h = -H[k + 1, k]            # row k + 1 in column k: the same for every shift
-        nxt = np.empty((n - k - 1, F), complex)   # row k + 1 right of column k
-        nxt[:] = -H[k + 1, k + 1:][:, None]
-        nxt[0] += s
-        rn = B[k + 1][:, None]
-        c0 = cur[0]
-        swap = np.abs(c0) < abs(h)  # the pivot: the larger of the two (the first on a tie)
-        if not swap.any():
-            l = h / c0
-            diag.append(c0)
-            tail.append(cur[1:])
-            Y.append(rc)
-            cur, rc = nxt - l * cur[1:], rn - l * rc
-        elif swap.all():
-            l = c0 / h
-            diag.append(np.full(F, h, complex))
-            tail.append(nxt)
-            Y.append(np.broadcast_to(rn, (m, F)))
-            cur, rc = cur[1:] - l * nxt, rc - l * rn
-        else:
-            with np.errstate(divide="ignore", invalid="ignore"):
+    # a zero pivot (0 / 0 on the way) is singular: raised below, once the factor is complete
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for k in range(n - 1):
+            h = -H[k + 1, k]            # row k + 1 in column k: the same for every shift
+            nxt = np.empty((n - k - 1, F), complex)   # row k + 1 right of column k
+            nxt[:] = -H[k + 1, k + 1:][:, None]
+            nxt[0] += s
+            rn = B[k + 1][:, None]
+            c0 = cur[0]
+            swap = np.abs(c0) < abs(h)  # the pivot: the larger of the two (the first on a tie)
+            if not swap.any():
+                l = h / c0
+                diag.append(c0)
+                tail.append(cur[1:])
+                Y.append(rc)
+                cur, rc = nxt - l * cur[1:], rn - l * rc
+            elif swap.all():
+                l = c0 / h
+                diag.append(np.full(F, h, complex))
+                tail.append(nxt)
+                Y.append(np.broadcast_to(rn, (m, F)))
+                cur, rc = cur[1:] - l * nxt, rc - l * rn
+            else:
                 l = np.where(swap, c0 / h, h / c0)
-            ct = cur[1:]
-            diag.append(np.where(swap, h, c0))
-            tail.append(np.where(swap, nxt, ct))
-            Y.append(np.where(swap, rn, rc))
-            cur = np.where(swap, ct, nxt) - l * tail[-1]
-            rc = np.where(swap, rc, rn) - l * Y[-1]
+                ct = cur[1:]
+                diag.append(np.where(swap, h, c0))
+                tail.append(np.where(swap, nxt, ct))
+                Y.append(np.where(swap, rn, rc))
+                cur = np.where(swap, ct, nxt) - l * tail[-1]
+                rc = np.where(swap, rc, rn) - l * Y[-1]
     diag.append(cur[0])
     Y.append(rc)
     if not all(np.all(d) for d in diag):
