@@ -69,7 +69,7 @@ class StateSpace:
         :attr:`_forms`)."""
         Ab = self._balanced
         n = Ab.shape[0]
-        return _hessenberg_form(Ab.tobytes(), n) if n <= SHARED_FORMS_MAX_N else _hessenberg_form.__wrapped__(Ab.tobytes(), n)
+        return (_hessenberg_form if n <= SHARED_FORMS_MAX_N else _hessenberg_form.__wrapped__)(Ab.tobytes(), n)
 
     def poles(self) -> np.ndarray:
         """Eigenvalues of A [1/s]."""
@@ -86,11 +86,12 @@ class StateSpace:
         at a time; many by the method of Laub (IEEE Trans. Automat. Control 26 (1981) 407): A is
         reduced once per system to Hessenberg form by orthogonal similarity (:func:`hessenberg`),
         then every frequency's Hessenberg system is solved at once by Gaussian elimination with
-        partial pivoting (:func:`hessenberg_solve`, O(n^2) a frequency instead of O(n^3)). Both
-        are backward stable; they agree to round-off relative to the response's norm (a response
-        many decades below its own peak, e.g. far above a high relative degree's roll-off, keeps
-        fewer correct digits on the Hessenberg path). Raises ``numpy.linalg.LinAlgError`` where
-        j w I - A is exactly singular.
+        partial pivoting (:func:`hessenberg_solve`, O(n^2) a frequency instead of O(n^3)). On
+        either path a frequency's response does not depend on the other frequencies of the call
+        (bit for bit). Both are backward stable and agree to round-off relative to the
+        response's largest value (a response many decades below its own peak, e.g. far above a
+        high relative degree's roll-off, keeps fewer correct digits on the Hessenberg path).
+        Raises ``numpy.linalg.LinAlgError`` where j w I - A is exactly singular.
         """
         f = np.atleast_1d(np.asarray(freq_hz, float))
         ii = self._sel(inputs, self.inputs)
