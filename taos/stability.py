@@ -109,20 +109,20 @@ def _sampled(freq_hz, L) -> LoopMargins:
     pc, gm, gc, pm = [], [], [], []
     im = L.imag
     lm = np.log10(np.maximum(np.abs(L), 1e-300))
-    for i in range(f.size - 1):
-        # negative real axis: Im L changes sign (or touches zero at the left sample)
-        if im[i] == 0.0 or im[i] * im[i + 1] < 0:
-            t = im[i] / (im[i] - im[i + 1]) if im[i] != im[i + 1] else 0.0
-            Lx = L[i] + t * (L[i + 1] - L[i])
-            if Lx.real < 0:
-                pc.append(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
-                gm.append(-20.0 * math.log10(-Lx.real))
-        # unit circle: log |L| changes sign
-        if (lm[i] >= 0 > lm[i + 1]) or (lm[i] < 0 <= lm[i + 1]):
-            t = lm[i] / (lm[i] - lm[i + 1])
-            Lx = L[i] + t * (L[i + 1] - L[i])
-            gc.append(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
-            pm.append(float(_wrap_pm(math.degrees(np.angle(Lx)))))
+    # the intervals [i, i + 1] holding a crossing, found at once; each then interpolated alone
+    # negative real axis: Im L changes sign (or touches zero at the left sample)
+    for i in np.flatnonzero((im[:-1] == 0.0) | (im[:-1] * im[1:] < 0)):
+        t = im[i] / (im[i] - im[i + 1]) if im[i] != im[i + 1] else 0.0
+        Lx = L[i] + t * (L[i + 1] - L[i])
+        if Lx.real < 0:
+            pc.append(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
+            gm.append(-20.0 * math.log10(-Lx.real))
+    # unit circle: log |L| changes sign
+    for i in np.flatnonzero(((lm[:-1] >= 0) & (lm[1:] < 0)) | ((lm[:-1] < 0) & (lm[1:] >= 0))):
+        t = lm[i] / (lm[i] - lm[i + 1])
+        Lx = L[i] + t * (L[i + 1] - L[i])
+        gc.append(10 ** (lf[i] + t * (lf[i + 1] - lf[i])))
+        pm.append(float(_wrap_pm(math.degrees(np.angle(Lx)))))
     return LoopMargins(np.asarray(pc), np.asarray(gm), np.asarray(gc), np.asarray(pm), "sampled")
 
 

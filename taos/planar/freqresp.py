@@ -52,9 +52,17 @@ def linear_phase_reference(model: TvcModel, freq_hz, axis: str = "pitch", f_min_
     more than ``max_step_deg`` between neighbours, then unwrapped in frequency order. The
     refinement follows a lightly damped notch's +180 deg turn, which a fixed grid could read
     as -180 deg; an undamped notch (a sign flip at any resolution) is taken as +180 deg."""
+    ph, _ = _phase_reference(simplex_state_space(model, axis), freq_hz, f_min_hz, points_per_decade, max_step_deg)
+    return ph[:, 0], ph[:, 1]
+
+
+def _phase_reference(ss, freq_hz, f_min_hz: float = 1e-3, points_per_decade: int = 100,
+                     max_step_deg: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`linear_phase_reference` of the simplex block ``ss``: (continuous phase [deg],
+    response) of command -> (x_p [m/rad], theta [-]) at ``freq_hz``, shape (n_freq, 2) each
+    (the response comes with the reference's own grid, which holds ``freq_hz``)."""
     f = np.atleast_1d(np.asarray(freq_hz, float))
     hi = max(float(f.max()), f_min_hz * 10)
-    ss = simplex_state_space(model, axis)
 
     def resp(x):
         return ss.freqresp(x, "command_rad", ["x_p_m", "theta_rad"])
@@ -81,7 +89,7 @@ def linear_phase_reference(model: TvcModel, freq_hz, axis: str = "pitch", f_min_
     d = np.where(np.abs(d) > math.radians(179.0), math.pi, d)
     ph = np.degrees(np.angle(h[:1]) + np.concatenate([np.zeros((1, 2)), np.cumsum(d, axis=0)]))
     idx = np.searchsorted(grid, f)
-    return ph[idx, 0], ph[idx, 1]
+    return ph[idx], h[idx]
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,14 +157,12 @@ def linear_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, axis: str = "
     from taos.bounds import check_response_args
 
     check_response_args(freq_hz, None, axis)
-    ss = simplex_state_space(model, axis)
-    h = ss.freqresp(freq_hz, "command_rad", ["x_p_m", "theta_rad"])
     R = model.actuator.moment_arm_m
     f = np.atleast_1d(np.asarray(freq_hz, float))
-    rp, re = linear_phase_reference(model, f, axis)
+    ph, h = _phase_reference(simplex_state_space(model, axis), f)   # the response with its phase reference
     return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, axis,
                              friction_model="none", provenance={"model_sha256": model.sha256, "method": "linear"},
-                             piston_phase_ref_deg=rp, engine_phase_ref_deg=re)
+                             piston_phase_ref_deg=ph[:, 0], engine_phase_ref_deg=ph[:, 1])
 
 
 def settle_time_s(model: TvcModel, axis: str = "pitch", decades: float = 4.0) -> float:
