@@ -59,14 +59,23 @@ def _scatter(row: int, col: int, ncols: int, **props) -> dict:
     return {"type": "scatter", **props, "xaxis": "x" if k == 1 else f"x{k}", "yaxis": "y" if k == 1 else f"y{k}"}
 
 
+def _subplots(**kw):
+    """:func:`plotly.subplots.make_subplots` (``kw``) on a figure made with the
+    ``plotly_white`` template (the template validated once, not also plotly's default)."""
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    return make_subplots(figure=go.Figure(layout=dict(template="plotly_white")), **kw)
+
+
 def _figure(layout_fig, traces):
     """A ``go.Figure`` of ``layout_fig``'s layout (validated: the template expanded) and the
-    trace dicts ``traces`` (:func:`_scatter`), taken as they are: plotly's per-property
-    validation of every trace (most of a figure's build time) is skipped; the traces are made
-    here, from numbers and fixed names, as plotly's JSON form."""
+    trace dicts ``traces`` (:func:`_scatter`), both taken as they are: plotly's per-property
+    validation of every trace (most of a figure's build time) and a second one of the layout
+    are skipped; the traces are made here, from numbers and fixed names, as plotly's JSON form."""
     import plotly.graph_objects as go
 
-    return go.Figure(data=traces, layout=layout_fig.layout, _validate=False)
+    return go.Figure(data=traces, layout=layout_fig.layout.to_plotly_json(), _validate=False)
 
 
 def bode_traces(traces: list, fr, *, name: str, colour: str, ref=None, mode: str = "lines", symbol: str = "circle",
@@ -141,12 +150,10 @@ def bode_figure(responses, *, resonance_hz: float | None = None, notch_hz: float
     ``measured`` (a measured record's response: orange squares), the load resonance
     ``resonance_hz`` [Hz] (dashed line) and the piston notch ``notch_hz`` [Hz] (triangle), and
     the spec mask ``spec_result``. Returns a ``plotly.graph_objects.Figure``."""
-    from plotly.subplots import make_subplots
-
     responses = list(responses)
     ref = max(responses, key=lambda r: (r.amplitude_rad is None, np.size(r.freq_hz)))
-    fig = make_subplots(rows=2, cols=2, shared_xaxes=True, vertical_spacing=0.07, horizontal_spacing=0.08,
-                        subplot_titles=("command → piston, x_p / (R θ_c)", "command → engine angle, θ / θ_c", "", ""))
+    fig = _subplots(rows=2, cols=2, shared_xaxes=True, vertical_spacing=0.07, horizontal_spacing=0.08,
+                    subplot_titles=("command → piston, x_p / (R θ_c)", "command → engine angle, θ / θ_c", "", ""))
     amps = sorted({fr.amplitude_rad for fr in responses if fr.amplitude_rad is not None})
     traces = []
     for fr in responses:
@@ -166,7 +173,7 @@ def bode_figure(responses, *, resonance_hz: float | None = None, notch_hz: float
     for (r, c), key in ((v, k) for k, v in PANELS.items()):
         fig.update_xaxes(type="log", showgrid=True, row=r, col=c, title_text="frequency [Hz]" if r == 2 else None)
         fig.update_yaxes(title_text=f"{key[1]} [{UNITS[key[1]]}]", row=r, col=c)
-    fig.update_layout(height=720, hovermode="closest", template="plotly_white", margin=dict(l=60, r=20, t=70, b=50),
+    fig.update_layout(height=720, hovermode="closest", margin=dict(l=60, r=20, t=70, b=50),
                       title=dict(text=title or "", x=0.01, font=dict(size=15)),
                       legend=dict(orientation="h", yanchor="top", y=-0.09, x=0, font=dict(size=11)))
     return _figure(fig, traces)
@@ -196,15 +203,13 @@ def _marks(fig, traces: list, ref, resonance_hz, notch_hz) -> None:
 def timehistory_figure(th, title: str | None = None):
     """Commands (FCS, solid; after avionics, dotted) [deg], piston x_p [in], engine angle [deg]
     and friction torque T_f [in lbf] of run ``th`` against time [s], one colour per axis."""
-    from plotly.subplots import make_subplots
-
     from ..units import from_si
 
     m_per_in = 1.0 / from_si(1.0, "m", "in")
     nm_per_inlbf = 1.0 / from_si(1.0, "N*m", "inch*lbf")
     rows = (("command", "command [deg]"), ("piston", "piston x_p [in]"), ("engine", "engine θ [deg]"),
             ("friction", "friction torque T_f [in lbf]"))
-    fig = make_subplots(rows=4, cols=1, shared_xaxes=True, vertical_spacing=0.03)
+    fig = _subplots(rows=4, cols=1, shared_xaxes=True, vertical_spacing=0.03)
     t = np.asarray(th.t_s, float)
     traces = []
     for i, ax in enumerate(th.axes):
@@ -222,7 +227,7 @@ def timehistory_figure(th, title: str | None = None):
     for k, (_, label) in enumerate(rows, start=1):
         fig.update_yaxes(title_text=label, row=k, col=1)
     fig.update_xaxes(title_text="time [s]", row=4, col=1)
-    fig.update_layout(height=900, hovermode="closest", template="plotly_white", margin=dict(l=70, r=20, t=50, b=40),
+    fig.update_layout(height=900, hovermode="closest", margin=dict(l=70, r=20, t=50, b=40),
                       title=dict(text=title or "", x=0.01, font=dict(size=15)), legend=dict(font=dict(size=11)))
     return _figure(fig, traces)
 
