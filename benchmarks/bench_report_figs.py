@@ -5,14 +5,28 @@ each figure of :mod:`taos.report.html` ``REPEAT`` times and prints the best and 
 time [s] per figure, and of ``render_html`` as a whole. With ``--png DIR`` also writes the
 four PNGs there (to look at them).
 
+``--fresh N``: what a ``taos greenrun`` process pays, N times: in a new process each, the run
+and its summary, then the FIRST ``_static_figures``, ``_interactive_figures`` and
+``render_html`` (each in its own process: the plotting libraries' imports, first figures and
+the garbage collector's full scans of a fresh process included), and a whole ``taos greenrun``
+process on the short profile (user + system CPU [s]). ``--baseline DIR``: the same rows for
+the source tree DIR (e.g. ``git worktree add /tmp/base <commit>``, or a copy of ``taos`` and
+``models`` with older files), each fresh process of the tree under test followed by the same
+one of DIR, so that a change of machine load hits both alike; best and median per row.
+
     PYTHONPATH=. .venv/bin/python benchmarks/bench_report_figs.py [--repeat 5] [--png DIR]
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_report_figs.py --fresh 5 [--baseline DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import base64
+import os
+import resource
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -40,11 +54,61 @@ def _time(fn, repeat: int) -> tuple[float, float, object]:
     return min(ts), statistics.median(ts), out
 
 
+#: one fresh process: the run and its summary untimed, then the first call of one function [CPU s]
+_FIRST = """import sys, time
+from taos.report import html as rh
+from taos.report.analysis import greenrun
+res = greenrun("models/rs25_ambient.toml", sys.argv[1]); s = res.summary()
+fn = {"static": lambda: rh._static_figures(res), "interactive": lambda: rh._interactive_figures(res),
+      "render_html": lambda: rh.render_html(res, s)}[sys.argv[2]]
+t0 = time.process_time(); fn(); print(time.process_time() - t0)
+"""
+
+
+def _fresh_row(tree: Path, what: str, prof: Path, out: Path) -> float:
+    """CPU [s] of one fresh-process measurement ``what`` with the sources of ``tree``."""
+    env = dict(os.environ, PYTHONPATH=str(tree))
+    if what == "greenrun process":
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([sys.executable, "-m", "taos", "greenrun", "models/rs25_ambient.toml", "--profile", str(prof),
+                        "--out", str(out), "--quiet"], cwd=tree, env=env, check=True, capture_output=True)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    r = subprocess.run([sys.executable, "-c", _FIRST, str(prof), what], cwd=tree, env=env, check=True,
+                       capture_output=True, text=True)
+    return float(r.stdout.split()[-1])
+
+
+def fresh(n: int, baseline: str | None) -> None:
+    """The ``--fresh`` rows (module docstring), interleaved with ``baseline``'s when given."""
+    trees = {"this tree": Path.cwd()}
+    if baseline:
+        trees["baseline"] = Path(baseline).resolve()
+    rows = ("static", "interactive", "render_html", "greenrun process")
+    got = {(w, k): [] for w in rows for k in trees}
+    with tempfile.TemporaryDirectory() as d:
+        prof = Path(d) / "short.toml"
+        prof.write_text(PROFILE)
+        for _ in range(n):
+            for w in rows:
+                for k, tree in trees.items():
+                    got[w, k].append(_fresh_row(tree, w, prof, Path(d) / "out"))
+    print(f"first call in a fresh process, CPU [s], {n} processes each")
+    print(f"{'row':20s} {'tree':10s} {'best':>7s} {'median':>7s}")
+    for (w, k), ts in got.items():
+        print(f"{w:20s} {k:10s} {min(ts):7.3f} {statistics.median(ts):7.3f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--png", default=None, help="folder for the four PNGs")
+    ap.add_argument("--fresh", type=int, default=0, help="fresh-process rows, this many processes each")
+    ap.add_argument("--baseline", default=None, help="source tree to compare with (--fresh)")
     a = ap.parse_args()
+    if a.fresh:
+        fresh(a.fresh, a.baseline)
+        return
 
     from taos.report import html as rh
     from taos.report.analysis import greenrun

@@ -161,3 +161,36 @@ def test_compare_ambient_hotfire_marks_each_notch_and_the_stiffer_one_is_higher(
     save(fig, tmp_path / "cmp.png")
     assert (tmp_path / "cmp.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     plt.close(fig)
+
+
+@pytest.mark.parametrize("span_hz", [(0.1, 40.0), (0.5, 3.0)])
+def test_frozen_log_axes_draw_the_same_minor_ticks_and_grid_as_matplotlib(span_hz, monkeypatch):
+    """freeze_layout draws the unlabelled minor ticks of log x axes as one artist per axes: the
+    saved pixels are those of matplotlib's own minor ticks (a span over a decade: merged; under
+    one, where minor ticks carry labels: left to matplotlib)."""
+    import io
+
+    from PIL import Image
+
+    from taos.plotting import _common
+
+    def png(merge: bool):
+        fig, ax = plt.subplots(2, 2, figsize=(5, 4), sharex=True)
+        _common.use_grid_layout(fig, ax)
+        f = np.logspace(*np.log10(span_hz), 50)
+        for a in ax.flat:
+            a.plot(f, np.sin(np.log(f)), "k-")
+        _common.finish_bode_axes(ax)
+        with monkeypatch.context() as m:
+            if not merge:
+                m.setattr(_common, "merge_log_minor_ticks", lambda fig: None)
+            _common.freeze_layout(fig)
+        merged = sum(isinstance(c, _common._MergedTicks) for a in fig.axes for c in a.get_children())
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=60)
+        plt.close(fig)
+        return np.asarray(Image.open(buf)), merged
+
+    (mine, n_mine), (theirs, n_theirs) = png(True), png(False)
+    assert n_theirs == 0 and n_mine == (4 if span_hz[1] / span_hz[0] > 10 else 0)
+    assert mine.shape == theirs.shape and (mine == theirs).all()

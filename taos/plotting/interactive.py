@@ -51,12 +51,38 @@ def _colour(i: int, n: int) -> str:
     return pc.sample_colorscale("Viridis", [0.1 + 0.7 * i / max(1, n - 1)])[0]
 
 
-def bode_traces(fig, fr, *, name: str, colour: str, ref=None, mode: str = "lines", symbol: str = "circle",
-                group: str | None = None, open_marker: bool = False) -> None:
-    """One response on the four Bode panels, one legend entry; engine points where friction holds
-    the engine (no motion: no gain or phase) left out and named in the legend entry."""
+def _scatter(row: int, col: int, ncols: int, **props) -> dict:
+    """A scatter trace (plotly's JSON form, as ``go.Scatter(**props)`` holds it) on subplot
+    (``row``, ``col``) of a :func:`plotly.subplots.make_subplots` grid of ``ncols`` columns
+    (axes numbered row by row: ``x``/``y``, ``x2``/``y2``, ...)."""
+    k = (row - 1) * ncols + col
+    return {"type": "scatter", **props, "xaxis": "x" if k == 1 else f"x{k}", "yaxis": "y" if k == 1 else f"y{k}"}
+
+
+def _subplots(**kw):
+    """:func:`plotly.subplots.make_subplots` (``kw``) on a figure made with the
+    ``plotly_white`` template (the template validated once, not also plotly's default)."""
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    return make_subplots(figure=go.Figure(layout=dict(template="plotly_white")), **kw)
+
+
+def _figure(layout_fig, traces):
+    """A ``go.Figure`` of ``layout_fig``'s layout (validated: the template expanded) and the
+    trace dicts ``traces`` (:func:`_scatter`), both taken as they are: plotly's per-property
+    validation of every trace (most of a figure's build time) and a second one of the layout
+    are skipped; the traces are made here, from numbers and fixed names, as plotly's JSON form."""
     import plotly.graph_objects as go
 
+    return go.Figure(data=traces, layout=layout_fig.layout.to_plotly_json(), _validate=False)
+
+
+def bode_traces(traces: list, fr, *, name: str, colour: str, ref=None, mode: str = "lines", symbol: str = "circle",
+                group: str | None = None, open_marker: bool = False) -> None:
+    """One response on the four Bode panels (four trace dicts appended to ``traces``), one legend
+    entry; engine points where friction holds the engine (no motion: no gain or phase) left out
+    and named in the legend entry."""
     f = np.asarray(fr.freq_hz, float)
     held = fr.engine_held() if hasattr(fr, "engine_held") else np.zeros(f.size, bool)
     if held.any():
@@ -73,18 +99,16 @@ def bode_traces(fig, fr, *, name: str, colour: str, ref=None, mode: str = "lines
     marker = dict(color=colour, symbol=symbol + ("-open" if open_marker else ""), size=7)
     for k, (key, y) in enumerate(vals.items()):
         r, c = PANELS[key]
-        fig.add_trace(go.Scatter(x=f, y=y, mode=mode, name=name, legendgroup=group, showlegend=k == 0,
-                                 line=dict(color=colour, width=2 if fr.amplitude_rad is None else 1.5),
-                                 marker=marker, hovertemplate=_hover(name, f"{key[0]} {key[1]}", UNITS[key[1]],
-                                                                     ".2f" if key[1] == "gain" else ".1f")),
-                      row=r, col=c)
+        traces.append(_scatter(r, c, 2, x=f, y=y, mode=mode, name=name, legendgroup=group, showlegend=k == 0,
+                               line=dict(color=colour, width=2 if fr.amplitude_rad is None else 1.5),
+                               marker=dict(marker), hovertemplate=_hover(name, f"{key[0]} {key[1]}", UNITS[key[1]],
+                                                                         ".2f" if key[1] == "gain" else ".1f")))
 
 
-def spec_traces(fig, result) -> None:
+def spec_traces(traces: list, result) -> None:
     """Mask bounds (grey bars) and the linear model's value (green circle pass, red cross fail)
-    at every mask point of a :class:`taos.report.spec.SpecResult`."""
-    import plotly.graph_objects as go
-
+    at every mask point of a :class:`taos.report.spec.SpecResult` (trace dicts appended to
+    ``traces``)."""
     bars = {}
     marks = {}
     for r in result.rows:
@@ -102,20 +126,18 @@ def spec_traces(fig, result) -> None:
                                                     f"[{bounds[0]:g}, {bounds[1]:g}] {UNITS[qty]}"))
     first = True
     for (r, c), (x, y, t) in bars.items():
-        fig.add_trace(go.Scatter(x=x, y=y, mode="lines", line=dict(color="rgba(110,110,110,0.45)", width=7),
-                                 name=f"spec mask: {result.mask.name}", legendgroup="spec-bounds", showlegend=first,
-                                 text=t, hovertemplate="mask limits %{text} at %{x:.4g} Hz<extra></extra>"),
-                      row=r, col=c)
+        traces.append(_scatter(r, c, 2, x=x, y=y, mode="lines", line=dict(color="rgba(110,110,110,0.45)", width=7),
+                               name=f"spec mask: {result.mask.name}", legendgroup="spec-bounds", showlegend=first,
+                               text=t, hovertemplate="mask limits %{text} at %{x:.4g} Hz<extra></extra>"))
         first = False
     shown = set()
     for ((r, c), ok), pts in marks.items():
         name = "linear model within the mask" if ok else "linear model outside the mask"
-        fig.add_trace(go.Scatter(
-            x=[p[0] for p in pts], y=[p[1] for p in pts], mode="markers", name=name, legendgroup=name,
+        traces.append(_scatter(
+            r, c, 2, x=[p[0] for p in pts], y=[p[1] for p in pts], mode="markers", name=name, legendgroup=name,
             showlegend=name not in shown, text=[p[2] for p in pts],
             marker=dict(symbol="circle" if ok else "x", size=10, color="#1a7f37" if ok else "#c62828"),
-            hovertemplate="%{text}<br>model %{y:.2f} at %{x:.4g} Hz<extra>" + ("pass" if ok else "FAIL") + "</extra>"),
-            row=r, col=c)
+            hovertemplate="%{text}<br>model %{y:.2f} at %{x:.4g} Hz<extra>" + ("pass" if ok else "FAIL") + "</extra>"))
         shown.add(name)
 
 
@@ -128,67 +150,68 @@ def bode_figure(responses, *, resonance_hz: float | None = None, notch_hz: float
     ``measured`` (a measured record's response: orange squares), the load resonance
     ``resonance_hz`` [Hz] (dashed line) and the piston notch ``notch_hz`` [Hz] (triangle), and
     the spec mask ``spec_result``. Returns a ``plotly.graph_objects.Figure``."""
-    from plotly.subplots import make_subplots
-
     responses = list(responses)
     ref = max(responses, key=lambda r: (r.amplitude_rad is None, np.size(r.freq_hz)))
-    fig = make_subplots(rows=2, cols=2, shared_xaxes=True, vertical_spacing=0.07, horizontal_spacing=0.08,
-                        subplot_titles=("command → piston, x_p / (R θ_c)", "command → engine angle, θ / θ_c", "", ""))
+    fig = _subplots(rows=2, cols=2, shared_xaxes=True, vertical_spacing=0.07, horizontal_spacing=0.08,
+                    subplot_titles=("command → piston, x_p / (R θ_c)", "command → engine angle, θ / θ_c", "", ""))
     amps = sorted({fr.amplitude_rad for fr in responses if fr.amplitude_rad is not None})
+    traces = []
     for fr in responses:
         if fr.amplitude_rad is None:
-            bode_traces(fig, fr, name="linear", colour="black", ref=ref)
+            bode_traces(traces, fr, name="linear", colour="black", ref=ref)
         else:
-            bode_traces(fig, fr, name=_label(fr), colour=_colour(amps.index(fr.amplitude_rad), len(amps)),
+            bode_traces(traces, fr, name=_label(fr), colour=_colour(amps.index(fr.amplitude_rad), len(amps)),
                         ref=ref, mode="lines+markers")
     for fr in data or ():
-        bode_traces(fig, fr, name=f"{data_label} {_label(fr)}", colour="#c62828", ref=ref, mode="markers",
+        bode_traces(traces, fr, name=f"{data_label} {_label(fr)}", colour="#c62828", ref=ref, mode="markers",
                     open_marker=True)
     if measured is not None:
-        bode_traces(fig, measured, name=measured_label, colour="#ef6c00", ref=ref, mode="markers", symbol="square")
+        bode_traces(traces, measured, name=measured_label, colour="#ef6c00", ref=ref, mode="markers", symbol="square")
     if spec_result is not None:
-        spec_traces(fig, spec_result)
-    _marks(fig, ref, resonance_hz, notch_hz)
+        spec_traces(traces, spec_result)
+    _marks(fig, traces, ref, resonance_hz, notch_hz)
     for (r, c), key in ((v, k) for k, v in PANELS.items()):
         fig.update_xaxes(type="log", showgrid=True, row=r, col=c, title_text="frequency [Hz]" if r == 2 else None)
         fig.update_yaxes(title_text=f"{key[1]} [{UNITS[key[1]]}]", row=r, col=c)
-    fig.update_layout(height=720, hovermode="closest", template="plotly_white", margin=dict(l=60, r=20, t=70, b=50),
+    fig.update_layout(height=720, hovermode="closest", margin=dict(l=60, r=20, t=70, b=50),
                       title=dict(text=title or "", x=0.01, font=dict(size=15)),
                       legend=dict(orientation="h", yanchor="top", y=-0.09, x=0, font=dict(size=11)))
-    return fig
+    return _figure(fig, traces)
 
 
-def _marks(fig, ref, resonance_hz, notch_hz) -> None:
-    import plotly.graph_objects as go
-
+def _marks(fig, traces: list, ref, resonance_hz, notch_hz) -> None:
+    """The load resonance (a dashed vertical line on each panel: layout shapes of ``fig``, as
+    ``add_vline`` makes them) and the piston notch (a triangle) of a Bode figure."""
     if resonance_hz is not None:
-        for k, (r, c) in enumerate(PANELS.values()):
-            fig.add_vline(x=resonance_hz, line=dict(color="grey", dash="dash", width=1), row=r, col=c)
-        fig.add_trace(go.Scatter(x=[None], y=[None], mode="lines", line=dict(color="grey", dash="dash"),
-                                 name=f"load resonance w_L {resonance_hz:.3f} Hz", hoverinfo="skip"), row=1, col=1)
+        shapes = []
+        for r, c in PANELS.values():
+            k = (r - 1) * 2 + c
+            ref_x, ref_y = ("x", "y") if k == 1 else (f"x{k}", f"y{k}")
+            shapes.append(dict(type="line", x0=resonance_hz, x1=resonance_hz, xref=ref_x, y0=0, y1=1,
+                               yref=f"{ref_y} domain", line=dict(color="grey", dash="dash", width=1)))
+        fig.update_layout(shapes=list(fig.layout.shapes) + shapes)
+        traces.append(_scatter(1, 1, 2, x=[None], y=[None], mode="lines", line=dict(color="grey", dash="dash"),
+                               name=f"load resonance w_L {resonance_hz:.3f} Hz", hoverinfo="skip"))
     if notch_hz is not None and math.isfinite(notch_hz):
         f = np.asarray(ref.freq_hz, float)
         y = float(np.interp(math.log10(notch_hz), np.log10(f), gain_db(ref.piston)))
-        fig.add_trace(go.Scatter(x=[notch_hz], y=[y], mode="markers", name=f"piston notch {notch_hz:.3f} Hz",
-                                 marker=dict(symbol="triangle-down", size=13, color="black"),
-                                 hovertemplate="notch %{x:.4g} Hz<br>piston gain %{y:.2f} dB<extra></extra>"),
-                      row=1, col=1)
+        traces.append(_scatter(1, 1, 2, x=[notch_hz], y=[y], mode="markers", name=f"piston notch {notch_hz:.3f} Hz",
+                               marker=dict(symbol="triangle-down", size=13, color="black"),
+                               hovertemplate="notch %{x:.4g} Hz<br>piston gain %{y:.2f} dB<extra></extra>"))
 
 
 def timehistory_figure(th, title: str | None = None):
     """Commands (FCS, solid; after avionics, dotted) [deg], piston x_p [in], engine angle [deg]
     and friction torque T_f [in lbf] of run ``th`` against time [s], one colour per axis."""
-    import plotly.graph_objects as go
-    from plotly.subplots import make_subplots
-
     from ..units import from_si
 
     m_per_in = 1.0 / from_si(1.0, "m", "in")
     nm_per_inlbf = 1.0 / from_si(1.0, "N*m", "inch*lbf")
     rows = (("command", "command [deg]"), ("piston", "piston x_p [in]"), ("engine", "engine θ [deg]"),
             ("friction", "friction torque T_f [in lbf]"))
-    fig = make_subplots(rows=4, cols=1, shared_xaxes=True, vertical_spacing=0.03)
+    fig = _subplots(rows=4, cols=1, shared_xaxes=True, vertical_spacing=0.03)
     t = np.asarray(th.t_s, float)
+    traces = []
     for i, ax in enumerate(th.axes):
         col = AXIS_COLOURS.get(ax, None)
         series = ((1, f"{ax} FCS command", np.degrees(th.command_rad[i]), "deg", "solid"),
@@ -197,17 +220,16 @@ def timehistory_figure(th, title: str | None = None):
                   (3, f"{ax} engine", np.degrees(th.engine_rad[i]), "deg", "solid"),
                   (4, f"{ax} friction torque", np.asarray(th.friction_torque_Nm[i]) / nm_per_inlbf, "in lbf", "solid"))
         for row, name, y, unit, dash in series:
-            fig.add_trace(go.Scatter(x=t.astype(np.float32), y=np.asarray(y, np.float32), mode="lines", name=name,
-                                     line=dict(color=col, width=1.2, dash=dash),
-                                     hovertemplate=f"<b>{name}</b><br>t = %{{x:.4f}} s<br>%{{y:.4g}} {unit}"
-                                                   "<extra></extra>"),
-                          row=row, col=1)
+            traces.append(_scatter(row, 1, 1, x=t.astype(np.float32), y=np.asarray(y, np.float32), mode="lines",
+                                   name=name, line=dict(color=col, width=1.2, dash=dash),
+                                   hovertemplate=f"<b>{name}</b><br>t = %{{x:.4f}} s<br>%{{y:.4g}} {unit}"
+                                                 "<extra></extra>"))
     for k, (_, label) in enumerate(rows, start=1):
         fig.update_yaxes(title_text=label, row=k, col=1)
     fig.update_xaxes(title_text="time [s]", row=4, col=1)
-    fig.update_layout(height=900, hovermode="closest", template="plotly_white", margin=dict(l=70, r=20, t=50, b=40),
+    fig.update_layout(height=900, hovermode="closest", margin=dict(l=70, r=20, t=50, b=40),
                       title=dict(text=title or "", x=0.01, font=dict(size=15)), legend=dict(font=dict(size=11)))
-    return fig
+    return _figure(fig, traces)
 
 
 def nichols_figure(pred, amplitudes_rad=None, n_freq: int = 400, title: str | None = None):

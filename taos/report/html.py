@@ -17,9 +17,13 @@ in the interactive plots; the HDF5 keeps every sample); the 3-D view holds at mo
 from __future__ import annotations
 
 import base64
+import contextlib
+import gc
 import html
 import io
 import math
+import threading
+
 import numpy as np
 
 #: keyframes of the embedded 3-D view (fps lowered for long runs) and samples per plotted trace
@@ -87,9 +91,42 @@ def render_html(result, summary: dict | None = None, *, view_angle_scale: float 
     ``view_angle_scale``: engine-angle exaggeration of the 3-D view [-]; ``view_fps``: its
     keyframe rate [1/s], lowered to keep at most :data:`MAX_VIEW_FRAMES` keyframes;
     ``progress``: a tqdm bar advanced after the plots and after the 3-D view, or None."""
+    s = result.summary() if summary is None else summary
+    with _no_full_collection():
+        return _render(result, s, view_angle_scale, view_fps, progress)
+
+
+_GC_LOCK = threading.Lock()
+_gc_saved: list = []     # [depth, thresholds before the outermost render]
+
+
+@contextlib.contextmanager
+def _no_full_collection():
+    """No full (generation-2) garbage collection while the page renders: the plotting
+    libraries' first import and the figures make many long-lived objects, and each full
+    collection then scans every object of the process (in a fresh ``taos greenrun`` two or
+    three of them, ~0.1-0.2 CPU-s each); the young generations are still collected, and the
+    thresholds are restored when the last of the renders running at once ends (the next full
+    collection then comes as usual)."""
+    with _GC_LOCK:
+        if not _gc_saved:
+            t = gc.get_threshold()
+            _gc_saved[:] = [0, t]
+            gc.set_threshold(t[0], t[1], max(t[2], 1 << 30))
+        _gc_saved[0] += 1
+    try:
+        yield
+    finally:
+        with _GC_LOCK:
+            _gc_saved[0] -= 1
+            if not _gc_saved[0]:
+                gc.set_threshold(*_gc_saved[1])
+                _gc_saved.clear()
+
+
+def _render(result, s, view_angle_scale, view_fps, progress) -> str:
     from taos.viewer import offline_html
 
-    s = result.summary() if summary is None else summary
     th = result.time_history
     if progress is not None:
         progress.set_postfix_str("plots")
