@@ -60,9 +60,12 @@ ALLOWED_ENV = frozenset({"PYTEST_CURRENT_TEST", "TAOS_TEST_NO_FORKSERVER"})
 #: modules the zygote imports after the command modules (their import-time reads reviewed:
 #: the environment, guarded; numba also ``.numba_config.yaml`` in the working folder, guarded)
 #: (none of these adds a warnings filter at import: ``scipy.signal`` and ``scipy.optimize``, which
-#: import ``scipy.special`` and its filters, are left out)
+#: import ``scipy.special`` and its filters, are left out); the plotting modules (matplotlib reads
+#: ``MPLBACKEND``/``MPLCONFIGDIR``, guarded as the environment; ``taos.plotting`` selects the Agg
+#: backend, as it does in a new process before anything is drawn): ~0.6 CPU-s of each plotting command
 PRELOAD = ("numpy", "scipy.linalg", "numba", "pint", "h5py", "tomlkit",
-           "taos.model", "taos.units", "taos.planar.freqresp", "taos.planar.simulate", "taos.results")
+           "taos.model", "taos.units", "taos.planar.freqresp", "taos.planar.simulate", "taos.results",
+           "matplotlib.pyplot", "taos.plotting.bode", "taos.plotting.timehist", "taos.plotting.interactive")
 
 _NUMBA_CONFIG = ".numba_config.yaml"
 
