@@ -67,9 +67,9 @@ def level() -> tuple[list[tuple[sp.spmatrix, np.ndarray]], float]:
     seen = []
     real = el.spd_inverse_form
 
-    def spy(A, B):
+    def spy(A, B, solver=None):
         seen.append((A, B.copy()))
-        return real(A, B)
+        return real(A, B, solver)
 
     r = fem_shift_share()
     spec, line = MeshSpec(r.mesh_h_m, r.mesh_n_theta), engine_actuator_line()

@@ -246,12 +246,12 @@ def spd_inverse_form(A: sp.spmatrix, B: np.ndarray, solver: str | None = None) -
     return np.array(Z).T @ np.array(W)
 
 
-def guyan_condense(model: ElasticModel, interfaces: Sequence[Interface]) -> np.ndarray:
+def guyan_condense(model: ElasticModel, interfaces: Sequence[Interface], solver: str | None = None) -> np.ndarray:
     """Condense the model onto the 6 DOFs of each interface reference point (RBE2 + Guyan).
 
     Returns the symmetric (6 m, 6 m) free-free stiffness in SI units (N/m, N/rad, N m/m,
     N m/rad blocks), DOF order (ux, uy, uz, rx, ry, rz) per reference point, in the order
-    of ``interfaces``.
+    of ``interfaces``. ``solver``: that of :func:`spd_inverse_form` (default :func:`spd_solver`).
     """
     K = model.K
     n = model.ndofs
@@ -275,7 +275,7 @@ def guyan_condense(model: ElasticModel, interfaces: Sequence[Interface]) -> np.n
     TS = Tfull[S]
     KSS = (TS.T @ K[S][:, S] @ TS).toarray()
     KIS_T = (K[interior][:, S] @ TS).toarray()
-    Kc = KSS - spd_inverse_form(K[interior][:, interior], KIS_T)
+    Kc = KSS - spd_inverse_form(K[interior][:, interior], KIS_T, solver)
     return 0.5 * (Kc + Kc.T)
 
 
