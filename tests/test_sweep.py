@@ -195,6 +195,53 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
     assert resumed["counts"]["ok"] == 24
 
 
+_CUT_WRITE = """
+import argparse, os, signal, sys, time
+import numpy as np
+import zarr.storage._local as local
+from taos.errors import run_cli
+from taos.montecarlo import store
+
+put, calls = local._put, []
+def cut(*a, **k):  # the first chunk file of the batch: Ctrl-C arrives while it is being written
+    calls.append(1)
+    if len(calls) == 1:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.3)
+    return put(*a, **k)
+
+def cmd(args):
+    store.create(args.path, labels=np.arange(4), names=("a",), factors=np.zeros((4, 1)), seeds=np.arange(4),
+                 scalars=("x",), flags=(), trace_t_s=np.zeros(0), batch=2, attrs={})
+    local._put = cut
+    store.write_batch(args.path, 0, {"x": np.ones(2), "status": np.ones(2)})
+    return 0
+
+ap = argparse.ArgumentParser(prog="taos")
+ap.add_argument("path")
+ap.set_defaults(func=cmd)
+sys.exit(run_cli(ap, None))
+"""
+
+
+def test_ctrl_c_inside_a_store_write_exits_with_one_line_and_a_readable_store(tmp_path):
+    """A Ctrl-C that lands while Zarr writes a batch (its I/O runs on Zarr's own thread): exit
+    130 with the one interrupt line and nothing else on standard error (no "Task was destroyed"
+    from a write the interpreter's exit cut short), the store still readable, and the cut batch
+    still pending, so a resume runs it again."""
+    from taos.montecarlo import store
+    from tests import _forkserver
+
+    path = tmp_path / "s.zarr"
+    r = _forkserver.run([sys.executable, "-c", _CUT_WRITE, path], tmp_path, timeout=120)
+    assert r.returncode == 130, r.stderr
+    assert r.stderr.splitlines() == ["taos: interrupted (Ctrl-C); no partial output written"], r.stderr
+    assert store.status(path).tolist() == [0, 0, 0, 0]
+    store.write_batch(path, 0, {"x": np.full(2, 2.0), "status": np.ones(2)})
+    ds = store.open_store(path, dask=False)
+    assert ds["status"].values.tolist() == [1, 1, 0, 0] and ds["x"].values[:2].tolist() == [2.0, 2.0]
+
+
 @pytest.mark.slow
 def test_lco_verdict_flips_between_the_papers_soft_and_stiff_structure(tmp_path):
     """Seed paper sec. 3.2, figs. 7-8: the soft load path (115,000 lbf/in) flies a limit cycle,

@@ -89,6 +89,33 @@ def open_store(path: Path, group: str | None = None, consolidated: bool | None =
                         **({} if dask else {"chunks": None}))
 
 
+def finish_pending_io(timeout_s: float = 5.0) -> None:
+    """Let the Zarr I/O that a signal cut off finish (at most ``timeout_s`` [s]) before the run exits.
+
+    Zarr runs its reads and writes as tasks of an event loop on its own thread; a Ctrl-C in the
+    main thread stops the wait, not the tasks. Left running into interpreter exit, a task finds
+    the thread pool already shut and the loop destroys it mid-write: a chunk file half written and
+    "Task was destroyed but it is pending!" on standard error. Called by
+    :func:`taos.errors.run_cli` after an interrupt; a no-op when Zarr never ran."""
+    import asyncio
+    import sys
+
+    zsync = sys.modules.get("zarr.core.sync")
+    loop = (getattr(zsync, "loop", None) or [None])[0] if zsync is not None else None
+    if loop is None or loop.is_closed() or not loop.is_running():
+        return
+
+    async def rest() -> None:
+        me = asyncio.current_task()
+        pending = [t for t in asyncio.all_tasks() if t is not me]
+        if pending:
+            await asyncio.wait(pending, timeout=timeout_s)
+    try:
+        asyncio.run_coroutine_threadsafe(rest(), loop).result(timeout_s + 1.0)
+    except Exception:  # the loop stopped meanwhile, or the wait ran out: nothing more to do here
+        pass
+
+
 def status(path: Path, group: str | None = None) -> np.ndarray | None:
     """Every run's status code, or None when the store cannot be read (read in this process)."""
     try:
