@@ -310,7 +310,8 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
     old_unraisable = sys.unraisablehook
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGINT):
-            old[s] = signal.signal(s, handler)
+            if signal.getsignal(s) is not signal.SIG_IGN:  # a background job's ignored Ctrl-C stays ignored
+                old[s] = signal.signal(s, handler)
         sys.unraisablehook = handler.unraisable(old_unraisable)
     rc = 1
     try:

@@ -264,6 +264,40 @@ def test_startup_handlers_are_not_installed_for_a_library_user():
     assert r.stdout.strip() == "True", r.stderr
 
 
+
+_IGNORED_INT = """
+import argparse, os, signal, sys
+signal.signal(signal.SIGINT, signal.SIG_IGN)
+from taos.errors import run_cli
+
+def cmd(args):
+    os.kill(os.getpid(), signal.SIGINT)   # ignored, as the shell set it up
+    print("ran on")
+    if args.term:
+        os.kill(os.getpid(), signal.SIGTERM)
+    return 0
+
+ap = argparse.ArgumentParser(prog="taos")
+ap.add_argument("--term", action="store_true")
+ap.set_defaults(func=cmd)
+sys.exit(run_cli(ap, None))
+"""
+
+
+@pytest.mark.parametrize("term", [False, True], ids=["SIGINT", "SIGINT-then-SIGTERM"])
+def test_a_background_jobs_ignored_ctrl_c_stays_ignored(term):
+    """A command started with SIGINT ignored (``taos greenrun ... &`` from a script: a shell
+    without job control ignores SIGINT in background jobs, so the terminal's Ctrl-C does not reach
+    them) runs on through a SIGINT; SIGTERM still ends it with 143 and its one line."""
+    r = subprocess.run([sys.executable, "-c", _IGNORED_INT, *(["--term"] if term else [])], capture_output=True,
+                       text=True, env=_env(), timeout=120)
+    assert r.stdout.strip() == "ran on", r.stderr
+    if term:
+        assert r.returncode == 143 and r.stderr.splitlines() == [
+            "taos: terminated (signal 15); no partial output written"], r.stderr
+    else:
+        assert r.returncode == 0 and r.stderr == "", r.stderr
+
 # -- hypothesis: loaders, unit text, the CSV reader, output names -----------------------------------
 
 @FUZZ

@@ -103,7 +103,8 @@ def serve(th: TimeHistory | TaosTimeHistory, *, angle_scale: float = 1.0, deflec
     old = {}
     if threading.current_thread() is threading.main_thread():
         for sig in (signal.SIGINT, signal.SIGTERM):
-            old[sig] = signal.signal(sig, lambda *a: stop.set())
+            if signal.getsignal(sig) is not signal.SIG_IGN:  # a background job's ignored Ctrl-C stays ignored
+                old[sig] = signal.signal(sig, lambda *a: stop.set())
     try:
         vis.load_scene()
         vis.play(fr, autoplay=True)
