@@ -140,10 +140,13 @@ def isolated(tmp_path_factory):
 def test_local_cluster_store_is_bit_identical_to_in_process(reference, tmp_path):
     """Default executor (LocalCluster, 2 workers, batch from the run cost) against the
     in-process engine with 7 runs per batch: the same store, bit for bit, and the same
-    statistics; the store reads with xarray.open_zarr."""
+    statistics; the store reads with xarray.open_zarr. This process's environment is as before
+    (the cluster's nannies set their workers' ``OMP_NUM_THREADS=1``, ... here)."""
     import xarray as xr
     out = tmp_path / "local"
+    env = dict(os.environ)
     assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--out", str(out), "--no-progress"]) == 0
+    assert dict(os.environ) == env
     assert {p.name for p in out.iterdir()} == {"campaign.json", "campaign.zarr", "summary.json", "montecarlo.png",
                                                ".taos-output.json"}   # taos's mark of the files it wrote
     same_store(out, reference)

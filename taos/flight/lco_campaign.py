@@ -147,8 +147,7 @@ def run_map_campaign(flight: FlightModel, model: TvcModel, axes, settings: MapSe
                 "package_version": package_version()}
     old = _check_out(out, manifest, resume)
     spath = out / STORE
-    client, cluster = engine.connect(workers, scheduler)
-    try:
+    with engine.connected(workers, scheduler) as client:
         n_workers = len(client.scheduler_info().get("workers", {})) if client is not None else 0
         n_var = len({tuple(r[[j for j, n in enumerate(names) if SWEEPABLE[n][0] != "fcs"]]) for r in rows})
         if old is not None and store.status(spath) is not None:
@@ -171,11 +170,6 @@ def run_map_campaign(flight: FlightModel, model: TvcModel, axes, settings: MapSe
                          attrs={"format": FORMAT, "inputs_sha256": inputs_sha256,
                                 "friction_model": model.friction.name})
         engine.execute(spath, kind, [Part(None, design)], batch, client, progress=progress)
-    finally:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
     return read_map(spath, axes, model.friction.name, loop_margins_of(flight, axes), settings)
 
 

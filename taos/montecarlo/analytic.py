@@ -64,8 +64,7 @@ def run_design(kind: RunKind, design: Design, path: str | Path, *, workers: int 
     """Run ``design`` with ``kind`` on the engine into the store ``path`` (a new one, or the
     one a previous call began when ``resume``); returns the store as a lazy xarray Dataset."""
     path = Path(path)
-    client, cluster = engine.connect(workers, scheduler)
-    try:
+    with engine.connected(workers, scheduler) as client:
         n_workers = len(client.scheduler_info().get("workers", {})) if client is not None else 1
         b = batch or engine.batch_size(design.n, kind.run_cost_s, n_workers)
         if not (resume and store.status(path) is not None):
@@ -75,9 +74,4 @@ def run_design(kind: RunKind, design: Design, path: str | Path, *, workers: int 
         else:
             b = int(store.open_store(path)["status"].encoding["chunks"][0])
         engine.execute(path, kind, [Part(None, design)], b, client, progress=progress)
-    finally:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
     return store.open_store(path)

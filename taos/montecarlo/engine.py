@@ -24,8 +24,10 @@ the store, for tests and debugging.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import os
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -156,6 +158,35 @@ def connect(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIME
                          f"{timeout_s:g} s", got=f"{scheduler} ({why})")
     return box["client"], None
 
+
+
+@contextlib.contextmanager
+def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIMEOUT_S):
+    """:func:`connect` as a context: yields the client (None for ``workers=0``); on exit the
+    client and any LocalCluster are closed and this process's environment is as it was before.
+
+    A LocalCluster's nannies set their workers' environment in the process that starts them,
+    this one (Dask's ``distributed.nanny.pre-spawn-environ``: ``OMP_NUM_THREADS=1``,
+    ``MALLOC_TRIM_THRESHOLD_``, ...; and ``__DASK_PARENT_PID``), at every worker (re)start. Left
+    there, every program the caller starts afterwards would run single-threaded BLAS: a library
+    call must not change its caller's process."""
+    env = dict(os.environ)
+    client, cluster = connect(workers, scheduler, timeout_s)
+    try:
+        yield client
+    finally:
+        try:
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+        finally:
+            if cluster is not None:
+                for k in set(os.environ) - set(env):
+                    del os.environ[k]
+                for k, v in env.items():
+                    if os.environ.get(k) != v:
+                        os.environ[k] = v
 
 def pending_batches(path: Path, part: Part, batch: int) -> list[int]:
     """Start rows of the batches of ``part`` with a run not yet stored."""

@@ -145,8 +145,7 @@ def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | Non
     parts = [Part("nominal", nominal_design(c)), Part(None, d)]
     spath = out / STORE
     t0 = time.perf_counter()
-    client, cluster = engine.connect(2 if workers is None else workers, scheduler, connect_timeout_s)
-    try:
+    with engine.connected(2 if workers is None else workers, scheduler, connect_timeout_s) as client:
         n_workers = len(client.scheduler_info().get("workers", {})) if client is not None else 0
         if old is not None and store.status(spath) is not None and store.status(spath, "nominal") is not None:
             manifest["batch"] = int(old["batch"])
@@ -164,11 +163,6 @@ def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | Non
                              seeds=p.design.seeds, scalars=kind.scalars, flags=kind.flags, trace_t_s=kind.trace_t_s,
                              batch=manifest["batch"], attrs=attrs, group=p.group)
         executed = engine.execute(spath, kind, parts, manifest["batch"], client, progress=progress)
-    finally:
-        if client is not None:
-            client.close()
-        if cluster is not None:
-            cluster.close()
     wall = time.perf_counter() - t0
     ds, nom = store.open_store(spath, dask=False), store.open_store(spath, "nominal", dask=False)
     flown = {str(v) for g in (ds, nom) for v in np.unique(g["inputs_sha256"].values)}

@@ -245,8 +245,7 @@ def run_sweep(defn: SweepDefinition, out_dir: str | Path | None = None, *, worke
         old = _check_out(out, manifest, resume)
         spath = out / STORE
         t0 = time.perf_counter()
-        client, cluster = engine.connect(0 if scheduler is None and workers == 1 else workers, scheduler)
-        try:
+        with engine.connected(0 if scheduler is None and workers == 1 else workers, scheduler) as client:
             n_workers = len(client.scheduler_info().get("workers", {})) if client is not None else 1
             if old is not None and store.status(spath) is not None:
                 manifest["batch"] = int(old["batch"])
@@ -261,11 +260,6 @@ def run_sweep(defn: SweepDefinition, out_dir: str | Path | None = None, *, worke
                              batch=manifest["batch"], attrs={"format": FORMAT, "inputs_sha256": kind.inputs_sha256,
                                                             "model_sha256": base["model_sha256"]})
             executed = engine.execute(spath, kind, [Part(None, design)], manifest["batch"], client, progress=progress)
-        finally:
-            if client is not None:
-                client.close()
-            if cluster is not None:
-                cluster.close()
         wall = time.perf_counter() - t0
         ds = store.open_store(spath, dask=False).load()
     finally:
