@@ -356,7 +356,8 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
             signal.signal(s, h)
         sys.unraisablehook = old_unraisable
     if handler.received is not None and "taos.montecarlo.store" in sys.modules:
-        sys.modules["taos.montecarlo.store"].finish_pending_io()
+        with contextlib.suppress(BaseException):   # (a second Ctrl-C stops the wait)
+            sys.modules["taos.montecarlo.store"].finish_pending_io()
     if handler.received == signal.SIGINT:
         print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
         return 130

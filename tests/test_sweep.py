@@ -242,6 +242,29 @@ def test_ctrl_c_inside_a_store_write_exits_with_one_line_and_a_readable_store(tm
     assert ds["status"].values.tolist() == [1, 1, 0, 0] and ds["x"].values[:2].tolist() == [2.0, 2.0]
 
 
+def test_waiting_for_the_store_after_an_interrupt_survives_a_half_finished_import(monkeypatch):
+    """The interrupt may cut an import short (seen: ``asyncio`` half initialised, its import
+    raising NameError): the wait for Zarr's I/O then gives up quietly, and the run still ends with
+    its one line and 130 (``test_a_signal_at_any_moment_is_one_line_and_its_status``)."""
+    import asyncio
+    import threading
+    import types
+
+    from taos.montecarlo.store import finish_pending_io
+
+    loop = asyncio.new_event_loop()
+    th = threading.Thread(target=loop.run_forever, daemon=True)
+    th.start()
+    try:
+        monkeypatch.setitem(sys.modules, "zarr.core.sync", types.SimpleNamespace(loop=[loop]))
+        monkeypatch.setitem(sys.modules, "asyncio", None)   # "import asyncio" raises
+        finish_pending_io(timeout_s=0.1)
+    finally:
+        loop.call_soon_threadsafe(loop.stop)
+        th.join(5)
+        loop.close()
+
+
 @pytest.mark.slow
 def test_lco_verdict_flips_between_the_papers_soft_and_stiff_structure(tmp_path):
     """Seed paper sec. 3.2, figs. 7-8: the soft load path (115,000 lbf/in) flies a limit cycle,

@@ -97,22 +97,22 @@ def finish_pending_io(timeout_s: float = 5.0) -> None:
     the thread pool already shut and the loop destroys it mid-write: a chunk file half written and
     "Task was destroyed but it is pending!" on standard error. Called by
     :func:`taos.errors.run_cli` after an interrupt; a no-op when Zarr never ran."""
-    import asyncio
     import sys
 
-    zsync = sys.modules.get("zarr.core.sync")
-    loop = (getattr(zsync, "loop", None) or [None])[0] if zsync is not None else None
-    if loop is None or loop.is_closed() or not loop.is_running():
-        return
+    try:   # (the interrupt may have cut an import short: Zarr or asyncio half initialised)
+        zsync = sys.modules.get("zarr.core.sync")
+        loop = (getattr(zsync, "loop", None) or [None])[0] if zsync is not None else None
+        if loop is None or loop.is_closed() or not loop.is_running():
+            return
+        import asyncio
 
-    async def rest() -> None:
-        me = asyncio.current_task()
-        pending = [t for t in asyncio.all_tasks() if t is not me]
-        if pending:
-            await asyncio.wait(pending, timeout=timeout_s)
-    try:
+        async def rest() -> None:
+            me = asyncio.current_task()
+            pending = [t for t in asyncio.all_tasks() if t is not me]
+            if pending:
+                await asyncio.wait(pending, timeout=timeout_s)
         asyncio.run_coroutine_threadsafe(rest(), loop).result(timeout_s + 1.0)
-    except Exception:  # the loop stopped meanwhile, or the wait ran out: nothing more to do here
+    except Exception:  # the loop stopped meanwhile, the wait ran out, a module half imported
         pass
 
 
