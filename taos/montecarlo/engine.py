@@ -159,7 +159,6 @@ def connect(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIME
     return box["client"], None
 
 
-
 @contextlib.contextmanager
 def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIMEOUT_S):
     """:func:`connect` as a context: yields the client (None for ``workers=0``); on exit the
@@ -171,8 +170,9 @@ def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TI
     there, every program the caller starts afterwards would run single-threaded BLAS: a library
     call must not change its caller's process."""
     env = dict(os.environ)
-    client, cluster = connect(workers, scheduler, timeout_s)
+    client = cluster = None
     try:
+        client, cluster = connect(workers, scheduler, timeout_s)
         yield client
     finally:
         try:
@@ -181,12 +181,13 @@ def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TI
             if cluster is not None:
                 cluster.close()
         finally:
-            if cluster is not None:
+            if scheduler is None and workers != 0:   # a LocalCluster was started (or begun)
                 for k in set(os.environ) - set(env):
                     del os.environ[k]
                 for k, v in env.items():
                     if os.environ.get(k) != v:
                         os.environ[k] = v
+
 
 def pending_batches(path: Path, part: Part, batch: int) -> list[int]:
     """Start rows of the batches of ``part`` with a run not yet stored."""
