@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import sys
 from pathlib import Path
 
@@ -9,6 +10,15 @@ import pytest
 
 from tests import _forkserver
 from tests._xdist_modules import pytest_xdist_make_scheduler  # noqa: F401  (a hook: worksteal cuts between modules)
+
+# A test run started with SIGINT ignored (a script's background job, ``make test &``: a shell
+# without job control ignores SIGINT there) would hand the ignored Ctrl-C to every command the
+# tests start, and a command leaves an ignored SIGINT ignored (taos.errors.run_cli). The tests
+# that press Ctrl-C mean a command started from a terminal: this process takes Python's own
+# handler, so what it starts gets SIGINT at its default. (The ignored case has its own test:
+# tests/test_hostile_fuzz.py::test_a_background_jobs_ignored_ctrl_c_stays_ignored.)
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 ROOT = Path(__file__).resolve().parents[1]
 MODELS = ROOT / "models"
