@@ -142,6 +142,7 @@ def test_local_cluster_store_is_bit_identical_to_in_process(reference, tmp_path)
     in-process engine with 7 runs per batch: the same store, bit for bit, and the same
     statistics; the store reads with xarray.open_zarr. This process's environment is as before
     (the cluster's nannies set their workers' ``OMP_NUM_THREADS=1``, ... here)."""
+    import dask
     import xarray as xr
     out = tmp_path / "local"
     env = dict(os.environ)
@@ -152,7 +153,10 @@ def test_local_cluster_store_is_bit_identical_to_in_process(reference, tmp_path)
     same_store(out, reference)
     assert stats(out) == stats(reference)
     ds = xr.open_zarr(out / "campaign.zarr")
-    assert ds.sizes["run"] == RUNS and (ds["status"].values > 0).all()
+    # read on this thread: a Dask client another test left registered as this process's default
+    # (its scheduler gone) would take the read and wait forever (seen once in make test)
+    with dask.config.set(scheduler="synchronous"):
+        assert ds.sizes["run"] == RUNS and (ds["status"].values > 0).all()
     summary = json.loads((out / "summary.json").read_text())
     assert summary["provenance"]["inputs_sha256"] == ds.attrs["inputs_sha256"]
     assert summary["timing"]["batch"] == json.loads((out / "campaign.json").read_text())["batch"]

@@ -176,10 +176,12 @@ def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TI
         yield client
     finally:
         try:
-            if client is not None:
-                client.close()
-            if cluster is not None:
-                cluster.close()
+            try:
+                if client is not None:
+                    client.close()
+            finally:
+                if cluster is not None:
+                    cluster.close()
         finally:
             if scheduler is None and workers != 0:   # a LocalCluster was started (or begun)
                 for k in set(os.environ) - set(env):
