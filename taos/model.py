@@ -1,17 +1,14 @@
 """Model files: TOML parameter sets with units, loaded into frozen SI dataclasses.
 
 A model file (``models/rs25_ambient.toml`` and friends) holds the sections below; every
-physical value is a string with its unit, parsed by pint (:mod:`taos.units`). These keys are
-a contract (model files written for one release load in the next)::
-
-    [engine]    mass, inertia_pitch, inertia_yaw, rotational_stiffness, (thrust)
-    [actuator]  moment_arm, (parameter_set), piston_area, supply_pressure, oil_bulk_modulus, trapped_volume,
-                piston_mass, piston_damping, loop_gain, valve_natural_frequency,
-                valve_damping_ratio, valve_order, flow_pressure_coefficient, leakage_coefficient,
-                (pressure_feedback_gain, pressure_feedback_time_constant)
-    [structure] load_stiffness
-    [friction]  model, coulomb_torque and the law's own parameters (taos.friction)
-    [avionics]  quantization_bits, command_range, rounding, crossover_command, crossover_gain
+physical value is a string with its unit, parsed by pint (:mod:`taos.units`). The DESIGN
+contract keys (model files written for one release load in the next) are ``[engine] mass,
+inertia_pitch, inertia_yaw, rotational_stiffness``, ``[actuator] moment_arm``, ``[structure]
+load_stiffness``, ``[friction] model, coulomb_torque``, ``[avionics] quantization_bits,
+command_range, rounding``; every key a file may hold, with its unit kind, is in one table,
+:mod:`taos.model_keys` (the docs' key reference is generated from the loader and it).
+A variant of a model, any key with another value, goes through this loader too
+(:meth:`TvcModel.with_values`, :mod:`taos.variants`).
 
 Shared hardware: ``[actuator] parameter_set`` and ``[friction] parameter_set`` name one TOML
 file per piece of hardware (``models/actuators/tvc_actuator.toml``,
@@ -161,7 +158,13 @@ class TvcModel:
     friction: FrictionLaw
     avionics: Avionics
     source: str = "<code>"
+    #: this model's hash: its files' combined hash (:attr:`base_sha256`) with its overrides
     sha256: str = ""
+    #: (``"section.key"``, value as a model file holds it) of a variant, in the order given
+    #: (:mod:`taos.variants`); ``code.FIELD`` for a field changed in code (:meth:`replace`)
+    overrides: tuple = ()
+    #: the combined hash of the files it was read from (:func:`combined_sha256`)
+    base_sha256: str = ""
     #: role -> (resolved path, SHA-256) of every file the model was read from: ``model``, and the
     #: ``actuator_parameter_set``, ``friction_parameter_set`` and ``stiffness_file`` it names;
     #: ``sha256`` is their combined hash (:func:`combined_sha256`)
@@ -184,16 +187,44 @@ class TvcModel:
         R = self.actuator.moment_arm_m
         return self.friction.coulomb_torque_Nm / (self.structure.load_stiffness_N_per_m * R * R)
 
-    # -- variants -------------------------------------------------------------------------
+    # -- variants (taos.variants) ----------------------------------------------------------
+    def with_values(self, values: Mapping[str, Any]) -> "TvcModel":
+        """The model file with the keys ``values`` (``{"structure.load_stiffness": "160000
+        lbf/in", ...}``; a plain number is SI) given other values, through the loader and its
+        bounds: the one way to make a variant (:mod:`taos.variants`)."""
+        from .variants import check_unchanged, check_variant_source, code_changes, merge_overrides, variant_sha256
+
+        check_variant_source(self, values)
+        code = code_changes(self)
+        overrides = merge_overrides(tuple(kv for kv in self.overrides if not kv[0].startswith("code.")), values)
+        table = dict(overrides)
+        out = load_model(self.source, friction=table.pop("friction.model", None), overrides=table)
+        check_unchanged(self, out)
+        if not code:
+            return out
+        out = dataclasses.replace(out, **code)   # the changes made in code stay, recorded as before
+        marks = tuple((f"code.{k}", v) for k, v in code.items())
+        return dataclasses.replace(out, overrides=overrides + marks, sha256=variant_sha256(out.base_sha256,
+                                                                                        overrides + marks))
+
     def with_friction(self, name: str) -> "TvcModel":
-        """The same model with friction law ``name``, keeping the file's torque levels."""
-        table = dict(self.friction_table) or {"coulomb_torque": f"{self.friction.coulomb_torque_Nm} N*m"}
-        law = friction_from_table(table, self.source, model=name)
-        return dataclasses.replace(self, friction=law)
+        """The same model with friction law ``name``, keeping the file's torque levels
+        (the variant ``{"friction.model": name}``)."""
+        return self.with_values({"friction.model": name})
 
     def replace(self, **changes) -> "TvcModel":
-        """Copy with fields replaced (``dataclasses.replace``)."""
-        return dataclasses.replace(self, **changes)
+        """Copy with dataclass fields replaced in code. The copy records it (``code.FIELD`` in
+        :attr:`overrides`) and carries its own hash; a change a model file can express is a
+        variant, :meth:`with_values`."""
+        from .variants import variant_sha256
+
+        out = dataclasses.replace(self, **changes)
+        marks = tuple((f"code.{k}", v) for k, v in sorted(changes.items())
+                      if k not in ("overrides", "sha256", "base_sha256"))
+        if not marks:
+            return out
+        overrides = tuple(kv for kv in out.overrides if kv[0] not in dict(marks)) + marks
+        return dataclasses.replace(out, overrides=overrides, sha256=variant_sha256(out.base_sha256, overrides))
 
 
 # -- loading ------------------------------------------------------------------------------
@@ -242,37 +273,8 @@ def parse_engine(doc: Mapping, src: str) -> Engine:
     )
 
 
-_ACTUATOR_FIELDS = {  # key -> (kind, check)
-    "moment_arm": ("length", "positive"),
-    "piston_area": ("area", "positive"),
-    "supply_pressure": ("pressure", "positive"),
-    "oil_bulk_modulus": ("pressure", "positive"),
-    "trapped_volume": ("volume", "positive"),
-    "piston_mass": ("mass", "positive"),
-    "piston_damping": ("damping", "nonnegative"),
-    "loop_gain": ("rate", "positive"),
-    "valve_natural_frequency": ("frequency", "positive"),
-    "valve_damping_ratio": ("dimensionless", "positive"),
-    "flow_pressure_coefficient": ("flow_pressure", "nonnegative"),
-    "leakage_coefficient": ("flow_pressure", "nonnegative"),
-    "pressure_feedback_gain": ("velocity_per_pressure", "nonnegative"),
-    "pressure_feedback_time_constant": ("time", "nonnegative"),
-    "max_rate": ("velocity", "positive"),
-    "relief_pressure": ("pressure", "positive"),
-    "relief_flow_coefficient": ("flow_pressure", "positive"),
-}
-_ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
-                "supply_pressure": "supply_pressure_Pa", "oil_bulk_modulus": "oil_bulk_modulus_Pa",
-                "trapped_volume": "trapped_volume_m3", "piston_mass": "piston_mass_kg",
-                "piston_damping": "piston_damping_Ns_per_m", "loop_gain": "loop_gain_per_s",
-                "valve_natural_frequency": "valve_natural_frequency_hz",
-                "valve_damping_ratio": "valve_damping_ratio",
-                "flow_pressure_coefficient": "flow_pressure_coefficient_m3_per_s_Pa",
-                "leakage_coefficient": "leakage_coefficient_m3_per_s_Pa",
-                "pressure_feedback_gain": "pressure_feedback_gain_m_per_s_Pa",
-                "pressure_feedback_time_constant": "pressure_feedback_time_constant_s",
-                "max_rate": "max_rate_m_per_s", "relief_pressure": "relief_pressure_Pa",
-                "relief_flow_coefficient": "relief_flow_coefficient_m3_per_s_Pa"}
+from .model_keys import ACTUATOR_FIELDS as _ACTUATOR_FIELDS, ACTUATOR_SI as _ACTUATOR_SI  # noqa: E402
+
 #: the relief valve's cracking pressure against the supply: P_s <= P_r <= RELIEF_PRESSURE_MAX P_s
 RELIEF_PRESSURE_MAX = 1.5
 
@@ -527,23 +529,6 @@ def model_inputs(model: "TvcModel") -> dict:
     return {role: {"file": f, "sha256": h} for role, (f, h) in model.input_files.items()}
 
 
-def _with_overrides(doc: dict, overrides: Mapping[str, Any]) -> tuple[dict, dict]:
-    """The model file's tables with ``overrides`` (``"section.key" -> TOML value``) written in,
-    and, per section, the overrides of keys the file does not hold itself (for ``[actuator]`` and
-    ``[friction]``: written after the parameter set is merged, so a swept set key is a variant of
-    the hardware and a swept model-file key is scaled with as the file's own would be)."""
-    doc, late = dict(doc), {}
-    for dotted, value in overrides.items():
-        section, _, key = dotted.partition(".")
-        table = dict(doc[section]) if isinstance(doc.get(section), Mapping) else {}
-        if section in ("actuator", "friction") and key not in table:
-            late.setdefault(section, {})[key] = value
-        else:
-            table[key] = value
-        doc[section] = table
-    return doc, late
-
-
 def load_model(path: str | Path, friction: str | None = None, overrides: Mapping[str, Any] | None = None) -> TvcModel:
     """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
     ``overrides``: ``{"section.key": TOML value}`` replacing (or adding) keys of the file before
@@ -554,7 +539,10 @@ def load_model(path: str | Path, friction: str | None = None, overrides: Mapping
     p = resolve(path, "model")
     src = str(p)
     raw, doc = read_toml(p, "a readable model file")
-    doc, late = _with_overrides(doc, overrides or {})
+    overrides = dict(overrides or {})
+    from .variants import level_follows, with_overrides
+
+    doc, late = with_overrides(level_follows(doc, overrides, src), overrides)
     _check_keys(doc, KNOWN_SECTIONS, src, "")
     if "name" in doc and not isinstance(doc["name"], str):
         raise InputError(src, "name", "a text name", got=repr(doc["name"])[:60])
@@ -573,10 +561,14 @@ def load_model(path: str | Path, friction: str | None = None, overrides: Mapping
     files = _input_files(p, raw, doc)
     from .bounds import check_model_bounds, check_model_plausible
 
+    from .variants import variant_sha256
+
     check_model_bounds(src, engine, actuator, structure, avionics, ftab, extra)
     check_model_plausible(src, engine, actuator, structure)
+    recorded = ((("friction.model", friction),) if friction is not None else ()) + tuple(overrides.items())
     return TvcModel(name=str(doc.get("name", p.stem)), engine=engine, actuator=actuator,
                     structure=structure, friction=law, avionics=avionics, source=src,
-                    sha256=combined_sha256(files), input_files=types.MappingProxyType(files),
+                    sha256=variant_sha256(combined_sha256(files), recorded), overrides=recorded,
+                    base_sha256=combined_sha256(files), input_files=types.MappingProxyType(files),
                     friction_table=types.MappingProxyType(dict(ftab)),
                     extra=types.MappingProxyType(extra))

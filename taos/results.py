@@ -121,6 +121,22 @@ def file_sha256(path: str | Path) -> str:
     return h.hexdigest()
 
 
+def model_provenance(model: Any) -> dict:
+    """What every output says of the model that produced it: ``model_file``, ``model_name``,
+    ``model_sha256`` (the variant's own hash), and for a modified model also
+    ``model_file_sha256`` (the files' combined hash) and ``model_overrides`` (key -> value as a
+    model file holds it; ``code.*`` for changes made in code with
+    :meth:`~taos.model.TvcModel.replace`; :mod:`taos.variants`). A 3-D model is described by its
+    planar base."""
+    m = getattr(model, "base", model)
+    out = {"model_file": str(m.source), "model_name": m.name, "model_sha256": m.sha256}
+    if getattr(m, "overrides", ()):
+        out["model_file_sha256"] = m.base_sha256
+        out["model_overrides"] = {k: v if isinstance(v, (str, int, float, bool, list)) else repr(v)
+                                  for k, v in m.overrides}
+    return out
+
+
 def output_provenance(models=(), inputs=()) -> dict:
     """Provenance block of a JSON output: package version, git revision, and the path and
     SHA-256 of each model (``TvcModel``: ``model_sha256`` the combined hash of the model file and
@@ -129,8 +145,7 @@ def output_provenance(models=(), inputs=()) -> dict:
     out = base_provenance()
     for i, m in enumerate(models):
         sfx = "" if len(models) == 1 else f"_{i + 1}"
-        out[f"model_file{sfx}"] = str(m.source)
-        out[f"model_sha256{sfx}"] = m.sha256
+        out.update({f"{k}{sfx}": v for k, v in model_provenance(m).items() if k != "model_name"})
         if getattr(m, "input_files", None):   # per-file hashes behind the combined model_sha256
             out[f"model_inputs{sfx}"] = {r: {"file": f, "sha256": h} for r, (f, h) in m.input_files.items()}
     for i, (kind, path) in enumerate(inputs):

@@ -86,7 +86,8 @@ def test_pendulum_frequency_about_each_axis(tm):
     """Small-angle frequencies sqrt(K/J): pitch and yaw on K_n, roll on the chain torsion."""
     Kstiff = HALF * 1e4
     t = dataclasses.replace(taos_model(tm.base, Kstiff, Kstiff),
-                            gimbal=dataclasses.replace(tm.gimbal, line_load_stiffness_N_per_m=1e-9))
+                            gimbal=dataclasses.replace(tm.gimbal, line_load_stiffness_N_per_m=1e-9,
+                                                                line_stiffness_basis=""))
     ss = linear_state_space(t)
     w = np.sort(np.abs(np.linalg.eigvals(ss.A[:12, :12])))
     e = t.base.engine

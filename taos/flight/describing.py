@@ -31,6 +31,7 @@ from taos.model import Structure, TvcModel
 from taos.results import atomic_write, package_version, write_json, write_provenance
 from taos.planar.simplex import simplex_state_space
 from taos.planar.simulate import DEFAULT_DT_S
+from taos.results import model_provenance
 
 #: gain floor [dB] below which the engine is taken as stuck (phase is then borrowed from the
 #: nearest amplitude at which it moves; the gain itself is kept, floored here)
@@ -166,7 +167,7 @@ def describing_function_map(model: TvcModel, amplitudes_rad: np.typing.ArrayLike
     f = np.sort(np.atleast_1d(np.asarray(freq_hz, float)))
     piston, engine = sine_dwell_grid(model, amps, f, axis, dt_max_s=dt_max_s, settle_cycles=settle_cycles,
                                      measure_cycles=measure_cycles, settle_s=settle_s, method=method)
-    prov = {"model_file": model.source, "model_sha256": model.sha256, "package_version": package_version(),
+    prov = {**model_provenance(model), "package_version": package_version(),
             "method": "sine-dwell", "steady_state": method, "dt_max_s": dt_max_s, "settle_cycles": settle_cycles,
             "measure_cycles": measure_cycles, "settle_s": settle_s}
     return DescribingFunctionMap(amps, f, engine, piston, model.friction.name, axis,

@@ -28,13 +28,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from taos.planar.avionics import Avionics
+from taos.errors import InputError
 from taos.harmonics import harmonic_amplitudes as _fit
 from taos.flight.describing import DescribingFunctionMap, describing_function_map
 from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
 from taos.linear import gain_db, phase_deg
 from taos.model import TvcModel
-from taos.results import atomic_write, package_version, write_provenance
+from taos.results import atomic_write, model_provenance, package_version, write_provenance
+from taos.planar.avionics import Avionics
 from taos.planar.simulate import DEFAULT_DT_S, integrate_plant
 
 DEG = math.pi / 180.0
@@ -56,6 +57,7 @@ def with_bounding_avionics(model: TvcModel, gain_db: float = BOUNDING_AVIONICS_G
     analysis replaced it by this gain, valid "for reasonable TVC motions above base
     quantization level" (paper sec. 2.3)."""
     g = 10.0 ** (gain_db / 20.0)
+    # an analysis choice made in code (recorded as code.avionics in the model's overrides and hash)
     return model.replace(avionics=Avionics(gain_table_rad=(0.0,), gain_table=(g,)))
 
 
@@ -246,7 +248,7 @@ def simulate_flight(flight: FlightModel, model: TvcModel, duration_s: float = 30
     x0[plant.ss.state_index("xi_rad")] = attitude0_rad
     y, aux = integrate_plant(plant, model, r, dt_s, record_every, x0)
     o = plant.ss.output_index
-    prov = {"model_file": model.source, "model_sha256": model.sha256, "flight_file": flight.source,
+    prov = {**model_provenance(model), "flight_file": flight.source,
             "flight_sha256": flight.sha256, "package_version": package_version(), "dt_s": dt_s,
             "record_every": record_every, "attitude0_rad": attitude0_rad, "axis": axis}
     return FlightHistory(t_s=t[::record_every], attitude_rad=y[:, o("attitude_rad")],
@@ -345,7 +347,7 @@ class LcoReport:
                         **self.verdict().to_dict()},
             "describing_function": {"amplitude_deg": np.degrees(self.prediction.df.amplitude_rad).tolist(),
                                     "freq_hz": self.prediction.df.freq_hz.tolist()},
-            "provenance": {"model_file": self.model.source, "model_sha256": self.model.sha256,
+            "provenance": {**model_provenance(self.model),
                            "flight_file": fl.source, "flight_sha256": fl.sha256,
                            "package_version": package_version()},
         })
@@ -431,9 +433,14 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
         df = describing_function_map_for(model, axis, amplitudes_rad=amplitudes_rad, freq_hz=freq_hz,
                                          avionics=avionics, settle_cycles=settle_cycles,
                                          measure_cycles=measure_cycles, steady=steady, flown=True)
-    elif df.axis != axis or df.friction_model != model.friction.name:
-        raise ValueError(f"the describing-function map given is for the {df.axis} axis and "
-                         f"{df.friction_model!r}, not {axis} and {model.friction.name!r}")
+    else:   # reused only when made from the same content: the flown model (its hash covers every
+        # override and the avionics), the axis and the dwell settings
+        want = {"model_sha256": model.sha256, "steady_state": steady, "settle_cycles": settle_cycles,
+                "measure_cycles": measure_cycles}
+        got = {k: df.provenance.get(k) for k in want}
+        if df.axis != axis or got != want:
+            raise InputError("describing-function map", "df", f"a map made for this flown model and settings "
+                             f"({axis} axis, {want})", got=f"one for the {df.axis} axis, {got}")
     pred = predict_lco(flight, df, axis)
     hist = meas = None
     if time_domain:

@@ -91,7 +91,8 @@ def apply_value(flight: FlightModel, model: TvcModel, name: str, value: float) -
     if not hasattr(obj, fld):
         raise InputError(model.source, f"friction.{name}", f"a friction law with {name} (the model's is "
                          f"{model.friction.name})", got="a law without it")
-    return flight, model.replace(**{part: dataclasses.replace(obj, **{fld: value})})
+    # the model variant through the loader (taos.variants): the key's one meaning, as `taos sweep --set`
+    return flight, model.with_values({f"{part}.{name}": float(value)})
 
 
 def loop_low_gain_margin_db(flight: FlightModel) -> float | None:
@@ -170,12 +171,9 @@ def map_points(flight: FlightModel, model: TvcModel, names, rows, settings: MapS
     maps, cases, jobs, rest = {}, [], [], []
     for i, row in enumerate(rows):
         fl, m = flight, model
-        key = []
         for name, v in zip(names, row):
             fl, m = apply_value(fl, m, name, float(v))
-            if SWEEPABLE[name][0] != "fcs":
-                key.append((name, float(v)))
-        key = tuple(key)
+        key = m.sha256   # the TVC variant's content (its files and overrides), not the swept names
         if key not in maps:   # the describing function depends on the TVC only: one map per TVC variant
             maps[key] = describing_function_map_for(m, fl.axis, amplitudes_rad=amps, freq_hz=freqs,
                                                     avionics=settings.avionics)

@@ -106,10 +106,34 @@ def _friction_level_set(m, v):
     return dataclasses.replace(m, friction=dataclasses.replace(law, coulomb_torque_Nm=v))
 
 
+def variant_values(model: TvcModel, names, values) -> dict:
+    """The model-file keys and values (SI) of free parameters ``names`` at ``values`` (floats),
+    for :meth:`~taos.model.TvcModel.with_values`: each parameter's own key, the avionics gain
+    as the crossover gain table times the factor."""
+    out = {}
+    for n, v in zip(names, values):
+        p = PARAMETERS[n]
+        if n == "avionics_gain":
+            av = model.avionics
+            if av.gain_table:
+                out["avionics.crossover_gain"] = [float(g * v) for g in av.gain_table]
+            else:
+                out["avionics.crossover_command"] = ["0 deg"]
+                out["avionics.crossover_gain"] = [float(v)]
+        else:
+            out[f"{p.section}.{p.toml_key}"] = float(v)
+    return out
+
+
 def apply_values(model: TvcModel, names, values) -> TvcModel:
-    """``model`` with parameters ``names`` set to ``values`` (SI, floats or CasADi SX), the
-    friction level first (it scales the law's other torque-like parameters, which a free one
-    then overrides), so the result does not depend on the order of ``--free``."""
+    """``model`` with parameters ``names`` set to ``values`` (SI). Floats: the model variant
+    through the loader (:mod:`taos.variants`; ``coulomb_torque`` is the friction level, the law's
+    other torque-like parameters following it, a free one among them set as given). CasADi SX
+    values (the surrogate's symbols): the same meaning on the dataclasses, the friction level
+    first (it scales the law's other torque-like parameters, which a free one then overrides),
+    so the result does not depend on the order of ``--free``."""
+    if all(isinstance(v, (int, float, np.floating)) for v in values):
+        return model.with_values(variant_values(model, names, values))
     pairs = sorted(zip(names, values), key=lambda nv: nv[0] != "coulomb_torque")
     for n, v in pairs:
         model = PARAMETERS[n].set(model, v)

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..model import TvcModel
 from ..results import atomic_write
+from taos.results import model_provenance
 
 AXES = ("pitch", "yaw")
 
@@ -44,7 +45,7 @@ def linear_export_data(model: TvcModel, freq_hz) -> dict:
                    "piston_phase_deg": fr.piston_phase_deg(), "engine_gain_db": gain_db(fr.engine),
                    "engine_phase_deg": fr.engine_phase_deg(),
                    "piston_definition": "x_p/(R theta_c), phase continuous from low frequency",
-                   "model_file": str(model.source), "model_sha256": model.sha256,
+                   **model_provenance(model),
                    "moment_arm_m": model.actuator.moment_arm_m}
     return out
 

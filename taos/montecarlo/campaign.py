@@ -288,30 +288,25 @@ def run_factors(c: Campaign, index: int) -> tuple[int, dict]:
     return run_seed, factors
 
 
-def _set(name: str, model: TvcModel, value) -> TvcModel:
-    """``model`` with the parameter ``name`` set to ``value`` (SI) alone. A campaign's dispersions
-    are independent factors, each on its own field: ``coulomb_torque`` moves T_c only (the
-    bristle stiffness has its own dispersion), not the fit's friction level, which carries the
-    law's other torque-like parameters with it (:func:`taos.identify.surrogate.apply_values`)."""
-    if name == "coulomb_torque":
-        return dataclasses.replace(model, friction=dataclasses.replace(model.friction, coulomb_torque_Nm=value))
-    return PARAMETERS[name].set(model, value)
-
-
 def apply_factors(ascent: Ascent, model: TvcModel, overrides: Mapping[str, float], factors: Mapping[str, float]
                   ) -> tuple[Ascent, TvcModel, list[str]]:
     """Ascent and model with the case's ``overrides`` (SI) and the run's ``factors`` applied;
     also the dispersed names that do not apply (e.g. bristle stiffness of a Coulomb law)."""
-    skipped = []
-    for k, v in overrides.items():
-        model = _set(k, model, v)
+    from taos.identify.surrogate import variant_values
+
+    skipped, names, values = [], list(overrides), list(overrides.values())
     for k, f in factors.items():
         if k in PARAMETERS:
             p = PARAMETERS[k]
             try:
-                model = _set(k, model, f if k == "avionics_gain" else p.get(model) * f)
+                values.append(f if k == "avionics_gain" else p.get(model) * f)
+                names.append(k)
             except (TypeError, AttributeError):  # the law has no such field
                 skipped.append(k)
+    # one variant through the loader (taos.variants): coulomb_torque is the friction level (the law's
+    # other torque-like parameters follow it; a dispersed one among them is set as drawn)
+    if names:
+        model = model.with_values(variant_values(model, names, [float(v) for v in values]))
     tr, fl = ascent.trajectory, ascent.flight
     rep = dataclasses.replace
     if "vehicle_mass" in factors:

@@ -39,6 +39,7 @@ from taos.montecarlo.inputs import digest, recording
 from taos.montecarlo.run import FlightRuns
 from taos.montecarlo.stats import CampaignResult, summarise
 from taos.results import atomic_write, package_version
+from taos.results import model_provenance
 
 FORMAT = "taos-montecarlo-2"
 MANIFEST = "campaign.json"
@@ -173,7 +174,7 @@ def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | Non
     if design != "montecarlo":
         sens = _sensitivity(c, design, ds)
     prov = {"campaign_file": c.source, "campaign_sha256": c.sha256, "inputs_sha256": kind.inputs_sha256,
-            "input_files": table, "ascent_sha256": kind.ascent.sha256, "model_sha256": kind.model.sha256,
+            "input_files": table, "ascent_sha256": kind.ascent.sha256, **model_provenance(kind.model),
             "package_version": package_version(), "seed": c.seed, "case": case, "design": design,
             "friction_model": kind.model.friction.name, "solver": {"method": "rk4-fixed-step", "dt_s": c.dt_s},
             "segment_s": [c.start_s, c.start_s + c.duration_s],

@@ -39,6 +39,7 @@ from taos.montecarlo import engine, store
 from taos.montecarlo.engine import Design, Part
 from taos.montecarlo.sweep_define import SweepDesign
 from taos.montecarlo.sweep_metrics import METRICS, LcoSettings, evaluate, run_cost_s, unstable_reason
+from taos.results import model_provenance
 
 FORMAT = "taos-sweep-1"
 MANIFEST = "sweep.json"
@@ -184,7 +185,7 @@ def load_runs(defn: SweepDefinition) -> tuple[SweepRuns, list[dict], dict]:
     settings = json.dumps({"format": FORMAT, "definition": defn.to_dict()}, sort_keys=True)
     sha, table = digest(files, settings)
     kind = SweepRuns(models, defn.design.factors, defn.metrics, defn.axis, lco, sha)
-    prov = {"model_file": base.source, "model_sha256": base.sha256, "friction_model": base.friction.name}
+    prov = {**model_provenance(base), "friction_model": base.friction.name}
     if lco is not None:
         prov |= {"flight_file": lco.flight.source, "flight_sha256": lco.flight.sha256}
     return kind, table, prov

@@ -25,6 +25,7 @@ from ..model import TvcModel, model_inputs
 from ..profiles import Profile, is_two_axis
 from ..results import atomic_write, base_provenance, write_provenance
 from .simplex import LurePlant, simplex_plant
+from taos.results import model_provenance
 
 DEFAULT_DT_S = 2e-4
 
@@ -173,7 +174,7 @@ def _with_spool_output(plant: LurePlant) -> LurePlant:
 
 
 def provenance(model: TvcModel, solver: SolverSettings, **more) -> dict:
-    return {"model_file": model.source, "model_sha256": model.sha256, "model_name": model.name,
+    return {**model_provenance(model),
             "model_inputs": model_inputs(model),
             **base_provenance(), "seeds": "none (deterministic)", "friction_model": model.friction.name,
             "solver": {"method": solver.method, "dt_s": solver.dt_s, "record_every": solver.record_every},

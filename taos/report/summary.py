@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING
+from taos.results import model_provenance
 
 if TYPE_CHECKING:  # imported when a summary is made, not when this module is
     from taos.model import TvcModel
@@ -63,8 +64,7 @@ def model_summary(model: TvcModel, steps: bool = True, threads: int | None = Non
     friction = {"model": model.friction.name, **asdict(model.friction)}
     av = model.avionics
     return {
-        "model_file": model.source,
-        "model_sha256": model.sha256,
+        **model_provenance(model),
         "name": model.name,
         "load_resonance_hz": model.load_resonance_hz("pitch"),
         "load_resonance_yaw_hz": model.load_resonance_hz("yaw"),
@@ -149,13 +149,14 @@ def greenrun_summary(result) -> dict:
     prov = th.provenance
     axes = tuple(th.axes)
     s = {
-        "model_file": str(model.source), "model_name": model.name, "model_sha256": model.sha256,
+        **model_provenance(model),
         "profile_file": result.profile_file, "profile": prov.get("profile", ""),
         "friction_model": fr.name, "engine_model": prov.get("engine", "simplex"),
         "package_version": prov.get("package_version", ""),
         "provenance": {k: prov.get(k, "") for k in (
             "package_version", "git_revision", "model_file", "model_sha256", "profile_file", "profile_sha256",
-            "stiffness_source", "stiffness_sha256", "solver", "seeds", "engine", "friction_model")},
+            "stiffness_source", "stiffness_sha256", "solver", "seeds", "engine", "friction_model")}
+        | {k: prov[k] for k in ("model_file_sha256", "model_overrides") if k in prov},
         "created_utc": result.created_utc,
         "load_resonance_hz": dict(result.load_resonance_hz), "notch_frequency_hz": dict(result.notch_hz),
         "breakaway_deflection_deg": info["breakaway_deflection_deg"],

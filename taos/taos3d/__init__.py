@@ -17,14 +17,14 @@ from typing import TYPE_CHECKING
 from taos import lazy_api
 
 if TYPE_CHECKING:
-    from .calibrate import load_taos_model, taos_model
+    from .calibrate import load_taos_model, taos_model, with_values
     from .model import ActuatorGeometry, GimbalParams, TaosModel, beam_half_stiffness, engine_pin_model
     from .simulate import (TaosTimeHistory, linear_state_space, simulate_taos, taos_freqresp, taos_freqresp_family,
                            two_axis_dwell)
 
 _WHERE = {
     "ActuatorGeometry": "model", "GimbalParams": "model", "TaosModel": "model", "beam_half_stiffness": "model",
-    "engine_pin_model": "model", "load_taos_model": "calibrate", "taos_model": "calibrate",
+    "engine_pin_model": "model", "load_taos_model": "calibrate", "taos_model": "calibrate", "with_values": "calibrate",
     "TaosTimeHistory": "simulate", "linear_state_space": "simulate", "simulate_taos": "simulate",
     "taos_freqresp": "simulate", "taos_freqresp_family": "simulate", "two_axis_dwell": "simulate",
 }
@@ -32,7 +32,7 @@ _WHERE = {
 __all__ = [
     "ActuatorGeometry", "GimbalParams", "TaosModel", "TaosTimeHistory", "beam_half_stiffness",
     "engine_pin_model", "linear_state_space", "load_taos_model", "simulate_taos", "taos_freqresp", "taos_freqresp_family",
-    "taos_model", "two_axis_dwell",
+    "taos_model", "two_axis_dwell", "with_values",
 ]
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import TvcModel, load_model
-from .model import DERIVED_RTOL, TaosModel, assemble_taos_model
+from .model import DERIVED_RTOL, TaosModel, assemble_taos_model, line_stiffness_basis
 
 #: N/m per lbf/in (for the messages, which quote the files' units too)
 _NPM_PER_LBF_IN = 175.12683524647636
@@ -85,7 +85,8 @@ def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.n
     given = tm0.gimbal.line_load_stiffness_N_per_m
     expected = _line_stiffness(model, tm0, rtol=1e-4)
     if given is None:
-        return dataclasses.replace(tm0, gimbal=dataclasses.replace(tm0.gimbal, line_load_stiffness_N_per_m=expected))
+        tm = dataclasses.replace(tm0, gimbal=dataclasses.replace(tm0.gimbal, line_load_stiffness_N_per_m=expected))
+        return dataclasses.replace(tm, gimbal=dataclasses.replace(tm.gimbal, line_stiffness_basis=line_stiffness_basis(tm)))
     if abs(given - expected) > DERIVED_RTOL * expected:
         K = model.structure.load_stiffness_N_per_m
         lbf = _NPM_PER_LBF_IN
@@ -96,6 +97,14 @@ def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.n
                          f"{model.load_resonance_hz():.4g} Hz); delete the key to have it derived",
                          got=f"{given:.6g} N/m ({given / lbf:.6g} lbf/in)")
     return tm0
+
+
+def with_values(tm: TaosModel, values) -> TaosModel:
+    """The 3-D model of the variant ``tm.base.with_values(values)`` (:mod:`taos.variants`: the
+    model file with other values, through the loader), rebuilt with every 3-D check and the line
+    stiffness derived for it; gimbal halves given in code stay."""
+    code = tm.stiffness_source == "<code>"
+    return taos_model(tm.base.with_values(values), tm.K_upper if code else None, tm.K_lower if code else None)
 
 
 def load_taos_model(path, friction: str | None = None, K_upper=None, K_lower=None) -> TaosModel:

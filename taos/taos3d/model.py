@@ -74,6 +74,9 @@ class GimbalParams:
     bearing_radius_m: float
     stiffness_file: str | None = None
     line_load_stiffness_N_per_m: float | None = None
+    #: :func:`line_stiffness_basis` of the model the line stiffness was derived for ('' when
+    #: given by the file): a model changed since is refused, never run on a stale value
+    line_stiffness_basis: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,8 +150,19 @@ class TaosModel:
 
     @property
     def line_load_stiffness_N_per_m(self) -> float:
-        k = self.gimbal.line_load_stiffness_N_per_m
-        return self.base.structure.load_stiffness_N_per_m if k is None else k
+        """The actuator-line stiffness outside the gimbal [N/m], derived at build from
+        ``[structure] load_stiffness`` with the gimbal in series (:mod:`taos.taos3d.calibrate`).
+        A model whose inputs to that derivation changed since (a ``replace`` of its base, its
+        halves or geometry) raises :class:`InputError`: rebuild it
+        (:func:`taos.taos3d.calibrate.with_values`, :func:`~taos.taos3d.calibrate.taos_model`)."""
+        g = self.gimbal
+        if g.line_stiffness_basis and g.line_stiffness_basis != line_stiffness_basis(self):
+            raise InputError(self.base.source, "gimbal.line_load_stiffness",
+                             "a line stiffness derived for this model (rebuild the 3-D model after changing its "
+                             "load stiffness, engine, moment arm, geometry or gimbal halves)",
+                             got="the value derived for another model")
+        return self.base.structure.load_stiffness_N_per_m if g.line_load_stiffness_N_per_m is None \
+            else g.line_load_stiffness_N_per_m
 
     @property
     def chain_stiffness(self) -> np.ndarray:
@@ -178,10 +192,26 @@ class TaosModel:
         return Ic
 
     def with_friction(self, name: str) -> "TaosModel":
+        """The same model with friction law ``name`` (the line stiffness does not depend on it)."""
         return replace(self, base=self.base.with_friction(name))
 
     def replace(self, **changes) -> "TaosModel":
+        """Copy with fields replaced in code (a derived line stiffness is checked on use)."""
         return replace(self, **changes)
+
+
+def line_stiffness_basis(tm: "TaosModel") -> str:
+    """Fingerprint of everything the derived line stiffness depends on: the total load
+    stiffness, the engine, the moment arm, the geometry and both gimbal halves."""
+    import hashlib
+
+    b = tm.base
+    h = hashlib.sha256(repr((b.structure.load_stiffness_N_per_m, b.engine, b.actuator.moment_arm_m,
+                             tm.geometry.engine_roll_inertia_kgm2)).encode())
+    for a in (tm.geometry.structure_attach_m, tm.geometry.engine_attach_m, tm.geometry.engine_cg_m,
+              tm.K_upper, tm.K_lower):
+        h.update(np.ascontiguousarray(a, float).tobytes())
+    return h.hexdigest()
 
 
 # -- Pinocchio ---------------------------------------------------------------------------
