@@ -29,7 +29,6 @@ from ._laws import (
     friction_keys,
     param,
 )
-from ._laws import BUILTIN_PARAMS
 from ..descfcn import coulomb_describing_function, dahl_angle_df
 from .registry import LAWS, FrictionLawEntry, declare_builtins, get, ids, param_classes, params_of, register, unregister
 
@@ -40,7 +39,13 @@ def _builtin_entries(law_id: str) -> tuple:
     return load(law_id)
 
 
-declare_builtins(BUILTIN_PARAMS, _builtin_entries)
+def _builtin_params() -> dict:
+    from ._builtin import discover  # the built-in laws' parameter classes, found in this package
+
+    return discover()
+
+
+declare_builtins(_builtin_params(), _builtin_entries)
 
 
 def __getattr__(name: str):

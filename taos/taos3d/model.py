@@ -276,7 +276,7 @@ def check_friction_coefficient(model: TvcModel, mu: float | None, bearing_radius
     expected = tc / (N * bearing_radius_m)
     if mu is None:
         return expected
-    if model.friction.name != "none" and abs(mu - expected) > DERIVED_RTOL * expected:
+    if model.friction.has_friction and abs(mu - expected) > DERIVED_RTOL * expected:
         load = f"thrust {N / 1e3:.6g} kN" if model.engine.thrust_N > 0 else f"engine weight m g0 {N / 1e3:.6g} kN"
         raise InputError(model.source, "gimbal.friction_coefficient",
                          f"{expected:.4g} within 1 %, from friction.coulomb_torque = {tc:.6g} N m "
