@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -276,3 +277,20 @@ def test_shipped_lugre_is_passive_at_every_rate_and_bristle_state(model_file, na
     r1, r2 = law.passivity_ratios()
     assert r1 == pytest.approx(0.322, abs=1e-3)
     assert r2 == pytest.approx(0.0506 if name == "modified-lugre" else 0.0, abs=1e-4)
+
+
+def test_readme_names_registered_laws_and_keys_only():
+    """README.md's friction laws and ``[friction]`` keys are prose examples of the registry's: every
+    law id it names in its friction bullet is a registered law, every key it lists is a law's key
+    (the complete lists are generated: ``--help``, docs/reference/model_files.md)."""
+    from .conftest import ROOT
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    bullet = text[text.index("* **Friction laws**"):]
+    bullet = bullet[:bullet.index("\n* **")]
+    named = set(re.findall(r"`([a-z][a-z-]*)`", bullet)) - {"taos.friction"}
+    assert named and named <= set(friction.ids()), named - set(friction.ids())
+    keys_at = text.index("plus the laws' parameters")
+    listed = text[keys_at:text.index(")", text.index("the shipped laws'", keys_at))]
+    keys = set(re.findall(r"\b([a-z]+(?:_[a-z]+)+)\b", listed.split("the shipped laws':")[1]))
+    assert keys and keys <= friction.friction_keys(), keys - friction.friction_keys()

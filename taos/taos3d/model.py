@@ -270,7 +270,7 @@ def check_friction_coefficient(model: TvcModel, mu: float | None, bearing_radius
     ``[friction] coulomb_torque`` T_c [N m], the normal load N [N] (:func:`normal_load_N`) and the
     bearing radius r_b [m] when ``mu`` is None; else ``mu`` checked against that within
     :data:`DERIVED_RTOL` (InputError naming both keys, their values and the expected mu).
-    A law without friction (``none``) checks nothing."""
+    A law without friction (``has_friction`` false: ``none``) checks nothing."""
     N = normal_load_N(model)
     tc = model.friction.coulomb_torque_Nm
     expected = tc / (N * bearing_radius_m)
