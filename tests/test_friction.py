@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -22,20 +23,27 @@ from .conftest import MODELS
 TC = 16270.0  # 144,000 in-lbf [N m]
 
 
-def laws():
+def law_cases() -> dict:
+    """Named parameter cases of the built-in laws (a case is named after its law, or its law and
+    what sets it apart); ``tests/verification`` picks its laws from here by name."""
     common = dict(coulomb_torque_Nm=TC)
     lug = dict(static_torque_Nm=1.2 * TC, stribeck_velocity_rad_s=2e-3, bristle_stiffness_Nm_per_rad=1.3e7,
                bristle_damping_Nms_per_rad=4e5, damping_decay_velocity_rad_s=0.05, viscous_damping_Nms_per_rad=1e3)
-    return [
-        CoulombSwitching(**common, static_torque_Nm=TC, stick_velocity_rad_s=1e-3),
-        CoulombSmooth(**common, regularization_velocity_rad_s=1e-3),
-        Dahl(**common, bristle_stiffness_Nm_per_rad=1.3e7),
-        Dahl(**common, bristle_stiffness_Nm_per_rad=1.3e7, dahl_exponent=2.0),
-        LuGre(**common, **lug),
-        ModifiedLuGre(**common, **lug, vibration_velocity_rad_s=5e-3),
-        ModifiedLuGre(coulomb_torque_Nm=TC, static_torque_Nm=0.7 * TC, stribeck_velocity_rad_s=2e-3,
-                      stribeck_exponent=1.3, bristle_stiffness_Nm_per_rad=1.3e7, vibration_velocity_rad_s=5e-3),
-    ]
+    return {
+        "coulomb-switching": CoulombSwitching(**common, static_torque_Nm=TC, stick_velocity_rad_s=1e-3),
+        "coulomb-smooth": CoulombSmooth(**common, regularization_velocity_rad_s=1e-3),
+        "dahl": Dahl(**common, bristle_stiffness_Nm_per_rad=1.3e7),
+        "dahl, exponent 2": Dahl(**common, bristle_stiffness_Nm_per_rad=1.3e7, dahl_exponent=2.0),
+        "lugre": LuGre(**common, **lug),
+        "modified-lugre": ModifiedLuGre(**common, **lug, vibration_velocity_rad_s=5e-3),
+        "modified-lugre, static below Coulomb": ModifiedLuGre(
+            coulomb_torque_Nm=TC, static_torque_Nm=0.7 * TC, stribeck_velocity_rad_s=2e-3, stribeck_exponent=1.3,
+            bristle_stiffness_Nm_per_rad=1.3e7, vibration_velocity_rad_s=5e-3),
+    }
+
+
+def laws():
+    return list(law_cases().values())
 
 
 @pytest.mark.parametrize("law", laws(), ids=lambda law: f"{law.name}")
@@ -123,9 +131,45 @@ def test_coulomb_describing_function_4Tc_over_piV(V):
 
 
 def test_registry_names_are_the_contract():
-    builtin = {"none", "coulomb-switching", "coulomb-smooth", "dahl", "lugre", "modified-lugre"}
-    assert builtin <= set(LAWS)
-    assert {k for k, e in LAWS.items() if e.builtin} == builtin
+    """The ids model files and ``--friction`` already use stay built in (a contract); every
+    built-in law the package defines is registered as one (the list is the package's, never
+    copied: a new built-in law is added by its files in taos/friction/ alone)."""
+    from taos.friction._builtin import discover
+
+    contract = {"none", "coulomb-switching", "coulomb-smooth", "dahl", "lugre", "modified-lugre"}
+    assert contract <= set(discover()) <= set(LAWS)
+    assert {k for k, e in LAWS.items() if e.builtin} == set(discover())
+    assert friction.ids()[:len(discover())] == tuple(discover())
+
+
+@pytest.mark.parametrize("name", friction.ids())
+def test_registry_law_describing_function_forms_share_one_convention(hotfire, name):
+    """The analytic, numeric and fit forms of a law's describing function are one function in one
+    convention (rate amplitude V, frequency w, torque over rate [N m s/rad]; fit: angle amplitude
+    X = V / w): where a law has the analytic form, the fit form equals it and
+    ``rate_describing_function`` returns it; without it, ``rate_describing_function`` is the
+    numeric one."""
+    law = hotfire.with_friction(name).friction
+    entry = friction.get(name)
+    for V, f in ((0.05, 1.0), (0.3, 5.0)):
+        w = 2 * math.pi * f
+        exact = law.describing_function(V, w)
+        n = law.rate_describing_function(V, w)
+        if exact is None:
+            assert n == law.numeric_describing_function(V, f)
+            continue
+        assert n == exact
+        if entry.fit_describing_function is not None and (entry.fit_check is None or _fit_ok(entry, law)):
+            re, im = entry.fit_describing_function(law, V / w, w)
+            assert complex(float(re), float(im)) == pytest.approx(exact, rel=1e-12, abs=1e-12 * abs(exact))
+
+
+def _fit_ok(entry, law) -> bool:
+    try:
+        entry.fit_check(law, "test")
+        return True
+    except Exception:
+        return False
 
 
 @pytest.fixture(scope="module")
@@ -233,3 +277,20 @@ def test_shipped_lugre_is_passive_at_every_rate_and_bristle_state(model_file, na
     r1, r2 = law.passivity_ratios()
     assert r1 == pytest.approx(0.322, abs=1e-3)
     assert r2 == pytest.approx(0.0506 if name == "modified-lugre" else 0.0, abs=1e-4)
+
+
+def test_readme_names_registered_laws_and_keys_only():
+    """README.md's friction laws and ``[friction]`` keys are prose examples of the registry's: every
+    law id it names in its friction bullet is a registered law, every key it lists is a law's key
+    (the complete lists are generated: ``--help``, docs/reference/model_files.md)."""
+    from .conftest import ROOT
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    bullet = text[text.index("* **Friction laws**"):]
+    bullet = bullet[:bullet.index("\n* **")]
+    named = set(re.findall(r"`([a-z][a-z-]*)`", bullet)) - {"taos.friction"}
+    assert named and named <= set(friction.ids()), named - set(friction.ids())
+    keys_at = text.index("plus the laws' parameters")
+    listed = text[keys_at:text.index(")", text.index("the shipped laws'", keys_at))]
+    keys = set(re.findall(r"\b([a-z]+(?:_[a-z]+)+)\b", listed.split("the shipped laws':")[1]))
+    assert keys and keys <= friction.friction_keys(), keys - friction.friction_keys()

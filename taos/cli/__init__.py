@@ -40,6 +40,24 @@ import importlib  # noqa: E402
 
 from taos.errors import run_cli as run  # noqa: E402
 
+class _FrictionLawIds:
+    """The friction law ids (built in, registered, installed plug-ins), read from the registry
+    when a help text is formatted: building the parser imports no friction law."""
+
+    def __str__(self) -> str:
+        from taos.friction import ids
+
+        return ", ".join(ids())
+
+
+def add_friction_option(parser: argparse.ArgumentParser,
+                        what: str = "swap the friction law, keeping the file's torque levels") -> argparse.Action:
+    """The ``--friction LAW`` option, its help listing the law ids of :func:`taos.friction.ids`."""
+    action = parser.add_argument("--friction", help=f"{what}; one of: %(law_ids)s")
+    action.law_ids = _FrictionLawIds()   # argparse formats %(law_ids)s from the action's attributes
+    return action
+
+
 #: subcommand modules, in help order
 COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.export",
             "taos.cli.montecarlo", "taos.cli.sweep", "taos.cli.fmu"]

@@ -8,6 +8,7 @@ import sys
 
 from typing import TYPE_CHECKING
 
+from taos.cli import add_friction_option
 from taos.errors import InputError
 from taos.planar.envelope import ENGINES
 from taos.report.summary import model_summary
@@ -218,8 +219,7 @@ def add_parsers(sub) -> None:
     def common(p, friction=True):
         p.add_argument("model", help="model file (TOML), e.g. models/rs25_ambient.toml")
         if friction:
-            p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels "
-                           "(none, coulomb-switching, coulomb-smooth, dahl, lugre, modified-lugre)")
+            add_friction_option(p)
         p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
 
     p = sub.add_parser("info", help="parameters in SI and derived figures")
@@ -252,7 +252,7 @@ def add_parsers(sub) -> None:
                    "are replayed and compared with its piston and engine angles")
     p.add_argument("--out", required=True, help="HDF5 file to write")
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
-    p.add_argument("--friction", help="swap the friction law")
+    add_friction_option(p, "swap the friction law")
     p.add_argument("--dt", type=float, default=None, help="integration step [s] (default: the engine's own, 2e-4 s "
                    "simplex, 4e-4 s taos)")
     p.add_argument("--integrator", choices=("rk4", "exp"), default="rk4",

@@ -3,6 +3,7 @@ co-simulation FMU (:func:`taos.cosim.build_fmu`)."""
 
 from __future__ import annotations
 
+from taos.cli import add_friction_option
 from taos.planar.envelope import ENGINES
 
 
@@ -24,7 +25,7 @@ def add_parsers(sub) -> None:
     p.add_argument("model", help="model file (TOML), e.g. models/rs25_hotfire.toml")
     p.add_argument("--out", required=True, help="FMU file to write (*.fmu)")
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex (planar, per axis) or taos (3-D)")
-    p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels")
+    add_friction_option(p)
     p.add_argument("--avionics", choices=AVIONICS, default="model",
                    help="model: the file's quantisation and crossover curve (default); bounding: the paper's "
                    "-1 dB gain without quantisation (as taos lco --avionics bounding)")

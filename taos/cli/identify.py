@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import sys
 
+from taos.cli import add_friction_option
 from taos.errors import InputError
 from taos.results import write_json
 
@@ -379,7 +380,7 @@ def add_parsers(sub) -> None:
     p.add_argument("data", nargs="+", help="time-history file(s), e.g. models/data/greenrun_hotfire_synthetic.csv")
     p.add_argument("--model", required=True, help="model file whose other values are held")
     p.add_argument("--free", required=True, help="comma-separated parameters, e.g. load_stiffness,coulomb_torque")
-    p.add_argument("--friction", help="swap the friction law before fitting (keeps the file's torque levels)")
+    add_friction_option(p, "swap the friction law before fitting (keeps the file's torque levels)")
     p.add_argument("--start", action="append", metavar="NAME=VALUE",
                    help="start value with unit, e.g. --start 'load_stiffness=150000 lbf/in' (repeatable)")
     p.add_argument("--starts", type=int, default=3,

@@ -9,6 +9,7 @@ import sys
 
 import numpy as np
 
+from taos.cli import add_friction_option
 from taos.errors import InputError
 from taos.results import write_json
 
@@ -169,8 +170,7 @@ def add_parsers(sub) -> None:
     p = sub.add_parser("lco", help="flight-control limit cycle: describing-function prediction and time domain")
     p.add_argument("model", help="TVC model file, e.g. models/rs25_flight.toml")
     p.add_argument("--flight", required=True, help="flight file, e.g. models/flight/core_stage.toml")
-    p.add_argument("--friction", help="swap the friction law (none, coulomb-switching, coulomb-smooth, dahl, "
-                   "lugre, modified-lugre), keeping the file's torque levels")
+    add_friction_option(p)
     p.add_argument("--axis", choices=("pitch", "yaw"), help="vehicle axis (default: the flight file's)")
     p.add_argument("--load-stiffness", help="override the load stiffness, e.g. '205000 lbf/in'")
     p.add_argument("--avionics", choices=("bounding", "model"), default="bounding",

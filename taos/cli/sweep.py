@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import sys
 
+from taos.cli import add_friction_option
 from taos.errors import InputError
 from taos.results import write_json
 
@@ -147,7 +148,7 @@ def add_parsers(sub) -> None:
                    "over the --set ranges, --samples N base points (a power of two; N (k + 2) points)")
     p.add_argument("--seed", type=_whole, default=0, help="seed of the Latin hypercube (default 0)")
     p.add_argument("--axis", choices=("pitch", "yaw"), default="pitch", help="axis of the figures (default pitch)")
-    p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels")
+    add_friction_option(p)
     p.add_argument("--flight", help="flight file for the LCO metrics, e.g. models/flight/core_stage.toml")
     p.add_argument("--avionics", choices=("bounding", "model"), default="bounding",
                    help="LCO metrics: bounding (the paper's -1 dB gain, default) or the file's quantiser")

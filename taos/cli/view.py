@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import sys
 
+from taos.cli import add_friction_option
 from taos.errors import InputError
 from taos.planar.envelope import ENGINES
 
@@ -81,7 +82,7 @@ def add_parsers(sub) -> None:
     p.add_argument("model", help="model file (TOML), e.g. models/rs25_hotfire.toml")
     p.add_argument("--out", default="out/greenrun", help="report folder (default out/greenrun)")
     p.add_argument("--profile", default=None, help="profile (default models/profiles/greenrun_two_axis.toml)")
-    p.add_argument("--friction", help="swap the friction law, keeping the file's torque levels")
+    add_friction_option(p)
     p.add_argument("--spec", help="spec mask (TOML) marked pass/fail on the plots and in summary.json "
                    "(default models/specs/tvc_actuator_notional.toml; 'none' for no check)")
     p.add_argument("--data", help="measured record overlaid on the model (e.g. models/data/greenrun_hotfire_synthetic.csv)")

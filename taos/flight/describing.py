@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from taos.errors import InputError
 from taos.planar.freqresp import sine_dwell_grid
 from taos.linear import StateSpace, gain_db, phase_deg
 from taos.model import Structure, TvcModel
@@ -184,7 +183,8 @@ def rigid_limit_model(model: TvcModel, stiffness_factor: float = 1000.0) -> TvcM
 def rigid_engine_response(model: TvcModel, amplitude_rad: float, freq_hz: float,
                           axis: str = "pitch") -> complex:
     """Analytic friction-in-loop engine response theta/theta_c [-] from the friction law's
-    analytic describing function (:meth:`taos.friction.FrictionLaw.describing_function`).
+    describing function (:meth:`taos.friction.FrictionLaw.rate_describing_function`: the
+    analytic one where the law has one, else the law's own, simulated alone).
 
     The linear simplex block gives theta = G_c theta_c - G_f T_f (G_c, G_f exact at j w).
     Replacing T_f by its describing function on the engine rate, T_f = N(V, w) (j w theta),
@@ -196,15 +196,12 @@ def rigid_engine_response(model: TvcModel, amplitude_rad: float, freq_hz: float,
 
     law = model.friction
     w = 2 * math.pi * freq_hz
-    if law.describing_function(1.0, w) is None:
-        raise InputError(model.source, "friction.model", "a law with an analytic describing function",
-                         got=law.name)
     ss: StateSpace = simplex_state_space(model, axis)
     h = ss.freqresp([freq_hz], ["command_rad", "friction_torque_Nm"], "theta_rad")[0]
     gc, gf = complex(h[0]), -complex(h[1])
 
     def resp(mag):
-        return gc / (1 + 1j * w * gf * law.describing_function(w * mag, w))
+        return gc / (1 + 1j * w * gf * law.rate_describing_function(w * mag, w))
 
     # |theta| = A |resp(|theta|)|: bracket from the linear amplitude downwards, take the largest root
     hi = 2 * abs(gc) * amplitude_rad

@@ -8,13 +8,16 @@ and its fit describing function. The planar and 3-D integrators, the describing-
 tools, the fit surrogate and the step check all ask the entry; an unknown id stops with
 :class:`~taos.errors.InputError`.
 
-To add a law (everything in this folder, or in your own code): write a frozen parameter
-class deriving :class:`FrictionLaw` with fields made by :func:`param`, its ``steady_state``
-(and ``describing_function``, ``check_step`` where they apply); write its kernels with the
-registry's signatures (``rates``, ``zdot3``, ``torque3``, ``bearing_step``; numba
-functions, see :mod:`._builtin` and its ``_law_*`` modules for the built-in ones, one module
-per law, and the helpers in :mod:`._vector`); and call :func:`register` with a
-:class:`FrictionLawEntry`. The tests parametrised over the registry then cover it.
+To add a built-in law (files in this folder only; ``docs/developer/adding_a_friction_law.md``):
+write a frozen parameter class deriving :class:`FrictionLaw` with fields made by :func:`param`,
+its ``steady_state`` (and ``describing_function``, ``check_step`` where they apply), naming its
+id (``name``) and its kernels' module (``kernels``), in ``_laws.py`` or a ``_params_<name>.py``
+module (:func:`._builtin.discover` finds it); write its kernels with the registry's signatures
+(``rates``, ``zdot3``, ``torque3``, ``bearing_step``; numba C callbacks) and its
+:class:`FrictionLawEntry` in ``_law_<name>.py`` (``ENTRIES``; see the built-in ones and the
+helpers in :mod:`._vector`). A law of your own code: the same class and kernels, and
+:func:`register` with a :class:`FrictionLawEntry`. The ids (:func:`ids`) feed the command-line
+help, the docs' key reference and the tests parametrised over the registry, which then cover it.
 """
 
 from ._laws import (
@@ -29,7 +32,6 @@ from ._laws import (
     friction_keys,
     param,
 )
-from ._laws import BUILTIN_PARAMS
 from ..descfcn import coulomb_describing_function, dahl_angle_df
 from .registry import LAWS, FrictionLawEntry, declare_builtins, get, ids, param_classes, params_of, register, unregister
 
@@ -40,7 +42,13 @@ def _builtin_entries(law_id: str) -> tuple:
     return load(law_id)
 
 
-declare_builtins(BUILTIN_PARAMS, _builtin_entries)
+def _builtin_params() -> dict:
+    from ._builtin import discover  # the built-in laws' parameter classes, found in this package
+
+    return discover()
+
+
+declare_builtins(_builtin_params(), _builtin_entries)
 
 
 def __getattr__(name: str):

@@ -12,7 +12,25 @@ Interface (a :class:`taos.descfcn.Nonlinearity`): ``law(v, z, t_app)`` gives the
 ``law.derivative(v, z)`` the state derivative, ``law.steady_state(v)`` the analytic
 steady-sliding curve, ``law.describing_function(V, w)`` the analytic describing function
 where one exists (else ``None``), ``law.numeric_describing_function(V, f)`` the numeric one
-by simulation, and ``law.check_step(J, dt, source)`` the explicit-step limit.
+by simulation, ``law.rate_describing_function(V, w)`` whichever of the two the law has, and
+``law.check_step(J, dt, source)`` the explicit-step limit.
+
+Describing functions, one convention for every law and every form: the relative rate is a sine
+v = V sin(w t) (rate amplitude V [rad/s], frequency w [rad/s]; relative-angle amplitude
+X = V / w), and N is the torque's fundamental over the rate's, a complex [N m s/rad]
+(real part: dissipation, Re N >= 0 for a passive law; imaginary part: stiffness, negative for a
+spring, -k / w). The three forms of it:
+
+* analytic, :meth:`FrictionLaw.describing_function` ``(V, w)`` (``None`` where the law has
+  none);
+* numeric, :meth:`FrictionLaw.numeric_describing_function` ``(V, f)``, by simulation of the
+  law's own kernel (frequency in Hz, f = w / 2 pi), for every law;
+* fit, the registry entry's ``fit_describing_function(law, X, w) -> (Re N, Im N)``, in
+  arithmetic that also takes CasADi symbols (optional: the fit refuses a law without it).
+
+:meth:`FrictionLaw.rate_describing_function` is what a caller outside this package asks: the
+analytic form where there is one, else the numeric one. Where a law has the analytic and the
+fit form, they agree (``tests/test_friction.py`` checks it over the registry).
 
 References
 ----------
@@ -43,12 +61,15 @@ from . import _slots as K
 from . import registry
 
 
-def param(default: float, key: str, kind: str, slot: int | None, *, torque_like: bool = False):
+def param(default: float, key: str, kind: str, slot: int | None, *, torque_like: bool = False, meaning: str = ""):
     """A law parameter field: its model-file ``key`` (in the ``[friction]`` table), pint unit
     ``kind`` (:func:`taos.units.to_si`), ``slot`` in the packed kernel vector (``None``: not
-    packed) and ``torque_like`` (a torque or torque per angle/rate: scaled with the bearing
-    normal load by :meth:`FrictionLaw.scaled`)."""
-    return field(default=default, metadata={"key": key, "kind": kind, "slot": slot, "torque_like": torque_like})
+    packed), ``torque_like`` (a torque or torque per angle/rate: scaled with the bearing
+    normal load by :meth:`FrictionLaw.scaled`) and ``meaning``, the key's one-line description
+    in the model-file key reference (``docs/reference/model_files.md`` is generated from it; a
+    key several laws share is described once, by the first law declaring it with a meaning)."""
+    return field(default=default, metadata={"key": key, "kind": kind, "slot": slot, "torque_like": torque_like,
+                                            "meaning": meaning})
 
 
 def _info(f: dataclasses.Field) -> dict:
@@ -70,8 +91,14 @@ class FrictionLaw(Nonlinearity):
     name: ClassVar[str] = ""
     has_state: ClassVar[bool] = False
     has_friction: ClassVar[bool] = True
+    #: built-in laws only: the module of :mod:`taos.friction` declaring this law's kernels and
+    #: registry entry (its ``ENTRIES``), e.g. ``"_law_dahl"``; a class with it, defined in
+    #: ``_laws.py`` or a ``_params_*.py`` module of the package, is a built-in law
+    #: (:func:`taos.friction._builtin.discover`). Empty for laws registered at run time or by plug-ins.
+    kernels: ClassVar[str] = ""
 
-    coulomb_torque_Nm: float = param(0.0, "coulomb_torque", "torque", K.SLOT_TC, torque_like=True)
+    coulomb_torque_Nm: float = param(0.0, "coulomb_torque", "torque", K.SLOT_TC, torque_like=True,
+                                     meaning="Coulomb (sliding) friction torque T_c")
 
     @property
     def entry(self) -> registry.FrictionLawEntry:
@@ -139,6 +166,16 @@ class FrictionLaw(Nonlinearity):
         return simulated_describing_function(lambda v, dt: self.response(v, dt)[0], rate_amplitude, freq_hz,
                                              cycles, steps_per_cycle)
 
+    def rate_describing_function(self, rate_amplitude: float, omega_rad_s: float) -> complex:
+        """The law's describing function in the one convention (module docstring): rate
+        amplitude V [rad/s], frequency w [rad/s] -> torque fundamental over rate fundamental
+        [N m s/rad]; the analytic one (:meth:`describing_function`) where the law has one, else
+        by simulation (:meth:`numeric_describing_function`)."""
+        exact = self.describing_function(rate_amplitude, omega_rad_s)
+        if exact is not None:
+            return complex(exact)
+        return self.numeric_describing_function(rate_amplitude, omega_rad_s / (2.0 * math.pi))
+
     # -- construction -----------------------------------------------------------------------
     @classmethod
     def from_table(cls, table: dict, source: str, section: str = "friction") -> "FrictionLaw":
@@ -168,6 +205,7 @@ class NoFriction(FrictionLaw):
     """No gimbal friction: T_f = 0."""
 
     name: ClassVar[str] = "none"
+    kernels: ClassVar[str] = "_law_none"
     has_friction: ClassVar[bool] = False
 
     def steady_state(self, v):
@@ -191,11 +229,15 @@ class CoulombSwitching(FrictionLaw):
     """
 
     name: ClassVar[str] = "coulomb-switching"
+    kernels: ClassVar[str] = "_law_switching"
 
-    static_torque_Nm: float = param(0.0, "static_torque", "torque", K.SLOT_TS, torque_like=True)
-    stick_velocity_rad_s: float = param(1e-3, "stick_velocity", "angular_velocity", K.SLOT_VEPS)
+    static_torque_Nm: float = param(0.0, "static_torque", "torque", K.SLOT_TS, torque_like=True,
+                                    meaning="static (breakaway) torque T_s of the Stribeck curve")
+    stick_velocity_rad_s: float = param(1e-3, "stick_velocity", "angular_velocity", K.SLOT_VEPS,
+                                        meaning="stick band of the switching Coulomb law")
     stick_damping_Nms_per_rad: float = param(0.0, "stick_damping", "rotational_damping", K.SLOT_CSTICK,
-                                             torque_like=True)
+                                             torque_like=True,
+                                             meaning="damping that bleeds the residual rate while stuck")
 
     def steady_state(self, v):
         return self.coulomb_torque_Nm * np.sign(np.asarray(v, float))
@@ -228,8 +270,10 @@ class CoulombSmooth(FrictionLaw):
     """
 
     name: ClassVar[str] = "coulomb-smooth"
+    kernels: ClassVar[str] = "_law_smooth"
 
-    regularization_velocity_rad_s: float = param(1e-3, "regularization_velocity", "angular_velocity", K.SLOT_VEPS)
+    regularization_velocity_rad_s: float = param(1e-3, "regularization_velocity", "angular_velocity", K.SLOT_VEPS,
+                                                 meaning="regularisation rate of the smooth Coulomb law")
 
     def steady_state(self, v):
         v = np.asarray(v, float)
@@ -264,11 +308,13 @@ class Dahl(FrictionLaw):
     """
 
     name: ClassVar[str] = "dahl"
+    kernels: ClassVar[str] = "_law_dahl"
     has_state: ClassVar[bool] = True
 
     bristle_stiffness_Nm_per_rad: float = param(0.0, "bristle_stiffness", "rotational_stiffness", K.SLOT_SIGMA0,
-                                                torque_like=True)
-    dahl_exponent: float = param(1.0, "dahl_exponent", "dimensionless", K.SLOT_ALPHA)
+                                                torque_like=True, meaning="bristle (pre-sliding) stiffness sigma_0")
+    dahl_exponent: float = param(1.0, "dahl_exponent", "dimensionless", K.SLOT_ALPHA,
+                                 meaning="Dahl shape exponent alpha")
 
     def steady_state(self, v):
         return self.coulomb_torque_Nm * np.sign(np.asarray(v, float))
@@ -324,18 +370,23 @@ class LuGre(FrictionLaw):
     """
 
     name: ClassVar[str] = "lugre"
+    kernels: ClassVar[str] = "_law_lugre"
     has_state: ClassVar[bool] = True
 
     static_torque_Nm: float = param(0.0, "static_torque", "torque", K.SLOT_TS, torque_like=True)
-    stribeck_velocity_rad_s: float = param(1e-3, "stribeck_velocity", "angular_velocity", K.SLOT_VS)
-    stribeck_exponent: float = param(2.0, "stribeck_exponent", "dimensionless", K.SLOT_DELTA)
+    stribeck_velocity_rad_s: float = param(1e-3, "stribeck_velocity", "angular_velocity", K.SLOT_VS,
+                                           meaning="Stribeck velocity v_s")
+    stribeck_exponent: float = param(2.0, "stribeck_exponent", "dimensionless", K.SLOT_DELTA,
+                                     meaning="Stribeck shape exponent delta")
     bristle_stiffness_Nm_per_rad: float = param(0.0, "bristle_stiffness", "rotational_stiffness", K.SLOT_SIGMA0,
                                                 torque_like=True)
     bristle_damping_Nms_per_rad: float = param(0.0, "bristle_damping", "rotational_damping", K.SLOT_SIGMA1,
-                                               torque_like=True)
+                                               torque_like=True, meaning="bristle damping sigma_1")
     viscous_damping_Nms_per_rad: float = param(0.0, "viscous_damping", "rotational_damping", K.SLOT_SIGMA2,
-                                               torque_like=True)
-    damping_decay_velocity_rad_s: float = param(0.0, "damping_decay_velocity", "angular_velocity", K.SLOT_V1)
+                                               torque_like=True, meaning="viscous friction sigma_2")
+    damping_decay_velocity_rad_s: float = param(0.0, "damping_decay_velocity", "angular_velocity", K.SLOT_V1,
+                                                meaning="bristle-damping decay rate v_1: sigma_1(v) = "
+                                                "sigma_1 v_1/(v_1 + |v|), half at v_1")
 
     def _g(self, v):
         v = np.abs(np.asarray(v, float))
@@ -404,8 +455,10 @@ class ModifiedLuGre(LuGre):
     """
 
     name: ClassVar[str] = "modified-lugre"
+    kernels: ClassVar[str] = "_law_lugre"
 
-    vibration_velocity_rad_s: float = param(0.0, "vibration_velocity", "angular_velocity", K.SLOT_VD)
+    vibration_velocity_rad_s: float = param(0.0, "vibration_velocity", "angular_velocity", K.SLOT_VD,
+                                            meaning="vibration rate amplitude V_d of the modified LuGre law")
 
     def _h(self, v):
         v = np.abs(np.asarray(v, float))
@@ -413,11 +466,6 @@ class ModifiedLuGre(LuGre):
         if vd <= 0:
             return np.ones_like(v)
         return (2.0 / math.pi) * np.arcsin(np.minimum(1.0, v / vd))
-
-
-#: the built-in laws' parameter classes by id (their kernels register with them in
-#: :mod:`._builtin`, loaded on first use of a kernel)
-BUILTIN_PARAMS = {cls.name: cls for cls in (NoFriction, CoulombSwitching, CoulombSmooth, Dahl, LuGre, ModifiedLuGre)}
 
 
 def friction_from_table(table: dict, source: str, model: str | None = None,

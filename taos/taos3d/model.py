@@ -300,13 +300,13 @@ def check_friction_coefficient(model: TvcModel, mu: float | None, bearing_radius
     ``[friction] coulomb_torque`` T_c [N m], the normal load N [N] (:func:`normal_load_N`) and the
     bearing radius r_b [m] when ``mu`` is None; else ``mu`` checked against that within
     :data:`DERIVED_RTOL` (InputError naming both keys, their values and the expected mu).
-    A law without friction (``none``) checks nothing."""
+    A law without friction (``has_friction`` false: ``none``) checks nothing."""
     N = normal_load_N(model)
     tc = model.friction.coulomb_torque_Nm
     expected = tc / (N * bearing_radius_m)
     if mu is None:
         return expected
-    if model.friction.name != "none" and abs(mu - expected) > DERIVED_RTOL * expected:
+    if model.friction.has_friction and abs(mu - expected) > DERIVED_RTOL * expected:
         load = f"thrust {N / 1e3:.6g} kN" if model.engine.thrust_N > 0 else f"engine weight m g0 {N / 1e3:.6g} kN"
         raise InputError(model.source, "gimbal.friction_coefficient",
                          f"{expected:.4g} within 1 %, from friction.coulomb_torque = {tc:.6g} N m "

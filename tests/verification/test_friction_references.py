@@ -10,7 +10,7 @@ import pytest
 
 from taos.friction import CoulombSmooth, CoulombSwitching, LuGre, ModifiedLuGre
 
-from ..test_friction import TC, laws
+from ..test_friction import TC, law_cases
 
 REFS = {"coulomb-switching": "Karnopp 1985 (stick-slip switching), sliding torque T_c sign(v)",
         "coulomb-smooth": "algebraic regularisation T_c v / sqrt(v^2 + v_eps^2)",
@@ -19,7 +19,7 @@ REFS = {"coulomb-switching": "Karnopp 1985 (stick-slip switching), sliding torqu
         "modified-lugre": "modified LuGre steady state (vibration-lowered Stribeck curve)"}
 
 
-@pytest.mark.parametrize("law", laws()[:3] + laws()[4:6], ids=lambda law: law.name)
+@pytest.mark.parametrize("law", [law_cases()[name] for name in REFS], ids=lambda law: law.name)
 def test_steady_sliding_torque_on_the_published_curve(law, verify):
     """At constant rate 7e-3 rad/s the simulated torque settles on the law's steady-state curve."""
     v = 7e-3

@@ -105,7 +105,8 @@ class TaosModelKeys(_MarkdownDirective):
         missing: list[str] = []
         text = reference.model_keys_markdown(missing)
         for key in missing:
-            logger.warning(f"model-file key {key!r} has no meaning in docs/_ext/taosdocs/reference.py MEANINGS",
+            logger.warning(f"model-file key {key!r} has no meaning in docs/_ext/taosdocs/reference.py MEANINGS "
+                           "(a [friction] key: in its law's taos.friction.param(..., meaning=...))",
                            location=(self.env.docname, self.lineno))
         for key in reference.stale_meanings():
             logger.warning(f"MEANINGS names {key!r}, a key the code does not read",

@@ -48,21 +48,8 @@ MEANINGS: dict[str, str] = {
     "vehicle.bending_frequency": "first bending mode frequency (0: no bending mode)",
     "vehicle.bending_damping_ratio": "damping ratio of the first bending mode",
     "vehicle.bending_gain": "bending-mode slope gain at the sensor and gimbal (rigid-body units)",
-    # [friction]
-    "friction.model": "friction law: none, coulomb-switching, coulomb-smooth, dahl, lugre, modified-lugre",
-    "friction.coulomb_torque": "Coulomb (sliding) friction torque T_c",
-    "friction.static_torque": "static (breakaway) torque T_s of the Stribeck curve",
-    "friction.stribeck_velocity": "Stribeck velocity v_s",
-    "friction.stribeck_exponent": "Stribeck shape exponent delta",
-    "friction.bristle_stiffness": "bristle (pre-sliding) stiffness sigma_0",
-    "friction.bristle_damping": "bristle damping sigma_1",
-    "friction.damping_decay_velocity": "bristle-damping decay rate v_1: sigma_1(v) = sigma_1 v_1/(v_1 + |v|), half at v_1",
-    "friction.viscous_damping": "viscous friction sigma_2",
-    "friction.vibration_velocity": "vibration rate amplitude V_d of the modified LuGre law",
-    "friction.stick_velocity": "stick band of the switching Coulomb law",
-    "friction.stick_damping": "damping that bleeds the residual rate while stuck",
-    "friction.regularization_velocity": "regularisation rate of the smooth Coulomb law",
-    "friction.dahl_exponent": "Dahl shape exponent alpha",
+    # [friction]: the law ids and each law's keys and their meanings come from the friction registry
+    # (friction_key_meanings: taos.friction.ids() and the laws' taos.friction.param(meaning=...))
     # [avionics]
     "avionics.quantization_bits": "bits of the flight-software command word",
     "avionics.command_range": "full range of the command word (LSB = range / 2^bits)",
@@ -188,15 +175,30 @@ def friction_keys() -> list[tuple[str, str, str]]:
     declares its model-file keys and units in its fields' metadata (taos.friction.param)."""
     import dataclasses
 
-    from taos.friction import LAWS
+    from taos.friction import ids, params_of
     kinds: dict[str, str] = {}
     users: dict[str, list[str]] = {}
-    for law_id, entry in LAWS.items():
-        for f in dataclasses.fields(entry.params):
+    for law_id in ids():
+        for f in dataclasses.fields(params_of(law_id)):
             key = f.metadata["key"]
             kinds.setdefault(key, f.metadata["kind"])
             users.setdefault(key, []).append(law_id)
     return [(key, _si(kinds[key]), ", ".join(users[key])) for key in sorted(kinds)]
+
+
+def friction_key_meanings() -> dict[str, str]:
+    """``[friction]`` key -> meaning, from the friction registry: ``model`` lists the law ids
+    (:func:`taos.friction.ids`), every other key has the meaning its law declares
+    (``taos.friction.param(..., meaning=...)``; the first law declaring a shared key says it)."""
+    import dataclasses
+
+    from taos.friction import ids, params_of
+    out = {"model": "friction law: " + ", ".join(ids()) + " (the ids of `taos.friction.ids()`)"}
+    for law_id in ids():
+        for f in dataclasses.fields(params_of(law_id)):
+            if f.metadata.get("meaning"):
+                out.setdefault(f.metadata["key"], f.metadata["meaning"])
+    return out
 
 
 def flight_key_table() -> dict[str, list[tuple[str, str, str]]]:
@@ -218,8 +220,9 @@ def _example(doc: dict, section: str, key: str) -> str:
 
 def _table(section: str, rows, doc: dict, example_file: str, missing: list[str]) -> list[str]:
     out = ["| key | SI unit / type | note (friction: laws that use it) | example | meaning |", "|---|---|---|---|---|"]
+    from_laws = friction_key_meanings() if section == "friction" else {}
     for key, unit, note in rows:
-        meaning = MEANINGS.get(f"{section}.{key}")
+        meaning = MEANINGS.get(f"{section}.{key}") or from_laws.get(key)
         if meaning is None:
             missing.append(f"{section}.{key}")
             meaning = ""
