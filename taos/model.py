@@ -219,8 +219,8 @@ class TvcModel:
         from .variants import variant_sha256
 
         out = dataclasses.replace(self, **changes)
-        marks = tuple((f"code.{k}", v) for k, v in sorted(changes.items())
-                      if k not in ("overrides", "sha256", "base_sha256"))
+        marks = tuple((f"code.{k}", v) for k, v in sorted(changes.items())   # an equal value changes nothing
+                      if k not in ("overrides", "sha256", "base_sha256") and getattr(self, k) != v)
         if not marks:
             return out
         overrides = tuple(kv for kv in out.overrides if kv[0] not in dict(marks)) + marks

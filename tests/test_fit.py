@@ -89,8 +89,7 @@ def test_standard_errors_are_neither_too_small_nor_too_large():
     hx = lin.piston * truth.actuator.moment_arm_m
     he = lin.engine
     free = ("load_stiffness", "loop_gain")
-    start = truth.replace(structure=dataclasses.replace(truth.structure,  # keeps the load damping
-                                                        load_stiffness_N_per_m=1.2 * truth.structure.load_stiffness_N_per_m))
+    start = truth.with_values({"structure.load_stiffness": 1.2 * truth.structure.load_stiffness_N_per_m})
     prob = FitProblem(start, free, np.array(["pitch"] * F.size), F, np.full(F.size, 0.4 * DEG))
     rng = np.random.default_rng(7)
     hits = np.zeros(2)
