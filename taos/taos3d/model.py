@@ -245,7 +245,9 @@ def parse_gimbal(model: TvcModel) -> GimbalParams:
     if "stiffness_file" in g:
         if not isinstance(g["stiffness_file"], str):
             raise InputError(src, "gimbal.stiffness_file", "a path string", got=repr(g["stiffness_file"]))
-        path = str((Path(src).parent / g["stiffness_file"]).resolve())
+        from ..shipped import resolve_reference   # the one rule: beside the model file, else shipped
+        path = str(resolve_reference(g["stiffness_file"], src, field="gimbal.stiffness_file", kind="model",
+                                     what="a gimbal stiffness file (.npz with K_upper, K_lower)"))
     kl = None
     if "line_load_stiffness" in g:
         kl = to_si(g["line_load_stiffness"], "stiffness", source=src, field="gimbal.line_load_stiffness",
