@@ -13,7 +13,8 @@ Model-file tables read here (the loader keeps them raw in ``TvcModel.extra``)::
                                       when given checked against it within 1 %]
                 bearing_radius        r_b [m], effective friction radius of the spherical seat
                 stiffness_file        fem_data .npz with K_upper, K_lower (path relative to the
-                                      model file)
+                                      model file, else to the shipped models/ folder:
+                                      taos.shipped.resolve_reference)
                 line_load_stiffness   actuator-line stiffness outside the gimbal [N/m] [derived key:
                                       optional; when absent derived from [structure] load_stiffness
                                       with the FEM gimbal in series, when given checked against that
