@@ -196,3 +196,21 @@ def test_a_missing_stiffness_file_exits_2_with_one_line(tmp_path):
     assert r.returncode == 2, r.stderr
     line, = r.stderr.strip().splitlines()
     assert f"{copy}: gimbal.stiffness_file:" in line and "(shipped)" in line, line
+
+
+def test_the_shipped_fallback_holds_in_the_wheel_layout(tmp_path, monkeypatch):
+    """A wheel carries models/ and fem_data/ as taos/shipped/models and taos/shipped/fem_data
+    (pyproject.toml): siblings, as in the repository, so ``../fem_data/...`` from the shipped
+    models folder is the shipped stiffness file there too."""
+    from taos import shipped
+
+    pkg = tmp_path / "site" / "taos" / "shipped"
+    for name in ("models", "fem_data"):
+        (pkg / name).mkdir(parents=True)
+    npz = pkg / "fem_data" / "gimbal_thrust.npz"
+    npz.write_bytes(b"")
+    monkeypatch.setattr(shipped, "_root", lambda name: pkg / name)
+    user = tmp_path / "user" / "rs25_hotfire.toml"
+    assert resolve_reference("../fem_data/gimbal_thrust.npz", user, field="gimbal.stiffness_file") == npz.resolve()
+    with pytest.raises(InputError, match=r"\(shipped\)"):
+        resolve_reference("../fem_data/other.npz", user, field="gimbal.stiffness_file")

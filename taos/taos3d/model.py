@@ -53,6 +53,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import TvcModel
+from ..shipped import resolve_reference
 from ..units import to_si
 
 G0 = 9.80665  # standard gravity [m/s^2]
@@ -246,7 +247,7 @@ def parse_gimbal(model: TvcModel) -> GimbalParams:
     if "stiffness_file" in g:
         if not isinstance(g["stiffness_file"], str):
             raise InputError(src, "gimbal.stiffness_file", "a path string", got=repr(g["stiffness_file"]))
-        from ..shipped import resolve_reference   # the one rule: beside the model file, else shipped
+        # the one rule for file references: beside the model file, else from the shipped models/
         path = str(resolve_reference(g["stiffness_file"], src, field="gimbal.stiffness_file", kind="model",
                                      what="a gimbal stiffness file (.npz with K_upper, K_lower)"))
     kl = None
