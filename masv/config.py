@@ -43,7 +43,7 @@ import numpy as np
 
 from taos.errors import InputError, check_keys
 from taos.model import TvcModel, load_model, read_toml
-from taos.shipped import resolve
+from taos.shipped import resolve, resolve_reference
 from taos.units import to_si
 
 from .structure import DEFAULT_DAMPING_RATIO, ModalStructure, load_modes, rigid_structure
@@ -196,7 +196,7 @@ def check_config(cfg: MasvConfig) -> None:
         raise InputError(src, "band", "0 < low < high", got=f"{cfg.band_low_hz} Hz .. {cfg.band_high_hz} Hz")
 
 
-def _structure(doc: Mapping, src: str, base: Path) -> ModalStructure:
+def _structure(doc: Mapping, src: str) -> ModalStructure:
     st = doc.get("structure")
     if not isinstance(st, Mapping):
         raise InputError(src, "[structure]", "a [structure] table", got="nothing (section missing)")
@@ -204,7 +204,8 @@ def _structure(doc: Mapping, src: str, base: Path) -> ModalStructure:
     modes = _str(st, "modes", src, "structure.modes")
     if modes == "rigid":
         return rigid_structure()
-    s = load_modes(base / modes)
+    s = load_modes(resolve_reference(modes, src, field="structure.modes", kind="masv",
+                                     what="a modal file (.npz or .toml)"))
     inm = st.get("engine_mass_in_modes", False)
     if not isinstance(inm, bool):
         raise InputError(src, "structure.engine_mass_in_modes", "true or false", got=repr(inm))
@@ -233,8 +234,7 @@ def load_config(path) -> MasvConfig:
     src = str(p)
     raw, doc = read_toml(p, "a readable MASV configuration file")
     check_keys(doc, {"name", "description", "reference", "structure", "band", "engine", "actuator"}, src)
-    base = p.parent
-    structure = _structure(doc, src, base)
+    structure = _structure(doc, src)
     band = doc.get("band", {})
     if not isinstance(band, Mapping):
         raise InputError(src, "[band]", "a [band] table with low and high", got=repr(band)[:60])
@@ -248,7 +248,8 @@ def load_config(path) -> MasvConfig:
     engines = []
     for i, t in enumerate(etabs):
         check_keys(t, {"name", "model", "gimbal_node", "cg_offset"}, src, f"engine[{i}]")
-        mpath = (base / _str(t, "model", src, f"engine[{i}].model")).resolve()
+        mpath = resolve_reference(_str(t, "model", src, f"engine[{i}].model"), p, field=f"engine[{i}].model",
+                                  kind="masv", what="a TVC model file")
         if mpath not in cache:
             cache[mpath] = load_model(mpath)
         cg = None
@@ -285,7 +286,8 @@ def load_config(path) -> MasvConfig:
                                       node, tuple(float(c) for c in n), tuple(float(c) for c in ax)))
     ref = None
     if "reference" in doc:
-        rp = (base / _str(doc, "reference", src, "reference")).resolve()
+        rp = resolve_reference(_str(doc, "reference", src, "reference"), p, field="reference", kind="masv",
+                               what="another MASV configuration file")
         if not rp.is_file() or rp == p.resolve():
             raise InputError(src, "reference", "the path of another MASV configuration file",
                              got=repr(doc["reference"]))

@@ -364,15 +364,16 @@ PARAMETER_SET_KEY = "parameter_set"
 REFERENCE_TORQUE_KEY = "reference_torque"
 
 
-def resolve_parameter_set(ref: str, model_path: Path) -> Path:
-    """Absolute path of a ``parameter_set`` named by the model file at ``model_path``: relative to
-    the model file, else to the shipped models folder (so a copied model file still finds it)."""
-    ppath = (Path(model_path).parent / ref).resolve()
-    if not ppath.is_file() and not Path(ref).is_absolute():
-        from .shipped import models_dir
-        if (models_dir() / ref).is_file():
-            ppath = (models_dir() / ref).resolve()
-    return ppath
+def resolve_parameter_set(ref: str, model_path: Path, section: str | None = None) -> Path:
+    """Absolute path of a ``parameter_set`` named by the model file at ``model_path`` (in its
+    ``[section]``): the one rule for file references (:func:`taos.shipped.resolve_reference`),
+    relative to the model file, else to the shipped models folder (so a copied model file still
+    finds it); :class:`InputError` naming the model file, the field and both places when missing."""
+    from .shipped import resolve_reference
+
+    field = f"{section}.{PARAMETER_SET_KEY}" if section else PARAMETER_SET_KEY
+    return resolve_reference(ref, model_path, field=field, kind="model",
+                             what=f"a {section + ' ' if section else ''}parameter-set file")
 
 
 def _parameter_set(ref, model_path: Path, src: str, section: str) -> tuple[Path, dict]:
@@ -495,21 +496,27 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
 
 def _input_files(p: Path, raw: bytes, doc: Mapping) -> dict[str, tuple[str, str]]:
     """role -> (path, SHA-256) of the model file and the shared files it names (parameter sets,
-    the 3-D ``[gimbal] stiffness_file`` when it exists; a missing one is the 3-D loader's error)."""
+    the 3-D ``[gimbal] stiffness_file`` when it exists; a missing one is the 3-D loader's error),
+    each at the path the one reference rule resolves it to (:func:`taos.shipped.resolve_reference`):
+    the file actually read."""
     from .errors import check_input_file
     from .results import file_sha256
+    from .shipped import resolve_reference
 
     files = {"model": (str(p), hashlib.sha256(raw).hexdigest())}
     for sec in ("actuator", "friction"):
         ref = doc.get(sec, {}).get(PARAMETER_SET_KEY) if isinstance(doc.get(sec), Mapping) else None
         if isinstance(ref, str) and ref:
-            q = resolve_parameter_set(ref, p)
+            q = resolve_parameter_set(ref, p, sec)
             files[f"{sec}_parameter_set"] = (str(q), file_sha256(q))
     gim = doc.get("gimbal")
     ref = gim.get("stiffness_file") if isinstance(gim, Mapping) else None
-    if isinstance(ref, str) and ref:   # read only, relative to the model file; a regular file of bounded size
-        q = (p.parent / ref).resolve()
-        if os.path.lexists(q):
+    if isinstance(ref, str) and ref:   # read only; a regular file of bounded size
+        try:
+            q = resolve_reference(ref, p, field="gimbal.stiffness_file", kind="model")
+        except InputError:
+            q = None   # the planar engine needs none: the 3-D loader reports it (taos.taos3d.model)
+        if q is not None:
             check_input_file(q, "a stiffness matrix file (.npz or .csv)", field="gimbal.stiffness_file")
             files["stiffness_file"] = (str(q), file_sha256(q))
     return files

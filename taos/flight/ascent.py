@@ -43,7 +43,7 @@ from taos.errors import InputError
 from taos.flight.vehicle import FlightModel, load_flight
 from taos.model import read_toml
 from taos.profiles import Multisine, SineSweep
-from taos.shipped import resolve
+from taos.shipped import resolve, resolve_reference
 from taos.units import to_si
 
 #: trajectory column -> (unit kind for to_si-style checks, SI unit)
@@ -325,12 +325,12 @@ def load_ascent(path: str | Path) -> Ascent:
     fl = doc.get("flight")
     if not isinstance(fl, str) or not fl:
         raise InputError(src, "flight", "the flight file (FCS) this ascent uses, a path", got=repr(fl))
-    flight = load_flight(p.parent / fl)
+    flight = load_flight(resolve_reference(fl, p, field="flight", kind="flight", what="a flight file"))
     tvc = doc.get("tvc_model", "")
     if not isinstance(tvc, str):
         raise InputError(src, "tvc_model", "a path string", got=repr(tvc))
     if tvc:
-        tvc = str((p.parent / tvc).resolve())
+        tvc = str(resolve_reference(tvc, p, field="tvc_model", kind="flight", what="a TVC model file"))
     dt_up = to_si(doc.get("update_interval", "1 s"), "time", source=src, field="update_interval", positive=True)
     if not 0.01 <= dt_up <= 10.0:
         raise InputError(src, "update_interval", "an interval from 0.01 s to 10 s", got=repr(doc.get("update_interval")))

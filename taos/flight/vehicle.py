@@ -48,7 +48,7 @@ from taos.errors import InputError
 from taos.linear import StateSpace
 from taos.stability import LoopMargins, loop_margins
 from taos.model import TvcModel, read_toml
-from taos.shipped import resolve
+from taos.shipped import resolve, resolve_reference
 from taos.planar.simplex import LurePlant, simplex_limits, simplex_state_space
 
 #: vehicle + FCS block signals
@@ -238,7 +238,7 @@ def load_flight(path: str | Path) -> FlightModel:
         raise InputError(src, "axis", "'pitch' or 'yaw'", got=repr(axis))
     tvc = doc.get("tvc_model", "")
     if tvc:
-        tvc = str((p.parent / tvc).resolve()) if not Path(tvc).is_absolute() else tvc
+        tvc = str(resolve_reference(tvc, p, field="tvc_model", kind="flight", what="a TVC model file"))
     return FlightModel(name=str(doc.get("name", p.stem)), vehicle=Vehicle(engine_count=n, **vkw),
                        fcs=FlightControl(pade_order=order, **fkw), axis=axis, tvc_model=tvc,
                        source=src, sha256=hashlib.sha256(raw).hexdigest())

@@ -51,7 +51,7 @@ from taos.errors import InputError
 from taos.flight.ascent import Ascent, load_ascent
 from taos.identify.surrogate import PARAMETERS
 from taos.model import TvcModel, load_model, read_toml
-from taos.shipped import resolve
+from taos.shipped import resolve, resolve_reference
 from taos.units import to_si
 
 #: flight-side dispersible parameters -> what the factor multiplies
@@ -236,8 +236,9 @@ def load_campaign(path: str | Path) -> Campaign:
     if not isinstance(ptis, bool):
         raise InputError(src, "ptis", "true or false", got=repr(ptis))
     c = Campaign(name=str(doc.get("name", p.stem)), source=src, sha256=hashlib.sha256(raw).hexdigest(),
-                 ascent_file=str((p.parent / asc).resolve()),
-                 tvc_model_file=str((p.parent / tvc).resolve()) if tvc else "",
+                 ascent_file=str(resolve_reference(asc, p, field="ascent", kind="campaign", what="an ascent file")),
+                 tvc_model_file=(str(resolve_reference(tvc, p, field="tvc_model", kind="campaign",
+                                                       what="a TVC model file")) if tvc else ""),
                  friction=fr, seed=seed, start_s=start, duration_s=dur, dt_s=dt, axis=axis,
                  analysis_window_s=win, trace_interval_s=trace, default_case=str(default), cases=cases,
                  dispersions=disp, update_interval_s=upd, ptis=ptis,

@@ -11,6 +11,7 @@ A shipped file can be named without a path: ``rs25_hotfire`` is ``models/rs25_ho
 
 from __future__ import annotations
 
+import os
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -66,3 +67,57 @@ def resolve(path: str | Path, kind: str = "model") -> Path:
         return p
     cand = models_dir() / KIND_FOLDERS[kind] / f"{p.name}.toml"
     return cand if cand.is_file() else p
+
+
+def _within_shipped(p: Path) -> bool:
+    """Whether ``p`` lies in the shipped data (the models/ or fem_data/ folder)."""
+    roots = []
+    for name in ("models", "fem_data"):
+        try:
+            roots.append(_root(name).resolve())
+        except FileNotFoundError:
+            pass
+    return any(p == r or r in p.parents for r in roots)
+
+
+def reference_places(ref: str, referring_file: str | Path, kind: str = "model") -> tuple[Path, Path | None]:
+    """The two places :func:`resolve_reference` looks for ``ref`` named inside ``referring_file``
+    (a file of ``kind``, :data:`KIND_FOLDERS`): beside the referring file, then the same path
+    from that kind's shipped folder (None when ``ref`` is absolute or leads out of the shipped
+    data); neither resolved."""
+    r = Path(ref)
+    here = Path(referring_file).parent / r     # an absolute ref: r itself
+    if r.is_absolute():
+        return here, None
+    shipped = models_dir() / KIND_FOLDERS[kind] / r
+    return here, (shipped if _within_shipped(shipped.resolve()) else None)
+
+
+def resolve_reference(ref, referring_file: str | Path, *, field: str, what: str = "a file",
+                      kind: str = "model") -> Path:
+    """The one rule for a file named inside another file (parameter sets, stiffness files,
+    flight, ascent and TVC model files, modal files, MASV references).
+
+    ``ref`` is a path written relative to the referring file. It is looked for
+
+    1. relative to the folder of ``referring_file`` (an absolute ``ref``: as given, nowhere else);
+    2. else as the same relative path from the shipped folder of the referring file's ``kind``
+       (``models/`` for a model file, ``models/flight/`` for a flight or ascent file, ...: the
+       place a shipped file of that kind lives), so a shipped file copied alone to another
+       folder still finds the shipped files it names (``../fem_data/gimbal_thrust.npz`` from
+       ``models/`` is the shipped ``fem_data/gimbal_thrust.npz``, in a checkout and in a wheel).
+
+    Something at the first place wins, whatever it is (its reader then checks it). Returns the
+    resolved absolute path; raises :class:`~taos.errors.InputError` (one line naming the
+    referring file, the ``field`` and the places looked) when it is in neither place."""
+    from taos.errors import InputError
+
+    if not isinstance(ref, str) or not ref:
+        raise InputError(str(referring_file), field, f"a path to {what}", got=repr(ref)[:60])
+    here, shipped = reference_places(ref, referring_file, kind)
+    for place in (here, shipped):
+        if place is not None and os.path.lexists(place):
+            return place.resolve()
+    here = here.resolve()
+    where = f"{here}" if shipped is None else f"{here} (beside the file) or {shipped.resolve()} (shipped)"
+    raise InputError(str(referring_file), field, f"{what} at {where}", got=f"no such file {ref!r}")

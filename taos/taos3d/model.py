@@ -13,7 +13,8 @@ Model-file tables read here (the loader keeps them raw in ``TvcModel.extra``)::
                                       when given checked against it within 1 %]
                 bearing_radius        r_b [m], effective friction radius of the spherical seat
                 stiffness_file        fem_data .npz with K_upper, K_lower (path relative to the
-                                      model file)
+                                      model file, else to the shipped models/ folder:
+                                      taos.shipped.resolve_reference)
                 line_load_stiffness   actuator-line stiffness outside the gimbal [N/m] [derived key:
                                       optional; when absent derived from [structure] load_stiffness
                                       with the FEM gimbal in series, when given checked against that
@@ -52,6 +53,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import TvcModel
+from ..shipped import resolve_reference
 from ..units import to_si
 
 G0 = 9.80665  # standard gravity [m/s^2]
@@ -275,7 +277,9 @@ def parse_gimbal(model: TvcModel) -> GimbalParams:
     if "stiffness_file" in g:
         if not isinstance(g["stiffness_file"], str):
             raise InputError(src, "gimbal.stiffness_file", "a path string", got=repr(g["stiffness_file"]))
-        path = str((Path(src).parent / g["stiffness_file"]).resolve())
+        # the one rule for file references: beside the model file, else from the shipped models/
+        path = str(resolve_reference(g["stiffness_file"], src, field="gimbal.stiffness_file", kind="model",
+                                     what="a gimbal stiffness file (.npz with K_upper, K_lower)"))
     kl = None
     if "line_load_stiffness" in g:
         kl = to_si(g["line_load_stiffness"], "stiffness", source=src, field="gimbal.line_load_stiffness",

@@ -247,7 +247,8 @@ def model_keys_markdown(missing: list[str]) -> str:
     fdoc = tomllib.loads((mdir / "flight" / "core_stage.toml").read_text(encoding="utf-8"))
     lines += ["## Flight files (`models/flight/*.toml`)\n",
               "Top-level keys `name`, `description`, `axis` (pitch or yaw), `tvc_model` (the TVC model "
-              "file it pairs with, relative to the flight file). Examples from `models/flight/core_stage.toml`.\n"]
+              "file it pairs with, relative to the flight file, else to the shipped `models/flight/`: the one rule "
+              "of file references, below). Examples from `models/flight/core_stage.toml`.\n"]
     for section, rows in flight_key_table().items():
         lines.append(f"### [{section}]\n")
         lines += _table(section, rows, fdoc, "core_stage", missing)
