@@ -25,7 +25,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
-import os
 import types
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -383,7 +382,7 @@ def _parameter_set(ref, model_path: Path, src: str, section: str) -> tuple[Path,
     if not isinstance(ref, str) or not ref:
         raise InputError(src, f"{section}.{PARAMETER_SET_KEY}", f"a path to a {section} parameter-set TOML file",
                          got=repr(ref))
-    ppath = resolve_parameter_set(ref, model_path)
+    ppath = resolve_parameter_set(ref, model_path, section)
     _, pdoc = read_toml(ppath, f"a readable {section} parameter-set file")
     shared = pdoc.get(section)
     if not isinstance(shared, Mapping):
