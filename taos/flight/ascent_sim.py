@@ -216,7 +216,8 @@ def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple
     heads = np.zeros((len(plants), sat.N_HEAD))
     iu = n + ne
     for M, H, p in zip(mats, heads, plants):
-        A, Br, bc, bf, cc, dc, cw, ca, lim = kernel_args(p, model)
+        pk = kernel_args(p, model)
+        A, Br, bc, bf, cc, dc, cw, ca, lim = pk.A, pk.Br, pk.bc, pk.bf, pk.cc, pk.dc, pk.cw, pk.ca, pk.lim
         M[:n, :n], M[:n, n:iu], M[:n, iu], M[:n, iu + 1] = A, Br, bc, bf
         M[n, :n], M[n, n:iu], M[n + 1, :n], M[n + 2, :n] = cc, dc, cw, ca
         if lim.size:  # the limit rows over x (u_v also over u) and their columns (taos.planar.saturation)

@@ -261,7 +261,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     else:
         from . import steady
 
-        Am, Br, bc, cc, dc = args[0], args[1], args[2], args[4], args[5]
+        Am, Br, bc, cc, dc = args.A, args.Br, args.bc, args.cc, args.dc
         x0, mag = steady.linear_orbit_start(Am + np.outer(bc, cc), Br.sum(axis=1) + bc * dc.sum(), A, F)
         n = Am.shape[0]
         nz = 1 if model.friction.has_state else 0
