@@ -171,9 +171,8 @@ def _axis_model(model: TvcModel, axis: str) -> TvcModel:
     """A model whose pitch axis is ``axis`` (single-axis profiles drive pitch)."""
     if axis == "pitch":
         return model
-    import dataclasses
-    e = model.engine
-    return dataclasses.replace(model, engine=dataclasses.replace(e, inertia_pitch_kgm2=e.inertia_yaw_kgm2))
+    import dataclasses   # an analysis device made in code: recorded in the copy's overrides and hash
+    return model.replace(engine=dataclasses.replace(model.engine, inertia_pitch_kgm2=model.engine.inertia_yaw_kgm2))
 
 
 def step_response_figures(model: TvcModel, axis: str = "pitch", step_amplitude_rad: float = math.radians(0.5),
