@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from .planar.avionics import Avionics
-from .errors import InputError
+from .errors import InputError, read_toml  # noqa: F401  (read_toml: model files and the 3-D loader)
 from .friction import FrictionLaw, friction_from_table
 from .shipped import resolve
 from .units import to_si
@@ -344,17 +344,6 @@ def parse_avionics(doc: Mapping, src: str) -> Avionics:
         raise InputError(src, "avionics.crossover_command", "strictly increasing command magnitudes")
     return Avionics(quantization_bits=bits, command_range_rad=rng, rounding=(rounding == "round"),
                     gain_table_rad=amps, gain_table=gains)
-
-
-def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
-    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it is not
-    a readable regular file of at most :data:`taos.errors.MAX_TOML_BYTES` (``what`` says what was
-    expected, e.g. "a readable model file"), is not TOML, or nests deeper than
-    :data:`taos.errors.MAX_TOML_DEPTH`. A FIFO or device never blocks or floods the run."""
-    from .errors import parse_toml, read_input_bytes
-
-    raw = read_input_bytes(path, what)
-    return raw, parse_toml(raw, str(path))
 
 
 #: ``[friction]`` key naming the shared friction parameter set of one piece of hardware
