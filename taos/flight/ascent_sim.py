@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from taos.flight.ascent import Ascent, aero_instability, control_acceleration, pti_command, wind_speed
-from taos.flight.lco import FlightHistory, measure_oscillation
+from taos.flight.lco import FlightHistory, flown_model, measure_oscillation
 from taos.flight.vehicle import FlightModel, PlantParts, flight_plant
 from taos.harmonics import fit_sines
 from taos.linear import StateSpace
@@ -497,10 +497,6 @@ def run_file(friction_model: str) -> str:
     return f"ascent_{friction_model}.h5"
 
 
-#: the ``avionics`` settings of :func:`fly_ascent`
-AVIONICS = ("bounding", "model")
-
-
 @dataclass(frozen=True, eq=False)
 class AscentStudy:
     """An ascent flown once per friction law (:func:`fly_ascent`): ``runs``, one
@@ -544,18 +540,12 @@ def fly_ascent(ascent: Ascent, models: Sequence[TvcModel], *, reference: TvcMode
     TVC without friction (law ``none``; a model of law ``none`` in ``models`` is that run), and
     analyse each run's post-separation windows against the reference (:func:`analyse_ascent`).
 
-    ``avionics``: ``"bounding"`` flies every model with the paper's bounding avionics gain
-    (:func:`taos.flight.lco.with_bounding_avionics`), ``"model"`` with the models' own
-    avionics. ``dt_s``, ``seed``: as :func:`simulate_ascent` (the same seed for every run, so the
+    ``avionics``: ``"bounding"`` flies every model with the paper's bounding avionics gain,
+    ``"model"`` with the models' own avionics (:func:`taos.flight.lco.flown_model`). ``dt_s``, ``seed``: as :func:`simulate_ascent` (the same seed for every run, so the
     runs differ by their TVC only). ``progress``: a bar over the models. Raises
     :class:`~taos.errors.SimulationUnstable` when a run diverges."""
-    if avionics not in AVIONICS:
-        raise ValueError(f"avionics must be one of {AVIONICS}, got {avionics!r}")
-    if avionics == "bounding":
-        from taos.flight.lco import with_bounding_avionics
-
-        models = [with_bounding_avionics(m) for m in models]
-        reference = with_bounding_avionics(reference)
+    models = [flown_model(m, avionics) for m in models]   # (ValueError for an unknown setting)
+    reference = flown_model(reference, avionics)
     axes = tuple(axes)
     end = ascent.end_time_s if end_s is None else float(end_s)
     fly = dict(axes=axes, start_s=start_s, end_s=end, dt_s=dt_s, seed=seed)
