@@ -100,3 +100,12 @@ def test_sine_dwell_description_follows_the_integrator_setting(ran, integrator):
     assert ran == [INTEGRATOR_NAMES[integrator]] == [s["integrator"]]
     assert (s["dt_max_s"], s["settle_cycles"], s["engine"]) == (1e-4, 3, "simplex")
     assert s["method"] == "sine dwell, settled from rest"
+
+
+def test_describing_function_map_names_the_integrator_that_ran(ran):
+    from taos.flight.describing import describing_function_map
+    from taos.model import load_model
+
+    df = describing_function_map(load_model(AMBIENT), [math.radians(0.2), math.radians(0.4)], [1.0, 2.0])
+    assert set(ran) == {df.provenance["solver"]["integrator"]}
+    assert _named_integrator({"provenance": df.provenance}) == df.provenance["solver"]["integrator"]
