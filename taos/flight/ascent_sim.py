@@ -548,7 +548,7 @@ def fly_ascent(ascent: Ascent, models: Sequence[TvcModel], *, reference: TvcMode
     reference = flown_model(reference, avionics)
     axes = tuple(axes)
     end = ascent.end_time_s if end_s is None else float(end_s)
-    fly = dict(axes=axes, start_s=start_s, end_s=end, dt_s=dt_s, seed=seed)
+    fly = {"axes": axes, "start_s": start_s, "end_s": end, "dt_s": dt_s, "seed": seed}
     ref = simulate_ascent(ascent, reference, **fly)
     from tqdm import tqdm
 

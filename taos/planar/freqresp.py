@@ -308,7 +308,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     h = (out[:, :, 0] + 1j * out[:, :, 1]) / A[:, None]
     R = model.actuator.moment_arm_m
     solver = {"method": STEADY_DESCRIPTIONS[method], "integrator": INTEGRATOR_NAMES[integrator],
-              "step": (f"per dwell, from the friction loop and the limits (taos.planar._expplan), dt_max_s where the "
+              "step": ("per dwell, from the friction loop and the limits (taos.planar._expplan), dt_max_s where the "
                        "linear orbit reaches the rate limit or the hard stops" if use_exp else "dt_max_s or less, a "
                        "whole number of steps per cycle"),
               "dt_max_s": float(dt_max_s), "min_steps_per_cycle": int(min_steps_per_cycle),
