@@ -26,7 +26,7 @@ def _out_folder(path: str, names: list[str]) -> Path:
 def cmd_ascent(args) -> int:
     from taos.flight.ascent import load_ascent
     from taos.flight.ascent_sim import fly_ascent, run_file
-    from taos.model import Structure, load_model
+    from taos.model import load_model
     from taos.units import to_si
 
     ascent = load_ascent(args.ascent)
@@ -48,12 +48,12 @@ def cmd_ascent(args) -> int:
     axes = ("pitch", "yaw") if args.axis == "both" else (args.axis,)
     # -- the models: one per friction law, then the reference without friction (law none)
     models = []
+    k = (to_si(args.load_stiffness, "stiffness", source="command line", field="--load-stiffness", positive=True)
+         if args.load_stiffness else None)
     for law in laws + ["none"]:
         m = load_model(tvc, friction=law)
-        if args.load_stiffness:
-            m = m.replace(structure=Structure(to_si(args.load_stiffness, "stiffness", source="command line",
-                                                    field="--load-stiffness", positive=True)))
-        models.append(m)
+        # a model variant (taos.variants): the file's load-path damping ratio kept
+        models.append(m.with_values({"structure.load_stiffness": k}) if k is not None else m)
     reference = models.pop()
     # --
     out = _out_folder(args.out, [run_file(m.friction.name) for m in models] + ["summary.json", "ascent.png"])

@@ -44,6 +44,7 @@ from taos.results import atomic_write, package_version, write_provenance
 from taos.planar import saturation as sat
 from taos.planar.simplex import LurePlant, extend_plant
 from taos.planar.simulate import check_friction_step, kernel_args
+from taos.results import model_provenance
 
 AXES = ("pitch", "yaw")
 DEFAULT_DT_S = 5e-4
@@ -366,7 +367,7 @@ def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tu
             out[k].append(Y[:, j])
         out["pti_rad"].append(Rr[:, 0])
         out["disturbance_rad_s2"].append(Rr[:, 1])
-    prov = {"model_file": model.source, "model_sha256": model.sha256, "ascent_file": ascent.source,
+    prov = {**model_provenance(model), "ascent_file": ascent.source,
             "ascent_sha256": ascent.sha256, "flight_file": ascent.flight.source,
             "flight_sha256": ascent.flight.sha256, "package_version": package_version(),
             "solver": {"method": INTEGRATOR, "dt_s": dt_s, "record_every": rec},

@@ -38,6 +38,7 @@ from ..model import TvcModel
 from .simplex import simplex_plant, simplex_state_space
 from ._parallel import run_each
 from .simulate import DEFAULT_DT_S, check_friction_step, kernel_args
+from taos.results import model_provenance
 
 
 #: engine fundamental below this fraction of the command (-80 dB) = engine held by friction
@@ -172,7 +173,7 @@ def linear_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, axis: str = "
     ph, h = _phase_reference(simplex_state_space(model, axis), f)   # the response with its phase reference
     return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, axis,
                              friction_model="none",
-                             provenance={"model_sha256": model.sha256, "seeds": "none (deterministic)",
+                             provenance={**model_provenance(model), "seeds": "none (deterministic)",
                                          "solver": {**LINEAR_SOLVER, "engine": "simplex"}},
                              piston_phase_ref_deg=ph[:, 0], engine_phase_ref_deg=ph[:, 1])
 
@@ -351,7 +352,7 @@ def sine_dwell_family(model: TvcModel, freq_hz, amplitudes_rad, axis: str = "pit
     shape = (amps.size, f.size)
     piston, engine = pts.piston.reshape(shape), pts.engine.reshape(shape)
     rp, re = linear_phase_reference(model, f, axis)
-    prov = {"model_sha256": model.sha256, "seeds": "none (deterministic)", "steady_state": pts.method,
+    prov = {**model_provenance(model), "seeds": "none (deterministic)", "steady_state": pts.method,
             "solver": {**pts.solver, "engine": "simplex"}}
     fam = []
     for i, a in enumerate(amps):

@@ -29,6 +29,7 @@ from ..planar.simulate import SolverSettings, TimeHistory, provenance
 from . import _args
 from . import dynamics as _dy
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
+from taos.results import model_provenance
 
 #: the 3-D model's step [s]: second-order bearing coupling (taos.taos3d.dynamics) makes it as
 #: accurate as the former first-order scheme at 2e-4 s (tests/test_taos3d_step.py)
@@ -274,7 +275,7 @@ def taos_freqresp(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitude_rad: fl
         ss = linear_state_space(tm)
         h = ss.freqresp(f, ss.inputs[i], [ss.outputs[o], ss.outputs[2 + o]])
         return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, label, engine_model="taos", friction_model="none",
-                                 provenance={"model_sha256": tm.base.sha256, "seeds": "none (deterministic)",
+                                 provenance={**model_provenance(tm.base), "seeds": "none (deterministic)",
                                              "solver": {**LINEAR_SOLVER, "method": "linear (exact, the 3-D model "
                                                         "linearised about rest)", "engine": "taos"}})
     return taos_freqresp_family(tm, f, [amplitude_rad], axis, cross, dt_max_s=dt_max_s, settle_cycles=settle_cycles,
@@ -337,7 +338,7 @@ def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = Fal
         k0 += A.size
         out[axis] = [FrequencyResponse(f, h[k, :, o] / R, h[k, :, 2 + o], float(ak), label, engine_model="taos",
                                        friction_model=tm.base.friction.name,
-                                       provenance={"model_sha256": tm.base.sha256, "seeds": "none (deterministic)",
+                                       provenance={**model_provenance(tm.base), "seeds": "none (deterministic)",
                                                    "solver": dict(solver), "friction_scale": tm.friction_scale})
                      for k, ak in enumerate(a)]
     return out
