@@ -36,7 +36,8 @@ class TaosParams(NamedTuple):
                                            [per N]
     act_c_xp                    (n_a,)     actuator output row of the piston position x_p
     bearing_axes                (2, 3)     pitch and yaw unit axes in the gimbal frame [-]
-    line_stiffness_N_per_m      scalar     K_L, the load path along an actuator line [N/m]
+    line_stiffness_N_per_m      scalar     actuator-line stiffness outside the gimbal [N/m], derived from the
+                                           total K_L with the FEM gimbal in series (taos.taos3d.calibrate)
     moment_arm_m                scalar     R, the actuator moment arm [m]
     engine_stiffness_Nm_per_rad scalar     K_n, the feedline/gravity spring on pitch and yaw
                                            [N m/rad]
