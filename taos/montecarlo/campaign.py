@@ -31,6 +31,10 @@ Distributions of a factor: ``normal`` (mean, std; optional truncation low/high b
 ``uniform`` (low, high). Parameters: the TVC model's fittable values
 (:data:`taos.identify.surrogate.PARAMETERS`: load_stiffness, coulomb_torque, bristle_stiffness,
 loop_gain, pressure_feedback_gain, avionics_gain, ...) and the flight's (:data:`FLIGHT_PARAMETERS`).
+A run's TVC model is one model variant through the loader (:mod:`taos.variants`), each key with the
+model file's meaning: ``coulomb_torque`` is the friction level (the law's other load-proportional
+parameters follow it), a dispersed torque-like parameter among them (``bristle_stiffness``) is set
+as drawn.
 A run is a pure function of (campaign, case, run index): the same seeds give the same results on
 any executor.
 """
