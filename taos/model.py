@@ -464,9 +464,7 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
     bearing normal load scales every one of them alike, so the pre-sliding angle T_c / sigma_0 and
     the law's shape stay those of the hardware; this is what the 3-D model does with the normal
     load (:meth:`taos.friction.FrictionLaw.scaled`), here applied to the planar torque level."""
-    import dataclasses as _dc
-
-    from .friction import param_classes
+    from .model_keys import torque_like_kinds
     from .units import DIMENSIONS
 
     ref = to_si(ref_torque, "torque", source=set_src, field=f"friction.{REFERENCE_TORQUE_KEY}", positive=True)
@@ -474,8 +472,7 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
         raise InputError(src, "friction.coulomb_torque", "this condition's torque level (the parameter set is "
                          "scaled to it)", got="nothing (key missing)")
     level = to_si(table["coulomb_torque"], "torque", source=src, field="friction.coulomb_torque", nonnegative=True)
-    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
-             if f.metadata.get("torque_like") and f.metadata["key"] not in ("coulomb_torque", "static_torque")}
+    kinds = torque_like_kinds(exclude=("coulomb_torque", "static_torque"))
     for key, kind in kinds.items():
         if key in table:
             v = to_si(table[key], kind, source=set_src, field=f"friction.{key}", nonnegative=True)

@@ -37,7 +37,7 @@ import numbers
 from typing import Any, Mapping
 
 from .errors import InputError
-from .model_keys import key_kind
+from .model_keys import key_kind, torque_like_kinds
 
 #: where a variant's errors say they come from when the value was given in code
 VARIANT_SOURCE = "model variant"
@@ -160,9 +160,6 @@ def level_follows(doc: dict, overrides: Mapping[str, Any], src: str) -> dict:
     ftab = dict(doc["friction"])
     if "coulomb_torque" not in ftab:
         return doc
-    import dataclasses as _dc
-
-    from .friction import param_classes
     from .units import DIMENSIONS, to_si
 
     old = to_si(ftab["coulomb_torque"], "torque", source=src, field="friction.coulomb_torque", nonnegative=True)
@@ -170,8 +167,7 @@ def level_follows(doc: dict, overrides: Mapping[str, Any], src: str) -> dict:
                 nonnegative=True)
     if not old > 0:
         return doc
-    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
-             if f.metadata.get("torque_like") and f.metadata["key"] != "coulomb_torque"}
+    kinds = torque_like_kinds()
     for key, kind in kinds.items():
         if key in ftab and f"friction.{key}" not in overrides:
             v = to_si(ftab[key], kind, source=src, field=f"friction.{key}", nonnegative=True)
