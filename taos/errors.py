@@ -12,6 +12,7 @@ import difflib
 import functools
 import os
 import stat
+import sys
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Callable, Iterable, Mapping
@@ -394,6 +395,7 @@ def read_toml(path: "str | os.PathLike", what: str) -> tuple[bytes, dict]:
     if key is None:   # not a regular file: read_input_bytes says what is wrong with it
         return _read_toml(str(path), what)
     raw, doc = _read_toml_cached(key, what)
+    sys.audit("open", str(path), "rb", os.O_RDONLY)   # read, as far as anyone recording inputs can tell
     return raw, copy.deepcopy(doc)
 
 

@@ -191,17 +191,24 @@ class TvcModel:
         """The model file with the keys ``values`` (``{"structure.load_stiffness": "160000
         lbf/in", ...}``; a plain number is SI) given other values, through the loader and its
         bounds: the one way to make a variant (:mod:`taos.variants`)."""
-        from .variants import check_unchanged, check_variant_source, code_changes, merge_overrides, variant_sha256
+        from .variants import (check_unchanged, check_variant_source, code_changes, keep_code_changes,
+                               merge_overrides, variant_sha256)
 
         check_variant_source(self, values)
         code = code_changes(self)
-        overrides = merge_overrides(tuple(kv for kv in self.overrides if not kv[0].startswith("code.")), values)
-        table = dict(overrides)
-        out = load_model(self.source, friction=table.pop("friction.model", None), overrides=table)
+        old = tuple(kv for kv in self.overrides if not kv[0].startswith("code."))
+        overrides = merge_overrides(old, values)
+
+        def load(over):
+            table = dict(over)
+            return load_model(self.source, friction=table.pop("friction.model", None), overrides=table)
+        out = load(overrides)
         check_unchanged(self, out)
         if not code:
             return out
-        out = dataclasses.replace(out, **code)   # the changes made in code stay, recorded as before
+        # the changes made in code stay, with the variant's own effect laid over them
+        code = keep_code_changes(code, load(old), out)
+        out = dataclasses.replace(out, **code)
         marks = tuple((f"code.{k}", v) for k, v in code.items())
         return dataclasses.replace(out, overrides=overrides + marks, sha256=variant_sha256(out.base_sha256,
                                                                                         overrides + marks))
@@ -215,11 +222,11 @@ class TvcModel:
         """Copy with dataclass fields replaced in code. The copy records it (``code.FIELD`` in
         :attr:`overrides`) and carries its own hash; a change a model file can express is a
         variant, :meth:`with_values`."""
-        from .variants import variant_sha256
+        from .variants import _same, variant_sha256
 
         out = dataclasses.replace(self, **changes)
         marks = tuple((f"code.{k}", v) for k, v in sorted(changes.items())   # an equal value changes nothing
-                      if k not in ("overrides", "sha256", "base_sha256") and getattr(self, k) != v)
+                      if k not in ("overrides", "sha256", "base_sha256") and not _same(getattr(self, k), v))
         if not marks:
             return out
         overrides = tuple(kv for kv in out.overrides if kv[0] not in dict(marks)) + marks

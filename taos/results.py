@@ -36,6 +36,7 @@ import secrets
 import shutil
 import stat
 import subprocess
+import sys
 import tempfile
 from contextlib import contextmanager
 from functools import cache
@@ -114,7 +115,10 @@ def file_sha256(path: str | Path) -> str:
     """SHA-256 of a file's bytes (hex), or '' when it cannot be read. A regular file's hash is
     remembered under its :func:`stat_key` (model variants hash the same files again and again)."""
     key = stat_key(path)
-    return _file_sha256(path) if key is None else _cached_sha256(key)
+    if key is None:
+        return _file_sha256(path)
+    sys.audit("open", str(path), "rb", os.O_RDONLY)   # read, as far as anyone recording inputs can tell
+    return _cached_sha256(key)
 
 
 @functools.lru_cache(maxsize=256)

@@ -159,13 +159,16 @@ def test_a_bad_variant_is_one_input_error_naming_the_key(hot, values, field):
     assert field in str(e.value) and "\n" not in str(e.value)
 
 
-def test_a_variant_of_a_code_change_or_a_changed_file_is_refused(hot, tmp_path):
+def test_a_variant_keeps_the_code_changes_and_a_changed_file_is_refused(hot, tmp_path):
     coded = hot.replace(structure=hot.structure.__class__(3e7, 0.0))
-    with pytest.raises(InputError, match="changed in code"):
-        coded.with_values({"structure.load_stiffness": 3e7})
     kept = coded.with_values({"engine.rotational_stiffness": 4e5})   # another section: the code change stays
     assert kept.structure == coded.structure and kept.engine.rotational_stiffness_Nm_per_rad == 4e5
     assert kept.sha256 not in (hot.sha256, coded.sha256)
+    over = coded.with_values({"structure.load_stiffness": 2e7})   # the key's field laid over the code's
+    assert over.structure == hot.structure.__class__(2e7, 0.0)
+    law = hot.replace(friction=hot.with_friction("dahl").friction)
+    with pytest.raises(InputError, match="friction.model"):
+        law.with_values({"friction.model": "lugre"})
     p = tmp_path / "m.toml"
     shutil.copy(models_dir() / "rs25_ambient.toml", p)
     m = load_model(p)

@@ -297,7 +297,7 @@ def apply_factors(ascent: Ascent, model: TvcModel, overrides: Mapping[str, float
                   ) -> tuple[Ascent, TvcModel, list[str]]:
     """Ascent and model with the case's ``overrides`` (SI) and the run's ``factors`` applied;
     also the dispersed names that do not apply (e.g. bristle stiffness of a Coulomb law)."""
-    from taos.identify.surrogate import variant_values
+    from taos.identify.surrogate import apply_values
 
     skipped, names, values = [], list(overrides), list(overrides.values())
     for k, f in factors.items():
@@ -311,7 +311,7 @@ def apply_factors(ascent: Ascent, model: TvcModel, overrides: Mapping[str, float
     # one variant through the loader (taos.variants): coulomb_torque is the friction level (the law's
     # other torque-like parameters follow it; a dispersed one among them is set as drawn)
     if names:
-        model = model.with_values(variant_values(model, names, [float(v) for v in values]))
+        model = apply_values(model, names, [float(v) for v in values])
     tr, fl = ascent.trajectory, ascent.flight
     rep = dataclasses.replace
     if "vehicle_mass" in factors:
