@@ -50,7 +50,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 import numpy as np
 
 from ..errors import InputError
-from ._fmu import CONFIG, RESOURCE_DIR, UNITS, FmuBuild, check_fmu_output, fmi_unit, fmu_model
+from ._fmu import CONFIG, RESOURCE_DIR, UNITS, FmuBuild, check_output_path, fmi_unit, fmu_model
 
 #: the standalone FMU's model identifier (its shared library's name)
 IDENTIFIER = "TaosTvcC"
@@ -205,15 +205,14 @@ def build_standalone_fmu(model_path, out, *, friction: str | None = None, avioni
     of the model (:class:`~taos.cosim.TvcBlock`'s construction); options as
     :func:`taos.cosim.build_fmu` (simplex engine only). Nothing is written on a refusal."""
     from ..planar.envelope import check_run_step
-    from ..results import atomic_write, base_provenance, check_output_file, model_provenance
+    from ..results import atomic_write, base_provenance, model_provenance
     from ._block import BlockOutputs, TvcBlock
     from ._standalone_xml import model_description
 
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
         raise InputError(SOURCE, "platform", "Linux x86-64 (the binary built is linux64; the sources build elsewhere)",
                          got=f"{platform.system()} {platform.machine()}")
-    out = check_output_file(out, "--out", (".fmu",))
-    check_fmu_output(out)
+    out = check_output_path(out)
     model = fmu_model(model_path, friction, avionics)
     if dt_s is not None:
         check_run_step(dt_s, model, field="--dt")
