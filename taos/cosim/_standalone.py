@@ -50,6 +50,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 import numpy as np
 
 from ..errors import InputError
+from ..model import TvcModel
 from ._fmu import CONFIG, RESOURCE_DIR, UNITS, FmuBuild, check_output_path, fmi_unit, fmu_model
 
 #: the standalone FMU's model identifier (its shared library's name)
@@ -201,8 +202,9 @@ def fmi_headers() -> Path:
 
 def build_standalone_fmu(model_path, out, *, friction: str | None = None, avionics: str = "model",
                          dt_s: float | None = None, allow_unstable: bool = False) -> FmuBuild:
-    """Build the standalone FMU (module docstring) of ``model_path`` into ``out`` after every check
-    of the model (:class:`~taos.cosim.TvcBlock`'s construction); options as
+    """Build the standalone FMU (module docstring) of ``model_path`` (a model file, or a loaded
+    :class:`~taos.model.TvcModel` such as a variant made with ``model.with_values``) into ``out``
+    after every check of the model (:class:`~taos.cosim.TvcBlock`'s construction); options as
     :func:`taos.cosim.build_fmu` (simplex engine only). Nothing is written on a refusal."""
     from ..planar.envelope import check_run_step
     from ..results import atomic_write, base_provenance, model_provenance
@@ -213,7 +215,13 @@ def build_standalone_fmu(model_path, out, *, friction: str | None = None, avioni
         raise InputError(SOURCE, "platform", "Linux x86-64 (the binary built is linux64; the sources build elsewhere)",
                          got=f"{platform.system()} {platform.machine()}")
     out = check_output_path(out)
-    model = fmu_model(model_path, friction, avionics)
+    if isinstance(model_path, TvcModel):
+        if friction is not None or avionics != "model":
+            raise InputError(SOURCE, "friction, avionics", "none with a loaded model (make the variant with "
+                             "model.with_values)", got=f"{friction!r}, {avionics!r}")
+        model = model_path
+    else:
+        model = fmu_model(model_path, friction, avionics)
     if dt_s is not None:
         check_run_step(dt_s, model, field="--dt")
     block = TvcBlock(model, dt_s=dt_s, allow_unstable=allow_unstable)   # every check taos simulate makes
