@@ -14,7 +14,6 @@ import shutil
 import subprocess
 import sys
 import zipfile
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -338,7 +337,7 @@ def test_a_c_master_runs_the_whole_life_cycle_and_exits_cleanly(cfmu, md, tmp_pa
     so = tmp_path / "fmu" / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
     r = subprocess.run([str(tmp_path / "master"), str(so), (tmp_path / "fmu" / "resources").as_uri(), md.guid,
                         repr(0.4 * DEG), "2500", "2e-4"], capture_output=True, text=True, timeout=300,
-                       env={"PATH": "/usr/bin:/bin"})
+                       env={"PATH": "/usr/bin:/bin"}, check=False)
     assert r.returncode == 0 and r.stderr == "", r.stdout[-2000:] + r.stderr[-2000:]
     got = float(r.stdout.split("pitch_engine_rad")[1])
     b = TvcBlock(hotfire)

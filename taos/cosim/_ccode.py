@@ -123,7 +123,7 @@ def _join(a: str, b: str) -> str:
 class _Func:
     """One specialisation being translated: its Python function, C name, parameter kinds."""
 
-    def __init__(self, tr: "Translator", fn, cname: str, kinds: tuple, static: bool):
+    def __init__(self, tr: Translator, fn, cname: str, kinds: tuple, static: bool):
         self.tr, self.fn, self.cname, self.kinds, self.static = tr, fn, cname, kinds, static
         src = textwrap.dedent(inspect.getsource(fn))
         tree = ast.parse(src)

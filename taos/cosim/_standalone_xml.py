@@ -23,6 +23,23 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from ._fmu import UNITS, fmi_unit
 
+#: the standalone FMU's model identifier (its shared library's name)
+IDENTIFIER = "TaosTvcC"
+#: the C files compiled into it (sources/)
+SOURCES = ("fmi2_glue.c", "taos_kernels.c")
+
+
+def envelope(model) -> tuple[float, float, float]:
+    """(command range [rad], hard-stop envelope [rad], load-force bound [N]) of the FMU: the
+    model's gimbal range (else :data:`taos.bounds.GIMBAL_RANGE_RAD`), 1.2 x it (as
+    :data:`taos.bounds.HARD_STOP_RAD` is of the default range), and
+    :data:`taos.bounds.LOAD_FORCE_FACTOR` x the stall force A P_s."""
+    from ..bounds import GIMBAL_RANGE_RAD, HARD_STOP_RAD, LOAD_FORCE_FACTOR
+
+    rng = model.engine.gimbal_range_rad if model.engine.gimbal_range_rad > 0 else GIMBAL_RANGE_RAD
+    return rng, rng * HARD_STOP_RAD / GIMBAL_RANGE_RAD, LOAD_FORCE_FACTOR * model.actuator.stall_force_N
+
+
 _DESCRIPTIONS = {
     "engine_rad": "engine angle about the {ax} gimbal axis",
     "engine_rate_rad_s": "engine angular rate about the {ax} gimbal axis",
@@ -48,8 +65,6 @@ def model_description(model, dt_s: float, guid: str, prov: dict, avionics: str) 
     """The model description (module docstring); ``prov`` the build's provenance (taos version,
     model hash and overrides), also written as the ``taos`` tool's vendor annotation."""
     from ._block import BlockOutputs
-    from ._standalone import IDENTIFIER, SOURCES, envelope
-
     rng, stop, force = envelope(model)
     version = prov.get("package_version", "?")
     root = Element("fmiModelDescription", {
