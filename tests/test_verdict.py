@@ -113,7 +113,7 @@ def test_avionics_gain_0_89_fails_a_half_db_mask_and_the_cause_says_avionics(hot
     for c in dw:
         assert c.bounds[0].value == pytest.approx(want, abs=0.02)
         assert not c.passed and c.cause == ("avionics",)
-        assert c.removed == {"friction": False, "load_stiffness": False, "avionics": True}
+        assert c.removed == {"friction": False, "load_stiffness": False, "avionics": True, "pressure_limit": False}
     assert "because of the avionics gain" in v.text() and "the linear servo passes" in v.text()
 
 
