@@ -90,7 +90,7 @@ def test_mask_step_table_is_read_and_checked(tmp_path):
     assert {s.figure: s.bounds for s in m.steps} == {"rise_time_s": (0.0, 0.1), "overshoot_pct": (0.0, 25.0)}
     assert m.steps[0].amplitude_rad == pytest.approx(0.5 * DEG)
     bad = tmp_path / "bad.toml"
-    bad.write_text('[[point]]\nfrequency = "1 Hz"\ngain_db = [-1, 1]\n[step]\nrise_time = [0, 0.1]\n')
+    bad.write_text('[[point]]\nfrequency = "1 Hz"\ngain_db = [-1, 1]\nsource = "test"\n[step]\nrise_time = [0, 0.1]\n')
     with pytest.raises(InputError, match="step.rise_time"):
         load_spec(bad)
 
