@@ -18,7 +18,13 @@ import pytest
 from taos.errors import InputError
 from taos.linear import gain_db
 from taos.model import load_model
-from taos.report.engines import SERVO_ALONE, TaosEngine, concurrent_dwells, measure_cycles, removal_values
+from taos.report.engines import (
+    SERVO_ALONE,
+    TaosEngine,
+    concurrent_dwells,
+    measure_cycles,
+    removal_values,
+)
 from taos.report.spec import SpecMask, SpecPoint, load_spec
 from taos.report.verdict import spec_verdict
 

@@ -222,15 +222,22 @@ class TaosEngine:
     tm: TaosModel
     dt_s: float = 4e-4
     name: str = field(default="taos", init=False)
+    #: the variants made so far, by removed factors (each 3-D rebuild once per verdict)
+    _variants: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def model(self) -> TvcModel:
         return self.tm.base
 
     def without(self, causes: Sequence[str]) -> TaosEngine:
+        """This engine's 3-D model with ``causes`` removed (module docstring), rebuilt through
+        the loader (:func:`taos.taos3d.with_values`) once and kept for the other groups."""
         from taos.taos3d import with_values
 
-        return TaosEngine(with_values(self.tm, removal_values(self.tm.base, causes)), self.dt_s)
+        key = tuple(sorted(causes))
+        if key not in self._variants:
+            self._variants[key] = TaosEngine(with_values(self.tm, removal_values(self.tm.base, causes)), self.dt_s)
+        return self._variants[key]
 
     def phase_reference(self, axis: str, freq_hz) -> tuple[np.ndarray, np.ndarray]:
         """Continuous phase [deg] of the 3-D linear command -> piston and -> engine responses of

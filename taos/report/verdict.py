@@ -64,8 +64,15 @@ from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 
-from .engines import (CAUSES, LAB_LOAD_STIFFNESS_N_PER_M, SERVO_ALONE, PlanarEngine, engine_for,  # noqa: F401
-                      laboratory_model, remove_causes)
+from .engines import (  # noqa: F401
+    CAUSES,
+    LAB_LOAD_STIFFNESS_N_PER_M,
+    SERVO_ALONE,
+    PlanarEngine,
+    engine_for,
+    laboratory_model,
+    remove_causes,
+)
 
 if TYPE_CHECKING:
     from taos.identify.estimation import MeasuredResponse
