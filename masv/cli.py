@@ -31,10 +31,9 @@ def _system(args):
 
 
 def _prov(cfg) -> dict:
-    from taos.results import base_provenance
+    from masv.provenance import config_provenance
 
-    return {"config_file": cfg.source, "config_sha256": cfg.sha256, "modes_file": cfg.structure.source,
-            "n_modes": cfg.structure.n_modes, "taos_version": package_version(), **base_provenance()}
+    return config_provenance(cfg)
 
 
 #: ``masv modes`` lists every mode up to this many (beyond, only the modes in the band)
