@@ -8,7 +8,7 @@
     masv simulate CONFIG --profile P --out RUN.h5 [--actuator-profile NAME=P ...] [--dt S]
                   [--record-every N] [--duration S] [--friction LAW] [--json PATH]
                                                       every engine's nonlinear TVC coupled through
-                                                      the modes, in the time domain (masv.simulate)
+                                                      the modes, in the time domain (masv.timedomain)
 
 Bad input exits with status 2 and one line naming the file, the field and what was expected.
 """
@@ -23,7 +23,7 @@ import numpy as np
 
 from taos.units import parse_float_list
 from taos.errors import InputError
-from taos.results import package_version, write_json
+from taos.results import write_json
 
 from . import analysis as an
 from .config import load_config
@@ -183,7 +183,7 @@ def cmd_simulate(args) -> int:
     from taos.profiles import load_profile
     from taos.results import check_output_file
 
-    from .simulate import simulate
+    from .timedomain import simulate
 
     check_output_file(args.out, "--out", suffixes=(".h5", ".hdf5"))
     cfg = load_config(args.config)

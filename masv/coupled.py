@@ -1,7 +1,7 @@
 """The coupled MASV model as one linear state space with chosen block inputs left open.
 
 :meth:`masv.system.MasvSystem.state_space` (inputs: the commands) and the nonlinear time
-domain (:mod:`masv.simulate`; inputs: the post-avionics commands and the engines' gimbal
+domain (:mod:`masv.timedomain`; inputs: the post-avionics commands and the engines' gimbal
 torques, friction and hard stop, that the compiled kernel closes) are both this assembly.
 
 Each engine-axis block k is :func:`taos.planar.simplex.simplex_state_space` with

@@ -1,4 +1,4 @@
-"""MASV nonlinear time domain (masv.simulate): one engine on a rigid structure is `taos simulate`;
+"""MASV nonlinear time domain (masv.timedomain, masv.simulate): one engine on a rigid structure is `taos simulate`;
 friction, avionics and limits off, sine dwells are the linear MASV frequency response; the
 structure's energy balance closes; the command line writes the run with provenance."""
 
@@ -14,7 +14,7 @@ import pytest
 
 from masv.cli import main
 from masv.config import ActuatorSpec, EngineSpec, load_config, make_config
-from masv.simulate import simulate
+from masv.timedomain import simulate
 from masv.system import build_system
 from taos.model import load_model
 from taos.planar.simulate import simulate as taos_simulate
