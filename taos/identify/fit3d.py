@@ -57,8 +57,9 @@ from taos.identify.params3d import Param3d, bounds3d, check_free3d, variant_valu
 REPLAY_DT_S = 4e-4
 MAX_REL_SE = 0.5
 MAX_CORR = 0.999
-#: residual of a point whose model run failed (a barrier the optimiser backs away from)
-FAILED_RESIDUAL = 30.0
+#: residual of every point when the model cannot be built or run there (a barrier far above any
+#: fitted cost, so neither the grid nor the optimiser ever prefers it)
+FAILED_RESIDUAL = 1e4
 
 
 class Unidentifiable(InputError):

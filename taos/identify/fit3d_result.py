@@ -75,18 +75,21 @@ class Fit3dResult:
         values = p0 * np.exp(x)
         names = [p.name for p in params]
         why = []
+        cn = np.linalg.norm(J, axis=0)
         for i, nm in enumerate(names):
-            if not np.any(J[:, i] != 0):
+            if not cn[i] > 1e-6 * max(float(cn.max()), 1e-300):
                 why.append(f"{nm}: the record does not see it (no residual changes)")
             elif se_x[i] > max_rel_se:
                 why.append(f"{nm}: relative standard error {100 * se_x[i]:.3g} % (> {100 * max_rel_se:g} %)")
             for j in range(i):
                 if abs(corr[i, j]) > max_corr:
                     why.append(f"{nm} and {names[j]}: correlation {corr[i, j]:+.5f}")
-        if n and rcond < RCOND_MIN and not why:
-            why.append(f"J^T J nearly singular (reciprocal condition {rcond:.2g})")
-        unid = tuple(nm for nm in names if any(w.startswith(nm + ":") or f" and {nm}:" in w or
-                                               w.startswith(nm + " and") for w in why))
+        if n and rcond < RCOND_MIN and not why:   # the parameters along the null direction
+            w, V = np.linalg.eigh(JtJ)
+            null = [names[i] for i in np.flatnonzero(np.abs(V[:, 0]) > 0.3)]
+            why.append(f"{' and '.join(null)}: J^T J nearly singular along them (reciprocal condition {rcond:.2g})")
+        unid = tuple(nm for nm in names if any(w.split(":")[0] == nm or nm in w.split(":")[0].split(" and ")
+                                               for w in why))
         if not unid and why:
             unid = tuple(names)
         reason = "; ".join(why)
