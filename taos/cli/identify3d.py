@@ -12,6 +12,16 @@ from taos.results import write_json
 COMPARE3D_FILES = ("table.txt", "comparison.json", "figure11.png")
 
 
+def _outputs(args, *names) -> None:
+    """Refuse output places that cannot be written before any work."""
+    from taos.results import check_output_file
+
+    for n in names:
+        v = getattr(args, n, None)
+        if v not in (None, "-"):
+            check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
+
+
 def _free(text, default=None) -> list[str]:
     free = [s.strip() for s in (text or default or "").split(",")]
     if not all(free):
@@ -50,8 +60,6 @@ def cmd_fit3d(args) -> int:
     from taos.model import load_model
     from taos.results import output_provenance
     from taos.taos3d import taos_model
-
-    from taos.cli.identify import _outputs
 
     _outputs(args, "json", "plot", "out_model")
     _refuse_planar_only(args)
@@ -95,8 +103,6 @@ def cmd_compare3d(args) -> int:
     from taos.model import load_model
     from taos.results import check_output_folder, output_provenance, write_output_folder
     from taos.taos3d import taos_model
-
-    from taos.cli.identify import _outputs
 
     if args.records or args.model:
         raise InputError("command line", "--records" if args.records else "--model",

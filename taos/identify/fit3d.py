@@ -51,19 +51,14 @@ from dataclasses import replace
 import numpy as np
 
 from taos.errors import InputError, SimulationUnstable
-from taos.identify.params3d import Param3d, bounds3d, check_free3d, variant_values
+from taos.identify.params3d import (REPLAY_DT_S, Param3d, Unidentifiable, bounds3d, check_free3d,  # noqa: F401
+                                    variant_values)
 
-#: the 3-D model's largest step in a replay [s] (its default step, taos.taos3d.simulate)
-REPLAY_DT_S = 4e-4
 MAX_REL_SE = 0.5
 MAX_CORR = 0.999
 #: residual of every point when the model cannot be built or run there (a barrier far above any
 #: fitted cost, so neither the grid nor the optimiser ever prefers it)
 FAILED_RESIDUAL = 1e4
-
-
-class Unidentifiable(InputError):
-    """The record does not identify some free parameters (:func:`fit_taos` refuses)."""
 
 
 def estimate_record(data, method: str = "auto", axes=None, nperseg=None):

@@ -59,7 +59,7 @@ class Fit3dResult:
     @classmethod
     def build(cls, tm0, params, p0, x, r, J, lo_si, hi_si, basis, replays, ev, gs, *, absolute_sigma, refuse,
               max_rel_se, max_corr, wall_s, nfev, fd_step):
-        from taos.identify.fit3d import REPLAY_DT_S, Unidentifiable
+        from taos.identify.params3d import REPLAY_DT_S, Unidentifiable
 
         n, m = len(params), r.size
         cost = 0.5 * float(r @ r)

@@ -42,6 +42,13 @@ import numpy as np
 from taos.errors import InputError
 
 DEG = math.pi / 180
+#: the 3-D model's largest step in a replay [s] (its default step, taos.taos3d.simulate)
+REPLAY_DT_S = 4e-4
+
+
+class Unidentifiable(InputError):
+    """The record does not identify some free parameters (:func:`taos.identify.fit3d.fit_taos`
+    refuses)."""
 
 
 @dataclass(frozen=True)
