@@ -183,6 +183,9 @@ MODEL_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "friction.static_torque": (0.0, 1e7, "N*m", "as the Coulomb torque"),
     "avionics.command_range": (1e-3 * DEG, 90.0 * DEG, "rad", "the command word spans the gimbal range "
                                "(RS-25 +-21 deg full scale)"),
+    "gimbal.upper_stiffness_scale": (1e-3, 1e3, "1", "a factor on the FEM half's stiffness: a fit's correction "
+                                     "of the FEM (tens of percent), never three orders of magnitude"),
+    "gimbal.lower_stiffness_scale": (1e-3, 1e3, "1", "as gimbal.upper_stiffness_scale"),
 }
 #: longest piston travel at the hard stops, R tan(theta_max) [m]: TVC actuator strokes are
 #: +-5 to +-15 cm; stops beyond half a metre of piston travel lie outside any actuator's stroke

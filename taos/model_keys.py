@@ -47,7 +47,8 @@ _ENGINE_KINDS = {"mass": "mass", "inertia_pitch": "inertia", "inertia_yaw": "ine
                  "hard_stop_stiffness": "rotational_stiffness", "hard_stop_damping_ratio": "dimensionless"}
 _STRUCTURE_KINDS = {"load_stiffness": "stiffness", "load_damping_ratio": "dimensionless"}
 _GIMBAL_KINDS = {"friction_coefficient": "dimensionless", "bearing_radius": "length",
-                 "line_load_stiffness": "stiffness", "stiffness_file": None}
+                 "line_load_stiffness": "stiffness", "stiffness_file": None,
+                 "upper_stiffness_scale": "dimensionless", "lower_stiffness_scale": "dimensionless"}
 #: keys whose value is not a physical quantity (text, whole numbers, switches, lists)
 _PLAIN = {"friction.model", "friction.parameter_set", "actuator.parameter_set", "actuator.valve_order",
           "actuator.pressure_limited", "avionics.quantization_bits", "avionics.rounding",

@@ -145,6 +145,11 @@ def _segment_table(segments: list[dict]) -> str:
 
 
 def cmd_fit(args) -> int:
+    if getattr(args, "engine", "simplex") == "taos":
+        from taos.cli.identify3d import cmd_fit3d
+        return cmd_fit3d(args)
+    if args.allow_unidentifiable:
+        raise InputError("command line", "--allow-unidentifiable", "--engine taos", got="--engine simplex")
     from taos.identify.fit import fit_frequency_response
     from taos.model import load_model
 
@@ -325,6 +330,9 @@ def _cmd_compare_series(args) -> int:
 
 
 def cmd_compare(args) -> int:
+    if getattr(args, "engine", "simplex") == "taos":
+        from taos.cli.identify3d import cmd_compare3d
+        return cmd_compare3d(args)
     if args.records:
         return _cmd_compare_series(args)
     if args.model is not None or args.free is not None:
@@ -400,6 +408,11 @@ def add_parsers(sub) -> None:
     p.add_argument("--out-model", metavar="TOML", help="write the fitted model file here")
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="save data vs fit and residuals")
     p.add_argument("--json", metavar="PATH", help="write JSON here ('-' for standard output)")
+    p.add_argument("--engine", choices=("simplex", "taos"), default="simplex",
+                   help="taos: fit the 3-D model (two-axis records replayed; taos.identify.fit3d)")
+    p.add_argument("--allow-unidentifiable", action="store_true",
+                   help="--engine taos: report parameters the record does not identify (flagged) instead of "
+                        "refusing (exit 2)")
     est_opts(p)
     p.set_defaults(func=cmd_fit)
 
@@ -417,5 +430,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--labels", help="labels, comma-separated: two (default the model names), or one per record "
                    "(default the file names)")
     p.add_argument("--json", metavar="PATH", help="also write the comparison JSON here ('-' for standard output)")
+    p.add_argument("--engine", choices=("simplex", "taos"), default="simplex",
+                   help="taos: each condition's record fitted with the 3-D model and its own FEM gimbal; "
+                        "Figure 11 analogue and the K_L shift the FEM does not explain")
     est_opts(p)
     p.set_defaults(func=cmd_compare)

@@ -94,3 +94,35 @@ def plot_compare_timehist(runs, axis: str = "pitch", length_unit: str = "in", an
         a.legend(fontsize=8, loc="upper right")
     fig.suptitle(wrapped_title(fig, title or f"{axis}: " + " vs ".join(runs)))
     return fig
+
+
+def plot_compare3d(curves, title: str | None = None):
+    """The paper's Figure 11 analogue: test data (markers) against the 3-D TAOS fit (lines through
+    the fitted points) for each condition, piston x_p/(R theta_c) and engine theta/theta_c gain
+    [dB] and phase [deg]; ``curves`` from :func:`taos.identify.compare3d.comparison3d_curves`."""
+    fig, ax = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    labels = sorted({c["label"] for c in curves}, key=[c["label"] for c in curves].index)
+    styles = {"pitch": "o", "yaw": "s"}
+    for c in curves:
+        col = COLOURS[labels.index(c["label"]) % len(COLOURS)]
+        for j, key in enumerate(("piston", "engine")):
+            if key not in c:
+                continue
+            v = c[key]
+            name = f"{c['label']} {c['axis']}"
+            ax[0, j].semilogx(c["freq_hz"], v["fit_db"], "-", color=col, alpha=0.7, label=f"{name}: 3-D fit")
+            ax[0, j].semilogx(c["freq_hz"], v["data_db"], styles.get(c["axis"], "o"), mfc="none", color=col,
+                              label=f"{name}: data")
+            ax[1, j].semilogx(c["freq_hz"], v["fit_deg"], "-", color=col, alpha=0.7)
+            ax[1, j].semilogx(c["freq_hz"], v["data_deg"], styles.get(c["axis"], "o"), mfc="none", color=col)
+    for j, key in enumerate(("piston x_p/(R theta_c)", "engine theta/theta_c")):
+        ax[0, j].set_title(key)
+        ax[0, j].set_ylabel("gain [dB]")
+        ax[1, j].set_ylabel("phase [deg]")
+        ax[1, j].set_xlabel("frequency [Hz]")
+        for a in ax[:, j]:
+            a.grid(True, which="both", alpha=0.3)
+    ax[0, 0].legend(fontsize=7, loc="best")
+    fig.suptitle(title or "Data against the 3-D TAOS fit (Figure 11 analogue)")
+    fig.tight_layout()
+    return fig

@@ -237,7 +237,7 @@ def _record(x, bs, c, u0, u1, P, avp, aux, dxs, out):
         out[REC_P + i] = x[X_P + i]
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy")
+@njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
 def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     """Integrate over command samples, recording :data:`REC` every ``rec_every`` steps.
 

@@ -19,6 +19,11 @@ Model-file tables read here (the loader keeps them raw in ``TvcModel.extra``)::
                                       optional; when absent derived from [structure] load_stiffness
                                       with the FEM gimbal in series, when given checked against that
                                       within 1 % (:mod:`taos.taos3d.calibrate`)]
+                upper_stiffness_scale s_u [-], factor on the upper half's 6x6 stiffness K_upper
+                lower_stiffness_scale s_l [-], factor on the lower half's K_lower [optional, default
+                                      1: the FEM matrices as computed; a fit's handle on the FEM
+                                      gimbal's compliance, K_s = ((s_u K_u)^-1 + (s_l K_l)^-1)^-1,
+                                      :mod:`taos.identify.fit3d`; bounds in taos.bounds]
     [geometry]  pitch_structure_attach, pitch_engine_attach, yaw_structure_attach,
                 yaw_engine_attach     [x, y, z] attach points [m] (engine points at zero angle)
                 engine_cg             [x, y, z] engine centre of mass [m]
@@ -61,7 +66,8 @@ AXES = ("pitch", "yaw")
 #: bearing rotation axes in the gimbal frame: pitch about +y, yaw about -x
 PITCH_AXIS = np.array([0.0, 1.0, 0.0])
 YAW_AXIS = np.array([-1.0, 0.0, 0.0])
-GIMBAL_KEYS = {"friction_coefficient", "bearing_radius", "stiffness_file", "line_load_stiffness"}
+GIMBAL_KEYS = {"friction_coefficient", "bearing_radius", "stiffness_file", "line_load_stiffness",
+               "upper_stiffness_scale", "lower_stiffness_scale"}
 GEOMETRY_KEYS = {"pitch_structure_attach", "pitch_engine_attach", "yaw_structure_attach",
                  "yaw_engine_attach", "engine_cg", "engine_roll_inertia"}
 
@@ -79,6 +85,11 @@ class GimbalParams:
     #: :func:`line_stiffness_basis` of the model the line stiffness was derived for ('' when
     #: given by the file): a model changed since is refused, never run on a stale value
     line_stiffness_basis: str = ""
+    #: s_u, s_l [-]: factors on the upper and lower halves' FEM stiffness (``[gimbal]
+    #: upper_stiffness_scale``/``lower_stiffness_scale``, default 1; applied by
+    #: :func:`assemble_taos_model` to the matrices of ``stiffness_file``)
+    upper_stiffness_scale: float = 1.0
+    lower_stiffness_scale: float = 1.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -284,7 +295,16 @@ def parse_gimbal(model: TvcModel) -> GimbalParams:
     if "line_load_stiffness" in g:
         kl = to_si(g["line_load_stiffness"], "stiffness", source=src, field="gimbal.line_load_stiffness",
                    positive=True)
-    return GimbalParams(mu, rb, path, kl)
+    from ..bounds import check_bound
+
+    scales = []
+    for key in ("upper_stiffness_scale", "lower_stiffness_scale"):
+        v = 1.0
+        if key in g:
+            v = to_si(g[key], "dimensionless", source=src, field=f"gimbal.{key}", positive=True)
+            check_bound(v, f"gimbal.{key}", src)
+        scales.append(float(v))
+    return GimbalParams(mu, rb, path, kl, upper_stiffness_scale=scales[0], lower_stiffness_scale=scales[1])
 
 
 def normal_load_N(model: TvcModel) -> float:
@@ -397,6 +417,10 @@ def assemble_taos_model(model: TvcModel, K_upper: np.ndarray | None = None,
                              "a fem_data .npz path (or matrices passed in code)", got="nothing (key missing)")
         Ku, Kl = load_stiffness_file(gim.stiffness_file)
         src = gim.stiffness_file
+        if gim.upper_stiffness_scale != 1.0:   # s_u K_u (the file's matrices unchanged at 1: bit-identical)
+            Ku = gim.upper_stiffness_scale * Ku
+        if gim.lower_stiffness_scale != 1.0:
+            Kl = gim.lower_stiffness_scale * Kl
     else:
         Ku = check_stiffness(K_upper, "<code>", "K_upper")
         Kl = check_stiffness(K_lower, "<code>", "K_lower")

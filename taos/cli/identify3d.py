@@ -1,0 +1,151 @@
+"""``taos fit --engine taos`` and ``taos compare --engine taos``: the 3-D TAOS model fitted to
+two-axis records (:mod:`taos.identify.fit3d`) and ambient against hot fire with each
+condition's FEM gimbal (:mod:`taos.identify.compare3d`)."""
+
+from __future__ import annotations
+
+import sys
+
+from taos.errors import InputError
+from taos.results import write_json
+
+COMPARE3D_FILES = ("table.txt", "comparison.json", "figure11.png")
+
+
+def _outputs(args, *names) -> None:
+    """Refuse output places that cannot be written before any work."""
+    from taos.results import check_output_file
+
+    for n in names:
+        v = getattr(args, n, None)
+        if v not in (None, "-"):
+            check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
+
+
+def _free(text, default=None) -> list[str]:
+    free = [s.strip() for s in (text or default or "").split(",")]
+    if not all(free):
+        raise InputError("command line", "--free", "parameter names separated by single commas, like "
+                         "load_stiffness,coulomb_torque", got=repr(text))
+    return free
+
+
+def _parse_start3d(items) -> dict:
+    from taos.identify.params3d import PARAMETERS3D
+    from taos.units import to_si
+
+    out = {}
+    for it in items or []:
+        if "=" not in it:
+            raise InputError("command line", "--start", "NAME=VALUE with a unit, like load_stiffness='150000 lbf/in'",
+                             got=repr(it))
+        k, v = (s.strip() for s in it.split("=", 1))
+        if k not in PARAMETERS3D:
+            raise InputError("command line", "--start", "a name from " + ", ".join(PARAMETERS3D), got=repr(k))
+        p = PARAMETERS3D[k]
+        out[k] = to_si(v if p.kind != "dimensionless" else float(v), p.kind, source="command line",
+                       field=f"--start {k}", positive=True)
+    return out
+
+
+def _refuse_planar_only(args) -> None:
+    if getattr(args, "bounds", None):
+        raise InputError("command line", "--bounds", "no --bounds with --engine taos (its bounds are physical: "
+                         "taos.identify.params3d)", got=" ".join(args.bounds))
+
+
+def cmd_fit3d(args) -> int:
+    from taos.identify.data import load_test_data
+    from taos.identify.fit3d import fit_taos
+    from taos.model import load_model
+    from taos.results import output_provenance
+    from taos.taos3d import taos_model
+
+    _outputs(args, "json", "plot", "out_model")
+    _refuse_planar_only(args)
+    if not 0.0 <= args.min_coherence <= 1.0:
+        raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
+    tm = taos_model(load_model(args.model, friction=args.friction))
+    free = _free(args.free)
+    start = _parse_start3d(args.start)
+    datas = [load_test_data(p) for p in args.data]             # every record read and checked first
+    axes = None if args.axis in (None, "both") else (args.axis,)
+    res = fit_taos(tm, datas, free, start=start, method=args.method, axes=axes, nperseg=args.nperseg,
+                   min_coherence=args.min_coherence, use_engine=not args.no_engine,
+                   refuse=not args.allow_unidentifiable)
+    d = res.to_dict()
+    d["model_file"] = tm.base.source
+    d["provenance"] = {**output_provenance([tm.base], [("data", p) for p in args.data]), "engine": "taos",
+                       "solver": res.solver, "seeds": "none (deterministic)"}
+    if args.out_model:
+        res.write_model(args.out_model, data_label=", ".join(map(str, args.data)))
+        d["fitted_model_file"] = str(args.out_model)
+    if args.plot:
+        from taos.identify.compare3d import Comparison3d, comparison3d_curves
+        from taos.plotting import save
+        from taos.plotting.compare import plot_compare3d
+        one = Comparison3d((tm.base.name, ""), (res,), (0.0,), (0.0,), (0.0,), (0.0,))
+        save(plot_compare3d(comparison3d_curves(one), "Data against the 3-D TAOS fit"), args.plot)
+    if args.json:
+        write_json(args.json, d)
+    out = sys.stderr if args.json == "-" else sys.stdout
+    print(res.table(), file=out)
+    if args.out_model:
+        print(f"wrote {args.out_model}", file=out)
+    if not res.adequacy().ok and args.strict:
+        return 4
+    return 0
+
+
+def cmd_compare3d(args) -> int:
+    from taos.identify.compare3d import compare_taos, comparison3d_curves
+    from taos.identify.data import load_test_data
+    from taos.model import load_model
+    from taos.results import check_output_folder, output_provenance, write_output_folder
+    from taos.taos3d import taos_model
+
+    if args.records or args.model:
+        raise InputError("command line", "--records" if args.records else "--model",
+                         "two models and --data A_DATA B_DATA with --engine taos (no series mode)", got="given")
+    if args.model_a is None or args.model_b is None or not args.data:
+        raise InputError("command line", "MODEL_A MODEL_B --data A_DATA B_DATA",
+                         "two models and their records with --engine taos",
+                         got=" ".join(x for x in (args.model_a, args.model_b) if x) or "none")
+    check_output_folder(args.out, COMPARE3D_FILES)
+    _outputs(args, "json")
+    labels = tuple(x.strip() for x in args.labels.split(",")) if args.labels is not None else None
+    if labels is not None and (len(labels) != 2 or not all(labels)):
+        raise InputError("command line", "--labels", "two labels like ambient,'hot fire'", got=args.labels)
+    models = [taos_model(load_model(p)) for p in (args.model_a, args.model_b)]
+    datas = [[load_test_data(p)] for p in args.data]
+    frees = []
+    for m in models:   # the friction level only where the law has friction
+        frees.append(_free(args.free, "load_stiffness,coulomb_torque" if m.base.friction.has_friction
+                           else "load_stiffness"))
+    axes = None if args.axis in (None, "both") else (args.axis,)
+    cmp = compare_taos(models, datas, frees, labels or (models[0].base.name, models[1].base.name),
+                       method=args.method, axes=axes, nperseg=args.nperseg)
+    payload = {**cmp.to_dict(), "provenance": {**output_provenance([m.base for m in models],
+                                                                   [("data", p) for p in args.data]),
+                                               "engine": "taos"}}
+    import json
+
+    import matplotlib.pyplot as plt
+
+    from taos.plotting.compare import plot_compare3d
+    text = json.dumps(payload, indent=2, allow_nan=False, default=str) + "\n"
+
+    def fig(p):
+        f = plot_compare3d(comparison3d_curves(cmp))
+        try:
+            f.savefig(p, dpi=120, format="png")
+        finally:
+            plt.close(f)
+    out = write_output_folder(args.out, {"table.txt": lambda p: p.write_text(cmp.table() + "\n"),
+                                         "comparison.json": lambda p: p.write_text(text), "figure11.png": fig})
+    if args.json:
+        write_json(args.json, json.loads(text))
+    stream = sys.stderr if args.json == "-" else sys.stdout
+    print(cmp.table(), file=stream)
+    print(f"wrote {out}/ ({', '.join(COMPARE3D_FILES)})", file=stream)
+    return 0
