@@ -42,7 +42,8 @@ def cmd_pti(args) -> int:
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         from taos.plotting import save
-        save(res.plot(), out / "pti.png")
+        from taos.plotting.pti import plot_pti
+        save(plot_pti(res), out / "pti.png")
         atomic_write(out / "pti.json", lambda p: p.write_text(text))
     if args.json:
         write_json(args.json, summary)

@@ -275,7 +275,8 @@ class PtiResponse:
 @dataclass(frozen=True, eq=False)
 class PtiAnalysis:
     """Every PTI window of a record (:func:`analyse_ptis`): ``responses`` in time order; the
-    record's and the ascent's sources; provenance (model, record, settings)."""
+    record's and the ascent's sources; provenance (model, record, settings). Drawn by
+    :func:`taos.plotting.pti.plot_pti` (analysis never imports the plotting layer)."""
 
     responses: tuple[PtiResponse, ...]
     record_source: str
@@ -287,11 +288,6 @@ class PtiAnalysis:
                 "windows": [r.to_dict() for r in self.responses], "provenance": self.provenance}
 
     summary = to_dict
-
-    def plot(self, axis: str | None = None):
-        """Bode plots of the reconstructed loop and piston response with the models (:mod:`taos.plotting.pti`)."""
-        from taos.plotting.pti import plot_pti
-        return plot_pti(self, axis)
 
 
 def pti_lines(pti) -> np.ndarray:
