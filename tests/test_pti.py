@@ -126,3 +126,39 @@ def test_cli_bad_input_writes_nothing(tmp_path):
     out = tmp_path / "o"
     assert main(["pti", str(tmp_path / "missing.h5"), "--flight", "ascent", "--out", str(out)]) == 2
     assert not out.exists()
+
+
+def test_duty_cycle_flow_integrates_to_piston_travel_times_area(ascent):
+    """Duty cycle (taos.flight.duty): the piston flow A v_p integrates to A times the piston
+    travel read from the recorded positions (sum |dx_p|) within 1 %, and the valve flow obeys the
+    continuity equation int (A q - (K_c + C_l) P_L) dt = A dx_p + (V_t / 4 beta) dP_L within 1 %."""
+    from taos.flight.ascent_sim import simulate_ascent
+    from taos.flight.duty import duty_cycle
+    from taos.flight.lco import with_bounding_avionics
+    from taos.model import load_model
+
+    m = with_bounding_avionics(load_model(ascent.tvc_model, friction="lugre"))
+    h = simulate_ascent(ascent, m, axes=("yaw",), start_s=340.0, end_s=440.0, dt_s=5e-4, attitude0_rad=0.002,
+                        record_interval_s=0.002)
+    d = duty_cycle(h, m, "yaw", 380.0, 440.0)
+    sel = (h.t_s >= 380.0) & (h.t_s <= 440.0)
+    x = h.signal("piston_m", "yaw")[sel]
+    travel = float(np.sum(np.abs(np.diff(x))))
+    A = m.actuator.piston_area_m2
+    assert A * d.piston_travel_m == pytest.approx(A * travel, rel=0.01)
+    act = m.actuator
+    P = h.signal("load_pressure_Pa", "yaw")[sel]
+    q = h.signal("valve_flow_m_s", "yaw")[sel]
+    net = np.trapezoid(A * q - (act.flow_pressure_coefficient_m3_per_s_Pa + act.leakage_coefficient_m3_per_s_Pa) * P,
+                       h.t_s[sel])
+    expect = A * (x[-1] - x[0]) + act.trapped_volume_m3 / (4 * act.oil_bulk_modulus_Pa) * (P[-1] - P[0])
+    scale = float(np.trapezoid(np.abs(A * q), h.t_s[sel]))
+    assert abs(net - expect) < 0.01 * scale
+    assert d.reversals > 0 and d.peak_flow_m3_s > d.mean_flow_m3_s > 0 and d.mean_supply_power_W > 0
+
+
+def test_reversal_counter():
+    from taos.flight.duty import reversals
+    t = np.linspace(0, 10, 10001)
+    assert reversals(np.sin(2 * np.pi * t), 0.01) == 20          # 10 cycles: 20 turning points
+    assert reversals(1e-4 * np.sin(2 * np.pi * t), 0.01) == 0     # inside the deadband
