@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -272,6 +273,10 @@ def check_model_bounds(src: str, engine, actuator, structure, avionics, friction
             check_bound(float(value), field, src)
         elif sec == "friction" and key in friction_table:
             check_bound(to_si(friction_table[key], "torque", source=src, field=field), field, src)
+        elif sec in ("gimbal", "geometry") and isinstance(extra.get(sec), Mapping) and key in extra[sec]:
+            from .model_keys import key_kind   # the 3-D model's keys, bounded at load like every other
+
+            check_bound(to_si(extra[sec][key], key_kind(field), source=src, field=field), field, src)
     check_bound(avionics.command_range_rad, "avionics.command_range", src)
     if "static_torque" in friction_table and "coulomb_torque" in friction_table:
         ts = to_si(friction_table["static_torque"], "torque", source=src, field="friction.static_torque")

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-LBF_IN = 175.12683524647636   # N/m per lbf/in
+from taos.units import N_PER_M_PER_LBF_PER_IN as LBF_IN  # N/m per lbf/in
 
 
 def line_stiffness_slope(result) -> float:

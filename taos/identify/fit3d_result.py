@@ -10,6 +10,8 @@ other parameter, and J^T J of reciprocal condition above 1e-12.
 
 from __future__ import annotations
 
+from taos.units import N_PER_M_PER_LBF_PER_IN
+
 import datetime as _dt
 import math
 from dataclasses import dataclass, field
@@ -190,7 +192,7 @@ class Fit3dResult:
             lines.append(f"{p.name:24s} {to_eng(p, self.start_values[i]):14.6g} {to_eng(p, v):14.6g} {se:12.3g} "
                          f"{b:>25s}  {p.unit or '-'}{flag}")
         lines.append(f"line stiffness (outside the FEM gimbal {Path(self.taos.stiffness_source).name}) "
-                     f"{self.line_stiffness_N_per_m() / 175.12683524647636:.6g} lbf/in")
+                     f"{self.line_stiffness_N_per_m() / N_PER_M_PER_LBF_PER_IN:.6g} lbf/in")
         g = self.global_search
         if g:
             lines.append(f"global first stage: {' x '.join(map(str, g['grid']))} grid over {', '.join(g['parameters'])}"

@@ -61,6 +61,8 @@ MEANINGS: dict[str, str] = {
     "gimbal.bearing_radius": "effective friction radius r_b of the spherical seat",
     "gimbal.stiffness_file": "FEM stiffness of the two gimbal halves (.npz in fem_data/)",
     "gimbal.line_load_stiffness": "load stiffness along the actuator lines outside the gimbal: derived key, from structure.load_stiffness with the gimbal in series when absent, checked (1 %) when given",
+    "gimbal.upper_stiffness_scale": "factor on the upper FEM half's stiffness matrix (default 1: the FEM as computed; a 3-D fit's correction of the FEM)",
+    "gimbal.lower_stiffness_scale": "factor on the lower FEM half's stiffness matrix (default 1)",
     # [geometry] (3-D)
     "geometry.pitch_structure_attach": "pitch actuator attach point on the structure (x, y, z)",
     "geometry.pitch_engine_attach": "pitch actuator attach point on the engine (x, y, z)",
