@@ -114,3 +114,22 @@ def test_template_writes_the_generic_ascent_and_it_loads(tmp_path):
     assert again.returncode == 2 and again.stderr.count("\n") == 1 and "exists" in again.stderr
     both = run_cli("ascent", ASCENT, "--template", tmp_path / "x.toml")
     assert both.returncode == 2 and not (tmp_path / "x.toml").exists()
+
+
+def test_flight_files_page_names_every_key_of_the_shipped_flight_and_ascent_files():
+    import tomllib
+
+    from taos.flight.ascent import TRAJECTORY_COLUMNS
+    from taos.flight.vehicle import _FCS_KEYS, _VEHICLE_KEYS
+
+    text = (MODELS.parent / "docs" / "reference" / "flight_files.md").read_text(encoding="utf-8")
+    keys = set(TRAJECTORY_COLUMNS) | set(_VEHICLE_KEYS) | set(_FCS_KEYS) | {"engine_count", "pade_order"}
+    for f in ("core_stage", "generic_upper_stage", "ascent", "generic_upper_ascent"):
+        doc = tomllib.loads((MODELS / "flight" / f"{f}.toml").read_text(encoding="utf-8"))
+        for k, v in doc.items():
+            keys.add(k)
+            for item in (v if isinstance(v, list) else [v]):
+                if isinstance(item, dict):
+                    keys.update(item)
+    missing = sorted(k for k in keys if not any(f"`{w}`" in text for w in (k, f"[{k}]", f"[[{k}]]")))
+    assert missing == []
