@@ -258,8 +258,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--actuator-profile", action="append", metavar="NAME=PROFILE",
                    help="a profile for one actuator (repeatable; overrides --profile for it)")
     p.add_argument("--out", required=True, help="HDF5 file of the run")
-    p.add_argument("--dt", type=float, default=None, help="RK4 step [s] (default 2e-4)")
-    p.add_argument("--record-every", type=int, default=10, help="keep every n-th step")
+    p.add_argument("--dt", type=float, default=None, help="RK4 step [s] (default 4e-4)")
+    p.add_argument("--record-every", type=int, default=5, help="keep every n-th step (default 5: 2 ms)")
     p.add_argument("--duration", type=float, default=None, help="simulated time [s] (default profile + 1 s)")
     p.add_argument("--friction", default=None, help="friction law for every engine (default each model's)")
     p.set_defaults(func=cmd_simulate)

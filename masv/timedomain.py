@@ -41,7 +41,14 @@ from .config import MasvConfig
 from .provenance import config_provenance
 from .system import build_system
 
-DEFAULT_DT_S = 2e-4
+#: default RK4 step [s]. 4e-4 s: on the Green Run two-axis profile (models/masv/core_stage.toml,
+#: modified LuGre, limits and avionics) the engine angles differ from a 1e-4 s run by at most
+#: 2.3e-4 deg of a 0.362 deg peak, as the 2e-4 s run's 1.5e-4 deg (the stick-slip instants, not
+#: the step, set the difference; benchmarks/RESULTS.md), at half the cost; the relief-valve step
+#: rule of the shipped servo (taos.bounds) is 1.6 of the RK4 limit 2.0 at this step
+DEFAULT_DT_S = 4e-4
+#: default recording: every 5th step (2 ms at the default step)
+DEFAULT_RECORD_EVERY = 5
 #: recorded per-actuator arrays of :class:`MasvTimeHistory` (each (n_act, n_rec), SI)
 ACTUATOR_ARRAYS = ("command_rad", "command_avionics_rad", "piston_m", "engine_rad", "load_force_N",
                    "gimbal_torque_Nm", "friction_state_rad", "elongation_m", "gimbal_rotation_rad")
@@ -122,7 +129,7 @@ def _duration(commands) -> float:
     return max(p.duration_s for p in ps if p is not None) + 1.0
 
 
-def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
+def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_every: int = DEFAULT_RECORD_EVERY,
              duration_s: float | None = None, friction: str | None = None, avionics: bool = True,
              limits: bool = True) -> MasvTimeHistory:
     """Run the configuration's engines, nonlinear, coupled through its modes (module docstring).

@@ -30,7 +30,7 @@ def test_one_engine_on_a_rigid_structure_is_taos_simulate():
     cfg = make_config([EngineSpec("e1", m, "gimbal_1", (0.0, 0.0, 0.0))],
                       [ActuatorSpec("a1", "e1", "pitch", "actuator_1_pitch", (-1.0, 0.0, 0.0), (0.0, 1.0, 0.0))])
     p = load_profile(ROOT / "models" / "profiles" / "step_pitch.toml")
-    h = simulate(cfg, p, duration_s=2.0)
+    h = simulate(cfg, p, duration_s=2.0, dt_s=2e-4, record_every=10)   # taos simulate's step and recording
     ref = taos_simulate(m, p, duration_s=2.0, threads=1)
     scale = np.abs(ref.engine_rad[0]).max()
     assert np.abs(h.engine_rad[0] - ref.engine_rad[0]).max() <= 1e-9 * scale

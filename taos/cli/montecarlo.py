@@ -23,12 +23,48 @@ def _out_folder(path: str, names: list[str]) -> Path:
     return out
 
 
+#: the shipped non-SLS ascent that ``taos ascent --template`` writes (docs/reference/flight_files.md)
+TEMPLATE = "generic_upper_ascent"
+
+
+def write_template(out: str) -> Path:
+    """Write the ascent template (the shipped ``models/flight/generic_upper_ascent.toml``, whose
+    ``flight`` and ``tvc_model`` references still resolve from a copy elsewhere by the one rule
+    of file references) to ``out``; an existing file is refused (nothing written)."""
+    from taos.shipped import models_dir
+
+    p = Path(out)
+    if p.suffix != ".toml":
+        raise InputError("command line", "--template", "a new .toml file name", got=repr(out))
+    if p.exists():
+        raise InputError("command line", "--template", "a new file (taos replaces no file it did not write)",
+                         got=f"{p} exists")
+    if not p.parent.is_dir():
+        raise InputError("command line", "--template", "a file in an existing folder", got=str(p))
+    text = (models_dir() / "flight" / f"{TEMPLATE}.toml").read_text(encoding="utf-8")
+    head = ("# Template written by `taos ascent --template`: the shipped generic upper-stage ascent\n"
+            "# (models/flight/generic_upper_ascent.toml). Edit every value for your vehicle; the keys,\n"
+            "# units and frames are in docs/reference/flight_files.md. `flight` and `tvc_model` name the\n"
+            "# shipped generic stage and engine until you point them at your own files.\n")
+    atomic_write(p, lambda q: q.write_text(head + text, encoding="utf-8"))
+    return p
+
+
 def cmd_ascent(args) -> int:
     from taos.flight.ascent import load_ascent
     from taos.flight.ascent_sim import fly_ascent, run_file
     from taos.model import load_model
     from taos.units import to_si
 
+    if args.template is not None:
+        if args.ascent is not None or args.out is not None:
+            raise InputError("command line", "--template", "no ascent file and no --out with --template",
+                             got=f"{args.ascent or ''} {args.out or ''}".strip())
+        print(f"ascent template written to {write_template(args.template)}")
+        return 0
+    if args.ascent is None or args.out is None:
+        raise InputError("command line", "ascent", "an ascent file and --out (or --template OUT.toml)",
+                         got="ascent" if args.ascent else "no ascent file")
     ascent = load_ascent(args.ascent)
     laws = [s.strip() for s in args.friction.split(",")] if args.friction is not None else [None]
     if args.friction is not None and not all(laws):
@@ -145,7 +181,10 @@ def _positive_int(text: str) -> int:
 
 def add_parsers(sub) -> None:
     p = sub.add_parser("ascent", help="fly an ascent (boosters, PTIs, winds) with the nonlinear TVC")
-    p.add_argument("ascent", help="ascent file or shipped name, e.g. ascent (models/flight/ascent.toml)")
+    p.add_argument("ascent", nargs="?", help="ascent file or shipped name, e.g. ascent (models/flight/ascent.toml) "
+                   "or generic_upper_ascent (a non-SLS two-engine upper stage)")
+    p.add_argument("--template", metavar="OUT.toml", help="write an ascent file template (the shipped generic "
+                   "upper stage, every key commented; docs/reference/flight_files.md) and stop")
     p.add_argument("--model", help="TVC model (default: the ascent file's tvc_model)")
     p.add_argument("--friction", help="friction law(s), comma-separated, overlaid (e.g. coulomb-switching,dahl,lugre)")
     p.add_argument("--load-stiffness", help="override the load stiffness, e.g. '205000 lbf/in' (stiff structure)")
@@ -156,7 +195,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--end", type=float, help="end of the flown segment [s] (default the trajectory's end)")
     p.add_argument("--dt", type=float, default=2e-4, help="RK4 step [s] (default 2e-4: the switching Coulomb stick band needs it)")
     p.add_argument("--seed", type=int, default=0, help="turbulence seed (default 0)")
-    p.add_argument("--out", required=True, help="output folder: ascent_<law>.h5, ascent.png, summary.json")
+    p.add_argument("--out", help="output folder: ascent_<law>.h5, ascent.png, summary.json (required to fly)")
     p.add_argument("--json", metavar="PATH", help="write the window analysis here ('-' for standard output)")
     p.add_argument("--progress", action="store_true", help="show a progress bar")
     p.set_defaults(func=cmd_ascent)

@@ -27,6 +27,13 @@ loop, which is why a friction-degraded core TVC does not limit-cycle there.
 Wind along the flight path: a steady profile (table), a 1-cosine gust, and first-order
 (Dryden-like) turbulence of a given RMS and correlation time drawn from a seeded generator; the
 pitch plane sees cos(azimuth) of it, the yaw plane sin(azimuth).
+
+Any launcher: the engine count, thrust, inertia and gains come from the files only. A stage
+without boosters leaves out ``[boosters]`` (and the ``booster_thrust`` column), an
+exo-atmospheric one ``[aero]``, ``[wind]`` and the ``dynamic_pressure`` / ``wind_speed`` columns
+(all zero). Every key, unit and frame: ``docs/reference/flight_files.md``; a template:
+``taos ascent --template OUT.toml`` (the shipped non-SLS example
+``models/flight/generic_upper_ascent.toml``).
 """
 
 from __future__ import annotations
@@ -213,8 +220,10 @@ def _column(t: Mapping, key: str, si_unit: str, src: str) -> np.ndarray:
 def _trajectory(doc: Mapping, src: str) -> Trajectory:
     t = _table(doc, "trajectory", src)
     _keys(t, TRAJECTORY_COLUMNS, src, "trajectory")
-    cols = {k: _column(t, k, u, src) for k, u in TRAJECTORY_COLUMNS.items()}
+    cols = {k: _column(t, k, u, src) for k, u in TRAJECTORY_COLUMNS.items() if k in t or k not in OPTIONAL_COLUMNS}
     n = cols["time"].size
+    for k in OPTIONAL_COLUMNS:
+        cols.setdefault(k, np.zeros(n))
     for k, v in cols.items():
         if v.size != n:
             raise InputError(src, f"trajectory.{k}.values", f"{n} values (as many as trajectory.time)", got=str(v.size))
@@ -232,7 +241,22 @@ def _trajectory(doc: Mapping, src: str) -> Trajectory:
                       velocity_m_s=cols["velocity"], wind_speed_m_s=cols["wind_speed"])
 
 
+#: an ascent without a ``[boosters]`` table: no boosters, no separation (the TVC engines alone
+#: from the start; the trajectory's ``booster_thrust`` column may then be left out)
+NO_BOOSTERS = Boosters(count=0, separation_time_s=0.0, gimbal_arm_m=1.0, actuator_time_constant_s=0.1,
+                       separation_rate_kick_rad_s=0.0)
+#: an ascent without an ``[aero]`` table: no aerodynamic moment (exo-atmospheric)
+NO_AERO = Aero(reference_area_m2=0.0, normal_force_slope_per_rad=0.0, center_of_pressure_ahead_m=0.0)
+#: an ascent without a ``[wind]`` table: no gust, no turbulence (a ``wind_speed`` column still applies)
+NO_WIND = Wind(azimuth_rad=0.0, gust_time_s=0.0, gust_amplitude_m_s=0.0, gust_duration_s=1.0,
+               turbulence_intensity_m_s=0.0, turbulence_time_constant_s=1.0)
+#: trajectory columns an ascent may leave out, with their value (zero along the whole ascent)
+OPTIONAL_COLUMNS = ("booster_thrust", "dynamic_pressure", "wind_speed")
+
+
 def _boosters(doc: Mapping, src: str) -> Boosters:
+    if "boosters" not in doc:
+        return NO_BOOSTERS
     b = _table(doc, "boosters", src)
     _keys(b, {"count", "separation_time", "gimbal_arm", "actuator_time_constant", "separation_rate_kick"},
           src, "boosters")
@@ -249,6 +273,8 @@ def _boosters(doc: Mapping, src: str) -> Boosters:
 def _aero(doc: Mapping, src: str) -> Aero:
     from taos.units import Q_
 
+    if "aero" not in doc:
+        return NO_AERO
     a = _table(doc, "aero", src)
     _keys(a, {"reference_area", "normal_force_slope", "center_of_pressure_ahead"}, src, "aero")
     slope = a.get("normal_force_slope")
@@ -268,6 +294,8 @@ def _aero(doc: Mapping, src: str) -> Aero:
 
 
 def _wind(doc: Mapping, src: str) -> Wind:
+    if "wind" not in doc:
+        return NO_WIND
     w = _table(doc, "wind", src)
     keys = {"azimuth": ("angle", {}), "gust_time": ("time", {"nonnegative": True}),
             "gust_amplitude": ("velocity", {}), "gust_duration": ("time", {"positive": True}),
