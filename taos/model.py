@@ -173,6 +173,8 @@ class TvcModel:
                                               compare=False, repr=False)
     extra: Mapping[str, Any] = field(default_factory=lambda: types.MappingProxyType({}),
                                      compare=False, repr=False)
+    #: the model file's bytes as read: variants parse these (the file may be gone or replaced since)
+    source_bytes: bytes = field(default=b"", compare=False, repr=False)
 
     # -- derived figures ------------------------------------------------------------------
     def load_resonance_hz(self, axis: str = "pitch") -> float:
@@ -201,7 +203,8 @@ class TvcModel:
 
         def load(over):
             table = dict(over)
-            return load_model(self.source, friction=table.pop("friction.model", None), overrides=table)
+            return load_model(self.source, friction=table.pop("friction.model", None), overrides=table,
+                              source_bytes=self.source_bytes or None)
         out = load(overrides)
         check_unchanged(self, out)
         if not code:
@@ -528,16 +531,25 @@ def model_inputs(model: "TvcModel") -> dict:
     return {role: {"file": f, "sha256": h} for role, (f, h) in model.input_files.items()}
 
 
-def load_model(path: str | Path, friction: str | None = None, overrides: Mapping[str, Any] | None = None) -> TvcModel:
+def load_model(path: str | Path, friction: str | None = None, overrides: Mapping[str, Any] | None = None,
+               *, source_bytes: bytes | None = None) -> TvcModel:
     """Load a model file. ``friction`` overrides the law (``--friction``), keeping torque levels.
     ``overrides``: ``{"section.key": TOML value}`` replacing (or adding) keys of the file before
-    it is checked, exactly as if the file held them (``taos sweep``).
+    it is checked, exactly as if the file held them (``taos sweep``). ``source_bytes``: the file's
+    contents as read before (a variant's reload, :meth:`TvcModel.with_values`); the files it names
+    are resolved from ``path`` as always.
 
     Raises :class:`~taos.errors.InputError` (one line: file, field, expectation) on bad input.
     """
-    p = resolve(path, "model")
+    if source_bytes is None:
+        p = resolve(path, "model")
+        raw, doc = read_toml(p, "a readable model file")
+    else:
+        from .errors import parse_toml
+
+        p, raw = Path(path), source_bytes
+        doc = parse_toml(raw, str(p))
     src = str(p)
-    raw, doc = read_toml(p, "a readable model file")
     overrides = dict(overrides or {})
     from .variants import level_follows, with_overrides
 
@@ -570,4 +582,4 @@ def load_model(path: str | Path, friction: str | None = None, overrides: Mapping
                     sha256=variant_sha256(combined_sha256(files), recorded), overrides=recorded,
                     base_sha256=combined_sha256(files), input_files=types.MappingProxyType(files),
                     friction_table=types.MappingProxyType(dict(ftab)),
-                    extra=types.MappingProxyType(extra))
+                    extra=types.MappingProxyType(extra), source_bytes=raw)

@@ -169,10 +169,16 @@ def test_a_variant_keeps_the_code_changes_and_a_changed_file_is_refused(hot, tmp
     law = hot.replace(friction=hot.with_friction("dahl").friction)
     with pytest.raises(InputError, match="friction.model"):
         law.with_values({"friction.model": "lugre"})
+    for sub in ("actuators", "friction"):   # a model file beside its own copies of the sets it names
+        shutil.copytree(models_dir() / sub, tmp_path / sub)
     p = tmp_path / "m.toml"
     shutil.copy(models_dir() / "rs25_ambient.toml", p)
     m = load_model(p)
-    p.write_text(p.read_text().replace('load_stiffness = "115000 lbf/in"', 'load_stiffness = "116000 lbf/in"'))
+    p.unlink()   # the model keeps its file's bytes: a variant needs no file
+    assert m.with_values({"structure.load_stiffness": "120000 lbf/in"}).structure.load_damping_ratio == \
+        m.structure.load_damping_ratio
+    sset = tmp_path / "friction" / "rs25_gimbal.toml"
+    sset.write_text(sset.read_text().replace('bristle_stiffness = "1.3e7 N*m/rad"', 'bristle_stiffness = "1.4e7 N*m/rad"'))
     with pytest.raises(InputError, match="unchanged since the model was loaded"):
         m.with_values({"engine.thrust": "0 N"})
 
