@@ -13,7 +13,12 @@ Green Run profile (models/profiles/greenrun_two_axis.toml) over ``--duration`` s
   block's);
 * the FMU (``taos fmu``) in FMPy (``fmpy.simulate_fmu`` in a child process ended with
   ``os._exit``, as tests/test_fmu.py runs it), at h = dt with ``command_hold = 1`` (its output at
-  t + h against ``taos simulate`` at t) and at h = 10 dt with ``command_hold = 0``.
+  t + h against ``taos simulate`` at t) and at h = 10 dt with ``command_hold = 0``;
+* simplex only: the standalone FMU (``taos fmu --standalone``, C, no Python) the same two ways in
+  FMPy (in this process: it holds no Python), and its bare per-step cost in a C master (the
+  FMU's ``fmi2DoStep`` and ``fmi2GetReal`` of every output in a loop, no FMPy; held command,
+  h = dt, timed inside the master with ``clock_gettime``). ``--skip-pythonfmu`` leaves out the
+  pythonfmu FMU's rows (the slowest).
 
 Agreement: the largest |engine angle - taos simulate| over both axes [deg] at the common
 samples. Speed: wall time of the run (FMU: of ``simulate_fmu`` inside the child, instantiation
@@ -83,10 +88,92 @@ def worst_deg(eng: np.ndarray, th, every: int, shift: int = 0) -> float:
     return math.degrees(float(np.max(np.abs(eng[:, shift:shift + m] - ref[:, :m]))))
 
 
+_C_BENCH = r"""
+#include <dlfcn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+#include "fmi2Functions.h"
+static void lg(fmi2ComponentEnvironment e, fmi2String n, fmi2Status s, fmi2String c, fmi2String m, ...) { puts(m); }
+int main(int argc, char **argv) {
+  void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+  fmi2InstantiateTYPE *inst = (fmi2InstantiateTYPE *)dlsym(lib, "fmi2Instantiate");
+  fmi2EnterInitializationModeTYPE *en = (fmi2EnterInitializationModeTYPE *)dlsym(lib, "fmi2EnterInitializationMode");
+  fmi2ExitInitializationModeTYPE *ex = (fmi2ExitInitializationModeTYPE *)dlsym(lib, "fmi2ExitInitializationMode");
+  fmi2SetRealTYPE *setr = (fmi2SetRealTYPE *)dlsym(lib, "fmi2SetReal");
+  fmi2GetRealTYPE *getr = (fmi2GetRealTYPE *)dlsym(lib, "fmi2GetReal");
+  fmi2DoStepTYPE *step = (fmi2DoStepTYPE *)dlsym(lib, "fmi2DoStep");
+  fmi2FreeInstanceTYPE *fr = (fmi2FreeInstanceTYPE *)dlsym(lib, "fmi2FreeInstance");
+  fmi2CallbackFunctions cb = {lg, calloc, free, NULL, NULL};
+  fmi2Component c = inst("b", fmi2CoSimulation, argv[2], "", &cb, fmi2False, fmi2False);
+  long n = atol(argv[3]); double h = atof(argv[4]), cmd[2] = {0.007, -0.005}, out[17];
+  fmi2ValueReference vin[2] = {0, 1}, vout[17];
+  for (int i = 0; i < 17; i++) vout[i] = 2 + i;
+  en(c); setr(c, vin, 2, cmd); ex(c);
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  for (long k = 0; k < n; k++) { if (step(c, k * h, h, fmi2True) || getr(c, vout, 17, out)) return 2; }
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  printf("%.6f\n", (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec));
+  fr(c);
+  return 0;
+}
+"""
+
+
+def c_master_per_step(fmu: Path, tmp: str, steps: int, h: float) -> float:
+    """Wall time [s] per communication step of the standalone FMU in a bare C master (module docstring)."""
+    import shutil
+    import zipfile
+
+    import fmpy
+
+    from taos.cosim._standalone import fmi_headers
+
+    d = Path(tmp) / "cbench"
+    d.mkdir(exist_ok=True)
+    (d / "m.c").write_text(_C_BENCH)
+    cc = shutil.which("cc") or shutil.which("gcc")
+    subprocess.run([cc, "-O2", "-I", str(fmi_headers()), "-o", str(d / "m"), str(d / "m.c"), "-ldl"], check=True)
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(d / "fmu")
+    md = fmpy.read_model_description(str(fmu))
+    so = d / "fmu" / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
+    r = subprocess.run([str(d / "m"), str(so), md.guid, str(steps), repr(h)], capture_output=True, text=True, check=True)
+    return float(r.stdout.split()[-1]) / steps
+
+
+def standalone_rows(prof, th, dt: float, T: float, tmp: str) -> list:
+    """The standalone FMU's rows (module docstring)."""
+    import fmpy
+
+    from taos.cosim._standalone import build_standalone_fmu
+
+    t0 = time.perf_counter()
+    fmu = build_standalone_fmu(ROOT / "models" / "rs25_hotfire.toml", Path(tmp) / "standalone.fmu").path
+    rows = [("simplex", "standalone FMU: taos fmu --standalone (build)", dt, float("nan"), time.perf_counter() - t0)]
+    for every, hold in ((1, 1), (10, 0)):
+        h = every * dt
+        sig = profile_input(prof, dt, T + h)[::every]
+        t0 = time.perf_counter()
+        res = fmpy.simulate_fmu(str(fmu), input=sig, stop_time=float(sig["time"][-1]), step_size=h, output_interval=h,
+                                start_values={"command_hold": hold})
+        wall = time.perf_counter() - t0
+        eng = np.vstack([res["pitch_engine_rad"], res["yaw_engine_rad"]])
+        rows.append(("simplex", f"standalone FMU in FMPy, h = {every} dt, command_hold {hold}", h,
+                     worst_deg(eng, th, every, shift=1 if hold == 1 else 0), wall))
+    steps = int(round(T / dt))
+    per = c_master_per_step(fmu, tmp, steps, dt)
+    rows.append(("simplex", f"standalone FMU in a C master, h = dt ({per * 1e6:.2f} us/step)", dt, float("nan"),
+                 per * steps))
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--duration", type=float, default=61.0, help="simulated time [s] (default: the whole profile)")
     ap.add_argument("--engine", choices=("simplex", "taos", "both"), default="both")
+    ap.add_argument("--skip-pythonfmu", action="store_true", help="leave out the pythonfmu FMU's rows")
     args = ap.parse_args(argv)
     print("uptime:", subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip())
     print(f"python {sys.version.split()[0]}, {os.cpu_count()} cores; Green Run two-axis, hot fire, {args.duration:g} s")
@@ -103,6 +190,10 @@ def main(argv=None) -> int:
             for every, hold in ((1, "ramp"), (10, "hold")):
                 eng, w = block_run(model, prof, engine, dt, T, every, hold)
                 rows.append((engine, f"TvcBlock, h = {every} dt, {hold}", every * dt, worst_deg(eng, th, every), w))
+            if engine == "simplex":
+                rows += standalone_rows(prof, th, dt, T, tmp)
+            if args.skip_pythonfmu:
+                continue
             fmu = build_fmu(ROOT / "models" / "rs25_hotfire.toml", Path(tmp) / f"{engine}.fmu", engine=engine).path
             *_, fixed = fmpy_in_child(fmu, tmp, stop_time=dt, step_size=dt, output_interval=dt)
             rows.append((engine, "FMU in FMPy, one step (start-up cost)", dt, float("nan"), fixed))
@@ -117,10 +208,10 @@ def main(argv=None) -> int:
                 eng = np.vstack([res["pitch_engine_rad"], res["yaw_engine_rad"]])
                 rows.append((engine, f"FMU in FMPy, h = {every} dt, command_hold {hold}", h,
                              worst_deg(eng, th, every, shift=1 if hold == 1 else 0), wall))
-    print(f"{'engine':8s} {'run':42s} {'h [s]':>8s} {'max |d engine| [deg]':>21s} {'wall [s]':>9s} {'x real time':>12s}")
+    print(f"{'engine':8s} {'run':58s} {'h [s]':>8s} {'max |d engine| [deg]':>21s} {'wall [s]':>9s} {'x real time':>12s}")
     for engine, what, h, d, w in rows:
         one = math.isnan(d)   # the start-up row: one step, no agreement or real-time figure
-        print(f"{engine:8s} {what:42s} {h:8.1e} {'-' if one else f'{d:.3g}':>21s} {w:9.2f} "
+        print(f"{engine:8s} {what:58s} {h:8.1e} {'-' if one else f'{d:.3g}':>21s} {w:9.2f} "
               f"{'-' if one else f'{args.duration / w:.1f}':>12s}")
     return 0
 

@@ -83,9 +83,7 @@ for k in range(f.size):
 assert np.allclose(mine.engine, ref.engine, rtol=1e-6)
 
 # %%
-# Adding viscous damping c changes the response: a law parameter like any other.
-import dataclasses  # noqa: E402
-
-damped = model.with_friction(LAW)
-damped = damped.replace(friction=dataclasses.replace(damped.friction, viscous_damping_Nms_per_rad=2e5))
+# Adding viscous damping c changes the response: a law parameter like any other, and a model
+# variant like any other (the model file with other values, through the loader and its bounds).
+damped = model.with_values({"friction.model": LAW, "friction.viscous_damping": "2e5 N*m*s/rad"})
 print("with c = 2e5 N m s/rad:", np.round(20 * np.log10(np.abs(taos.sine_dwell_freqresp(damped, f, amp).engine)), 3), "dB")

@@ -16,8 +16,7 @@ from taos.profiles import Sequence, SineDwell
 
 deg = math.pi / 180
 model = taos.load_model("rs25_hotfire")
-truth = model.replace(structure=model.structure.__class__(
-    **{**model.structure.__dict__, "load_stiffness_N_per_m": 0.85 * model.structure.load_stiffness_N_per_m}))
+truth = model.with_values({"structure.load_stiffness": 0.85 * model.structure.load_stiffness_N_per_m})  # a variant, SI
 
 # %%
 # The "record": 0.4 deg dwells in pitch at five frequencies around the load resonance.

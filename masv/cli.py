@@ -5,6 +5,10 @@
     masv coupling CONFIG [--reference CONFIG] [--json PATH] [--plot MATRIX.png]
                                                       (with a reference: the same figures for it)
     masv tvse CONFIG [--json PATH] [--plot BODE.png]   TVSE loops (paper sec. 3.3) and their margins
+    masv simulate CONFIG --profile P --out RUN.h5 [--actuator-profile NAME=P ...] [--dt S]
+                  [--record-every N] [--duration S] [--friction LAW] [--json PATH]
+                                                      every engine's nonlinear TVC coupled through
+                                                      the modes, in the time domain (masv.timedomain)
 
 Bad input exits with status 2 and one line naming the file, the field and what was expected.
 """
@@ -19,7 +23,7 @@ import numpy as np
 
 from taos.units import parse_float_list
 from taos.errors import InputError
-from taos.results import package_version, write_json
+from taos.results import write_json
 
 from . import analysis as an
 from .config import load_config
@@ -31,10 +35,9 @@ def _system(args):
 
 
 def _prov(cfg) -> dict:
-    from taos.results import base_provenance
+    from masv.provenance import config_provenance
 
-    return {"config_file": cfg.source, "config_sha256": cfg.sha256, "modes_file": cfg.structure.source,
-            "n_modes": cfg.structure.n_modes, "taos_version": package_version(), **base_provenance()}
+    return config_provenance(cfg)
 
 
 #: ``masv modes`` lists every mode up to this many (beyond, only the modes in the band)
@@ -176,6 +179,50 @@ def cmd_tvse(args) -> int:
     return 0
 
 
+def cmd_simulate(args) -> int:
+    from taos.profiles import load_profile
+    from taos.results import check_output_file
+
+    from .timedomain import simulate
+
+    check_output_file(args.out, "--out", suffixes=(".h5", ".hdf5"))
+    cfg = load_config(args.config)
+    commands = {n: None for n in cfg.actuator_names}
+    if args.profile:
+        p = load_profile(args.profile)
+        commands = {n: p for n in cfg.actuator_names}
+    for item in args.actuator_profile or []:
+        name, sep, path = item.partition("=")
+        if not sep or name not in commands:
+            raise InputError("command line", "--actuator-profile", "NAME=PROFILE with NAME an actuator of "
+                             + cfg.source + " (" + ", ".join(cfg.actuator_names) + ")", got=repr(item))
+        commands[name] = load_profile(path)
+    if all(v is None for v in commands.values()):
+        raise InputError("command line", "--profile", "a command profile (or --actuator-profile NAME=P)")
+    for opt, v in (("--dt", args.dt), ("--duration", args.duration)):
+        if v is not None and not (v > 0 and math.isfinite(v)):
+            raise InputError("command line", opt, "a positive number of seconds", got=repr(v))
+    if args.record_every < 1:
+        raise InputError("command line", "--record-every", "a whole number >= 1", got=str(args.record_every))
+    kw = {} if args.dt is None else {"dt_s": args.dt}
+    h = simulate(cfg, commands, record_every=args.record_every, duration_s=args.duration, friction=args.friction,
+                 **kw)
+    h.to_hdf5(args.out)
+    d = {"out": args.out, "t_end_s": float(h.t_s[-1]), "actuators": list(h.actuators),
+         "peak_engine_deg": {a: float(np.degrees(np.abs(h.engine_rad[i]).max())) for i, a in enumerate(h.actuators)},
+         "peak_load_force_N": {a: float(np.abs(h.load_force_N[i]).max()) for i, a in enumerate(h.actuators)},
+         "provenance": h.provenance}
+    if args.json:
+        write_json(args.json, d)
+    else:
+        s = h.provenance["solver"]
+        print(f"{len(h.actuators)} actuators, {h.modal_q.shape[0]} modes, {h.t_s[-1]:.2f} s simulated in "
+              f"{s['kernel_wall_s']:.2f} s ({s['real_time_factor']:.1f}x real time) -> {args.out}")
+        for a in h.actuators:
+            print(f"  {a:>18}: peak engine {d['peak_engine_deg'][a]:.3f} deg, peak load {d['peak_load_force_N'][a]:.4g} N")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="masv", description="MASV: four engines, eight actuators, thrust-structure modes")
     sub = ap.add_subparsers(dest="command", required=True)
@@ -205,6 +252,17 @@ def build_parser() -> argparse.ArgumentParser:
     common(p)
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="also save the Bode plot of the loops")
     p.set_defaults(func=cmd_tvse)
+    p = sub.add_parser("simulate", help="nonlinear time domain: every engine's TVC coupled through the modes")
+    common(p)
+    p.add_argument("--profile", help="command profile (TOML) for every actuator (two-axis: pitch/yaw parts)")
+    p.add_argument("--actuator-profile", action="append", metavar="NAME=PROFILE",
+                   help="a profile for one actuator (repeatable; overrides --profile for it)")
+    p.add_argument("--out", required=True, help="HDF5 file of the run")
+    p.add_argument("--dt", type=float, default=None, help="RK4 step [s] (default 2e-4)")
+    p.add_argument("--record-every", type=int, default=10, help="keep every n-th step")
+    p.add_argument("--duration", type=float, default=None, help="simulated time [s] (default profile + 1 s)")
+    p.add_argument("--friction", default=None, help="friction law for every engine (default each model's)")
+    p.set_defaults(func=cmd_simulate)
     return ap
 
 

@@ -6,7 +6,10 @@ Format (every physical value with its unit, parsed by pint; paths relative to th
     reference = "core_stage.toml"  # optional: another MASV configuration (the nominal structure)
                                  # that ``masv coupling`` compares this one with
     [structure]
-    modes = "../../fem_data/thrust_structure_modes.npz"   # or "rigid" (no modes)
+    modes = "../../fem_data/thrust_structure_modes.npz"   # or "rigid" (no modes), or an FE file
+                                 # (.uff/.unv Universal File 55, .pch Nastran punch) with the
+                                 # keys nodes, length_unit, mass_unit, modal_mass, fe_to_vehicle
+                                 # (masv.fe_import; docs/reference/masv_files.md)
     damping_ratio = 0.005        # every mode (default, paper sec. 3.3); "file" keeps the file's
     max_frequency = "200 Hz"     # optional: drop modes above this
     engine_mass_in_modes = false # optional: true when the modes already lump the engines'
@@ -30,12 +33,14 @@ Format (every physical value with its unit, parsed by pint; paths relative to th
                                      # default unit((attach - gimbal) x direction)
 
 Engine positions in the core-stage layout are the gimbal nodes' coordinates in the modal file.
+One to :data:`MAX_ENGINES` engines, one or two actuators each, any number of structure nodes.
+Every key, array, unit and frame: ``docs/reference/masv_files.md``.
 """
 
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping
 
@@ -49,6 +54,8 @@ from taos.units import to_si
 from .structure import DEFAULT_DAMPING_RATIO, ModalStructure, load_modes, rigid_structure
 
 AXES = ("pitch", "yaw")
+#: most engines a configuration may hold
+MAX_ENGINES = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,7 +110,8 @@ class ActuatorSpec:
 class MasvConfig:
     """A validated MASV configuration (SI inside): engines, actuators, modal structure and the
     band of interest [Hz]; ``reference`` the path of another configuration to compare with
-    (``masv coupling``), or None."""
+    (``masv coupling``), or None; ``structure_import`` how an FE file was imported (format,
+    unit scales, normalisation; :func:`masv.fe_import.load_fe_modes`), empty otherwise."""
 
     name: str
     engines: tuple[EngineSpec, ...]
@@ -114,6 +122,7 @@ class MasvConfig:
     source: str = "<code>"
     sha256: str = ""
     reference: str | None = None
+    structure_import: dict = field(default_factory=dict)
 
     def engine(self, name: str) -> EngineSpec:
         return next(e for e in self.engines if e.name == name)
@@ -167,8 +176,8 @@ def check_config(cfg: MasvConfig) -> None:
     """Cross-checks: unique names, engines referenced, one actuator per engine axis, nodes exist
     (when the structure has modes), a sensible band."""
     src = cfg.source
-    if not cfg.engines:
-        raise InputError(src, "engine", "at least one [[engine]] table")
+    if not 1 <= len(cfg.engines) <= MAX_ENGINES:
+        raise InputError(src, "engine", f"1 to {MAX_ENGINES} [[engine]] tables", got=str(len(cfg.engines)))
     if not cfg.actuators:
         raise InputError(src, "actuator", "at least one [[actuator]] table")
     names = [e.name for e in cfg.engines]
@@ -196,16 +205,28 @@ def check_config(cfg: MasvConfig) -> None:
         raise InputError(src, "band", "0 < low < high", got=f"{cfg.band_low_hz} Hz .. {cfg.band_high_hz} Hz")
 
 
-def _structure(doc: Mapping, src: str) -> ModalStructure:
+def _structure(doc: Mapping, src: str) -> tuple[ModalStructure, dict]:
+    from .fe_import import FE_KEYS, is_fe_file, load_fe_modes
+
     st = doc.get("structure")
     if not isinstance(st, Mapping):
         raise InputError(src, "[structure]", "a [structure] table", got="nothing (section missing)")
-    check_keys(st, {"modes", "damping_ratio", "max_frequency", "engine_mass_in_modes"}, src, "structure")
+    check_keys(st, {"modes", "damping_ratio", "max_frequency", "engine_mass_in_modes"} | FE_KEYS, src, "structure")
     modes = _str(st, "modes", src, "structure.modes")
+    fe = modes != "rigid" and is_fe_file(modes)
+    extra = sorted(k for k in FE_KEYS if k in st)
+    if extra and not fe:
+        raise InputError(src, f"structure.{extra[0]}", "no FE import key with a .npz modal file or \"rigid\" "
+                         "(FE files: .uff, .unv, .pch)", got=repr(modes))
     if modes == "rigid":
-        return rigid_structure()
-    s = load_modes(resolve_reference(modes, src, field="structure.modes", kind="masv",
-                                     what="a modal file (.npz or .toml)"))
+        return rigid_structure(), {}
+    path = resolve_reference(modes, src, field="structure.modes", kind="masv",
+                             what="a modal file (.npz, .uff/.unv or .pch)")
+    info: dict = {}
+    if fe:
+        s, info = load_fe_modes(path, st, src)
+    else:
+        s = load_modes(path)
     inm = st.get("engine_mass_in_modes", False)
     if not isinstance(inm, bool):
         raise InputError(src, "structure.engine_mass_in_modes", "true or false", got=repr(inm))
@@ -213,6 +234,9 @@ def _structure(doc: Mapping, src: str) -> ModalStructure:
         from dataclasses import replace
         s = replace(s, engine_mass_in_modes=True)
     z = st.get("damping_ratio", DEFAULT_DAMPING_RATIO)
+    if z == "file" and info.get("format") == "nastran-punch":
+        raise InputError(src, "structure.damping_ratio", "a damping ratio (a Nastran punch file holds none)",
+                         got='"file"')
     if z != "file":
         zeta = to_si(z, "dimensionless", source=src, field="structure.damping_ratio", nonnegative=True)
         if zeta >= 1:
@@ -221,7 +245,7 @@ def _structure(doc: Mapping, src: str) -> ModalStructure:
     if "max_frequency" in st:
         s = s.truncated(to_si(st["max_frequency"], "frequency", source=src, field="structure.max_frequency",
                               positive=True))
-    return s
+    return s, info
 
 
 def load_config(path) -> MasvConfig:
@@ -234,7 +258,7 @@ def load_config(path) -> MasvConfig:
     src = str(p)
     raw, doc = read_toml(p, "a readable MASV configuration file")
     check_keys(doc, {"name", "description", "reference", "structure", "band", "engine", "actuator"}, src)
-    structure = _structure(doc, src)
+    structure, st_info = _structure(doc, src)
     band = doc.get("band", {})
     if not isinstance(band, Mapping):
         raise InputError(src, "[band]", "a [band] table with low and high", got=repr(band)[:60])
@@ -293,6 +317,6 @@ def load_config(path) -> MasvConfig:
                              got=repr(doc["reference"]))
         ref = str(rp)
     cfg = MasvConfig(str(doc.get("name", p.stem)), tuple(engines), tuple(actuators), structure, lo, hi, src,
-                     hashlib.sha256(raw).hexdigest(), ref)
+                     hashlib.sha256(raw).hexdigest(), ref, st_info)
     check_config(cfg)
     return cfg

@@ -8,17 +8,21 @@ is represented by its ``n`` normal modes::
 
 with ``w_i = 2 pi freq_hz[i]`` [rad/s], ``zeta_i`` viscous damping ratios (0.5 % by default,
 the paper's conservative assumption, section 3.3), and ``phi`` the mass-normalised mode shapes
-at the twelve coupling nodes (four gimbal points, eight actuator attach points): translations
-in m/sqrt(kg), rotations in rad/sqrt(kg), vehicle frame (x along the vehicle axis forward,
-y and z lateral). No modes means a rigid structure.
+at the coupling nodes (each engine's gimbal point and each actuator's attach point; any
+number, any names: the shipped SLS file has the twelve of :data:`NODE_NAMES`): translations
+in m/sqrt(kg), rotations in rad/sqrt(kg) (numerically 1/sqrt(kg) and 1/(sqrt(kg) m): with
+u = phi q the kinetic energy is 1/2 |q'|^2), vehicle frame (x along the vehicle axis forward,
+y and z lateral). No modes means a rigid structure. The format of every file and key:
+``docs/reference/masv_files.md``; FE results (Universal File 55, Nastran punch) are read by
+:mod:`masv.fe_import`.
 
 The engines are MASV's (:mod:`masv.system`): their rotation always, and their translational
 mass m_e at the gimbal unless the modal model already lumps it there
 (``engine_mass_in_modes``; the shipped FEM does not, the synthetic truss does).
 
 File contract (``fem_data/thrust_structure_modes.npz``, with a sidecar ``.toml`` holding its
-provenance): ``freq_hz`` (n,), ``damping_ratio`` (n,), ``node_names`` (12,),
-``node_xyz_m`` (12, 3), ``phi`` (n, 12, 6). :func:`load_modes` validates a user's file the
+provenance): ``freq_hz`` (n,), ``damping_ratio`` (n,), ``node_names`` (N,),
+``node_xyz_m`` (N, 3), ``phi`` (n, N, 6). :func:`load_modes` validates a user's file the
 same way (one-line :class:`~taos.errors.InputError` on NaN, wrong shapes, negative
 frequencies, missing node names).
 """
@@ -31,7 +35,7 @@ import numpy as np
 
 from taos.errors import InputError
 
-#: The twelve coupling nodes of the contract, in order.
+#: The twelve coupling nodes of the shipped SLS layout (four engines), in order.
 NODE_NAMES = tuple([f"gimbal_{e}" for e in range(1, 5)]
                    + [f"actuator_{e}_{ax}" for e in range(1, 5) for ax in ("pitch", "yaw")])
 
@@ -117,8 +121,11 @@ def rigid_structure(node_names=NODE_NAMES, node_xyz_m=None) -> ModalStructure:
 
 
 def validate_modes(freq_hz, damping_ratio, node_names, node_xyz_m, phi, source: str = "<code>",
-                   required_nodes=NODE_NAMES) -> ModalStructure:
+                   required_nodes=()) -> ModalStructure:
     """Check arrays against the file contract and return a :class:`ModalStructure`.
+
+    ``required_nodes``: names the file must hold (the configuration checks the nodes it names
+    itself; :data:`NODE_NAMES` is the shipped four-engine layout's).
 
     Raises InputError (one line: source, field, expectation) on a wrong shape, NaN/inf,
     a negative or zero frequency, a negative damping ratio, or a missing or repeated node name.
@@ -164,7 +171,7 @@ def validate_modes(freq_hz, damping_ratio, node_names, node_xyz_m, phi, source: 
     return ModalStructure(f[order], z[order], names, xyz, p[order], source)
 
 
-def load_modes(path, required_nodes=NODE_NAMES) -> ModalStructure:
+def load_modes(path, required_nodes=()) -> ModalStructure:
     """Read a modal file (.npz with the contract's keys) and validate it (see module docstring)."""
     src = str(path)
     try:

@@ -86,12 +86,19 @@ def engine_axis_block(model: TvcModel, axis: str, engine_cg_offset_m: float = 0.
     K_n (theta - r), ``twd_force_N`` = -m_e l_e theta'' [N]. ``engine_cg_offset_m`` l_e [m].
     The taos load-path damping (``[structure] load_damping_ratio``) is off here: MASV's structural
     damping is modal (the structure's own damping ratios)."""
-    import dataclasses
-    model = model.replace(structure=dataclasses.replace(model.structure, load_damping_ratio=0.0))
-    ss = simplex_state_space(model, axis, structure_inputs=True, engine_cg_offset_m=engine_cg_offset_m)
+    ss = full_block(model, axis, engine_cg_offset_m)
     ii = [ss.input_index(n) for n in BLOCK_INPUTS]
     oo = [ss.output_index(n) for n in BLOCK_OUTPUTS]
     return StateSpace(ss.A, ss.B[:, ii], ss.C[oo], ss.D[np.ix_(oo, ii)], ss.states, BLOCK_INPUTS, BLOCK_OUTPUTS)
+
+
+def full_block(model: TvcModel, axis: str, engine_cg_offset_m: float = 0.0) -> StateSpace:
+    """The simplex block with every input (command, friction torque, e, r, a_g) and the
+    structure outputs, load-path damping off (MASV's damping is modal): the block
+    :func:`engine_axis_block` and the time domain (:mod:`masv.coupled`) take their parts of."""
+    import dataclasses
+    model = model.replace(structure=dataclasses.replace(model.structure, load_damping_ratio=0.0))
+    return simplex_state_space(model, axis, structure_inputs=True, engine_cg_offset_m=engine_cg_offset_m)
 
 
 def coupling_shapes(cfg: MasvConfig, phi: np.ndarray | None = None) -> np.ndarray:
@@ -212,84 +219,33 @@ class MasvSystem:
     def state_space(self) -> StateSpace:
         """One StateSpace of the whole: states [each block's states, q, q'], inputs the eight
         commands ``<actuator>.command_rad``, outputs ``<actuator>.x_p_m`` then
-        ``<actuator>.theta_rad`` (all eight position loops closed)."""
+        ``<actuator>.theta_rad`` (all eight position loops closed); assembled by
+        :func:`masv.coupled.assemble` (the time domain's assembly, with only the commands open)."""
         if "ss" in self._cache:
             return self._cache["ss"]
-        na, nm, ng = self.n_actuators, self.omega_rad_s.size, self.phi_g.shape[0]
-        md = 2 * na
-        sizes = [b.A.shape[0] for b in self.blocks]
-        off = np.concatenate([[0], np.cumsum(sizes)])
-        nb = int(off[-1])
-        N = nb + 2 * nm
-        A = np.zeros((N, N))
-        B = np.zeros((N, na))
-        C = np.zeros((2 * na, N))
-        Bc = np.zeros((nb, md))       # block state rates per coupling coordinate e, r
-        Ba = np.zeros((nb, ng))       # ... per gimbal acceleration
-        Cf = np.zeros((md, nb))       # coupling forces F_L, K_n (theta - r) from block states
-        Dfc = np.zeros((md, md))      # ... directly from e, r
-        Ct = np.zeros((ng, nb))       # gimbal forces f_G from block states
-        Dtu = np.zeros((ng, na))      # ... from the commands
-        Dtc = np.zeros((ng, md))      # ... from e, r
-        Dtg = -np.diag(np.repeat(self.added_mass_kg, 3))   # ... from the gimbal accelerations
-        ic, ie, ir, ia = _IN["command_rad"], _IN["elongation_m"], _IN["gimbal_rotation_rad"], _IN["gimbal_accel_m_s2"]
-        of, ot, otw = _OUT["load_force_N"], _OUT["spring_torque_Nm"], _OUT["twd_force_N"]
-        for k, b in enumerate(self.blocks):
-            sl = slice(off[k], off[k + 1])
-            gs = slice(3 * int(self.engine_of[k]), 3 * int(self.engine_of[k]) + 3)
-            d = self.cg_dirs[k]
-            A[sl, sl] = b.A
-            B[sl, k] = b.B[:, ic]
-            C[k, sl] = b.C[_OUT["x_p_m"]]
-            C[na + k, sl] = b.C[_OUT["theta_rad"]]
-            Bc[sl, k] = b.B[:, ie]
-            Bc[sl, na + k] = b.B[:, ir]
-            Ba[sl, gs] = np.outer(b.B[:, ia], d)
-            Cf[k, sl] = b.C[of]
-            Cf[na + k, sl] = b.C[ot]
-            Dfc[k, k] = b.D[of, ie]
-            Dfc[na + k, na + k] = b.D[ot, ir]
-            Ct[gs, sl] += np.outer(d, b.C[otw])
-            Dtu[gs, k] += d * b.D[otw, ic]
-            Dtc[gs, k] += d * b.D[otw, ie]
-            Dtc[gs, na + k] += d * b.D[otw, ir]
-            Dtg[gs, gs] += b.D[otw, ia] * np.outer(d, d)
-        # coupling coordinates as a row map over the state: u_c = Phi_c q + g_res f_c with
-        # f_c = Cf x_b + Dfc u_c, i.e. u_c = W (Phi_c q + g_res Cf x_b), W = (I - g_res Dfc)^-1
-        U = np.zeros((md, N))
-        W = np.linalg.inv(np.eye(md) - self.g_res @ Dfc)
-        U[:, :nb] = W @ self.g_res @ Cf
-        if nm:
-            U[:, nb:nb + nm] = W @ self.phi_c
-        Fc = np.zeros((md, N))
-        Fc[:, :nb] = Cf
-        Fc += Dfc @ U
-        A[:nb] += Bc @ U
-        if nm:
-            iq = slice(nb, nb + nm)
-            iv = slice(nb + nm, N)
-            # S q'' = Qx X + Qu u with g = Phi_G q'' and f_G = Ct x_b + Dtu u + Dtc u_c + Dtg g
-            Ft = np.zeros((ng, N))
-            Ft[:, :nb] = Ct
-            Ft += Dtc @ U
-            Qx = self.phi_c.T @ Fc + self.phi_g.T @ Ft
-            Qx[:, iq] -= np.diag(self.omega_rad_s ** 2)
-            Qx[:, iv] -= np.diag(2.0 * self.zeta * self.omega_rad_s)
-            Qu = self.phi_g.T @ Dtu
-            S = np.eye(nm) - self.phi_g.T @ Dtg @ self.phi_g
-            Qx, Qu = np.linalg.solve(S, Qx), np.linalg.solve(S, Qu)
-            A[iq, iv] = np.eye(nm)
-            A[iv] += Qx
-            B[iv] += Qu
-            A[:nb] += Ba @ self.phi_g @ Qx
-            B[:nb] += Ba @ self.phi_g @ Qu
+        cm = self.coupled(("command_rad",))
+        na, nm = self.n_actuators, self.omega_rad_s.size
+        C = np.vstack([cm.output_rows(k, o)[0] for o in ("x_p_m", "theta_rad") for k in range(na)])
         names = self.actuator_names
         states = tuple(f"{names[k]}.{s}" for k, b in enumerate(self.blocks) for s in b.states) + tuple(
             f"mode_{i + 1}.q" for i in range(nm)) + tuple(f"mode_{i + 1}.qdot" for i in range(nm))
-        ss = StateSpace(A, B, C, np.zeros((2 * na, na)), states, tuple(f"{a}.command_rad" for a in names),
+        ss = StateSpace(cm.A, cm.B, C, np.zeros((2 * na, na)), states, tuple(f"{a}.command_rad" for a in names),
                         tuple(f"{a}.x_p_m" for a in names) + tuple(f"{a}.theta_rad" for a in names))
         self._cache["ss"] = ss
         return ss
+
+    def coupled(self, ext=("command_rad",), torque_reaction: bool = False):
+        """The whole as a :class:`masv.coupled.CoupledModel` with the block inputs ``ext`` open
+        (:func:`masv.coupled.assemble`)."""
+        from .coupled import assemble
+
+        full = tuple(full_block(self.config.engine(a.engine).model, a.axis, self._cg_arm(k))
+                     for k, a in enumerate(self.config.actuators))
+        return assemble(full, self.phi_c, self.phi_g, self.omega_rad_s, self.zeta, self.g_res, self.engine_of,
+                        self.cg_dirs, self.added_mass_kg, ext, torque_reaction)
+
+    def _cg_arm(self, k: int) -> float:
+        return float(cg_lever_arms(self.config)[0][k])
 
     # -- fast exact frequency response --------------------------------------------------------
     def receptance(self, freq_hz) -> np.ndarray:

@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from taos.fem.build import build_fem_data  # noqa: E402
+from taos.units import N_PER_M_PER_LBF_PER_IN  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -26,8 +27,8 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     s = build_fem_data(args.out, coarse=args.coarse)
     sh = s["shift"]
-    print(f"K_L ambient {sh.K_L_ambient_N_per_m / 175.126835:,.0f} lbf/in -> hot fire "
-          f"{sh.K_L_hotfire_N_per_m / 175.126835:,.0f} lbf/in; modes {[round(float(f), 2) for f in s['modes'].freq_hz]} Hz")
+    print(f"K_L ambient {sh.K_L_ambient_N_per_m / N_PER_M_PER_LBF_PER_IN:,.0f} lbf/in -> hot fire "
+          f"{sh.K_L_hotfire_N_per_m / N_PER_M_PER_LBF_PER_IN:,.0f} lbf/in; modes {[round(float(f), 2) for f in s['modes'].freq_hz]} Hz")
     print(f"wrote {args.out} in {time.perf_counter() - t0:.1f} s")
     return 0
 

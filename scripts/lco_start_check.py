@@ -29,12 +29,12 @@ import numpy as np
 from taos.flight.lco_map import SweepAxis, lco_map
 from taos.flight.vehicle import load_flight
 from taos.model import Structure, load_model
+from taos.units import N_PER_M_PER_LBF_PER_IN as LBF_IN
 
 ROOT = Path(__file__).resolve().parents[1]
 MODEL = ROOT / "models" / "rs25_flight.toml"
 FLIGHT = ROOT / "models" / "flight" / "core_stage.toml"
 DEG = math.pi / 180
-LBF_IN = 4.4482216152605 / 0.0254
 AMPS = tuple(np.logspace(np.log10(0.01), 0.0, 8) * DEG)
 FREQ = tuple(np.logspace(np.log10(0.06), np.log10(0.5), 6))
 GRID_A = tuple(np.array([0.02, 0.05, 0.1, 0.2, 0.5]) * DEG)

@@ -31,12 +31,12 @@ from taos.flight.lco import analyse_lco
 from taos.flight.lco_map import SweepAxis, lco_map
 from taos.flight.vehicle import load_flight
 from taos.model import Structure, load_model
+from taos.units import N_PER_M_PER_LBF_PER_IN as LBF_IN
 
 ROOT = Path(__file__).resolve().parents[1]
 MODEL = ROOT / "models" / "rs25_flight.toml"
 FLIGHT = ROOT / "models" / "flight" / "core_stage.toml"
 DEG = math.pi / 180
-LBF_IN = 4.4482216152605 / 0.0254
 AMPS = np.logspace(np.log10(0.01), 0.0, 8) * DEG
 FREQ = np.logspace(np.log10(0.06), np.log10(0.5), 6)
 LAWS = ("coulomb-switching", "coulomb-smooth", "dahl", "lugre", "modified-lugre")

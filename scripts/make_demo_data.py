@@ -49,6 +49,7 @@ from taos.identify.data import from_time_history  # noqa: E402
 from taos.model import load_model  # noqa: E402
 from taos.profiles import load_profile  # noqa: E402
 from taos.planar.simulate import simulate  # noqa: E402
+from taos.units import M_PER_IN, N_PER_M_PER_LBF_PER_IN, NM_PER_IN_LBF  # noqa: E402
 
 DEG = math.pi / 180
 
@@ -86,14 +87,14 @@ def make(condition: str, out_dir: Path, engine: str = "simplex") -> Path:
     data = from_time_history(th, engine_offset_rad=off, condition="hot fire" if condition == "hotfire" else condition,
                              source=condition)
     noisy = data.__class__(**{**data.__dict__,
-                              "piston_m": data.piston_m + PISTON_NOISE_IN * 0.0254 * rng.standard_normal(data.piston_m.shape),
+                              "piston_m": data.piston_m + PISTON_NOISE_IN * M_PER_IN * rng.standard_normal(data.piston_m.shape),
                               "engine_rad": data.engine_rad + ENGINE_NOISE_DEG * DEG * rng.standard_normal(data.engine_rad.shape),
                               "metadata": {
                                   "description": "SYNTHETIC vectoring record made by scripts/make_demo_data.py, not test data",
                                   "engine_model": engine, "model_file": f"models/{spec['model']}",
                                   "friction_model": model.friction.name,
-                                  "true_load_stiffness": f"{model.structure.load_stiffness_N_per_m / 175.126835:.6g} lbf/in",
-                                  "true_coulomb_torque": (f"{model.friction.coulomb_torque_Nm / 0.112984829:.6g} in*lbf"
+                                  "true_load_stiffness": f"{model.structure.load_stiffness_N_per_m / N_PER_M_PER_LBF_PER_IN:.6g} lbf/in",
+                                  "true_coulomb_torque": (f"{model.friction.coulomb_torque_Nm / NM_PER_IN_LBF:.6g} in*lbf"
                                                           if model.friction.name != "none" else "none"),
                                   "profile": "models/profiles/greenrun_two_axis.toml",
                                   "piston_noise_rms": f"{PISTON_NOISE_IN} in", "engine_noise_rms": f"{ENGINE_NOISE_DEG} deg",

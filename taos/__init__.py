@@ -8,6 +8,8 @@ The public API, by task (each name is importable from ``taos``)::
     taos.simulate(model, taos.load_profile("greenrun_two_axis"))  # a time history
     taos.describing_function_map(model, amplitudes_rad, freq_hz)  # N(A, w)
     taos.analyse_lco(taos.load_flight("core_stage"), model)       # limit-cycle prediction
+    study = taos.fly_ascent(taos.load_ascent("ascent"), [tvc], reference=tvc_no_friction)
+    study.runs, study.summary()                            # one flown ascent per TVC, their windows
     taos.fit_frequency_response(model, responses, ["load_stiffness"])
     taos.compare_models(model_a, model_b)
     taos.write_html(run, "run.html")                       # offline 3-D view
@@ -84,6 +86,7 @@ _API = {
     "load_test_data": "taos.identify.data", "estimate": "taos.identify.estimation",
     "fit_frequency_response": "taos.identify.fit", "compare_models": "taos.identify.compare",
     "load_ascent": "taos.flight.ascent", "simulate_ascent": "taos.flight.ascent_sim",
+    "fly_ascent": "taos.flight.ascent_sim", "AscentStudy": "taos.flight.ascent_sim",
     "load_campaign": "taos.montecarlo", "run_campaign": "taos.montecarlo",
     "load_run": "taos.viewer", "write_html": "taos.viewer", "serve": "taos.viewer",
     "loop_margins": "taos.stability", "LoopMargins": "taos.stability",

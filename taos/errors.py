@@ -9,7 +9,10 @@ was expected. The CLI prints ``str(err)`` and exits with status 2
 from __future__ import annotations
 
 import difflib
+import functools
 import os
+import stat
+import sys
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Callable, Iterable, Mapping
@@ -366,3 +369,44 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
               file=sys.stderr)
         return 128 + handler.received
     return rc
+
+
+def stat_key(path: "str | os.PathLike") -> tuple | None:
+    """What identifies a regular file's contents without reading them: (path, device, inode,
+    size, modification and change times in ns); ``None`` for anything else (a FIFO, a device, a
+    missing file), which is never cached. Any rewrite of the file changes the key."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    if not stat.S_ISREG(st.st_mode):
+        return None
+    return (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+
+
+def read_toml(path: "str | os.PathLike", what: str) -> tuple[bytes, dict]:
+    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it is not
+    a readable regular file of at most :data:`taos.errors.MAX_TOML_BYTES` (``what`` says what was
+    expected, e.g. "a readable model file"), is not TOML, or nests deeper than
+    :data:`taos.errors.MAX_TOML_DEPTH`. A FIFO or device never blocks or floods the run."""
+    import copy
+
+    key = stat_key(path)
+    if key is None:   # not a regular file: read_input_bytes says what is wrong with it
+        return _read_toml(str(path), what)
+    raw, doc = _read_toml_cached(key, what)
+    sys.audit("open", str(path), "rb", os.O_RDONLY)   # read, as far as anyone recording inputs can tell
+    return raw, copy.deepcopy(doc)
+
+
+def _read_toml(path: str, what: str) -> tuple[bytes, dict]:
+    raw = read_input_bytes(path, what)
+    return raw, parse_toml(raw, path)
+
+
+@functools.lru_cache(maxsize=64)
+def _read_toml_cached(key: tuple, what: str) -> tuple[bytes, dict]:
+    """:func:`_read_toml` of the regular file ``key[0]`` remembered under its stat key (model
+    variants read the same model file and parameter sets again; any rewrite changes the key;
+    errors are not remembered). Callers get a copy of the table."""
+    return _read_toml(key[0], what)

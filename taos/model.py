@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from .planar.avionics import Avionics
-from .errors import InputError
+from .errors import InputError, read_toml  # noqa: F401  (read_toml: model files and the 3-D loader)
 from .friction import FrictionLaw, friction_from_table
 from .shipped import resolve
 from .units import to_si
@@ -205,17 +205,24 @@ class TvcModel:
         """The model file with the keys ``values`` (``{"structure.load_stiffness": "160000
         lbf/in", ...}``; a plain number is SI) given other values, through the loader and its
         bounds: the one way to make a variant (:mod:`taos.variants`)."""
-        from .variants import check_unchanged, check_variant_source, code_changes, merge_overrides, variant_sha256
+        from .variants import (check_unchanged, check_variant_source, code_changes, keep_code_changes,
+                               merge_overrides, variant_sha256)
 
         check_variant_source(self, values)
         code = code_changes(self)
-        overrides = merge_overrides(tuple(kv for kv in self.overrides if not kv[0].startswith("code.")), values)
-        table = dict(overrides)
-        out = load_model(self.source, friction=table.pop("friction.model", None), overrides=table)
+        old = tuple(kv for kv in self.overrides if not kv[0].startswith("code."))
+        overrides = merge_overrides(old, values)
+
+        def load(over):
+            table = dict(over)
+            return load_model(self.source, friction=table.pop("friction.model", None), overrides=table)
+        out = load(overrides)
         check_unchanged(self, out)
         if not code:
             return out
-        out = dataclasses.replace(out, **code)   # the changes made in code stay, recorded as before
+        # the changes made in code stay, with the variant's own effect laid over them
+        code = keep_code_changes(code, load(old), out)
+        out = dataclasses.replace(out, **code)
         marks = tuple((f"code.{k}", v) for k, v in code.items())
         return dataclasses.replace(out, overrides=overrides + marks, sha256=variant_sha256(out.base_sha256,
                                                                                         overrides + marks))
@@ -229,11 +236,11 @@ class TvcModel:
         """Copy with dataclass fields replaced in code. The copy records it (``code.FIELD`` in
         :attr:`overrides`) and carries its own hash; a change a model file can express is a
         variant, :meth:`with_values`."""
-        from .variants import variant_sha256
+        from .variants import _same, variant_sha256
 
         out = dataclasses.replace(self, **changes)
         marks = tuple((f"code.{k}", v) for k, v in sorted(changes.items())   # an equal value changes nothing
-                      if k not in ("overrides", "sha256", "base_sha256") and getattr(self, k) != v)
+                      if k not in ("overrides", "sha256", "base_sha256") and not _same(getattr(self, k), v))
         if not marks:
             return out
         overrides = tuple(kv for kv in out.overrides if kv[0] not in dict(marks)) + marks
@@ -360,17 +367,6 @@ def parse_avionics(doc: Mapping, src: str) -> Avionics:
                     gain_table_rad=amps, gain_table=gains)
 
 
-def read_toml(path: str | Path, what: str) -> tuple[bytes, dict]:
-    """Bytes and parsed table of a TOML input file; :class:`InputError` (one line) if it is not
-    a readable regular file of at most :data:`taos.errors.MAX_TOML_BYTES` (``what`` says what was
-    expected, e.g. "a readable model file"), is not TOML, or nests deeper than
-    :data:`taos.errors.MAX_TOML_DEPTH`. A FIFO or device never blocks or floods the run."""
-    from .errors import parse_toml, read_input_bytes
-
-    raw = read_input_bytes(path, what)
-    return raw, parse_toml(raw, str(path))
-
-
 #: ``[friction]`` key naming the shared friction parameter set of one piece of hardware
 PARAMETER_SET_KEY = "parameter_set"
 #: key of a parameter set: the torque level its load-proportional values hold at
@@ -489,9 +485,7 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
     bearing normal load scales every one of them alike, so the pre-sliding angle T_c / sigma_0 and
     the law's shape stay those of the hardware; this is what the 3-D model does with the normal
     load (:meth:`taos.friction.FrictionLaw.scaled`), here applied to the planar torque level."""
-    import dataclasses as _dc
-
-    from .friction import param_classes
+    from .model_keys import torque_like_kinds
     from .units import DIMENSIONS
 
     ref = to_si(ref_torque, "torque", source=set_src, field=f"friction.{REFERENCE_TORQUE_KEY}", positive=True)
@@ -499,8 +493,7 @@ def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> N
         raise InputError(src, "friction.coulomb_torque", "this condition's torque level (the parameter set is "
                          "scaled to it)", got="nothing (key missing)")
     level = to_si(table["coulomb_torque"], "torque", source=src, field="friction.coulomb_torque", nonnegative=True)
-    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
-             if f.metadata.get("torque_like") and f.metadata["key"] not in ("coulomb_torque", "static_torque")}
+    kinds = torque_like_kinds(exclude=("coulomb_torque", "static_torque"))
     for key, kind in kinds.items():
         if key in table:
             v = to_si(table[key], kind, source=set_src, field=f"friction.{key}", nonnegative=True)

@@ -93,3 +93,13 @@ def key_kind(dotted: str) -> str | None:
     return kinds[key]
 
 
+def torque_like_kinds(exclude: tuple[str, ...] = ("coulomb_torque",)) -> dict[str, str]:
+    """``[friction]`` key -> unit kind of every registered law's torque-like parameters (those
+    proportional to the bearing normal load: torque levels, bristle stiffness and damping,
+    viscous and stick damping), less ``exclude``: what follows the friction level."""
+    import dataclasses
+
+    from .friction import param_classes
+
+    return {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in dataclasses.fields(cls)
+            if f.metadata.get("torque_like") and f.metadata["key"] not in exclude}

@@ -26,6 +26,7 @@ permission, a name too long) is bad input: :class:`~taos.errors.InputError`, exi
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import json
 import math
@@ -35,6 +36,7 @@ import secrets
 import shutil
 import stat
 import subprocess
+import sys
 import tempfile
 from contextlib import contextmanager
 from functools import cache
@@ -44,7 +46,7 @@ from typing import TYPE_CHECKING, Callable, Mapping
 if TYPE_CHECKING:  # h5py is imported where a file is written (start-up of the CLI)
     import h5py
 
-from .errors import _FORCE, InputError, check_not_input, note_input, output_policy  # noqa: F401
+from .errors import _FORCE, InputError, stat_key, check_not_input, note_input, output_policy  # noqa: F401
 
 MARK = ".taos-output.json"
 MAX_MARK_BYTES = 16 * 2 ** 20
@@ -110,7 +112,21 @@ def base_provenance() -> dict:
 
 
 def file_sha256(path: str | Path) -> str:
-    """SHA-256 of a file's bytes (hex), or '' when it cannot be read."""
+    """SHA-256 of a file's bytes (hex), or '' when it cannot be read. A regular file's hash is
+    remembered under its :func:`stat_key` (model variants hash the same files again and again)."""
+    key = stat_key(path)
+    if key is None:
+        return _file_sha256(path)
+    sys.audit("open", str(path), "rb", os.O_RDONLY)   # read, as far as anyone recording inputs can tell
+    return _cached_sha256(key)
+
+
+@functools.lru_cache(maxsize=256)
+def _cached_sha256(key: tuple) -> str:
+    return _file_sha256(key[0])
+
+
+def _file_sha256(path: str | Path) -> str:
     h = hashlib.sha256()
     try:
         with open(path, "rb") as f:
@@ -121,7 +137,7 @@ def file_sha256(path: str | Path) -> str:
     return h.hexdigest()
 
 
-def model_provenance(model: Any) -> dict:
+def model_provenance(model: object) -> dict:
     """What every output says of the model that produced it: ``model_file``, ``model_name``,
     ``model_sha256`` (the variant's own hash), and for a modified model also
     ``model_file_sha256`` (the files' combined hash) and ``model_overrides`` (key -> value as a

@@ -26,6 +26,22 @@ from pathlib import Path
 
 from .errors import InputError
 
+# -- the unit table: every hand-written conversion factor of the package, once -----------------
+# From the exact definitions (1 lbf = 4.4482216152605 N, 1 in = 0.0254 m; pint's are the same,
+# its float arithmetic a few ulp away: tests/test_units_table.py checks each against pint). The
+# derived factors are the float expressions below (within 2 ulp of the exact decimal value).
+
+#: newtons per pound-force [N/lbf] (exact: 0.45359237 kg x 9.80665 m/s^2)
+N_PER_LBF = 4.4482216152605
+#: metres per inch [m/in] (exact)
+M_PER_IN = 0.0254
+#: stiffness, (N/m) per (lbf/in) [N/m per lbf/in] = N_PER_LBF / M_PER_IN
+N_PER_M_PER_LBF_PER_IN = N_PER_LBF / M_PER_IN
+#: torque, (N m) per (in lbf) [N m per in lbf] = N_PER_LBF * M_PER_IN
+NM_PER_IN_LBF = N_PER_LBF * M_PER_IN
+#: pressure, pascals per psi [Pa/psi] = N_PER_LBF / M_PER_IN^2
+PA_PER_PSI = N_PER_LBF / (M_PER_IN * M_PER_IN)
+
 
 @functools.cache
 def _registry():

@@ -37,7 +37,7 @@ import numbers
 from typing import Any, Mapping
 
 from .errors import InputError
-from .model_keys import key_kind
+from .model_keys import key_kind, torque_like_kinds
 
 #: where a variant's errors say they come from when the value was given in code
 VARIANT_SOURCE = "model variant"
@@ -105,24 +105,54 @@ def variant_sha256(base_sha256: str, overrides: tuple[tuple[str, Any], ...]) -> 
 
 
 def check_variant_source(model: Any, values: Mapping[str, Any]) -> None:
-    """Refuse a variant of a model built in code (no file to vary), or one giving a key of a
-    section changed in code (:meth:`~taos.model.TvcModel.replace`): :class:`InputError`."""
+    """Refuse a variant of a model built in code (no file to vary), or a law swap of a model whose
+    law was replaced in code (:meth:`~taos.model.TvcModel.replace`): :class:`InputError`."""
     if model.source in ("", "<code>") or not model.input_files:
         raise InputError(VARIANT_SOURCE, ", ".join(map(str, values))[:80] or "values",
                          "a model loaded from a model file (a variant is that file with other values)",
                          got=f"a model built in code ({model.source})")
     code = {k[5:] for k, _ in model.overrides if k.startswith("code.")}
-    clash = sorted(k for k in values if str(k).partition(".")[0] in code)
-    if clash:   # the file's value would silently undo, or be undone by, the change made in code
-        raise InputError(VARIANT_SOURCE, ", ".join(clash)[:80], "keys of sections not changed in code (make the "
-                         "change with with_values instead of replace)",
-                         got="section(s) changed in code: " + ", ".join(sorted(code)))
+    if "friction" in code and "friction.model" in values:   # a law swap would drop the law set in code
+        raise InputError(VARIANT_SOURCE, "friction.model", "a model whose friction law was not replaced in code "
+                         "(swap the law with with_values instead of replace)", got="a law set in code")
 
 
 def code_changes(model: Any) -> dict:
     """field -> value of the changes made in code (:meth:`~taos.model.TvcModel.replace`), which a
-    variant keeps: re-applied over the model file's variant."""
+    variant keeps (:func:`keep_code_changes`)."""
     return {k[5:]: v for k, v in model.overrides if k.startswith("code.")}
+
+
+def keep_code_changes(code: Mapping[str, Any], before: Any, after: Any) -> dict:
+    """The sections changed in code, with the variant's own effect laid over them: each field the
+    new keys changed (``after`` against ``before``, the file's variant with and without them, both
+    through the loader) set on the object made in code; the code's other fields stay. A field the
+    object made in code does not have (a friction law of another class) is refused."""
+    import dataclasses
+
+    out = {}
+    for sec, obj in code.items():
+        new, old = getattr(after, sec, None), getattr(before, sec, None)
+        if not dataclasses.is_dataclass(new) or not dataclasses.is_dataclass(obj):
+            out[sec] = obj
+            continue
+        changed = {f.name: getattr(new, f.name) for f in dataclasses.fields(new)
+                   if not _same(getattr(new, f.name), getattr(old, f.name))}
+        names = {f.name for f in dataclasses.fields(obj)}
+        missing = sorted(set(changed) - names)
+        if missing:
+            raise InputError(VARIANT_SOURCE, f"{sec}.{missing[0]}", f"a key of the {sec} made in code",
+                             got=f"a field its {type(obj).__name__} does not have")
+        out[sec] = dataclasses.replace(obj, **changed) if changed else obj
+    return out
+
+
+def _same(a: Any, b: Any) -> bool:
+    """``a == b`` as a plain truth value (False where it has none: CasADi symbols, arrays)."""
+    try:
+        return bool(a == b)
+    except Exception:   # noqa: BLE001 - any value without a plain truth value differs
+        return False
 
 
 def check_unchanged(model: Any, out: Any) -> None:
@@ -160,9 +190,6 @@ def level_follows(doc: dict, overrides: Mapping[str, Any], src: str) -> dict:
     ftab = dict(doc["friction"])
     if "coulomb_torque" not in ftab:
         return doc
-    import dataclasses as _dc
-
-    from .friction import param_classes
     from .units import DIMENSIONS, to_si
 
     old = to_si(ftab["coulomb_torque"], "torque", source=src, field="friction.coulomb_torque", nonnegative=True)
@@ -170,8 +197,7 @@ def level_follows(doc: dict, overrides: Mapping[str, Any], src: str) -> dict:
                 nonnegative=True)
     if not old > 0:
         return doc
-    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
-             if f.metadata.get("torque_like") and f.metadata["key"] != "coulomb_torque"}
+    kinds = torque_like_kinds()
     for key, kind in kinds.items():
         if key in ftab and f"friction.{key}" not in overrides:
             v = to_si(ftab[key], kind, source=src, field=f"friction.{key}", nonnegative=True)

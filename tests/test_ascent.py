@@ -177,6 +177,25 @@ def test_ascent_cli_writes_runs_and_refuses_foreign_names(tmp_path):
     assert (tmp_path / "mine" / "summary.json").read_text() == "my notes"
 
 
+def test_fly_ascent_is_the_cli_study(tmp_path, ascent):
+    """``taos ascent`` is :func:`taos.fly_ascent` plus files: the library's study summarises to
+    the command's summary.json; a law ``none`` in the list is the reference run itself."""
+    import json
+
+    import taos
+    from taos.cli import main
+    out = tmp_path / "asc"
+    assert main(["ascent", "ascent", "--friction", "dahl,none", "--start", "120", "--end", "150", "--dt", "1e-3",
+                 "--out", str(out)]) == 0
+    tvc = lambda law: load_model(ascent.tvc_model, friction=law)  # noqa: E731
+    study = taos.fly_ascent(ascent, [tvc("dahl"), tvc("none")], reference=tvc("none"), start_s=120.0,
+                            end_s=150.0, dt_s=1e-3)
+    assert isinstance(study, taos.AscentStudy) and study.runs[1] is study.reference
+    assert [h.friction_model for h in study.runs] == ["dahl", "none"] and study.axes == ("yaw",)
+    assert study.summary() == json.loads((out / "summary.json").read_text())
+    assert {p.name for p in out.iterdir()} >= {f["file"] for f in study.summary()["runs"]}
+
+
 @pytest.mark.parametrize("patch, field", [
     ("[boosters]\ncount = -1", "boosters.count"),
     ("[wind]\ngust_duratoin = \"4 s\"", "wind.gust_duratoin"),

@@ -47,7 +47,7 @@ def flight():
 
 def _exp_run(args, Cy, fid, fp, avp, amp, npc, dt, n_steps, every=1):
     """Engine angle [rad] every ``every`` ETDRK4 steps from rest (r = amp sin(2 pi k / npc))."""
-    A, bc = args[0], args[2]
+    A, bc = args.A, args.bc
     co = X.etd_coefficients(A, dt)
     G, D = X.command_table(A, bc, 0.5 * dt, X.table_nodes(A, 0.5 * dt))
     x = np.zeros(A.shape[0])
@@ -65,20 +65,20 @@ def _rk4_run(args, Cy, fid, fp, avp, amp, npc, dt, n_steps, every):
     """The same with the fixed-step RK4 kernel on the sampled sine
     (taos.planar.dynamics.integrate_samples; linear interpolation between samples, 1e-8 of the
     amplitude at the reference step)."""
-    nr = args[1].shape[1]
+    nr = args.Br.shape[1]
     k = np.arange(n_steps + 1)
     r = np.ascontiguousarray(np.repeat((amp * np.sin(2 * math.pi * k / npc))[:, None], nr, axis=1))
     nrec = n_steps // every + 1
     y = np.empty((nrec, Cy.shape[0]))
     aux = np.empty((nrec, _ig.N_AUX))
-    st = _ig.integrate_samples(*args, Cy, fid, fp, avp, np.zeros(args[0].shape[0]), 0.0, r, dt, every, y, aux)
+    st = _ig.integrate_samples(*args, Cy, fid, fp, avp, np.zeros(args.A.shape[0]), 0.0, r, dt, every, y, aux)
     assert st < 0
     return y[:, 1]
 
 
 def test_phi_functions_match_their_recurrences(flight):
     _, args, _ = flight
-    A = args[0]
+    A = args.A
     for h in (1e-4, 3e-3, 1e-2):
         E, p1, p2, p3 = X.phi_functions(A, h)
         Xh = h * A
@@ -94,7 +94,7 @@ def _engine_exact(args, Cy, amp, f, ts):
     """Exact engine angle [rad] at times ``ts`` of the linear block driven by b_c u(t), u = amp
     sin(2 pi f t), from rest: the steady orbit minus the free response that cancels its initial
     state, expm(A t) x_orbit(0)."""
-    A, bc = args[0], args[2]
+    A, bc = args.A, args.bc
     Xc = P.orbit(A, bc, amp, f)
     x0o = np.imag(Xc)
     return np.array([Cy[1] @ (np.imag(Xc * np.exp(2j * math.pi * f * t)) - expm(A * t) @ x0o) for t in ts])
@@ -105,7 +105,7 @@ def test_linear_block_fourth_order_against_exact_solution(flight):
     fourth order (error ratio ~16 per halving); the linear block itself is exact, so the
     error is the sine command's quadrature only."""
     m, args, Cy = flight
-    args = args[:8] + (np.zeros(0),)
+    args = args._replace(lim=np.zeros(0))
     none = load_model(MODELS / "rs25_flight.toml", friction="none")
     fid, fp = none.friction.entry.rates, none.friction.pack()
     avp = np.zeros(4)
@@ -131,7 +131,7 @@ def test_quantised_command_is_exact_in_the_linear_block(flight):
     too few for the sine's quadrature) matches a 4x finer one to the table's interpolation
     error, and both match a fine RK4 run to its own time-discretisation error."""
     m, args, Cy = flight
-    args = args[:8] + (np.zeros(0),)
+    args = args._replace(lim=np.zeros(0))
     none = load_model(MODELS / "rs25_flight.toml", friction="none")
     fid, fp = none.friction.entry.rates, none.friction.pack()
     avp = m.avionics.pack()
@@ -215,7 +215,7 @@ def test_switching_law_step_is_its_stick_band_rate_not_its_jump(kl_lbf_in):
     m = load_model(MODELS / "rs25_flight.toml", friction="coulomb-switching")
     m = m.replace(structure=Structure(kl_lbf_in * 4.4482216152605 / 0.0254))
     args = kernel_args(simplex_plant(m), m)
-    cw, ca, bf = args[6], args[7], args[3]
+    cw, ca, bf = args.cw, args.ca, args.bf
     law = m.friction
     rate = abs(law.stick_damping_Nms_per_rad * float(cw @ bf) + float(ca @ bf))
     amps = np.logspace(np.log10(0.01), 0.0, 8) * DEG          # the LCO tests' map (tests/test_lco.py)

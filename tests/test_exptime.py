@@ -74,7 +74,7 @@ def _rk4(args, Cy, law, avp, r, dt, every):
     """Engine angle [rad] every ``every`` steps of the fixed-step RK4 kernel on the samples ``r``."""
     nrec = (r.size - 1) // every + 1
     y, aux = np.empty((nrec, Cy.shape[0])), np.empty((nrec, _dy.N_AUX))
-    st = _dy.integrate_samples(*args, Cy, law.friction.entry.rates, law.friction.pack(), avp, np.zeros(args[0].shape[0]),
+    st = _dy.integrate_samples(*args, Cy, law.friction.entry.rates, law.friction.pack(), avp, np.zeros(args.A.shape[0]),
                                0.0, np.ascontiguousarray(r[:, None]), dt, every, y, aux)
     assert st < 0
     return y[:, 1]
@@ -88,10 +88,10 @@ def _exp(args, Cy, law, avp, p, r, dt, every, breaks, cap=math.inf):
 
 def test_ramp_and_step_exact_in_the_linear_block(ambient):
     _, none, p, Cy, args = ambient
-    lin = args[:8] + (np.zeros(0),)
+    lin = args._replace(lim=np.zeros(0))
     prof = Sequence((MultiRamp((0.3 * DEG, -0.1 * DEG), 3 * DEG, 0.05), Step(-0.2 * DEG, 0.1, 0.2)))
     r = _samples(prof, prof.duration_s, DT)
-    ex = _exact_foh(args[0], args[1][:, 0] + args[2] * args[5].sum(), r, DT, 40) @ Cy[1]
+    ex = _exact_foh(args.A, args.Br[:, 0] + args.bc * args.dc.sum(), r, DT, 40) @ Cy[1]
     for cap in (8e-3, 4e-3, 2e-3, 1e-3):
         th, _ = _exp(lin, Cy, none, np.zeros(4), p, r, DT, 40, XT.breakpoints(prof), cap)
         # measured 2.4e-11 at every step (RK4 at 2e-4 s: 8.0e-11)
@@ -100,11 +100,11 @@ def test_ramp_and_step_exact_in_the_linear_block(ambient):
 
 def test_sine_fourth_order_against_the_exact_solution(ambient):
     _, none, p, Cy, args = ambient
-    lin = args[:8] + (np.zeros(0),)
+    lin = args._replace(lim=np.zeros(0))
     f, amp, dt, T = 4.0, 0.3 * DEG, 1e-5, 0.5
     prof = SineDwell(amp, f, 2)
     r = _samples(prof, T, dt)
-    A, b = args[0], args[1][:, 0] + args[2] * args[5].sum()
+    A, b = args.A, args.Br[:, 0] + args.bc * args.dc.sum()
     Xc = PL.orbit(A, b, amp, f)
     ex = np.array([Cy[1] @ (np.imag(Xc * np.exp(2j * math.pi * f * t)) - expm(A * t) @ np.imag(Xc))
                    for t in np.arange(0, T + 1e-9, 8e-3)])
@@ -118,7 +118,7 @@ def test_sine_fourth_order_against_the_exact_solution(ambient):
 
 def test_quantised_staircase_exact(ambient):
     m, none, p, Cy, args = ambient
-    lin = args[:8] + (np.zeros(0),)
+    lin = args._replace(lim=np.zeros(0))
     avp = m.avionics.pack()
     prof = Sequence((MultiRamp((0.05 * DEG, -0.03 * DEG), 0.2 * DEG, 0.05), Step(0.04 * DEG, 0.05, 0.2)))
     T = prof.duration_s
@@ -191,7 +191,7 @@ def test_limits_reached_fall_back_to_rk4(ambient):
 
 def test_unstable_plant_raises_at_the_rk4_time(ambient):
     _, none, p, Cy, args = ambient
-    bad = (args[0] + 300.0 * np.eye(args[0].shape[0]),) + args[1:8] + (np.zeros(0),)
+    bad = args._replace(A=args.A + 300.0 * np.eye(args.A.shape[0]), lim=np.zeros(0))
     prof = Step(0.1 * DEG, 0.0, 5.0)
     r = _samples(prof, 5.0, DT)
     with pytest.raises(SimulationUnstable) as ei:

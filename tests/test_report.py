@@ -149,6 +149,9 @@ def test_greenrun_with_the_3d_engine(tmp_path, short_profile):
     assert res.engine == "taos" and res.summary()["engine_model"] == "taos"
     assert s["engine_model"] == "taos"
     assert "taos engine model" in (out / "index.html").read_text()
+    # the verdict is the 3-D model's too (issue 39.3): every spec point names the engine that made it
+    assert s["spec_engine"] == "taos" and {p["engine"] for p in s["spec_points"]} == {"taos"}
+    assert s["spec_verdict_text"].startswith(res.model.name + " (3-D taos model)")
 
 
 def test_report_shows_figures_of_merit_and_spec_mask_result(report, hotfire, page_image):

@@ -159,13 +159,16 @@ def test_a_bad_variant_is_one_input_error_naming_the_key(hot, values, field):
     assert field in str(e.value) and "\n" not in str(e.value)
 
 
-def test_a_variant_of_a_code_change_or_a_changed_file_is_refused(hot, tmp_path):
+def test_a_variant_keeps_the_code_changes_and_a_changed_file_is_refused(hot, tmp_path):
     coded = hot.replace(structure=hot.structure.__class__(3e7, 0.0))
-    with pytest.raises(InputError, match="changed in code"):
-        coded.with_values({"structure.load_stiffness": 3e7})
     kept = coded.with_values({"engine.rotational_stiffness": 4e5})   # another section: the code change stays
     assert kept.structure == coded.structure and kept.engine.rotational_stiffness_Nm_per_rad == 4e5
     assert kept.sha256 not in (hot.sha256, coded.sha256)
+    over = coded.with_values({"structure.load_stiffness": 2e7})   # the key's field laid over the code's
+    assert over.structure == hot.structure.__class__(2e7, 0.0)
+    law = hot.replace(friction=hot.with_friction("dahl").friction)
+    with pytest.raises(InputError, match="friction.model"):
+        law.with_values({"friction.model": "lugre"})
     p = tmp_path / "m.toml"
     shutil.copy(models_dir() / "rs25_ambient.toml", p)
     m = load_model(p)
@@ -205,3 +208,25 @@ def test_describing_function_maps_are_reused_only_for_the_same_content(hot):
         analyse_lco(fl, other, amplitudes_rad=amps, freq_hz=freqs, time_domain=False, df=df)
     rep = analyse_lco(fl, flight_model, amplitudes_rad=amps, freq_hz=freqs, time_domain=False, df=df)
     assert rep.prediction.df is df and math.isfinite(rep.prediction.df.engine[0, 0].real)
+
+
+def test_ascent_load_stiffness_is_a_variant_that_keeps_the_files_damping_ratio(tmp_path):
+    """`taos ascent --load-stiffness` once made a new Structure (zeta_L = 0) and kept the file's
+    hash; now its runs name the variant: its own hash and only the overridden key (the damping
+    ratio stays the file's), beside the friction swap and the bounding avionics made in code."""
+    import json
+
+    from .conftest import ROOT, run_cli
+
+    p = run_cli("ascent", ROOT / "models" / "flight" / "ascent.toml", "--start", "120", "--end", "120.5",
+                "--friction", "dahl", "--load-stiffness", "160000 lbf/in", "--out", tmp_path / "a", "--json", "-")
+    assert p.returncode == 0, p.stderr
+    prov = json.loads(p.stdout)["runs"][0]["provenance"]
+    flight = load_model("rs25_flight")
+    assert prov["model_file_sha256"] == flight.sha256 != prov["model_sha256"]
+    over = prov["model_overrides"]
+    assert over["friction.model"] == "dahl" and float(over["structure.load_stiffness"].split()[0]) == \
+        pytest.approx(160000 * LBF_IN, rel=1e-12)
+    assert not any(k.startswith(("structure.load_damping", "code.structure")) for k in over)
+    assert flight.with_values({"structure.load_stiffness": "160000 lbf/in"}).structure.load_damping_ratio == \
+        flight.structure.load_damping_ratio > 0

@@ -90,7 +90,7 @@ def test_mask_step_table_is_read_and_checked(tmp_path):
     assert {s.figure: s.bounds for s in m.steps} == {"rise_time_s": (0.0, 0.1), "overshoot_pct": (0.0, 25.0)}
     assert m.steps[0].amplitude_rad == pytest.approx(0.5 * DEG)
     bad = tmp_path / "bad.toml"
-    bad.write_text('[[point]]\nfrequency = "1 Hz"\ngain_db = [-1, 1]\n[step]\nrise_time = [0, 0.1]\n')
+    bad.write_text('[[point]]\nfrequency = "1 Hz"\ngain_db = [-1, 1]\nsource = "test"\n[step]\nrise_time = [0, 0.1]\n')
     with pytest.raises(InputError, match="step.rise_time"):
         load_spec(bad)
 
@@ -113,7 +113,7 @@ def test_avionics_gain_0_89_fails_a_half_db_mask_and_the_cause_says_avionics(hot
     for c in dw:
         assert c.bounds[0].value == pytest.approx(want, abs=0.02)
         assert not c.passed and c.cause == ("avionics",)
-        assert c.removed == {"friction": False, "load_stiffness": False, "avionics": True}
+        assert c.removed == {"friction": False, "load_stiffness": False, "avionics": True, "pressure_limit": False}
     assert "because of the avionics gain" in v.text() and "the linear servo passes" in v.text()
 
 

@@ -59,7 +59,7 @@ def add_friction_option(parser: argparse.ArgumentParser,
 
 
 #: subcommand modules, in help order
-COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.lco", "taos.cli.export",
+COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.reduce", "taos.cli.lco", "taos.cli.export",
             "taos.cli.montecarlo", "taos.cli.sweep", "taos.cli.fmu"]
 
 

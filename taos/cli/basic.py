@@ -134,12 +134,7 @@ def cmd_freqresp(args) -> int:
     fr = fam[0]
     d = family_to_dict(fam) if len(fam) > 1 else fr.to_dict()
     from taos.results import output_provenance
-    d["provenance"].update(output_provenance([model]))
-    d["provenance"]["solver"] = {"method": "linear (exact)" if not amps_rad else
-                                 ("rk4 sine dwell, periodic steady state by shooting" if args.steady == "shoot"
-                                  else "rk4 sine dwell, settled from rest"),
-                                 "engine": args.engine}
-    d["provenance"]["seeds"] = "none (deterministic)"
+    d["provenance"].update(output_provenance([model]))   # the solver's own account (what ran) stays as it is
     if not args.cross:
         from taos.report.merit import frequency_merit
         # figures of the model that answered: the 3-D model's own linearisation with --engine taos

@@ -25,9 +25,8 @@ def _out_folder(path: str, names: list[str]) -> Path:
 
 def cmd_ascent(args) -> int:
     from taos.flight.ascent import load_ascent
-    from taos.flight.ascent_sim import analyse_ascent, simulate_ascent
-    from taos.flight.lco import with_bounding_avionics
-    from taos.model import Structure, load_model
+    from taos.flight.ascent_sim import fly_ascent, run_file
+    from taos.model import load_model
     from taos.units import to_si
 
     ascent = load_ascent(args.ascent)
@@ -47,33 +46,27 @@ def cmd_ascent(args) -> int:
     if not 1e-5 <= args.dt <= 2e-3:
         raise InputError("command line", "--dt", "an RK4 step from 1e-5 to 2e-3 s", got=repr(args.dt))
     axes = ("pitch", "yaw") if args.axis == "both" else (args.axis,)
+    # -- the models: one per friction law, then the reference without friction (law none)
     models = []
+    k = (to_si(args.load_stiffness, "stiffness", source="command line", field="--load-stiffness", positive=True)
+         if args.load_stiffness else None)
     for law in laws + ["none"]:
         m = load_model(tvc, friction=law)
-        if args.load_stiffness:
-            m = m.replace(structure=Structure(to_si(args.load_stiffness, "stiffness", source="command line",
-                                                    field="--load-stiffness", positive=True)))
-        models.append(with_bounding_avionics(m) if args.avionics == "bounding" else m)
-    names = [f"ascent_{m.friction.name}.h5" for m in models[:-1]] + ["summary.json", "ascent.png"]
-    out = _out_folder(args.out, names)
-    reference = simulate_ascent(ascent, models[-1], axes=axes, start_s=start, end_s=end, dt_s=args.dt, seed=args.seed)
-    runs, summary = [], {"ascent_file": ascent.source, "ascent_sha256": ascent.sha256, "avionics": args.avionics,
-                         "axes": list(axes), "runs": []}
-    from tqdm import tqdm
-    for m in tqdm(models[:-1], desc="ascent", unit="law", disable=not args.progress):
-        h = reference if m.friction.name == "none" else simulate_ascent(
-            ascent, m, axes=axes, start_s=start, end_s=end, dt_s=args.dt, seed=args.seed)
-        runs.append(h)
-        wins = analyse_ascent(h, reference)
-        summary["runs"].append({"friction_model": m.friction.name, "file": f"ascent_{m.friction.name}.h5",
-                                "windows": [w.to_dict() for w in wins], "provenance": h.provenance})
+        # a model variant (taos.variants): the file's load-path damping ratio kept
+        models.append(m.with_values({"structure.load_stiffness": k}) if k is not None else m)
+    reference = models.pop()
+    # --
+    out = _out_folder(args.out, [run_file(m.friction.name) for m in models] + ["summary.json", "ascent.png"])
+    study = fly_ascent(ascent, models, reference=reference, avionics=args.avionics, axes=axes, start_s=start,
+                       end_s=end, dt_s=args.dt, seed=args.seed, progress=args.progress)
+    summary = study.summary()
     text = json.dumps(summary, indent=1, allow_nan=False) + "\n"  # checked before anything is written
     out.mkdir(parents=True, exist_ok=True)
-    for h in runs:
-        h.to_hdf5(out / f"ascent_{h.friction_model}.h5")
+    for h in study.runs:
+        h.to_hdf5(out / run_file(h.friction_model))
     from taos.plotting import save
-    from taos.plotting.ascent import plot_ascent
-    save(plot_ascent(runs, axis=axes[-1], zoom_s=min(60.0, 0.25 * (end - start))), out / "ascent.png")
+    from taos.plotting.ascent import plot_study
+    save(plot_study(study), out / "ascent.png")
     atomic_write(out / "summary.json", lambda p: p.write_text(text))
     if args.json:
         write_json(args.json, summary)

@@ -17,7 +17,8 @@ that callee too, so the steps sharing such callees form one group and a group is
 * ``planar``: the planar simulation, the dwells (ETDRK4 and RK4), the shooting kernels and the
   verdict map's confirmation share ``planar.dynamics`` (``integrate_samples``, ``sine_steps``,
   ``saturation.apply``) and ``planar._expstep``;
-* ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` and ``taos3d._bearing``;
+* ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` (with its pieces ``taos3d._rhs``,
+  ``taos3d._commands``, ``taos3d._so3``) and ``taos3d._bearing``;
 * ``friction``: every built-in law's C callbacks (``friction.registry.load_all``).
 
 Between groups the only shared callees are ``planar._avionics_kernels.apply`` and the model's

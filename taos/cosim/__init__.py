@@ -7,7 +7,10 @@ FMI 2.0 co-simulation FMU built from it.
   :mod:`taos.cosim._block`);
 * :func:`build_fmu`: the block as an FMI 2.0 co-simulation FMU through ``pythonfmu``
   (``taos fmu``; :mod:`taos.cosim._fmu`). Such an FMU runs the block in a Python with ``taos``
-  importable on the importing machine.
+  importable on the importing machine;
+* the standalone FMU (``taos fmu --standalone``; :mod:`taos.cosim._standalone`): the planar
+  model in C emitted from the kernels' own Python source (:mod:`taos.cosim._ccode`), no Python
+  at run time.
 """
 
 from __future__ import annotations

@@ -118,12 +118,21 @@ def with_parameters(model: TvcModel, values: dict) -> TvcModel:
     return model.replace(**secs)
 
 
+def check_output_path(out) -> Path:
+    """``--out`` checked (:func:`check_fmu_output`, then :func:`taos.results.check_output_file`:
+    the FMU's own refusal first, so that no message offers ``--force``, which ``taos fmu`` does
+    not honour for a file it did not write)."""
+    check_fmu_output(Path(out))
+    return check_output_file(out, "--out", (".fmu",))
+
+
 def check_fmu_output(out: Path) -> None:
-    """Refuse an ``--out`` that exists and is not an FMU ``taos fmu`` wrote (a zip holding
-    ``resources/taos_fmu/config.json``): an output never replaces a file the program did not write."""
+    """Refuse an ``--out`` that is an existing regular file and not an FMU ``taos fmu`` wrote (a zip
+    holding ``resources/taos_fmu/config.json``): an output never replaces a file the program did
+    not write, ``--force`` or not."""
     import zipfile
 
-    if not out.exists():
+    if not out.is_file():
         return
     try:
         with zipfile.ZipFile(out) as z:
@@ -208,8 +217,7 @@ def build_fmu(model_path: str | Path, out: str | Path, *, engine: str = "simplex
 
     from ..planar.envelope import check_run_step
 
-    out = check_output_file(out, "--out", (".fmu",))
-    check_fmu_output(out)
+    out = check_output_path(out)
     model = fmu_model(model_path, friction, avionics)
     if dt_s is not None:
         check_run_step(dt_s, model, field="--dt")
@@ -220,7 +228,8 @@ def build_fmu(model_path: str | Path, out: str | Path, *, engine: str = "simplex
     except ImportError:
         raise InputError("taos fmu", "pythonfmu", "the pythonfmu package installed (pip install pythonfmu)",
                          got="not importable") from None
-    config = {"format": 1, "engine": engine, "friction": model.friction.name, "avionics": avionics,
+    config = {"format": 1, "engine": engine, "friction": model.friction.name, "friction_option": friction,
+              "avionics": avionics,
               "dt_s": block.dt_s, "allow_unstable": allow_unstable, "model_name": model.name,
               "model_sha256": model.sha256, "model_source": model.source,
               "model_inputs": {r: {"file": Path(f).name, "sha256": h} for r, (f, h) in model.input_files.items()},

@@ -79,7 +79,9 @@ class TvcSlave(Fmi2Slave):
         res = Path(str(self.resources)) / RESOURCE_DIR
         cfg = json.loads((res / CONFIG).read_text())
         self._cfg = cfg
-        model = fmu_model(res / "model" / cfg["model_file"], cfg["friction"], cfg["avionics"])
+        # the --friction option as given (None: the file's law; naming a law makes a variant, its own hash)
+        model = fmu_model(res / "model" / cfg["model_file"], cfg.get("friction_option", cfg["friction"]),
+                          cfg["avionics"])
         if model.sha256 != cfg["model_sha256"]:
             raise InputError(str(res / "model"), "model_sha256", f"the model the FMU was built from "
                              f"({cfg['model_sha256'][:12]}...)", got=f"{model.sha256[:12]}... (files changed)")

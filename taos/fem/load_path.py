@@ -31,10 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solve
 
-from ..units import to_si
+from ..units import N_PER_M_PER_LBF_PER_IN
 from .elasticity import rigid_transform
 
-LBF_PER_IN = to_si("1 lbf/in", "stiffness", source="taos.fem", field="LBF_PER_IN")  # N/m per lbf/in
+#: N/m per lbf/in (:data:`taos.units.N_PER_M_PER_LBF_PER_IN`, under the name the FEM API exports)
+LBF_PER_IN = N_PER_M_PER_LBF_PER_IN
 
 
 @dataclass(frozen=True)

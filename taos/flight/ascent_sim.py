@@ -20,18 +20,22 @@ An axis is one call of :func:`taos.planar.dynamics.integrate_segments_lanes` thr
 intervals (each interval's plant as data, the re-basing and the kick as state jumps);
 :func:`simulate_ascents` flies many runs (Monte Carlo batches) side by side in the same kernel,
 :data:`LANES` at a time, each run's numbers its own.
+
+:func:`fly_ascent` is the ``taos ascent`` study: the ascent flown once per friction law and once
+without friction, each run's post-separation windows analysed (:class:`AscentStudy`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from taos.flight.ascent import Ascent, aero_instability, control_acceleration, pti_command, wind_speed
-from taos.flight.lco import FlightHistory, measure_oscillation
+from taos.flight.lco import FlightHistory, flown_model, measure_oscillation
 from taos.flight.vehicle import FlightModel, PlantParts, flight_plant
 from taos.harmonics import fit_sines
 from taos.linear import StateSpace
@@ -40,6 +44,7 @@ from taos.results import atomic_write, package_version, write_provenance
 from taos.planar import saturation as sat
 from taos.planar.simplex import LurePlant, extend_plant
 from taos.planar.simulate import check_friction_step, kernel_args
+from taos.results import model_provenance
 
 AXES = ("pitch", "yaw")
 DEFAULT_DT_S = 5e-4
@@ -47,6 +52,9 @@ DEFAULT_DT_S = 5e-4
 SIGNALS = ("attitude_rad", "rate_rad_s", "command_rad", "engine_rad", "engine_rate_rad_s", "piston_m",
            "friction_torque_Nm", "booster_deflection_rad", "pti_rad", "disturbance_rad_s2")
 MAX_STEPS = 50_000_000
+#: the integrator of every ascent run (the compiled RK4 kernel of :mod:`taos.planar.dynamics`), as
+#: the runs' provenance names it
+INTEGRATOR = "rk4-fixed-step"
 
 
 def flight_at(ascent: Ascent, t_s: float, axis: str) -> tuple[FlightModel, float]:
@@ -216,7 +224,8 @@ def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple
     heads = np.zeros((len(plants), sat.N_HEAD))
     iu = n + ne
     for M, H, p in zip(mats, heads, plants):
-        A, Br, bc, bf, cc, dc, cw, ca, lim = kernel_args(p, model)
+        pk = kernel_args(p, model)
+        A, Br, bc, bf, cc, dc, cw, ca, lim = pk.A, pk.Br, pk.bc, pk.bf, pk.cc, pk.dc, pk.cw, pk.ca, pk.lim
         M[:n, :n], M[:n, n:iu], M[:n, iu], M[:n, iu + 1] = A, Br, bc, bf
         M[n, :n], M[n, n:iu], M[n + 1, :n], M[n + 2, :n] = cc, dc, cw, ca
         if lim.size:  # the limit rows over x (u_v also over u) and their columns (taos.planar.saturation)
@@ -358,10 +367,10 @@ def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tu
             out[k].append(Y[:, j])
         out["pti_rad"].append(Rr[:, 0])
         out["disturbance_rad_s2"].append(Rr[:, 1])
-    prov = {"model_file": model.source, "model_sha256": model.sha256, "ascent_file": ascent.source,
+    prov = {**model_provenance(model), "ascent_file": ascent.source,
             "ascent_sha256": ascent.sha256, "flight_file": ascent.flight.source,
             "flight_sha256": ascent.flight.sha256, "package_version": package_version(),
-            "solver": {"method": "rk4-fixed-step", "dt_s": dt_s, "record_every": rec},
+            "solver": {"method": INTEGRATOR, "dt_s": dt_s, "record_every": rec},
             "seed": int(seed), "start_s": start_s, "end_s": end, "attitude0_rad": attitude0_rad,
             "friction_model": model.friction.name}
     return AscentHistory(t_s=t[::rec], axes=tuple(axes), signals={k: np.vstack(v) for k, v in out.items()},
@@ -482,3 +491,72 @@ def analyse_ascent(h: AscentHistory, linear: AscentHistory | None = None, axes=N
                 band = float(fit_sines(h.t_s[sel], d, f, trend=True).amplitude()[0, 0])
             res.append(WindowResult(ax, kind, a, b, False, float("nan"), float("nan"), f or float("nan"), band))
     return sorted(res, key=lambda r: (r.axis, r.start_s))
+
+
+# -- the study: one run per friction law, windows against the run without friction -------------
+def run_file(friction_model: str) -> str:
+    """The file name of the run with friction law ``friction_model`` in an ascent study's folder."""
+    return f"ascent_{friction_model}.h5"
+
+
+@dataclass(frozen=True, eq=False)
+class AscentStudy:
+    """An ascent flown once per friction law (:func:`fly_ascent`): ``runs``, one
+    :class:`AscentHistory` per model in the order given; ``windows``, each run's analysed
+    post-separation windows (:func:`analyse_ascent` against ``reference``, the same ascent flown
+    without friction); the flown ``axes``, segment [``start_s``, ``end_s``] [s] and the
+    ``avionics`` setting the runs were flown with."""
+
+    ascent: Ascent
+    runs: tuple[AscentHistory, ...]
+    windows: tuple[tuple[WindowResult, ...], ...]
+    reference: AscentHistory
+    axes: tuple[str, ...]
+    start_s: float
+    end_s: float
+    avionics: str
+
+    @property
+    def zoom_s(self) -> float:
+        """The late-burn stretch the study's plot zooms on [s]: at most 60 s, a quarter of the run."""
+        return min(60.0, 0.25 * (self.end_s - self.start_s))
+
+    def summary(self) -> dict:
+        """The ``summary.json`` of ``taos ascent`` (JSON-ready): the ascent file and hash, the
+        avionics setting, the axes, and per run its law, its file name (:func:`run_file`), its
+        windows (:meth:`WindowResult.to_dict`) and provenance."""
+        return {"ascent_file": self.ascent.source, "ascent_sha256": self.ascent.sha256, "avionics": self.avionics,
+                "axes": list(self.axes),
+                "runs": [{"friction_model": h.friction_model, "file": run_file(h.friction_model),
+                          "windows": [w.to_dict() for w in wins], "provenance": h.provenance}
+                         for h, wins in zip(self.runs, self.windows)]}
+
+    to_dict = summary
+
+
+def fly_ascent(ascent: Ascent, models: Sequence[TvcModel], *, reference: TvcModel, avionics: str = "bounding",
+               axes: tuple[str, ...] = ("yaw",), start_s: float = 0.0, end_s: float | None = None,
+               dt_s: float = DEFAULT_DT_S, seed: int = 0, progress: bool = False) -> AscentStudy:
+    """Fly ``ascent`` from ``start_s`` to ``end_s`` [s] (default the trajectory's end) on ``axes``
+    with each TVC of ``models`` (typically one per friction law) and with ``reference``, the same
+    TVC without friction (law ``none``; a model of law ``none`` in ``models`` is that run), and
+    analyse each run's post-separation windows against the reference (:func:`analyse_ascent`).
+
+    ``avionics``: ``"bounding"`` flies every model with the paper's bounding avionics gain,
+    ``"model"`` with the models' own avionics (:func:`taos.flight.lco.flown_model`). ``dt_s``, ``seed``: as :func:`simulate_ascent` (the same seed for every run, so the
+    runs differ by their TVC only). ``progress``: a bar over the models. Raises
+    :class:`~taos.errors.SimulationUnstable` when a run diverges."""
+    models = [flown_model(m, avionics) for m in models]   # (ValueError for an unknown setting)
+    reference = flown_model(reference, avionics)
+    axes = tuple(axes)
+    end = ascent.end_time_s if end_s is None else float(end_s)
+    fly = {"axes": axes, "start_s": start_s, "end_s": end, "dt_s": dt_s, "seed": seed}
+    ref = simulate_ascent(ascent, reference, **fly)
+    from tqdm import tqdm
+
+    runs, windows = [], []
+    for m in tqdm(models, desc="ascent", unit="law", disable=not progress):
+        h = ref if m.friction.name == "none" else simulate_ascent(ascent, m, **fly)
+        runs.append(h)
+        windows.append(tuple(analyse_ascent(h, ref)))
+    return AscentStudy(ascent, tuple(runs), tuple(windows), ref, axes, float(start_s), end, avionics)

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from taos.planar.freqresp import sine_dwell_grid
+from taos.bounds import check_response_args
+from taos.planar.freqresp import sine_dwell_points
 from taos.linear import StateSpace, gain_db, phase_deg
 from taos.model import Structure, TvcModel
 from taos.results import atomic_write, package_version, write_json, write_provenance
@@ -164,11 +165,15 @@ def describing_function_map(model: TvcModel, amplitudes_rad: np.typing.ArrayLike
     """
     amps = np.sort(np.atleast_1d(np.asarray(amplitudes_rad, float)))
     f = np.sort(np.atleast_1d(np.asarray(freq_hz, float)))
-    piston, engine = sine_dwell_grid(model, amps, f, axis, dt_max_s=dt_max_s, settle_cycles=settle_cycles,
-                                     measure_cycles=measure_cycles, settle_s=settle_s, method=method)
+    check_response_args(f, amps, axis)   # the grid of taos.planar.freqresp.sine_dwell_grid, with its solver's account
+    A, F = np.meshgrid(amps, f, indexing="ij")
+    pts = sine_dwell_points(model, A.ravel(), F.ravel(), axis, dt_max_s=dt_max_s, settle_cycles=settle_cycles,
+                            measure_cycles=measure_cycles, settle_s=settle_s, method=method)
+    piston, engine = pts.piston.reshape(A.shape), pts.engine.reshape(A.shape)
+    # the settings as asked (the lco module matches a reused map on them) and the solver's own account
     prov = {**model_provenance(model), "package_version": package_version(),
             "method": "sine-dwell", "steady_state": method, "dt_max_s": dt_max_s, "settle_cycles": settle_cycles,
-            "measure_cycles": measure_cycles, "settle_s": settle_s}
+            "measure_cycles": measure_cycles, "settle_s": settle_s, "solver": pts.solver}
     return DescribingFunctionMap(amps, f, engine, piston, model.friction.name, axis,
                                  model.structure.load_stiffness_N_per_m, prov)
 

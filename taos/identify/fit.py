@@ -466,9 +466,7 @@ def _keep_law_shape(result: FitResult, doc, todo: dict, note_stamp: str) -> None
     docs/reference/bounds.md; also keys of other laws, for a law swapped by ``--friction``);
     those of a shared parameter set follow the file's ``coulomb_torque`` through its
     ``reference_torque``."""
-    import dataclasses as _dc
-
-    from taos.friction import param_classes
+    from taos.model_keys import torque_like_kinds
     from taos.units import DIMENSIONS, to_si
 
     ftab = doc.get("friction", {})
@@ -479,8 +477,7 @@ def _keep_law_shape(result: FitResult, doc, todo: dict, note_stamp: str) -> None
     if not tc_file > 0:
         return
     ratio = result.values[result.names.index("coulomb_torque")] / tc_file
-    kinds = {f.metadata["key"]: f.metadata["kind"] for cls in param_classes().values() for f in _dc.fields(cls)
-             if f.metadata.get("torque_like") and f.metadata["key"] != "coulomb_torque"}
+    kinds = torque_like_kinds()
     for key, kind in kinds.items():
         if key not in ftab or key in result.names:
             continue

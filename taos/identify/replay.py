@@ -14,6 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import M_PER_IN
+
+
 #: file suffixes read as measured records (:func:`taos.identify.data.load_test_data`)
 RECORD_SUFFIXES = (".csv", ".txt", ".h5", ".hdf5")
 
@@ -42,7 +45,7 @@ class AxisReplay:
     engine_rms_rad: float | None
 
     def to_dict(self) -> dict:
-        return {"axis": self.axis, "piston_rms_error_in": self.piston_rms_error_m / 0.0254,
+        return {"axis": self.axis, "piston_rms_error_in": self.piston_rms_error_m / M_PER_IN,
                 "piston_relative_rms_error": self.piston_rms_error_m / max(self.piston_rms_m, 1e-300),
                 "engine_rms_error_deg": None if self.engine_rms_error_rad is None
                 else math.degrees(self.engine_rms_error_rad),

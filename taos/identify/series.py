@@ -150,7 +150,7 @@ def weighted_line(x, y, s) -> Trend:
 
 def notch_estimates(fit) -> dict:
     """{``notch_<axis>_hz``: Estimate} of a fit's model, standard error by the delta method."""
-    from taos.identify.surrogate import PARAMETERS
+    from taos.identify.surrogate import apply_values
     from taos.planar.simplex import load_resonance_from_notch
 
     cov = np.asarray(fit.correlation, float) * np.outer(fit.std_errors, fit.std_errors)
@@ -160,8 +160,8 @@ def notch_estimates(fit) -> dict:
         for j, n in enumerate(fit.names):
             v = float(fit.values[j])
             h = 1e-4 * abs(v) if v else 1e-8
-            hi = load_resonance_from_notch(PARAMETERS[n].set(fit.model, v + h), ax)
-            lo = load_resonance_from_notch(PARAMETERS[n].set(fit.model, v - h), ax)
+            hi = load_resonance_from_notch(apply_values(fit.model, [n], [v + h]), ax)   # model variants
+            lo = load_resonance_from_notch(apply_values(fit.model, [n], [v - h]), ax)
             g[j] = (hi - lo) / (2 * h)
         var = float(g @ cov @ g)
         out[f"notch_{ax}_hz"] = Estimate(float(fit.notch_hz[ax]), math.sqrt(max(var, 0.0)), "Hz")

@@ -133,6 +133,13 @@ def apply_values(model: TvcModel, names, values) -> TvcModel:
     first (it scales the law's other torque-like parameters, which a free one then overrides),
     so the result does not depend on the order of ``--free``."""
     if all(isinstance(v, (int, float, np.floating)) for v in values):
+        names, values = list(names), [float(v) for v in values]
+        if "avionics_gain" in names and any(k == "code.avionics" for k, _ in model.overrides):
+            # avionics set in code (e.g. the bounding gain): the factor scales that table, in code
+            g = values.pop(names.index("avionics_gain"))
+            names.remove("avionics_gain")
+            model = model.with_values(variant_values(model, names, values)) if names else model
+            return model.replace(avionics=_avionics_set(model, g).avionics)
         return model.with_values(variant_values(model, names, values))
     pairs = sorted(zip(names, values), key=lambda nv: nv[0] != "coulomb_torque")
     for n, v in pairs:

@@ -31,6 +31,10 @@ Distributions of a factor: ``normal`` (mean, std; optional truncation low/high b
 ``uniform`` (low, high). Parameters: the TVC model's fittable values
 (:data:`taos.identify.surrogate.PARAMETERS`: load_stiffness, coulomb_torque, bristle_stiffness,
 loop_gain, pressure_feedback_gain, avionics_gain, ...) and the flight's (:data:`FLIGHT_PARAMETERS`).
+A run's TVC model is one model variant through the loader (:mod:`taos.variants`), each key with the
+model file's meaning: ``coulomb_torque`` is the friction level (the law's other load-proportional
+parameters follow it), a dispersed torque-like parameter among them (``bristle_stiffness``) is set
+as drawn.
 A run is a pure function of (campaign, case, run index): the same seeds give the same results on
 any executor.
 """
@@ -293,7 +297,7 @@ def apply_factors(ascent: Ascent, model: TvcModel, overrides: Mapping[str, float
                   ) -> tuple[Ascent, TvcModel, list[str]]:
     """Ascent and model with the case's ``overrides`` (SI) and the run's ``factors`` applied;
     also the dispersed names that do not apply (e.g. bristle stiffness of a Coulomb law)."""
-    from taos.identify.surrogate import variant_values
+    from taos.identify.surrogate import apply_values
 
     skipped, names, values = [], list(overrides), list(overrides.values())
     for k, f in factors.items():
@@ -307,7 +311,7 @@ def apply_factors(ascent: Ascent, model: TvcModel, overrides: Mapping[str, float
     # one variant through the loader (taos.variants): coulomb_torque is the friction level (the law's
     # other torque-like parameters follow it; a dispersed one among them is set as drawn)
     if names:
-        model = model.with_values(variant_values(model, names, [float(v) for v in values]))
+        model = apply_values(model, names, [float(v) for v in values])
     tr, fl = ascent.trajectory, ascent.flight
     rep = dataclasses.replace
     if "vehicle_mass" in factors:

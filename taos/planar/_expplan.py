@@ -157,7 +157,8 @@ def dwell_step_s(args, model, amp: float, freq: float, fixed_dt_s: float) -> tup
     kept where the limits are reached [s]."""
     from ..friction._kernels import prescribed_rate_response
 
-    A, Br, bc, bf, cc, dc, cw, ca, lim = args
+    A, Br, bc, bf, cc, dc, cw, ca, lim = (args.A, args.Br, args.bc, args.bf, args.cc, args.dc, args.cw, args.ca,
+                                          args.lim)
     X = orbit(A + np.outer(bc, cc), Br.sum(axis=1) + bc * dc.sum(), amp, freq)
     ph = 2 * math.pi * np.arange(2 * N_ORBIT) / N_ORBIT
     xs = np.imag(X[None, :] * np.exp(1j * ph)[:, None])       # (2 N, n) over two cycles
@@ -218,7 +219,7 @@ def run_dwells(args, Cy, kern, amps, freqs, npc, n_settle, n_meas, out, status):
     (:func:`taos.planar._parallel.run_each`)."""
     from ._parallel import run_each
 
-    stack, G, D, ms, idx = step_tables(args[0], args[2], 1.0 / (freqs * npc))
+    stack, G, D, ms, idx = step_tables(args.A, args.bc, 1.0 / (freqs * npc))
     run_each(lambda b: _ex.dwell_batch(*args, Cy, *kern, *stack, G, D, ms, idx, idx, amps, freqs, npc, n_settle,
                                        n_meas, out, status, b, b + 1), n_settle + n_meas)
 

@@ -335,7 +335,8 @@ def _plan(args, model, inertia_kgm2, r, dt_s, record_every, breaks, max_step_s, 
     from ..errors import InputError
     from . import saturation as _lim
 
-    A, Br, bc, bf, cc, dc, cw, ca, lim = args
+    A, Br, bc, bf, cc, dc, cw, ca, lim = (args.A, args.Br, args.bc, args.bf, args.cc, args.dc, args.cw, args.ca,
+                                          args.lim)
     stair = (model.avionics.pack() if avp is None else avp)[AV_LSB] > 0.0
     if np.any(cc != 0.0) or Br.shape[1] != 1:
         return "the command depends on the state or on several inputs"
@@ -442,10 +443,10 @@ def run_exp(args, Cy, model, avp, inertia_kgm2: float, r, dt_s: float, record_ev
         return plan
     model.friction.check_step(inertia_kgm2, plan.h_max_s, model.source)
     sizes = np.unique(np.append(plan.sizes, 1))          # and one sample: the retaken steps
-    stack, G, D, ms, _ = _pl.step_tables(args[0], args[2], sizes * dt_s)
+    stack, G, D, ms, _ = _pl.step_tables(args.A, args.bc, sizes * dt_s)
     slot = np.searchsorted(sizes, plan.sizes)[plan.slot].astype(np.int64)
-    lim = args[8]
-    qrow = np.zeros(args[0].shape[0])
+    lim = args.lim
+    qrow = np.zeros(args.A.shape[0])
     if lim.size:
         from . import saturation as _lim
 
@@ -456,7 +457,7 @@ def run_exp(args, Cy, model, avp, inertia_kgm2: float, r, dt_s: float, record_ev
     y = np.empty((nrec, Cy.shape[0]))
     aux = np.empty((nrec, _dy.N_AUX))
     st = profile_steps_exp(*args, np.ascontiguousarray(Cy), model.friction.entry.rates, model.friction.pack(), avp,
-                           *stack, G, D, ms, slot, plan.pos, r, dt_s, record_every, np.zeros(args[0].shape[0]),
+                           *stack, G, D, ms, slot, plan.pos, r, dt_s, record_every, np.zeros(args.A.shape[0]),
                            0.0, y, aux, qrow, int(np.searchsorted(sizes, 1) if RETAKE_REVERSALS else -1))
     if st >= 0:
         raise SimulationUnstable(st * dt_s, f"{model.friction.name} friction, ETDRK4 step <= {plan.h_max_s:g} s")

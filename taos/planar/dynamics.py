@@ -17,7 +17,7 @@ function, so one compiled integrator serves every law, including laws registered
 time. The avionics kernel is the single definition in :mod:`taos.planar.avionics`. A non-finite
 state stops the run and reports the step.
 
-Kernel arguments (the plant's arrays in the order of :func:`taos.planar.simulate.kernel_args`,
+Kernel arguments (the plant's arrays in the order of :class:`taos.planar.simulate.PlantArrays`,
 then the outputs, the friction law and the avionics; n states, n_r external inputs, n_y
 outputs; [x], [r] and [y] stand for the SI units of the plant's states, inputs and outputs)::
 

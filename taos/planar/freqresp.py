@@ -38,6 +38,7 @@ from ..model import TvcModel
 from .simplex import simplex_plant, simplex_state_space
 from ._parallel import run_each
 from .simulate import DEFAULT_DT_S, check_friction_step, kernel_args
+from taos.results import model_provenance
 
 
 #: engine fundamental below this fraction of the command (-80 dB) = engine held by friction
@@ -152,6 +153,16 @@ class FrequencyResponse:
         return d
 
 
+#: the ``solver`` provenance of an exact linear response (no time integration runs)
+LINEAR_SOLVER = {"method": "linear (exact)", "integrator": "none (the state space's response at s = j w)"}
+#: the integrator each ``integrator`` setting runs, as every result names it (the same names as
+#: :class:`taos.planar.simulate.SolverSettings`' ``method``)
+INTEGRATOR_NAMES = {"exp": "etdrk4", "rk4": "rk4-fixed-step"}
+#: what each ``method`` of :func:`sine_dwell_points` does, as its ``solver`` provenance says it
+STEADY_DESCRIPTIONS = {"settle": "sine dwell, settled from rest",
+                       "shoot": "sine dwell, periodic steady state by shooting"}
+
+
 def linear_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, axis: str = "pitch") -> FrequencyResponse:
     """Exact response of the linear simplex block (no friction, unity avionics)."""
     from taos.bounds import check_response_args
@@ -161,7 +172,9 @@ def linear_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, axis: str = "
     f = np.atleast_1d(np.asarray(freq_hz, float))
     ph, h = _phase_reference(simplex_state_space(model, axis), f)   # the response with its phase reference
     return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, axis,
-                             friction_model="none", provenance={"model_sha256": model.sha256, "method": "linear"},
+                             friction_model="none",
+                             provenance={**model_provenance(model), "seeds": "none (deterministic)",
+                                         "solver": {**LINEAR_SOLVER, "engine": "simplex"}},
                              piston_phase_ref_deg=ph[:, 0], engine_phase_ref_deg=ph[:, 1])
 
 
@@ -184,7 +197,10 @@ class DwellPoints:
     """Sine-dwell responses at paired (amplitude, frequency) points: complex ``piston``
     (x_p / (R theta_c)) and ``engine`` (theta / theta_c); with ``method="shoot"`` also the
     final scaled residual of the one-period map [-], the periods integrated and whether
-    shooting converged (:mod:`taos.planar.steady`); for settled dwells these are None."""
+    shooting converged (:mod:`taos.planar.steady`); for settled dwells these are None.
+    ``solver``: what ran, as :func:`sine_dwell_points` ran it (``method``, ``integrator``
+    (:data:`INTEGRATOR_NAMES`) and its settings), the ``solver`` provenance of every result
+    built on these points."""
 
     piston: np.ndarray
     engine: np.ndarray
@@ -192,6 +208,7 @@ class DwellPoints:
     residual: np.ndarray | None = None
     periods: np.ndarray | None = None
     converged: np.ndarray | None = None
+    solver: dict = field(default_factory=dict)
 
 
 def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,
@@ -261,7 +278,7 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     else:
         from . import steady
 
-        Am, Br, bc, cc, dc = args[0], args[1], args[2], args[4], args[5]
+        Am, Br, bc, cc, dc = args.A, args.Br, args.bc, args.cc, args.dc
         x0, mag = steady.linear_orbit_start(Am + np.outer(bc, cc), Br.sum(axis=1) + bc * dc.sum(), A, F)
         n = Am.shape[0]
         nz = 1 if model.friction.has_state else 0
@@ -291,7 +308,15 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     # fundamental: y ~ a sin + b cos  ->  complex gain (a + j b) / A relative to A sin
     h = (out[:, :, 0] + 1j * out[:, :, 1]) / A[:, None]
     R = model.actuator.moment_arm_m
-    return DwellPoints(h[:, 0] / R, h[:, 1], method, **extra)
+    solver = {"method": STEADY_DESCRIPTIONS[method], "integrator": INTEGRATOR_NAMES[integrator],
+              "step": ("per dwell, from the friction loop and the limits (taos.planar._expplan), dt_max_s where the "
+                       "linear orbit reaches the rate limit or the hard stops" if use_exp else "dt_max_s or less, a "
+                       "whole number of steps per cycle"),
+              "dt_max_s": float(dt_max_s), "min_steps_per_cycle": int(min_steps_per_cycle),
+              "settle_cycles": int(settle_cycles), "settle_s": float(ts), "measure_cycles": int(measure_cycles)}
+    if method == "shoot":
+        solver.update({"tol": float(tol), "k_rre": int(k_rre), "max_cycles": int(max_cycles)})
+    return DwellPoints(h[:, 0] / R, h[:, 1], method, **extra, solver=solver)
 
 
 def sine_dwell_grid(model: TvcModel, amplitudes_rad: np.typing.ArrayLike, freq_hz: np.typing.ArrayLike,
@@ -327,9 +352,8 @@ def sine_dwell_family(model: TvcModel, freq_hz, amplitudes_rad, axis: str = "pit
     shape = (amps.size, f.size)
     piston, engine = pts.piston.reshape(shape), pts.engine.reshape(shape)
     rp, re = linear_phase_reference(model, f, axis)
-    prov = {"model_sha256": model.sha256, "method": "sine-dwell", "steady_state": pts.method,
-            "dt_max_s": kwargs.get("dt_max_s") or DEFAULT_DT_S,
-            "integrator": "etdrk4" if kwargs.get("integrator", "exp") == "exp" else "rk4-fixed-step"}
+    prov = {**model_provenance(model), "seeds": "none (deterministic)", "steady_state": pts.method,
+            "solver": {**pts.solver, "engine": "simplex"}}
     fam = []
     for i, a in enumerate(amps):
         p = dict(prov)

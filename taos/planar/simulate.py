@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -45,15 +45,44 @@ def check_friction_step(model: TvcModel, inertia_kgm2: float, dt_s: float) -> No
     model.friction.check_step(inertia_kgm2, dt_s, model.source)
 
 
-def kernel_args(plant: LurePlant, model: TvcModel):
-    """The arrays the compiled kernels take, in order (A, Br, bc, bf, cc, dc, cw, ca, lim)."""
+class PlantArrays(NamedTuple):
+    """The plant's arrays the compiled planar kernels take (:mod:`taos.planar.dynamics`), named; a
+    kernel call passes them in this order (``kernel(*arrays, Cy, ...)``). n states, n_r external
+    inputs; [x] and [r] the SI units of the plant's states and inputs; every array C-contiguous
+    float64."""
+
+    #: (n, n) state matrix [x/s per x]
+    A: np.ndarray
+    #: (n, n_r) external-input columns [x/s per r]
+    Br: np.ndarray
+    #: (n,) post-avionics command column [x/s per rad]
+    bc: np.ndarray
+    #: (n,) friction-torque column [x/s per N m]
+    bf: np.ndarray
+    #: (n,) pre-avionics command row over x [rad per x]
+    cc: np.ndarray
+    #: (n_r,) pre-avionics command row over r [rad per r]
+    dc: np.ndarray
+    #: (n,) friction relative-rate row [rad/s per x]
+    cw: np.ndarray
+    #: (n,) applied (non-friction) torque row [N m per x]
+    ca: np.ndarray
+    #: (k,) packed actuator/gimbal limits over the state (empty: no limits;
+    #: :mod:`taos.planar.saturation`, ``LIM_*``, ``ROW_*``)
+    lim: np.ndarray
+
+
+def kernel_args(plant: LurePlant, model: TvcModel) -> PlantArrays:
+    """The arrays the compiled kernels take (:class:`PlantArrays`: A, Br, bc, bf, cc, dc, cw, ca,
+    lim, in the kernels' order)."""
     ss = plant.ss
     ne = plant.n_ext
     ic = ss.input_index("command_rad")
     ifr = ss.input_index("friction_torque_Nm")
     f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
-    return (f64(ss.A), f64(ss.B[:, :ne]), f64(ss.B[:, ic]), f64(ss.B[:, ifr]), f64(plant.cmd_c),
-            f64(plant.cmd_d), f64(plant.rate_c), f64(plant.applied_c), f64(plant.limits))
+    return PlantArrays(A=f64(ss.A), Br=f64(ss.B[:, :ne]), bc=f64(ss.B[:, ic]), bf=f64(ss.B[:, ifr]),
+                       cc=f64(plant.cmd_c), dc=f64(plant.cmd_d), cw=f64(plant.rate_c), ca=f64(plant.applied_c),
+                       lim=f64(plant.limits))
 
 
 def integrate_plant(plant: LurePlant, model: TvcModel, r: np.ndarray, dt_s: float, record_every: int = 1,

@@ -40,6 +40,12 @@ def plot_ascent(histories, axis: str = "yaw", zoom_s: float = 60.0, signal: str 
     return fig
 
 
+def plot_study(study, signal: str = "engine_rad"):
+    """:func:`plot_ascent` of an ascent study (:class:`taos.flight.ascent_sim.AscentStudy`): its
+    runs on its last flown axis, zoomed on its :attr:`~taos.flight.ascent_sim.AscentStudy.zoom_s`."""
+    return plot_ascent(list(study.runs), axis=study.axes[-1], zoom_s=study.zoom_s, signal=signal)
+
+
 def plot_campaign(result, max_runs: int = 400):
     """Every run's FCS command normalised by the nominal run's peak (grey), the 5-95 %
     envelope, and the nominal (black): figure 9 of the seed paper. ``result`` is a

@@ -20,7 +20,8 @@ computes per axis:
   the spec-mask check of the linear response (:mod:`taos.report.spec`) and, given a measured
   record, its estimated responses (:func:`taos.identify.estimation.estimate`);
 * the mask on every basis (linear, nonlinear dwell, measured, step) with the cause of each
-  failing point, and the verdict in words (:mod:`taos.report.verdict`).
+  failing point, and the verdict in words (:mod:`taos.report.verdict`), on the engine that ran
+  (3-D: its own dwells with the profile's cross-axis dither, its causes by 3-D re-runs).
 
 The result, :class:`GreenRunResult`, holds all of it; ``.summary()`` is the ``summary.json``
 dict and ``.write(DIR)`` writes the report folder: ``DIR/index.html`` (self-contained, drawn by
@@ -277,16 +278,23 @@ def _spec_results(model, mask) -> dict:
     return {ax: check_spec(model, mask, ax) for ax in AXES}
 
 
-def _verdict(model, mask, prof, measured, info, dt_s, threads=None) -> Verdict | None:
-    """The mask on every basis with causes (:func:`taos.report.verdict.spec_verdict`): dwells at
-    the profile's amplitudes, the measured record, the step figures ``info`` already holds."""
+def _verdict(model, mask, prof, measured, info, dt_s, threads=None, engine="simplex", tm=None) -> Verdict | None:
+    """The mask on every basis with causes (:func:`taos.report.verdict.spec_verdict`) on the
+    engine that ran: dwells at the profile's amplitudes (3-D: with the other axis' dwell the
+    profile commands meanwhile, :func:`taos.report.engines.concurrent_dwells`), the measured
+    record, the planar step figures ``info`` already holds (simplex; the 3-D engine runs its own)."""
     if mask is None:
         return None
+    from .engines import concurrent_dwells
     from .verdict import spec_verdict
 
-    segs = {ax: [(s.frequency_hz, s.amplitude_rad) for _, s in dwell_segments(getattr(prof, ax))] for ax in AXES}
+    if engine == "taos":
+        segs = concurrent_dwells(prof)
+    else:
+        segs = {ax: [(s.frequency_hz, s.amplitude_rad) for _, s in dwell_segments(getattr(prof, ax))] for ax in AXES}
     steps = {ax: m["step"] for ax, m in info["figures_of_merit"].items() if "step" in m}
-    return spec_verdict(model, mask, segments=segs, measured=measured, step_figures=steps, dt_s=dt_s, threads=threads)
+    return spec_verdict(model, mask, segments=segs, measured=measured, step_figures=steps, dt_s=dt_s, threads=threads,
+                        engine=engine, taos_model=tm)
 
 
 def _measured_responses(data) -> dict:
@@ -372,6 +380,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
         model = load_model(model, friction=friction)
     if engine not in run_checks.ENGINES:
         raise InputError("command line", "--engine", " or ".join(run_checks.ENGINES), got=repr(engine))
+    tm = None
     if engine == "taos":   # every 3-D input check before any work; one model object, one friction
         from taos.taos3d import taos_model
         tm = taos_model(model)
@@ -449,7 +458,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
         verdict = None
         if mask is not None:   # part of the dwell step: the mask's dwells and the causes' re-runs
             bar.set_postfix_str("spec verdict")
-            verdict = _verdict(model, mask, prof, measured, info, dt_s, threads)
+            verdict = _verdict(model, mask, prof, measured, info, dt_s, threads, engine, tm)
         bar.update()
 
         result = GreenRunResult(

@@ -313,7 +313,8 @@ way (threshold), and a slow ±0.2 deg triangle (hysteresis: engine angle down mi
                                  f"<td>{p['freq_hz']:g}</td><td>[{b[0]:g}, {b[1]:g}]</td><td>{v:.2f}</td>"
                                  f"<td><b>{'pass' if ok else 'FAIL'}</b></td></tr>")
         name = next(iter(s["spec"].values()))["spec"]
-        out.append(f"""<h2 id="spec-mask">Spec mask on the linear response: {_h(name)} — <span class="{'pass' if s['spec_pass'] else 'fail'}">{verdict}</span></h2>
+        planar = "" if s.get("engine_model", "simplex") == "simplex" else " (planar simplex model)"
+        out.append(f"""<h2 id="spec-mask">Spec mask on the linear response{planar}: {_h(name)} — <span class="{'pass' if s['spec_pass'] else 'fail'}">{verdict}</span></h2>
 <table><tr><th>axis</th><th>bound</th><th>freq [Hz]</th><th>limits</th><th>model (linear)</th><th>result</th></tr>{''.join(srows)}</table>
 <p class="note">Mask file <code>{_h(next(iter(s['spec'].values()))['spec_file'])}</code>; the same marks are on the Bode plots.</p>""")
     out.append(verdict_table_html(s))
@@ -352,18 +353,30 @@ def verdict_table_html(s: dict) -> str:
             where = "step" if p["response"] == "step" else f"{p['response']} {p['freq_hz']:g} Hz"
             amp = "–" if p["amplitude_deg"] is None else f"{p['amplitude_deg']:.2g}"
             cause = ", ".join(p["cause"]) if (p["cause"] and not ok) else ""
-            trs.append(f"<tr class='{'pass' if ok else 'fail'}'><td>{_h(p['basis'])}</td><td>{_h(p['axis'])}</td>"
+            if p.get("cross_axis_freq_hz"):   # a 3-D dwell with the other axis moving
+                amp += f" (other axis {p['cross_axis_amplitude_deg']:.2g} at {p['cross_axis_freq_hz']:g} Hz)"
+            trs.append(f"<tr class='{'pass' if ok else 'fail'}'><td>{_h(p['basis'])}</td><td>{_h(p.get('engine', ''))}</td>"
+                       f"<td>{_h(p['axis'])}</td>"
                        f"<td>{_h(where)}</td><td>{amp}</td><td>{_h(q)}</td><td>{_fmt(v, '.2f')}</td>"
                        f"<td>[{b[0]:g}, {b[1]:g}]</td><td><b>{'pass' if ok else 'FAIL'}</b></td><td>{_h(cause)}</td></tr>")
     by = ", ".join(f"{k} {'pass' if v else 'FAIL'}" for k, v in s["spec_pass_by_basis"].items())
     att = s["spec_attribution"]
     return f"""<h2 id="spec-verdict-table">Spec mask on every basis: {_h(by)}</h2>
 <p>{_h(s['spec_verdict_text'])}</p>
-<table><tr><th>basis</th><th>axis</th><th>point</th><th>amplitude [deg]</th><th>quantity</th><th>value</th><th>limits</th>
+<table><tr><th>basis</th><th>engine</th><th>axis</th><th>point</th><th>amplitude [deg]</th><th>quantity</th><th>value</th><th>limits</th>
 <th>result</th><th>cause</th></tr>{''.join(trs)}</table>
-<p class="note">Bases: linear (exact linear response), dwell (nonlinear sine dwell, friction and avionics included,
-at the profile's amplitude for that frequency), measured (the record's points at mask frequencies), step (the
+<p class="note">Every point was evaluated on the engine named in its row: {_h(_engine_words(att.get('engine', 'simplex')))}.
+Bases: linear (exact linear response), dwell (nonlinear sine dwell, friction and avionics included,
+at the profile's amplitude for that frequency; on the 3-D model with the other axis running the dwell the profile
+commands at the same time), measured (the record's points at mask frequencies), step (the
 simulated step figures). Cause of a failing point: the factor(s) whose removal alone makes it pass, found by
-re-evaluating it with gimbal friction none, the laboratory load (K_L ≥ {att['laboratory_load_stiffness_N_per_m']:.3g} N/m)
-or unity avionics; "combined" when only removing all three passes, "servo" when even the servo alone fails,
-"unexplained" when the model's own dwell passes where the measurement fails.</p>"""
+re-evaluating it on the same engine with gimbal friction none, the laboratory load (K_L ≥
+{att['laboratory_load_stiffness_N_per_m']:.3g} N/m), unity avionics or the supply-pressure limit lifted
+(pressure_limit: valve pressure saturation); "combined" when only removing friction, load path and avionics together
+passes, "servo" when even the servo alone (those three removed) fails, "unexplained" when the model's own dwell passes
+where the measurement fails. The mask's bounds and their sources are in {_h(s.get('spec', {}).get('pitch', {}).get('spec_file', 'the mask file'))}.</p>"""
+
+
+def _engine_words(engine: str) -> str:
+    return {"simplex": "the planar simplex model", "taos": "the 3-D taos model (its own dwells and causes)"}.get(
+        engine, engine)

@@ -160,7 +160,12 @@ class StepMerit:
         return {k: (_none(v) if isinstance(v, float) else v) for k, v in asdict(self).items()}
 
 
-def _engine_step(model, axis, amp_rad, t_step=0.2, hold=1.5, dt_s=2e-4):
+#: the step figures' command: a step at t0 [s], held [s]
+STEP_T0_S = 0.2
+STEP_HOLD_S = 1.5
+
+
+def _engine_step(model, axis, amp_rad, t_step=STEP_T0_S, hold=STEP_HOLD_S, dt_s=2e-4):
     from ..profiles import Step
     from ..planar.simulate import simulate
     th = simulate(_axis_model(model, axis), Step(amp_rad, t_step, hold), dt_s=dt_s, record_every=1, duration_s=t_step + hold)
@@ -171,20 +176,17 @@ def _axis_model(model: TvcModel, axis: str) -> TvcModel:
     """A model whose pitch axis is ``axis`` (single-axis profiles drive pitch)."""
     if axis == "pitch":
         return model
-    import dataclasses
-    e = model.engine
-    return dataclasses.replace(model, engine=dataclasses.replace(e, inertia_pitch_kgm2=e.inertia_yaw_kgm2))
+    import dataclasses   # an analysis device made in code: recorded in the copy's overrides and hash
+    return model.replace(engine=dataclasses.replace(model.engine, inertia_pitch_kgm2=model.engine.inertia_yaw_kgm2))
 
 
-def step_response_figures(model: TvcModel, axis: str = "pitch", step_amplitude_rad: float = math.radians(0.5),
-                          dt_s: float = 2e-4) -> tuple[float | None, float | None]:
-    """(rise time 10-90 % [s], overshoot [%]) of the engine angle after a command step of
-    ``step_amplitude_rad`` [rad] on the nonlinear simplex model (module docstring), relative to
-    the final value (the mean of the last tenth of the 1.5 s hold); None when undefined."""
-    t, th = _engine_step(model, axis, step_amplitude_rad, dt_s=dt_s)
-    t0 = 0.2
-    m = t >= t0
-    tt, yy = t[m] - t0, th[m]
+def rise_and_overshoot(t_s, engine_rad, t0_s: float = STEP_T0_S) -> tuple[float | None, float | None]:
+    """(rise time 10-90 % [s], overshoot [%]) of an engine angle ``engine_rad`` [rad] at times
+    ``t_s`` [s] after a command step at ``t0_s``, relative to the final value (the mean of the
+    last tenth of the record); None when undefined. Any engine's step run (planar or 3-D)."""
+    t, th = np.asarray(t_s), np.asarray(engine_rad)
+    m = t >= t0_s
+    tt, yy = t[m] - t0_s, th[m]
     final = float(np.mean(yy[-max(10, yy.size // 10):]))
     rise = over = None
     if abs(final) > 0:
@@ -195,6 +197,15 @@ def step_response_figures(model: TvcModel, axis: str = "pitch", step_amplitude_r
             rise = float(tt[i90[0]] - tt[i10[0]])
         over = float(100.0 * max(0.0, (np.max(s) - 1.0)))
     return rise, over
+
+
+def step_response_figures(model: TvcModel, axis: str = "pitch", step_amplitude_rad: float = math.radians(0.5),
+                          dt_s: float = 2e-4) -> tuple[float | None, float | None]:
+    """(rise time 10-90 % [s], overshoot [%]) of the engine angle after a command step of
+    ``step_amplitude_rad`` [rad] on the nonlinear simplex model (module docstring), relative to
+    the final value (the mean of the last tenth of the 1.5 s hold); None when undefined."""
+    t, th = _engine_step(model, axis, step_amplitude_rad, dt_s=dt_s)
+    return rise_and_overshoot(t, th)
 
 
 def _threshold_rad(model: TvcModel, axis: str, step_amplitude_rad: float, threshold_tol_rad: float,

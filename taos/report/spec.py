@@ -8,11 +8,19 @@ A mask file (TOML, shipped ones in ``models/specs/``)::
     frequency = "2 Hz"
     gain_db = [-2.0, 2.0]        # optional [min, max], dB of the dimensionless gain
     phase_deg = [-45.0, 5.0]     # optional [min, max], phase continuous from low frequency
+    source = "..."               # required: where these bounds come from (a document, or
+                                 # "[notional] ..." with the reasoning that chose them)
 
     [step]                       # optional: step requirements on the simulated step figures
     amplitude = "0.5 deg"        # the command step (default 0.5 deg)
     rise_time_s = [0.0, 0.1]     # [min, max] of any of STEP_FIGURES (taos.report.merit.StepMerit)
     overshoot_pct = [0.0, 25.0]
+    source = "..."               # required, as a point's
+
+Every bound carries its ``source`` (a mask is a requirement; a number without a provenance is
+not one): the loader refuses a point or a ``[step]`` table without a non-empty ``source``
+(:class:`~taos.errors.InputError` naming ``point[i].source`` / ``step.source``). Masks built in
+code (:class:`SpecPoint`) may leave it empty.
 
 :func:`check_spec` evaluates the exact linear response of a model at each point
 (:func:`taos.planar.freqresp.linear_freqresp`, the project's conventions) and returns a
@@ -39,10 +47,14 @@ DEFAULT_STEP_AMPLITUDE_RAD = math.radians(0.5)
 
 @dataclass(frozen=True)
 class SpecPoint:
+    """One mask point: bounds [min, max] on the gain [dB] and phase [deg] of ``response`` at
+    ``freq_hz`` [Hz], and where they come from (``source``; required in a file)."""
+
     response: str
     freq_hz: float
     gain_db: tuple[float, float] | None
     phase_deg: tuple[float, float] | None
+    source: str = ""
 
 
 @dataclass(frozen=True)
@@ -53,6 +65,7 @@ class StepRequirement:
     figure: str
     bounds: tuple[float, float]
     amplitude_rad: float
+    source: str = ""
 
 
 @dataclass(frozen=True)
@@ -89,9 +102,10 @@ def load_spec(path) -> SpecMask:
     pts = []
     for i, pt in enumerate(tab.get("point", [])):
         f = f"point[{i}]"
-        bad = set(pt) - {"response", "frequency", "gain_db", "phase_deg"}
+        bad = set(pt) - {"response", "frequency", "gain_db", "phase_deg", "source"}
         if bad:
-            raise InputError(src, f"{f}.{sorted(bad)[0]}", "response, frequency, gain_db, phase_deg", got="unknown key")
+            raise InputError(src, f"{f}.{sorted(bad)[0]}", "response, frequency, gain_db, phase_deg, source",
+                             got="unknown key")
         resp = pt.get("response", "engine")
         if resp not in RESPONSES:
             raise InputError(src, f"{f}.response", "'engine' or 'piston'", got=repr(resp))
@@ -101,7 +115,7 @@ def load_spec(path) -> SpecMask:
         g, ph = _pair(pt.get("gain_db"), src, f"{f}.gain_db"), _pair(pt.get("phase_deg"), src, f"{f}.phase_deg")
         if g is None and ph is None:
             raise InputError(src, f, "gain_db and/or phase_deg bounds", got="neither")
-        pts.append(SpecPoint(resp, fz, g, ph))
+        pts.append(SpecPoint(resp, fz, g, ph, _source(pt, src, f)))
     if not pts:
         raise InputError(src, "point", "at least one [[point]]", got="none")
     return SpecMask(str(tab.get("name", p.stem)), src, tuple(pts), _steps(tab.get("step"), src))
@@ -113,16 +127,26 @@ def _steps(tab, src) -> tuple[StepRequirement, ...]:
         return ()
     if not isinstance(tab, dict):
         raise InputError(src, "step", "a [step] table", got=type(tab).__name__)
-    bad = set(tab) - {"amplitude", *STEP_FIGURES}
+    bad = set(tab) - {"amplitude", "source", *STEP_FIGURES}
     if bad:
-        raise InputError(src, f"step.{sorted(bad)[0]}", "amplitude or one of " + ", ".join(STEP_FIGURES),
+        raise InputError(src, f"step.{sorted(bad)[0]}", "amplitude, source or one of " + ", ".join(STEP_FIGURES),
                          got="unknown key")
     amp = (to_si(tab["amplitude"], "angle", source=src, field="step.amplitude", positive=True)
            if "amplitude" in tab else DEFAULT_STEP_AMPLITUDE_RAD)
     out = tuple(StepRequirement(k, _pair(tab[k], src, f"step.{k}"), amp) for k in STEP_FIGURES if k in tab)
     if not out:
         raise InputError(src, "step", "bounds on at least one of " + ", ".join(STEP_FIGURES), got="none")
-    return out
+    where = _source(tab, src, "step")
+    return tuple(StepRequirement(r.figure, r.bounds, r.amplitude_rad, where) for r in out)
+
+
+def _source(tab: dict, src: str, where: str) -> str:
+    """The required ``source`` of a point or ``[step]`` table (module docstring)."""
+    v = tab.get("source")
+    if not isinstance(v, str) or not v.strip():
+        raise InputError(src, f"{where}.source", "where the bounds come from: a document, or '[notional] ...' with "
+                         "the reasoning that chose them", got="nothing" if v is None else repr(v)[:40])
+    return v.strip()
 
 
 @dataclass(frozen=True)

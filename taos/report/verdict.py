@@ -23,24 +23,32 @@ Bases (``basis`` of each :class:`SpecCheck`):
 Phases are continuous from low frequency on the branch of the (evaluated) model's linear phase
 (:func:`taos.planar.freqresp.linear_phase_reference`), as everywhere in the project.
 
+Every check is evaluated on an **engine** (:mod:`taos.report.engines`), named in its ``engine``:
+``"simplex"`` (the planar model, one axis at a time) or ``"taos"`` (the 3-D model: its own
+linear response; its dwells run as the profile runs them, the other axis moving with the dwell
+the profile commands meanwhile, so the cross-axis dither is in; its steps with the other axis at
+rest; phases on the 3-D linear branch). A step requirement on the threshold or hysteresis is
+simulated on the planar model and says so (``engine`` ``"simplex"``).
+
 Causes, found by re-evaluating each FAILING point (only those: the passing ones are never
-re-simulated; the dwells of one basis and axis go in one batched call per variant) on the model
-with one factor removed (:func:`remove_causes`):
+re-simulated; the dwells of one basis and axis go in one batched call per variant) on the SAME
+engine with one factor removed (:func:`taos.report.engines.remove_causes`; 3-D: the 3-D model
+rebuilt from the variant, :func:`taos.taos3d.with_values`):
 
 * ``friction``: the gimbal friction law set to ``none``;
 * ``load_stiffness``: the laboratory load, K_L -> :data:`LAB_LOAD_STIFFNESS_N_PER_M` (kept when
   the model's own K_L is stiffer), the "rigid load" an actuator is specified and accepted against;
-* ``avionics``: a unity command path (no quantisation, crossover gain 1:
-  :meth:`taos.planar.avionics.Avionics.ideal`);
-* and, when no single removal passes, the **servo alone** (all three removed).
+* ``avionics``: a unity command path (no quantisation, crossover gain 1);
+* ``pressure_limit``: the supply-pressure limit lifted (``actuator.pressure_limited = false``:
+  no square-root valve law, no relief): "valve pressure saturation";
+* and, when no single removal passes, the **servo alone** (friction, load path and avionics
+  removed; the servo's own valve and supply kept).
 
 The cause (:func:`cause_of`) is the tuple of single factors whose removal alone makes the point
-pass (several when each alone suffices); ``("combined",)`` when only removing all three passes;
+pass (several when each alone suffices); ``("combined",)`` when only the servo alone passes;
 ``("servo",)`` when even the servo alone fails. A failing ``measured`` point is attributed on the
-model at the same amplitude and frequency: if the model's dwell there passes, the model does not
+engine at the same amplitude and frequency: if the model's dwell there passes, the model does not
 reproduce the shortfall and the cause is ``("unexplained",)``; otherwise as a ``dwell`` point.
-With ``--engine taos`` the dwell basis and the causes still come from the planar simplex model
-(the 3-D model's own dwells stay in the report's Bode plots and tables).
 
 :class:`Verdict` holds the checks; :meth:`Verdict.text` says in words why the model fails (or
 passes) its mask, as the report's first line; :meth:`Verdict.to_dict` is what ``summary.json``
@@ -56,6 +64,16 @@ from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
 
+from .engines import (  # noqa: F401
+    CAUSES,
+    LAB_LOAD_STIFFNESS_N_PER_M,
+    SERVO_ALONE,
+    PlanarEngine,
+    engine_for,
+    laboratory_model,
+    remove_causes,
+)
+
 if TYPE_CHECKING:
     from taos.identify.estimation import MeasuredResponse
     from taos.model import TvcModel
@@ -63,56 +81,26 @@ if TYPE_CHECKING:
     from .spec import SpecMask
 
 AXES = ("pitch", "yaw")
-#: the factors a shortfall is attributed to, in the order they are tried
-CAUSES = ("friction", "load_stiffness", "avionics")
 BASES = ("linear", "dwell", "measured", "step")
-#: the laboratory ("rigid") load stiffness [N/m]: 1e9 N/m = 5.7e6 lbf/in, 28 x the hot-fire and
-#: 50 x the ambient K_L and 4 x the oil column (2.4e8 N/m), so the load resonance (36 Hz with the
-#: shipped J_n and R) is far above the servo's band: the shipped servo's engine response is then
-#: within 0.2 dB and 0.8 deg of a truly rigid load (K_L = 1e12 N/m) at 5 Hz and within 0.03 dB /
-#: 0.1 deg up to 2 Hz, while the fastest mode (sqrt((K_L + oil column) / M_p), 5,200 rad/s)
-#: stays integrable by the explicit step (dt |lambda|max = 1.05 at 2e-4 s; a truly rigid 1e12
-#: would need a 100 x smaller step)
-LAB_LOAD_STIFFNESS_N_PER_M = 1e9
 #: a measured point is on a mask point when their frequencies agree within this relative tolerance
 FREQ_MATCH_RTOL = 0.02
 #: words of each cause in the verdict text
 CAUSE_WORDS = {"friction": "gimbal friction", "load_stiffness": "the load stiffness (structure)",
-               "avionics": "the avionics gain", "combined": "friction, load stiffness and avionics together",
+               "avionics": "the avionics gain", "pressure_limit": "valve pressure saturation (the supply-pressure limit)",
+               "combined": "friction, load stiffness and avionics together",
                "servo": "the servo itself", "unexplained": "something the model does not reproduce"}
+#: words of each engine in the verdict text
+ENGINE_WORDS = {"simplex": "planar simplex model", "taos": "3-D taos model"}
 _UNITS = {"gain_db": "dB", "phase_deg": "deg", "rise_time_s": "s", "overshoot_pct": "%", "threshold_deg": "deg",
           "hysteresis_deg": "deg"}
 _NAMES = {"gain_db": "gain", "phase_deg": "phase", "rise_time_s": "rise time", "overshoot_pct": "overshoot",
           "threshold_deg": "threshold", "hysteresis_deg": "hysteresis"}
 
 
-# -- the causes --------------------------------------------------------------------------------
-
-def laboratory_model(model: TvcModel) -> TvcModel:
-    """``model`` on the laboratory load: K_L = max(K_L, :data:`LAB_LOAD_STIFFNESS_N_PER_M`)."""
-    k = max(model.structure.load_stiffness_N_per_m, LAB_LOAD_STIFFNESS_N_PER_M)
-    return model.replace(structure=dataclasses.replace(model.structure, load_stiffness_N_per_m=k))
-
-
-def remove_causes(model: TvcModel, causes: Sequence[str]) -> TvcModel:
-    """``model`` with each factor in ``causes`` (names in :data:`CAUSES`) removed (module docstring)."""
-    bad = set(causes) - set(CAUSES)
-    if bad:
-        raise ValueError(f"unknown cause {sorted(bad)[0]!r}; expected one of {CAUSES}")
-    m = model
-    if "friction" in causes:
-        m = m.with_friction("none")
-    if "load_stiffness" in causes:
-        m = laboratory_model(m)
-    if "avionics" in causes:
-        m = m.replace(avionics=m.avionics.ideal())
-    return m
-
-
 def cause_of(single_passes: Mapping[str, bool], servo_passes: bool | None) -> tuple[str, ...]:
     """The cause of a failing point from its re-evaluations: the factors whose removal alone
-    makes it pass (in :data:`CAUSES` order); else ``("combined",)`` if the servo alone (all
-    removed) passes, ``("servo",)`` if not."""
+    makes it pass (in :data:`CAUSES` order); else ``("combined",)`` if the servo alone passes,
+    ``("servo",)`` if not."""
     singles = tuple(c for c in CAUSES if single_passes.get(c))
     if singles:
         return singles
@@ -153,7 +141,10 @@ class Bound:
 class SpecCheck:
     """One mask point on one basis and axis (module docstring): its bounds, and for a failing
     point the ``cause`` and whether each removal (``"friction"``, ..., ``"servo"``) passed (a
-    measured point also ``"model_dwell"``: the unmodified model's dwell at that point)."""
+    measured point also ``"model_dwell"``: the unmodified model's dwell at that point);
+    ``engine`` the engine that produced its values and causes (``"simplex"`` or ``"taos"``);
+    ``dither`` the other axis' (amplitude [rad], frequency [Hz]) during a 3-D dwell (None: at
+    rest, or a planar point)."""
 
     basis: str
     axis: str
@@ -163,6 +154,8 @@ class SpecCheck:
     bounds: tuple[Bound, ...]
     cause: tuple[str, ...] = ()
     removed: Mapping[str, bool] = field(default_factory=dict)
+    engine: str = "simplex"
+    dither: tuple[float, float] | None = None
 
     @property
     def passed(self) -> bool:
@@ -182,7 +175,10 @@ class SpecCheck:
     def to_dict(self) -> dict:
         d = {"basis": self.basis, "axis": self.axis, "response": self.response, "freq_hz": self.freq_hz,
              "amplitude_deg": None if self.amplitude_rad is None else math.degrees(self.amplitude_rad),
-             "pass": self.passed}
+             "pass": self.passed, "engine": self.engine}
+        if self.dither is not None:
+            d["cross_axis_amplitude_deg"] = math.degrees(self.dither[0])
+            d["cross_axis_freq_hz"] = self.dither[1]
         for b in self.bounds:
             d[b.quantity] = b.value
             d[f"{b.quantity}_bounds"] = [b.lo, b.hi]
@@ -212,58 +208,45 @@ def _freq_bounds(point, h: complex, ref_deg: float) -> tuple[Bound, ...]:
     return tuple(out)
 
 
-def _responses(model: TvcModel, axis: str, freq_hz, amplitudes_rad, dt_s: float):
-    """{"piston": (h, phase ref), "engine": (h, phase ref)} of ``model`` at paired points:
-    linear when ``amplitudes_rad`` is None, else sine dwells (one batched call)."""
-    from taos.planar.freqresp import linear_freqresp, linear_phase_reference, sine_dwell_points
-
-    f = np.asarray(freq_hz, float)
-    if amplitudes_rad is None:
-        fr = linear_freqresp(model, f, axis)
-        p, e = fr.piston, fr.engine
-    else:
-        d = sine_dwell_points(model, np.asarray(amplitudes_rad, float), f, axis, dt_max_s=_dwell_dt(model, dt_s))
-        p, e = d.piston, d.engine
-    fu, inv = np.unique(f, return_inverse=True)
-    rp, re = linear_phase_reference(model, fu, axis)
-    return {"piston": (p, rp[inv]), "engine": (e, re[inv])}
-
-
-def _dwell_dt(model: TvcModel, dt_s: float) -> float:
-    """``dt_s``, or smaller where the (stiffened) model's fastest mode asks for it (RK4 limit,
-    with a factor 2 of margin)."""
-    from taos.bounds import RK4_STEP_LIMIT
-    from taos.planar.envelope import fastest_mode_rad_s
-
-    lam = fastest_mode_rad_s(model)
-    return min(dt_s, 0.5 * RK4_STEP_LIMIT / lam) if dt_s * lam > 0.5 * RK4_STEP_LIMIT else dt_s
-
-
-def dwell_amplitude_rad(segments: Sequence[tuple[float, float]], freq_hz: float) -> float | None:
-    """The profile's command amplitude at ``freq_hz`` (module docstring): of the lowest-frequency
-    dwell segment at or above it, else of the highest one. ``segments``: (frequency [Hz],
-    amplitude [rad]) of one axis' dwell segments; None when there are none."""
+def dwell_segment(segments: Sequence[tuple], freq_hz: float) -> tuple | None:
+    """The profile's dwell segment a mask point at ``freq_hz`` is run at: the lowest-frequency
+    one at or above it, else the highest. ``segments``: one axis' dwell segments as (frequency
+    [Hz], amplitude [rad]) or, with the other axis' dwell meanwhile, (frequency, amplitude, other
+    frequency [Hz], other amplitude [rad]) (:func:`taos.report.engines.concurrent_dwells`);
+    None when there are none."""
     if not segments:
         return None
     segs = sorted(segments)
-    above = [a for f, a in segs if f >= freq_hz * (1 - 1e-9)]
-    return above[0] if above else segs[-1][1]
+    above = [s for s in segs if s[0] >= freq_hz * (1 - 1e-9)]
+    return above[0] if above else segs[-1]
 
 
-def _freq_checks(model, mask, axis, basis, amps, dt_s) -> list[SpecCheck]:
+def dwell_amplitude_rad(segments: Sequence[tuple], freq_hz: float) -> float | None:
+    """The profile's command amplitude [rad] at ``freq_hz`` (:func:`dwell_segment`'s); None
+    when there are no segments."""
+    s = dwell_segment(segments, freq_hz)
+    return None if s is None else s[1]
+
+
+def _dither(segments, freq_hz) -> tuple[float, float] | None:
+    """The other axis' (amplitude [rad], frequency [Hz]) meanwhile, when ``segments`` carry it."""
+    s = dwell_segment(segments, freq_hz)
+    return (s[3], s[2]) if s is not None and len(s) >= 4 and s[3] > 0 else None
+
+
+def _freq_checks(engine, mask, axis, basis, amps, dithers=None) -> list[SpecCheck]:
     pts = mask.points
-    f = [p.freq_hz for p in pts]
-    r = _responses(model, axis, f, amps, dt_s)
+    r = engine.responses(axis, [p.freq_hz for p in pts], amps, dithers)
     return [SpecCheck(basis, axis, p.response, p.freq_hz, None if amps is None else float(amps[k]),
-                      _freq_bounds(p, complex(r[p.response][0][k]), float(r[p.response][1][k])))
+                      _freq_bounds(p, complex(r[p.response][0][k]), float(r[p.response][1][k])),
+                      engine=engine.name, dither=None if dithers is None else dithers[k])
             for k, p in enumerate(pts)]
 
 
-def _measured_checks(model, mask, m: MeasuredResponse) -> list[SpecCheck]:
-    """Mask points on a measured record's points at the mask's frequencies (module docstring)."""
-    from taos.planar.freqresp import linear_phase_reference
-
-    R = model.actuator.moment_arm_m
+def _measured_checks(engine, mask, m: MeasuredResponse, segments=None) -> list[SpecCheck]:
+    """Mask points on a measured record's points at the mask's frequencies (module docstring);
+    phases on ``engine``'s linear branch, and its dwell (with the profile's dither) attributes them."""
+    R = engine.model.actuator.moment_arm_m
     out = []
     for p in mask.points:
         h_all = m.piston_m_per_rad / R if p.response == "piston" else m.engine
@@ -273,38 +256,28 @@ def _measured_checks(model, mask, m: MeasuredResponse) -> list[SpecCheck]:
             a = float(m.amplitude_rad[k])
             if not math.isfinite(a):
                 continue
-            rp, re = linear_phase_reference(model, [float(m.freq_hz[k])], m.axis)
+            rp, re = engine.phase_reference(m.axis, [float(m.freq_hz[k])])
             ref = float((rp if p.response == "piston" else re)[0])
+            dither = _dither(segments, float(m.freq_hz[k])) if segments else None
             out.append(SpecCheck("measured", m.axis, p.response, float(m.freq_hz[k]), a,
-                                 _freq_bounds(p, complex(h_all[k]), ref)))
+                                 _freq_bounds(p, complex(h_all[k]), ref), engine=engine.name, dither=dither))
     return out
 
 
-def _step_values(model, axis, reqs, dt_s, threads=None) -> dict:
-    """The step figures the requirements name, simulated on ``model`` (the step figures' runs on
-    ``threads`` threads, :func:`taos.report.merit.step_merit`)."""
-    from .merit import step_merit, step_response_figures
-
-    amp = reqs[0].amplitude_rad
-    if {r.figure for r in reqs} <= {"rise_time_s", "overshoot_pct"}:
-        rise, over = step_response_figures(model, axis, amp, dt_s=dt_s)
-        return {"rise_time_s": rise, "overshoot_pct": over}
-    return step_merit(model, axis, step_amplitude_rad=amp, dt_s=dt_s, threads=threads).to_dict()
-
-
-def _step_check(axis, reqs, values) -> SpecCheck:
+def _step_check(axis, reqs, values, engine: str = "simplex") -> SpecCheck:
     return SpecCheck("step", axis, "step", None, reqs[0].amplitude_rad,
                      tuple(Bound(r.figure, None if values.get(r.figure) is None else _finite(values[r.figure]),
-                                 *r.bounds) for r in reqs))
+                                 *r.bounds) for r in reqs), engine=engine)
 
 
-def _reevaluate(model, checks: list[SpecCheck], mask, dt_s, threads=None) -> list[bool]:
-    """Whether each check (one basis and axis) passes on ``model``."""
+def _reevaluate(engine, checks: list[SpecCheck], mask, threads=None) -> list[bool]:
+    """Whether each check (one basis and axis) passes on ``engine``."""
     c0 = checks[0]
     if c0.basis == "step":
-        return [_step_check(c0.axis, mask.steps, _step_values(model, c0.axis, mask.steps, dt_s, threads)).passed]
+        return [_step_check(c0.axis, mask.steps, engine.step_values(c0.axis, mask.steps, threads)).passed]
     amps = None if c0.basis == "linear" else [c.amplitude_rad for c in checks]
-    r = _responses(model, c0.axis, [c.freq_hz for c in checks], amps, dt_s)
+    dithers = None if c0.basis == "linear" else [c.dither for c in checks]
+    r = engine.responses(c0.axis, [c.freq_hz for c in checks], amps, dithers)
     out = []
     for k, c in enumerate(checks):
         h, ref = r[c.response][0][k], r[c.response][1][k]
@@ -320,15 +293,18 @@ def _bounds_like(c: SpecCheck, h: complex, ref: float) -> tuple[Bound, ...]:
     return _freq_bounds(SpecPoint(c.response, c.freq_hz, q.get("gain_db"), q.get("phase_deg")), h, ref)
 
 
-def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s: float,
+def attribute(engine, checks: Sequence[SpecCheck], mask: SpecMask, dt_s: float | None = None,
               threads: int | None = None) -> list[SpecCheck]:
     """``checks`` with the cause of each failing one (module docstring); passing ones unchanged.
-    Each basis and axis is re-evaluated once per removal, on its failing points only. A failing
-    step's three single removals are independent runs, on ``threads`` threads
-    (:func:`taos.planar._parallel.run_tasks`, the serial run's numbers); a dwell basis' removals
-    are one parallel batch each, one after the other."""
+    ``engine``: a verdict engine (:mod:`taos.report.engines`), or a planar model (with ``dt_s``
+    [s]). Each basis and axis is re-evaluated once per removal, on the same engine and its
+    failing points only. A failing step's single removals are independent runs, on ``threads``
+    threads (:func:`taos.planar._parallel.run_tasks`, the serial run's numbers); a dwell basis'
+    removals are one parallel batch each, one after the other."""
     from taos.planar._parallel import run_tasks
 
+    if not hasattr(engine, "responses"):
+        engine = PlanarEngine(engine, 2e-4 if dt_s is None else dt_s)
     out = list(checks)
     groups: dict[tuple[str, str], list[int]] = {}
     for i, c in enumerate(checks):
@@ -339,15 +315,15 @@ def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s
         removed = [dict() for _ in idx]
         todo = list(range(len(idx)))
         if basis == "measured":    # does the model itself fail there?
-            own = _reevaluate(model, [dataclasses.replace(c, basis="dwell") for c in group], mask, dt_s)
+            own = _reevaluate(engine, [dataclasses.replace(c, basis="dwell") for c in group], mask)
             for j, ok in enumerate(own):
                 removed[j]["model_dwell"] = ok
             todo = [j for j in todo if not own[j]]
         variants = CAUSES + ("servo",)
         if basis == "step" and todo:   # the single removals' step runs at once
             sub = [group[j] for j in todo]
-            got = run_tasks([lambda c=c: _reevaluate(remove_causes(model, (c,)), sub, mask, dt_s, threads)
-                             for c in CAUSES], threads)
+            got = run_tasks([lambda c=c, sub=sub: _reevaluate(engine.without((c,)), sub, mask, threads) for c in CAUSES],
+                            threads)
             for c, oks in zip(CAUSES, got):
                 for j, ok in zip(todo, oks):
                     removed[j][c] = ok
@@ -357,9 +333,9 @@ def attribute(model: TvcModel, checks: Sequence[SpecCheck], mask: SpecMask, dt_s
                 todo = [j for j in todo if not any(removed[j].get(c) for c in CAUSES)]
             if not todo:
                 break
-            mv = remove_causes(model, CAUSES if variant == "servo" else (variant,))
+            ev = engine.without(SERVO_ALONE if variant == "servo" else (variant,))
             sub = [dataclasses.replace(group[j], basis="dwell") if basis == "measured" else group[j] for j in todo]
-            for j, ok in zip(todo, _reevaluate(mv, sub, mask, dt_s, threads)):
+            for j, ok in zip(todo, _reevaluate(ev, sub, mask, threads)):
                 removed[j][variant] = ok
         for j, i in enumerate(idx):
             rem = removed[j]
@@ -381,6 +357,8 @@ class Verdict:
     mask_name: str
     mask_source: str
     checks: tuple[SpecCheck, ...]
+    #: the engine the dwells, linear responses and causes were evaluated on ("simplex" or "taos")
+    engine: str = "simplex"
 
     @property
     def passed(self) -> bool:
@@ -402,8 +380,9 @@ class Verdict:
         passes." """
         by = self.passed_by_basis()
         bases = ", ".join(b for b in BASES if b in by)
+        name = self.model_name if self.engine == "simplex" else f"{self.model_name} ({ENGINE_WORDS[self.engine]})"
         if self.passed:
-            return f"{self.model_name}: passes the mask ({self.mask_name}) on every basis checked ({bases})."
+            return f"{name}: passes the mask ({self.mask_name}) on every basis checked ({bases})."
         groups: dict[tuple[str, ...], list[SpecCheck]] = {}
         for c in self.failures():
             groups.setdefault(c.cause, []).append(c)
@@ -428,7 +407,7 @@ class Verdict:
                                                                if len(cause) > 1 else "")
             parts.append(f"at {_and(where)} ({', '.join(cb)}; worst: {worst.where()} {worst.worst().words()}) "
                          f"because of {why}")
-        s = f"{self.model_name}: fails the mask ({self.mask_name}) " + "; and ".join(parts)
+        s = f"{name}: fails the mask ({self.mask_name}) " + "; and ".join(parts)
         if by.get("linear"):
             s += "; the linear servo passes"
         return s + "."
@@ -437,15 +416,18 @@ class Verdict:
         """The ``summary.json`` keys this adds (docs/reference/outputs.md)."""
         return {"spec_verdict_text": self.text(), "spec_verdict_pass": self.passed,
                 "spec_pass_by_basis": self.passed_by_basis(),
+                "spec_engine": self.engine,
                 "spec_points": [c.to_dict() for c in self.checks],
                 "spec_attribution": {
                     "causes": list(CAUSES) + ["combined", "servo", "unexplained"],
                     "laboratory_load_stiffness_N_per_m": LAB_LOAD_STIFFNESS_N_PER_M,
-                    "method": "each failing point re-evaluated with one factor removed (friction law none; load "
-                              "stiffness K_L -> max(K_L, laboratory); unity avionics) and, if none passes, all three "
-                              "(the servo alone); the cause is the factors whose removal alone passes, 'combined' "
-                              "when only the servo alone passes, 'servo' when it fails too; a measured point the "
-                              "model's own dwell passes is 'unexplained'"}}
+                    "engine": self.engine,
+                    "method": "each failing point re-evaluated on the same engine with one factor removed (friction "
+                              "law none; load stiffness K_L -> max(K_L, laboratory); unity avionics; supply-pressure "
+                              "limit lifted) and, if none passes, friction, load path and avionics together (the "
+                              "servo alone, its valve kept); the cause is the factors whose removal alone passes, "
+                              "'combined' when only the servo alone passes, 'servo' when it fails too; a measured "
+                              "point the model's own dwell passes is 'unexplained'"}}
 
 
 def _and(items: Sequence[str]) -> str:
@@ -453,36 +435,41 @@ def _and(items: Sequence[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def spec_verdict(model: TvcModel, mask: SpecMask, *, segments: Mapping[str, Sequence[tuple[float, float]]] | None = None,
+def spec_verdict(model: TvcModel, mask: SpecMask, *, segments: Mapping[str, Sequence[tuple]] | None = None,
                  measured: Mapping[str, MeasuredResponse] | None = None, step_figures: Mapping[str, dict] | None = None,
-                 dt_s: float = 2e-4, axes: Sequence[str] = AXES, attribute_causes: bool = True,
-                 threads: int | None = None) -> Verdict:
-    """``model`` against ``mask`` on every basis (module docstring), with causes.
+                 dt_s: float | None = None, axes: Sequence[str] = AXES, attribute_causes: bool = True,
+                 threads: int | None = None, engine: str = "simplex", taos_model=None) -> Verdict:
+    """``model`` against ``mask`` on every basis (module docstring), with causes, on ``engine``
+    (``"simplex"`` or ``"taos"``; 3-D: ``taos_model``, else built from ``model``).
 
-    ``segments``: per axis the profile's dwell segments as (frequency [Hz], amplitude [rad])
-    (none: no dwell basis); ``measured``: per axis a measured record's responses (none: no
-    measured basis); ``step_figures``: per axis the step figures already simulated
-    (``StepMerit.to_dict()``, reused when their amplitude is the mask's); ``dt_s``: the
-    integration step [s] of dwells and steps; ``threads``: for the independent step runs
-    (:func:`attribute`; the same numbers on any count)."""
+    ``segments``: per axis the profile's dwell segments as (frequency [Hz], amplitude [rad]), or
+    with the other axis' dwell meanwhile (:func:`taos.report.engines.concurrent_dwells`: the 3-D
+    dwells run it; the planar ones ignore it) (none: no dwell basis); ``measured``: per axis a
+    measured record's responses (none: no measured basis); ``step_figures``: per axis the planar
+    step figures already simulated (``StepMerit.to_dict()``, reused on the simplex engine when
+    their amplitude is the mask's); ``dt_s``: the integration step [s] of dwells and steps
+    (default the engine's own); ``threads``: for the independent step runs (:func:`attribute`;
+    the same numbers on any count)."""
+    ev = engine_for(model, engine, dt_s, taos_model)
     checks: list[SpecCheck] = []
     for ax in axes:
-        checks += _freq_checks(model, mask, ax, "linear", None, dt_s)
+        checks += _freq_checks(ev, mask, ax, "linear", None)
     for ax in axes:
         segs = (segments or {}).get(ax)
         if segs:
             amps = [dwell_amplitude_rad(segs, p.freq_hz) for p in mask.points]
-            checks += _freq_checks(model, mask, ax, "dwell", amps, dt_s)
+            dith = [_dither(segs, p.freq_hz) for p in mask.points] if ev.name == "taos" else None
+            checks += _freq_checks(ev, mask, ax, "dwell", amps, dith)
     for ax in axes:
         if measured and ax in measured:
-            checks += _measured_checks(model, mask, measured[ax])
+            checks += _measured_checks(ev, mask, measured[ax], (segments or {}).get(ax) if ev.name == "taos" else None)
     if mask.steps:
         for ax in axes:
-            have = (step_figures or {}).get(ax)
+            have = (step_figures or {}).get(ax) if ev.name == "simplex" else None
             amp_deg = math.degrees(mask.steps[0].amplitude_rad)
             if have is None or not math.isclose(have.get("step_amplitude_deg", math.nan), amp_deg, rel_tol=1e-9):
-                have = _step_values(model, ax, mask.steps, dt_s, threads)
-            checks.append(_step_check(ax, mask.steps, have))
+                have = ev.step_values(ax, mask.steps, threads)
+            checks.append(_step_check(ax, mask.steps, have, ev.step_engine(mask.steps)))
     if attribute_causes:
-        checks = attribute(model, checks, mask, dt_s, threads)
-    return Verdict(model.name, mask.name, mask.source, tuple(checks))
+        checks = attribute(ev, checks, mask, threads=threads)
+    return Verdict(model.name, mask.name, mask.source, tuple(checks), ev.name)

@@ -36,8 +36,10 @@ class TaosParams(NamedTuple):
                                            [per N]
     act_c_xp                    (n_a,)     actuator output row of the piston position x_p
     bearing_axes                (2, 3)     pitch and yaw unit axes in the gimbal frame [-]
-    line_stiffness_N_per_m      (2,)       K_line of the pitch and yaw actuator lines, the load
-                                           path along each line outside the gimbal [N/m]
+    line_stiffness_N_per_m      (2,)       K_line of the pitch and yaw actuator lines: each line's
+                                           stiffness outside the gimbal [N/m], derived from that
+                                           axis' total K_L with the FEM gimbal in series
+                                           (taos.taos3d.calibrate)
     moment_arm_m                scalar     R, the actuator moment arm [m]
     engine_stiffness_Nm_per_rad scalar     K_n, the feedline/gravity spring on pitch and yaw
                                            [N m/rad]

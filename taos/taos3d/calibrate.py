@@ -30,10 +30,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..model import TvcModel, load_model
+from ..units import N_PER_M_PER_LBF_PER_IN
 from .model import DERIVED_RTOL, TaosModel, assemble_taos_model, line_stiffness_basis
-
-#: N/m per lbf/in (for the messages, which quote the files' units too)
-_NPM_PER_LBF_IN = 175.12683524647636
 
 
 def taos_notch_hz(tm: TaosModel, guess_hz: float, axis: str = "pitch") -> float:
@@ -101,7 +99,7 @@ def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.n
         return dataclasses.replace(tm, gimbal=dataclasses.replace(tm.gimbal, line_stiffness_basis=line_stiffness_basis(tm)))
     if abs(given - expected) > DERIVED_RTOL * expected:
         K = model.structure.load_stiffness_N_per_m
-        lbf = _NPM_PER_LBF_IN
+        lbf = N_PER_M_PER_LBF_PER_IN  # the messages quote the files' units too
         raise InputError(model.source, "gimbal.line_load_stiffness",
                          f"{expected:.6g} N/m ({expected / lbf:.6g} lbf/in) within 1 %, derived from "
                          f"structure.load_stiffness = {K:.6g} N/m ({K / lbf:.6g} lbf/in) with the gimbal "

@@ -62,7 +62,7 @@ import numpy as np
 from ..errors import InputError
 from ..model import TvcModel
 from ..shipped import resolve_reference
-from ..units import to_si
+from ..units import NM_PER_IN_LBF, to_si
 
 G0 = 9.80665  # standard gravity [m/s^2]
 AXES = ("pitch", "yaw")
@@ -332,8 +332,6 @@ def normal_load_N(model: TvcModel) -> float:
 
 #: relative tolerance of a derived key given in a file against its source keys
 DERIVED_RTOL = 0.01
-#: N m per in*lbf (for the messages, which quote the files' units too)
-_NM_PER_INLBF = 0.1129848290276167
 
 
 def check_friction_coefficient(model: TvcModel, mu: float | None, bearing_radius_m: float) -> float:
@@ -351,7 +349,7 @@ def check_friction_coefficient(model: TvcModel, mu: float | None, bearing_radius
         load = f"thrust {N / 1e3:.6g} kN" if model.engine.thrust_N > 0 else f"engine weight m g0 {N / 1e3:.6g} kN"
         raise InputError(model.source, "gimbal.friction_coefficient",
                          f"{expected:.4g} within 1 %, from friction.coulomb_torque = {tc:.6g} N m "
-                         f"({tc / _NM_PER_INLBF:.6g} in*lbf) = mu N r_b with N = {load}, r_b = {bearing_radius_m:.4g} m "
+                         f"({tc / NM_PER_IN_LBF:.6g} in*lbf) = mu N r_b with N = {load}, r_b = {bearing_radius_m:.4g} m "
                          f"(one friction for the planar and 3-D models; delete the key to have it derived)",
                          got=f"{mu:.6g} (mu N r_b = {mu * N * bearing_radius_m:.6g} N m)")
     return mu

@@ -22,17 +22,20 @@ import numpy as np
 from ..planar.actuator import actuator_state_space
 from ..errors import SimulationUnstable
 from ..planar._parallel import run_each
-from ..planar.freqresp import FrequencyResponse, settle_time_s
+from ..planar.freqresp import LINEAR_SOLVER, FrequencyResponse, settle_time_s
 from ..linear import StateSpace
 from ..profiles import Profile, is_two_axis
 from ..planar.simulate import SolverSettings, TimeHistory, provenance
 from . import _args
 from . import dynamics as _dy
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
+from taos.results import model_provenance
 
 #: the 3-D model's step [s]: second-order bearing coupling (taos.taos3d.dynamics) makes it as
 #: accurate as the former first-order scheme at 2e-4 s (tests/test_taos3d_step.py)
 DEFAULT_DT_S = 4e-4
+#: the integrator of every 3-D run and dwell (:func:`taos.taos3d.dynamics.step`), as results name it
+INTEGRATOR = "rk4, trapezoidal bearing torque + BDF2 bearing substeps"
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,7 +157,7 @@ def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S
     extra = {"bearing_slip_rad": two("phi_pitch", "phi_yaw"), "chain_wrench": W,
              "upper_deflection": np.linalg.solve(tm.K_upper, W), "lower_deflection": np.linalg.solve(tm.K_lower, W),
              "engine_point_m": out[:, [col["px"], col["py"], col["pz"]]].T}
-    solver = SolverSettings(method="rk4, trapezoidal bearing torque + BDF2 bearing substeps", dt_s=dt_s, record_every=record_every)
+    solver = SolverSettings(method=INTEGRATOR, dt_s=dt_s, record_every=record_every)
     prov = provenance(tm.base, solver, engine="taos", profile=getattr(profile, "name", type(profile).__name__),
                       stiffness_source=tm.stiffness_source, friction_scale=tm.friction_scale,
                       bearing_coulomb_torque_Nm=tm.bearing_friction.coulomb_torque_Nm,
@@ -273,7 +276,9 @@ def taos_freqresp(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitude_rad: fl
         ss = linear_state_space(tm)
         h = ss.freqresp(f, ss.inputs[i], [ss.outputs[o], ss.outputs[2 + o]])
         return FrequencyResponse(f, h[:, 0] / R, h[:, 1], None, label, engine_model="taos", friction_model="none",
-                                 provenance={"model_sha256": tm.base.sha256, "method": "linear (taos)"})
+                                 provenance={**model_provenance(tm.base), "seeds": "none (deterministic)",
+                                             "solver": {**LINEAR_SOLVER, "method": "linear (exact, the 3-D model "
+                                                        "linearised about rest)", "engine": "taos"}})
     return taos_freqresp_family(tm, f, [amplitude_rad], axis, cross, dt_max_s=dt_max_s, settle_cycles=settle_cycles,
                                 measure_cycles=measure_cycles, settle_s=settle_s,
                                 min_steps_per_cycle=min_steps_per_cycle)[0]
@@ -322,6 +327,10 @@ def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = Fal
                  np.concatenate([p[7] for p in parts]), dt_max_s, settle_cycles, measure_cycles, settle_s,
                  min_steps_per_cycle, groups=[p[4].size for p in parts])
     R = tm.base.actuator.moment_arm_m
+    solver = {"method": "sine dwell, settled from rest", "integrator": INTEGRATOR,
+              "step": "dt_max_s or less, a whole number of steps per cycle", "dt_max_s": float(dt_max_s),
+              "min_steps_per_cycle": int(min_steps_per_cycle), "settle_cycles": int(settle_cycles),
+              "settle_s": _settle_s(tm, settle_s), "measure_cycles": int(measure_cycles), "engine": "taos"}
     out, k0 = {}, 0
     for axis, f, a, i, A, _, _, _ in parts:
         o = 1 - i if cross else i
@@ -330,10 +339,16 @@ def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = Fal
         k0 += A.size
         out[axis] = [FrequencyResponse(f, h[k, :, o] / R, h[k, :, 2 + o], float(ak), label, engine_model="taos",
                                        friction_model=tm.base.friction.name,
-                                       provenance={"model_sha256": tm.base.sha256, "method": "sine-dwell (taos)",
-                                                   "dt_max_s": dt_max_s, "friction_scale": tm.friction_scale})
+                                       provenance={**model_provenance(tm.base), "seeds": "none (deterministic)",
+                                                   "solver": dict(solver), "friction_scale": tm.friction_scale})
                      for k, ak in enumerate(a)]
     return out
+
+
+def _settle_s(tm: TaosModel, settle_s: float | None) -> float:
+    """The settling time of a dwell [s]: ``settle_s``, default four decades of the base model's
+    slowest linear pitch mode."""
+    return float(settle_time_s(tm.base, "pitch")) if settle_s is None else float(settle_s)
 
 
 def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, settle_s, min_steps_per_cycle,
@@ -342,7 +357,7 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
     one parallel call: (n, 4, 3) correlation coefficients in row order. The step budget is
     checked on the whole grid, or on each group of consecutive rows of sizes ``groups``."""
     pk = pack(tm)
-    ts = settle_time_s(tm.base, "pitch") if settle_s is None else settle_s
+    ts = _settle_s(tm, settle_s)
     fmeas = np.array(fmeas, float)   # own copies (writable, C order: the kernel's compiled signature)
     npc = np.maximum(np.ceil(1.0 / (fmeas * dt_max_s)), min_steps_per_cycle).astype(np.int64)
     dts = 1.0 / (fmeas * npc)

@@ -1,0 +1,472 @@
+/* FMI 2.0 co-simulation interface of the standalone taos TVC FMU (taos fmu --standalone).
+
+   Hand-written and model-independent: the FMI life cycle, the variables, the communication
+   step and the FMU state. It holds no dynamics. The state equations and the RK4 step are
+   taos_kernels.c, which taos emits from the compiled kernels' own Python definitions
+   (taos.cosim._ccode); the model's numbers are taos_model.h, written from the loaded model.
+
+   Per axis (pitch, yaw; each its own planar plant, as taos simulate): a communication step of
+   n internal steps of TAOS_DT runs taos_rk4_step n times with the command held (command_hold 0)
+   or ramped linearly from the previous communication point's command (command_hold 1, taos
+   simulate's linear interpolation of its samples), then the outputs are read at the step's
+   end: y = Cy x, and the friction torque and post-avionics command of taos_rates there.
+
+   Statuses: a host mistake (a call in the wrong state, an unknown value reference, a fixed
+   parameter set after initialisation, a NaN or out-of-range input, a communication point
+   that is not the FMU's time, a step that is not a whole multiple of the internal step) is
+   fmi2Error with one log line, and changes nothing. A step whose state becomes non-finite or
+   leaves the physical envelope is fmi2Discard: the FMU stays at the step's start
+   (fmi2LastSuccessfulTime) and reports fmi2Terminated = true (the run cannot go on).
+   Memory comes from the host's allocateMemory/freeMemory; nothing is global but constants. */
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "fmi2Functions.h"
+#include "taos_kernels.h"
+#include "taos_model.h"
+
+#define N_AX 2
+#define N_OUT 17
+#define VR_OUT0 2                   /* Real value references: 0, 1 the commands, 2..18 the outputs */
+#define VR_DT (VR_OUT0 + N_OUT)     /* internal_step_s (constant) */
+#define VR_HOLD 0                   /* Integer value reference of command_hold */
+#define TIME_TOL (1e-3 * TAOS_DT)   /* a communication point is the FMU's time within this [s] */
+#define STEP_TOL (1e-6 * TAOS_DT)   /* a step is a whole multiple of TAOS_DT within this [s] */
+
+enum { ST_INSTANTIATED, ST_INIT, ST_STEP, ST_TERMINATED };
+static const char *const STATE_NAME[] = {"instantiated", "initialization mode", "stepping", "terminated"};
+
+/* Everything an FMU state (fmi2GetFMUstate) holds. */
+typedef struct {
+    double x[N_AX][TAOS_NX];  /* linear states per axis [SI] */
+    double z[N_AX];           /* friction states [rad] */
+    long k;                   /* internal steps since the start */
+    double cmd_prev[N_AX];    /* commands at the last communication point [rad] (a ramp's start) */
+    double in[N_AX];          /* the inputs as set [rad] */
+    double out[N_OUT];        /* outputs at the last communication point [SI] */
+    int hold;                 /* command_hold: 0 hold, 1 ramp */
+    int terminated;           /* fmi2Terminated */
+    double t0;                /* start time [s] */
+} Dyn;
+
+typedef struct {
+    Dyn d;
+    int state;
+    int logging;
+    char *name;
+    fmi2CallbackLogger logger;
+    fmi2CallbackAllocateMemory alloc;
+    fmi2CallbackFreeMemory dealloc;
+    fmi2ComponentEnvironment env;
+    double k1[TAOS_NX], k2[TAOS_NX], k3[TAOS_NX], k4[TAOS_NX], xt[TAOS_NX];
+} Inst;
+
+#define SER_MAGIC "taos-fmu-state-1"
+
+static void logmsg(Inst *s, fmi2Status st, const char *cat, const char *fmt, ...) {
+    char buf[512];
+    va_list ap;
+    if (s == NULL || s->logger == NULL || (st == fmi2OK && !s->logging)) return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    for (char *p = buf; *p; p++) if (*p == '%') *p = ' ';   /* the host may read it as a format */
+    s->logger(s->env, s->name, st, cat, buf);
+}
+
+#define ERR(s, ...) (logmsg((s), fmi2Error, "logStatusError", __VA_ARGS__), fmi2Error)
+
+static int allowed(Inst *s, const char *fn, unsigned mask) {
+    if (mask & (1u << s->state)) return 1;
+    logmsg(s, fmi2Error, "logStatusError", "%s: not allowed in state %s", fn, STATE_NAME[s->state]);
+    return 0;
+}
+#define M(st) (1u << (st))
+#define CHECK(c, fn, mask) Inst *s = (Inst *)(c); if (s == NULL) return fmi2Error; if (!allowed(s, fn, (mask))) return fmi2Error
+
+/* the plant arrays of axis ax in the order of the kernels' arguments (taos.planar.simulate.PlantArrays) */
+#define PLANT(ax) taos_A[ax], (long)TAOS_NX, (long)TAOS_NX, taos_Br[ax], (long)TAOS_NX, (long)TAOS_NR, \
+    taos_bc[ax], (long)TAOS_NX, taos_bf[ax], (long)TAOS_NX, taos_cc[ax], (long)TAOS_NX, taos_dc[ax], (long)TAOS_NR, \
+    taos_cw[ax], (long)TAOS_NX, taos_ca[ax], (long)TAOS_NX, taos_lim[ax], (long)TAOS_NLIM, \
+    taos_fp, (long)TAOS_NFP, taos_avp, (long)TAOS_NAVP
+
+/* Outputs at the current state with the commands cmd [rad] (taos.cosim._cores.SIGNALS order:
+   each per-axis signal pitch then yaw, then the thrust direction). */
+static void outputs(Inst *s, const double cmd[N_AX]) {
+    double th[N_AX];
+    for (int ax = 0; ax < N_AX; ax++) {
+        double r[TAOS_NR];
+        for (int j = 0; j < TAOS_NR; j++) r[j] = cmd[ax];
+        taos_tup3 q = taos_rates(s->d.x[ax], TAOS_NX, s->d.z[ax], r, TAOS_NR, PLANT(ax), s->k1, TAOS_NX);
+        double y[TAOS_NY];
+        for (int o = 0; o < TAOS_NY; o++) {
+            double acc = 0.0;
+            for (int i = 0; i < TAOS_NX; i++) acc += taos_cy[ax][o][i] * s->d.x[ax][i];
+            y[o] = acc;
+        }
+        /* TAOS_NY rows: engine angle, engine rate, piston, load force, load pressure */
+        for (int o = 0; o < TAOS_NY; o++) s->d.out[2 * o + ax] = y[o];
+        s->d.out[2 * TAOS_NY + ax] = q.v[1];       /* friction torque [N m] */
+        s->d.out[2 * TAOS_NY + 2 + ax] = q.v[2];   /* command after the avionics [rad] */
+        th[ax] = y[0];
+    }
+    taos_tup3 d = taos_thrust_direction(th[0], th[1]);
+    for (int i = 0; i < 3; i++) s->d.out[2 * TAOS_NY + 4 + i] = d.v[i];
+}
+
+static void rest(Inst *s) {
+    memset(s->d.x, 0, sizeof s->d.x);
+    memset(s->d.z, 0, sizeof s->d.z);
+    s->d.k = 0;
+    s->d.terminated = 0;
+}
+
+static double now(const Inst *s) { return s->d.t0 + s->d.k * TAOS_DT; }
+
+/* -- common functions ------------------------------------------------------------------- */
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cats[]) {
+    Inst *s = (Inst *)c;
+    if (s == NULL) return fmi2Error;
+    for (size_t i = 0; i < n; i++)
+        if (cats == NULL || cats[i] == NULL || (strcmp(cats[i], "logStatusError") && strcmp(cats[i], "logStatusDiscard")
+                                                && strcmp(cats[i], "logAll")))
+            return ERR(s, "fmi2SetDebugLogging: unknown log category %s (logStatusError, logStatusDiscard, logAll)",
+                       cats && cats[i] ? cats[i] : "(null)");
+    s->logging = on ? 1 : 0;
+    return fmi2OK;
+}
+
+fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
+                              const fmi2CallbackFunctions *f, fmi2Boolean visible, fmi2Boolean loggingOn) {
+    Inst tmp;
+    (void)resources; (void)visible;
+    if (f == NULL || f->allocateMemory == NULL || f->freeMemory == NULL) return NULL;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.logger = f->logger;
+    tmp.env = f->componentEnvironment;
+    tmp.name = (char *)(name ? name : "?");
+    if (name == NULL || !*name) { logmsg(&tmp, fmi2Error, "logStatusError", "fmi2Instantiate: no instance name"); return NULL; }
+    if (type != fmi2CoSimulation) {
+        logmsg(&tmp, fmi2Error, "logStatusError", "fmi2Instantiate: this FMU is for co-simulation only");
+        return NULL;
+    }
+    if (guid == NULL || strcmp(guid, TAOS_GUID)) {
+        logmsg(&tmp, fmi2Error, "logStatusError", "fmi2Instantiate: GUID %s is not this FMU's %s", guid ? guid : "(null)",
+               TAOS_GUID);
+        return NULL;
+    }
+    Inst *s = (Inst *)f->allocateMemory(1, sizeof(Inst));
+    char *nm = (char *)f->allocateMemory(strlen(name) + 1, 1);
+    if (s == NULL || nm == NULL) {
+        if (s) f->freeMemory(s);
+        if (nm) f->freeMemory(nm);
+        logmsg(&tmp, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
+        return NULL;
+    }
+    memset(s, 0, sizeof *s);
+    strcpy(nm, name);
+    s->name = nm;
+    s->logger = f->logger;
+    s->alloc = f->allocateMemory;
+    s->dealloc = f->freeMemory;
+    s->env = f->componentEnvironment;
+    s->logging = loggingOn ? 1 : 0;
+    s->d.hold = TAOS_HOLD_DEFAULT;
+    s->state = ST_INSTANTIATED;
+    return s;
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    Inst *s = (Inst *)c;
+    if (s == NULL) return;
+    fmi2CallbackFreeMemory dealloc = s->dealloc;
+    dealloc(s->name);
+    dealloc(s);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolDefined, fmi2Real tol, fmi2Real start,
+                               fmi2Boolean stopDefined, fmi2Real stop) {
+    CHECK(c, "fmi2SetupExperiment", M(ST_INSTANTIATED));
+    (void)tolDefined; (void)tol;
+    if (!isfinite(start) || (stopDefined && !(stop >= start)))
+        return ERR(s, "fmi2SetupExperiment: start time %g s and stop time %g s: expected a finite start before the stop",
+                   start, stop);
+    s->d.t0 = start;
+    return fmi2OK;
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    CHECK(c, "fmi2EnterInitializationMode", M(ST_INSTANTIATED));
+    s->state = ST_INIT;
+    return fmi2OK;
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    CHECK(c, "fmi2ExitInitializationMode", M(ST_INIT));
+    rest(s);
+    memcpy(s->d.cmd_prev, s->d.in, sizeof s->d.in);
+    outputs(s, s->d.in);
+    s->state = ST_STEP;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Terminate(fmi2Component c) {
+    CHECK(c, "fmi2Terminate", M(ST_STEP));
+    s->state = ST_TERMINATED;
+    return fmi2OK;
+}
+
+fmi2Status fmi2Reset(fmi2Component c) {
+    CHECK(c, "fmi2Reset", M(ST_INSTANTIATED) | M(ST_INIT) | M(ST_STEP) | M(ST_TERMINATED));
+    memset(&s->d, 0, sizeof s->d);
+    s->d.hold = TAOS_HOLD_DEFAULT;
+    s->state = ST_INSTANTIATED;
+    return fmi2OK;
+}
+
+/* -- variables -------------------------------------------------------------------------- */
+#define ALL (M(ST_INSTANTIATED) | M(ST_INIT) | M(ST_STEP) | M(ST_TERMINATED))
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]) {
+    CHECK(c, "fmi2GetReal", ALL);
+    if (n > 0 && (vr == NULL || v == NULL)) return ERR(s, "fmi2GetReal: no value references or no values");
+    if (s->state == ST_INSTANTIATED || s->state == ST_INIT) outputs(s, s->d.in);   /* at rest: the initial values */
+    for (size_t i = 0; i < n; i++) {
+        if (vr[i] < VR_OUT0) v[i] = s->d.in[vr[i]];
+        else if (vr[i] < VR_DT) v[i] = s->d.out[vr[i] - VR_OUT0];
+        else if (vr[i] == VR_DT) v[i] = TAOS_DT;
+        else return ERR(s, "fmi2GetReal: no Real with value reference %u", vr[i]);
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]) {
+    CHECK(c, "fmi2SetReal", M(ST_INSTANTIATED) | M(ST_INIT) | M(ST_STEP));
+    if (n > 0 && (vr == NULL || v == NULL)) return ERR(s, "fmi2SetReal: no value references or no values");
+    for (size_t i = 0; i < n; i++) {   /* every value checked before any is taken */
+        if (vr[i] >= VR_OUT0)
+            return ERR(s, "fmi2SetReal: value reference %u is %s, which cannot be set", vr[i],
+                       vr[i] < VR_DT ? "an output" : vr[i] == VR_DT ? "the constant internal_step_s" : "no Real");
+        if (!(fabs(v[i]) <= TAOS_COMMAND_RANGE_RAD))
+            return ERR(s, "%s_command_rad: expected a command within the gimbal range +-%g rad, got %g",
+                       vr[i] == 0 ? "pitch" : "yaw", TAOS_COMMAND_RANGE_RAD, v[i]);
+    }
+    for (size_t i = 0; i < n; i++) s->d.in[vr[i]] = v[i];
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]) {
+    CHECK(c, "fmi2GetInteger", ALL);
+    for (size_t i = 0; i < n; i++) {
+        if (vr[i] != VR_HOLD) return ERR(s, "fmi2GetInteger: no Integer with value reference %u", vr[i]);
+        v[i] = s->d.hold;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]) {
+    CHECK(c, "fmi2SetInteger", M(ST_INSTANTIATED) | M(ST_INIT) | M(ST_STEP));
+    for (size_t i = 0; i < n; i++) {
+        if (vr[i] != VR_HOLD) return ERR(s, "fmi2SetInteger: no Integer with value reference %u", vr[i]);
+        if (s->state == ST_STEP)
+            return ERR(s, "command_hold: a fixed parameter, set only before initialisation ends");
+        if (v[i] != 0 && v[i] != 1) return ERR(s, "command_hold: expected 0 (hold) or 1 (ramp), got %d", v[i]);
+    }
+    for (size_t i = 0; i < n; i++) s->d.hold = v[i];
+    return fmi2OK;
+}
+
+static fmi2Status no_vars(fmi2Component c, const char *fn, size_t n) {
+    CHECK(c, fn, ALL);
+    return n ? ERR(s, "%s: the FMU has no variable of that type", fn) : fmi2OK;
+}
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]) {
+    (void)vr; (void)v; return no_vars(c, "fmi2GetBoolean", n);
+}
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]) {
+    (void)vr; (void)v; return no_vars(c, "fmi2SetBoolean", n);
+}
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]) {
+    (void)vr; (void)v; return no_vars(c, "fmi2GetString", n);
+}
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]) {
+    (void)vr; (void)v; return no_vars(c, "fmi2SetString", n);
+}
+
+/* -- FMU state -------------------------------------------------------------------------- */
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *st) {
+    CHECK(c, "fmi2GetFMUstate", ALL);
+    if (st == NULL) return ERR(s, "fmi2GetFMUstate: no state pointer");
+    if (*st == NULL) *st = s->alloc(1, sizeof(Dyn));
+    if (*st == NULL) return ERR(s, "fmi2GetFMUstate: out of memory");
+    memcpy(*st, &s->d, sizeof(Dyn));
+    return fmi2OK;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate st) {
+    CHECK(c, "fmi2SetFMUstate", ALL);
+    if (st == NULL) return ERR(s, "fmi2SetFMUstate: no state");
+    memcpy(&s->d, st, sizeof(Dyn));
+    return fmi2OK;
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *st) {
+    CHECK(c, "fmi2FreeFMUstate", ALL);
+    if (st != NULL && *st != NULL) { s->dealloc(*st); *st = NULL; }
+    return fmi2OK;
+}
+
+#define SER_HEAD (sizeof SER_MAGIC + sizeof TAOS_GUID)
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate st, size_t *size) {
+    CHECK(c, "fmi2SerializedFMUstateSize", ALL);
+    (void)st;
+    *size = SER_HEAD + sizeof(Dyn);
+    return fmi2OK;
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate st, fmi2Byte out[], size_t size) {
+    CHECK(c, "fmi2SerializeFMUstate", ALL);
+    if (st == NULL || out == NULL || size < SER_HEAD + sizeof(Dyn))
+        return ERR(s, "fmi2SerializeFMUstate: no state, or a buffer shorter than fmi2SerializedFMUstateSize");
+    memcpy(out, SER_MAGIC, sizeof SER_MAGIC);
+    memcpy(out + sizeof SER_MAGIC, TAOS_GUID, sizeof TAOS_GUID);
+    memcpy(out + SER_HEAD, st, sizeof(Dyn));
+    return fmi2OK;
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte in[], size_t size, fmi2FMUstate *st) {
+    CHECK(c, "fmi2DeSerializeFMUstate", ALL);
+    if (in == NULL || st == NULL || size != SER_HEAD + sizeof(Dyn) || memcmp(in, SER_MAGIC, sizeof SER_MAGIC)
+        || memcmp(in + sizeof SER_MAGIC, TAOS_GUID, sizeof TAOS_GUID))
+        return ERR(s, "fmi2DeSerializeFMUstate: not a state serialised by this FMU (size, format or GUID)");
+    if (*st == NULL) *st = s->alloc(1, sizeof(Dyn));
+    if (*st == NULL) return ERR(s, "fmi2DeSerializeFMUstate: out of memory");
+    memcpy(*st, in + SER_HEAD, sizeof(Dyn));
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                        const fmi2ValueReference z[], size_t nz, const fmi2Real dv[], fmi2Real dz[]) {
+    CHECK(c, "fmi2GetDirectionalDerivative", ALL);
+    (void)u; (void)nu; (void)z; (void)nz; (void)dv; (void)dz;
+    return ERR(s, "fmi2GetDirectionalDerivative: not provided (providesDirectionalDerivative=false)");
+}
+
+/* -- co-simulation ---------------------------------------------------------------------- */
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer o[],
+                                       const fmi2Real v[]) {
+    CHECK(c, "fmi2SetRealInputDerivatives", ALL);
+    (void)vr; (void)n; (void)o; (void)v;
+    return ERR(s, "fmi2SetRealInputDerivatives: not supported (canInterpolateInputs=false)");
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer o[],
+                                        fmi2Real v[]) {
+    CHECK(c, "fmi2GetRealOutputDerivatives", ALL);
+    (void)vr; (void)n; (void)o; (void)v;
+    return ERR(s, "fmi2GetRealOutputDerivatives: not supported (maxOutputDerivativeOrder=0)");
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c) {
+    CHECK(c, "fmi2CancelStep", ALL);
+    return ERR(s, "fmi2CancelStep: the FMU never runs asynchronously");
+}
+
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior) {
+    CHECK(c, "fmi2DoStep", M(ST_STEP));
+    (void)noSetPrior;
+    if (s->d.terminated)
+        return ERR(s, "fmi2DoStep: the FMU reported fmi2Terminated at t = %.9g s; reset it or set an earlier state", now(s));
+    if (!(fabs(t - now(s)) <= TIME_TOL))
+        return ERR(s, "fmi2DoStep: currentCommunicationPoint %.12g s is not the FMU's time %.12g s", t, now(s));
+    double nd = isfinite(h) && h > 0 ? floor(h / TAOS_DT + 0.5) : 0.0;
+    if (nd < 1 || nd > 1e12 || fabs(h - nd * TAOS_DT) > STEP_TOL)
+        return ERR(s, "fmi2DoStep: communication step %.12g s: expected a positive whole multiple of the internal "
+                   "step %g s (rebuild with taos fmu --dt to divide the host's step)", h, TAOS_DT);
+    long n = (long)nd;
+    Dyn save = s->d;
+    double r0[TAOS_NR], rm[TAOS_NR], r1[TAOS_NR];
+    for (int ax = 0; ax < N_AX; ax++) {
+        double c0 = s->d.cmd_prev[ax], c1 = s->d.in[ax];
+        for (long k = 0; k < n; k++) {
+            double a = c1, b = c1;
+            if (s->d.hold == 1) {   /* taos simulate's linear interpolation: c0 + (k / n) (c1 - c0), end points exact */
+                a = k == 0 ? c0 : ((double)k / (double)n) * (c1 - c0) + c0;
+                b = k + 1 == n ? c1 : ((double)(k + 1) / (double)n) * (c1 - c0) + c0;
+            }
+            for (int j = 0; j < TAOS_NR; j++) { r0[j] = a; r1[j] = b; rm[j] = 0.5 * (a + b); }
+            taos_tup3 q = taos_rk4_step(s->d.x[ax], TAOS_NX, s->d.z[ax], r0, TAOS_NR, rm, TAOS_NR, r1, TAOS_NR, TAOS_DT,
+                                        PLANT(ax), s->k1, TAOS_NX, s->k2, TAOS_NX, s->k3, TAOS_NX, s->k4, TAOS_NX,
+                                        s->xt, TAOS_NX);
+            s->d.z[ax] = q.v[0];
+            if (!taos_finite(s->d.x[ax], TAOS_NX, s->d.z[ax])) {
+                double tk = now(s) + (k + 1) * TAOS_DT;
+                s->d = save;
+                s->d.terminated = 1;
+                logmsg(s, fmi2Discard, "logStatusDiscard", "t = %.9g s: %s: state not finite at %.9g s (unstable; "
+                       TAOS_LABEL "); the FMU stays at %.9g s", t, ax ? "yaw" : "pitch", tk, now(s));
+                return fmi2Discard;
+            }
+        }
+    }
+    s->d.k += n;
+    memcpy(s->d.cmd_prev, s->d.in, sizeof s->d.in);
+    outputs(s, s->d.in);
+#if TAOS_CHECK_ENVELOPE
+    for (int ax = 0; ax < N_AX; ax++) {
+        double th = s->d.out[ax], fl = s->d.out[6 + ax];
+        const char *what = !(fabs(th) <= TAOS_HARD_STOP_RAD) ? "engine angle beyond the hard stops"
+                         : !(fabs(fl) <= TAOS_FORCE_LIMIT_N) ? "load force beyond 3 x the stall force" : NULL;
+        if (what) {
+            double tk = now(s);
+            s->d = save;
+            s->d.terminated = 1;
+            logmsg(s, fmi2Discard, "logStatusDiscard", "t = %.9g s: %s %s at %.9g s (envelope: +-%g rad, +-%g N); the "
+                   "FMU stays at %.9g s", t, ax ? "yaw" : "pitch", what, tk, TAOS_HARD_STOP_RAD, TAOS_FORCE_LIMIT_N, now(s));
+            return fmi2Discard;
+        }
+    }
+#endif
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind k, fmi2Status *v) {
+    CHECK(c, "fmi2GetStatus", ALL);
+    (void)k; (void)v;
+    return fmi2Discard;   /* fmi2DoStepStatus and fmi2PendingStatus: the FMU never runs asynchronously */
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v) {
+    CHECK(c, "fmi2GetRealStatus", ALL);
+    if (k != fmi2LastSuccessfulTime || v == NULL) return fmi2Discard;
+    *v = now(s);
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind k, fmi2Integer *v) {
+    CHECK(c, "fmi2GetIntegerStatus", ALL);
+    (void)k; (void)v;
+    return fmi2Discard;
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v) {
+    CHECK(c, "fmi2GetBooleanStatus", ALL);
+    if (k != fmi2Terminated || v == NULL) return fmi2Discard;
+    *v = s->d.terminated ? fmi2True : fmi2False;
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind k, fmi2String *v) {
+    CHECK(c, "fmi2GetStringStatus", ALL);
+    (void)k; (void)v;
+    return fmi2Discard;
+}
+
+/* Model-exchange functions are not part of a co-simulation FMU: none is exported. */
