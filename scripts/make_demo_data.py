@@ -18,12 +18,19 @@ and a constant engine-angle offset per axis (string pots without an absolute ref
 paper sec. 2), written as CSV with a TOML-comment header (``synthetic = true``, the truth
 values, the seed). Deterministic (seeded).
 
-Engines: ``--engine simplex`` (default) uses :func:`taos.planar.simulate.simulate`. HOOK for the
-3-D TAOS model (written separately): register its simulate function in ``ENGINES`` below
-(same signature: ``(model, profile, dt_s=..., record_every=...) -> TimeHistory``), then
-``--engine taos`` makes the same datasets from it.
+Engines: ``--engine simplex`` (default) uses :func:`taos.planar.simulate.simulate` and writes
+``greenrun_<condition>_synthetic.csv``. ``--engine taos`` runs the 3-D TAOS model
+(:func:`taos.taos3d.simulate_taos`: the engine on its two-half FEM gimbal, each condition's own
+``[gimbal] stiffness_file``: ambient ``gimbal_hanging.npz``, hot fire ``gimbal_thrust.npz``;
+the actuator lines' stiffness derived from K_L with that gimbal in series) and writes
+``greenrun_<condition>_synthetic_3d.csv`` beside the planar files. The 3-D ambient record keeps
+the ambient model's OWN friction (its modified LuGre law at mu N r_b with N the engine weight,
+not "none": the 3-D bearing carries the hanging engine's weight), so ``taos compare --engine
+taos`` fits a friction level in both conditions. These files are regression data from a solver
+independent of the planar one, kept with this script that made them (regenerate them whenever
+a model file, the actuator set or a FEM gimbal pair changes).
 
-Usage:  .venv/bin/python scripts/make_demo_data.py [--out models/data] [--engine simplex]
+Usage:  .venv/bin/python scripts/make_demo_data.py [--out models/data] [--engine simplex|taos]
 """
 
 from __future__ import annotations
@@ -45,13 +52,24 @@ from taos.planar.simulate import simulate  # noqa: E402
 from taos.units import M_PER_IN, N_PER_M_PER_LBF_PER_IN, NM_PER_IN_LBF  # noqa: E402
 
 DEG = math.pi / 180
-ENGINES = {"simplex": simulate}
-# HOOK: the 3-D TAOS model registers here, e.g.
-#   from taos.<taos3d module> import simulate as simulate_taos; ENGINES["taos"] = simulate_taos
+
+
+def simulate_taos3d(model, profile, dt_s, record_every):
+    """The 3-D TAOS model of ``model`` (its own FEM gimbal pair) run on ``profile``."""
+    from taos.taos3d import simulate_taos, taos_model
+    return simulate_taos(taos_model(model), profile, dt_s=dt_s, record_every=record_every)
+
+
+ENGINES = {"simplex": simulate, "taos": simulate_taos3d}
 
 CONDITIONS = {
     "ambient": dict(model="rs25_ambient.toml", friction="none", offset_deg=(0.031, -0.022), seed=11),
     "hotfire": dict(model="rs25_hotfire.toml", friction=None, offset_deg=(-0.017, 0.026), seed=12),
+}
+#: the 3-D records: the ambient model's own friction (None: the file's law), other seeds
+CONDITIONS_3D = {
+    "ambient": dict(CONDITIONS["ambient"], friction=None, seed=21),
+    "hotfire": dict(CONDITIONS["hotfire"], seed=22),
 }
 PISTON_NOISE_IN = 0.001
 ENGINE_NOISE_DEG = 0.004
@@ -60,7 +78,7 @@ RECORD_EVERY = 20          # 250 Hz
 
 
 def make(condition: str, out_dir: Path, engine: str = "simplex") -> Path:
-    spec = CONDITIONS[condition]
+    spec = (CONDITIONS_3D if engine == "taos" else CONDITIONS)[condition]
     model = load_model(ROOT / "models" / spec["model"], friction=spec["friction"])
     profile = load_profile(ROOT / "models" / "profiles" / "greenrun_two_axis.toml")
     th = ENGINES[engine](model, profile, dt_s=DT_S, record_every=RECORD_EVERY)
@@ -81,10 +99,22 @@ def make(condition: str, out_dir: Path, engine: str = "simplex") -> Path:
                                   "profile": "models/profiles/greenrun_two_axis.toml",
                                   "piston_noise_rms": f"{PISTON_NOISE_IN} in", "engine_noise_rms": f"{ENGINE_NOISE_DEG} deg",
                                   "engine_offset_deg": ", ".join(f"{o:g}" for o in spec["offset_deg"]),
-                                  "seed": spec["seed"]}})
-    path = out_dir / f"greenrun_{condition}_synthetic.csv"
+                                  "seed": spec["seed"], **_taos_meta(model, engine)}})
+    path = out_dir / f"greenrun_{condition}_synthetic{'_3d' if engine == 'taos' else ''}.csv"
     noisy.to_csv(path, digits=6)
     return path
+
+
+def _taos_meta(model, engine: str) -> dict:
+    """The 3-D truth beyond K_L and T_c: the FEM gimbal pair and the derived line stiffness."""
+    if engine != "taos":
+        return {}
+    from taos.taos3d import taos_model
+    tm = taos_model(model)
+    return {"stiffness_file": Path(tm.stiffness_source).name,
+            "true_line_load_stiffness": f"{tm.line_load_stiffness_N_per_m / 175.126835:.6g} lbf/in",
+            "true_friction_coefficient": f"{tm.gimbal.friction_coefficient:.6g}",
+            "integration_step": f"{DT_S:g} s"}
 
 
 def main(argv=None) -> int:

@@ -83,6 +83,9 @@ def check_model_plausible(src: str, engine, actuator, structure) -> None:
             ("structure.load_stiffness", "load resonance sqrt((K_L R^2 + K_n)/J_n)",
              math.sqrt((structure.load_stiffness_N_per_m * R * R + engine.rotational_stiffness_Nm_per_rad)
                        / min(engine.inertia_pitch_kgm2, engine.inertia_yaw_kgm2)) / (2 * math.pi)),
+            ("structure.load_stiffness_yaw", "yaw load resonance sqrt((K_L,yaw R^2 + K_n)/J_n)",
+             math.sqrt((structure.stiffness_N_per_m("yaw") * R * R + engine.rotational_stiffness_Nm_per_rad)
+                       / engine.inertia_yaw_kgm2) / (2 * math.pi)),
             ("actuator.oil_bulk_modulus", "oil-column frequency sqrt(4 beta A^2 / (V_t M_p))",
              math.sqrt(4 * actuator.oil_bulk_modulus_Pa * actuator.piston_area_m2 ** 2
                        / (actuator.trapped_volume_m3 * actuator.piston_mass_kg)) / (2 * math.pi)),
@@ -179,6 +182,7 @@ MODEL_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "actuator.relief_flow_coefficient": (0.0, 1e-4, "m**3/s/Pa", "a relief valve passes at most the pump flow"),
     "structure.load_stiffness": (1e4, 1e11, "N/m", "57 lbf/in to 5.7e8 lbf/in; RS-25 load path "
                                  "1.15e5-2.05e5 lbf/in"),
+    "structure.load_stiffness_yaw": (1e4, 1e11, "N/m", "as structure.load_stiffness (the yaw axis' own)"),
     "structure.load_damping_ratio": (0.0, 10.0, "1", "structures are 0.005-0.05"),
     "friction.coulomb_torque": (0.0, 1e7, "N*m", "RS-25 hot fire 1.3e4 N m; 1e7 N m would hold a stage"),
     "friction.static_torque": (0.0, 1e7, "N*m", "as the Coulomb torque"),
@@ -267,7 +271,8 @@ def check_model_bounds(src: str, engine, actuator, structure, avionics, friction
             obj = objs[sec]
             attr = next((a for a in vars(obj) if a == key or a.startswith(key + "_")), None)
             value = getattr(obj, attr) if attr is not None else None
-            optional_zero = key in ("gimbal_range", "hard_stop_stiffness", "max_rate", "relief_flow_coefficient")
+            optional_zero = key in ("gimbal_range", "hard_stop_stiffness", "max_rate", "relief_flow_coefficient",
+                                    "load_stiffness_yaw")
             if value is None or (optional_zero and value == 0.0):
                 continue
             check_bound(float(value), field, src)

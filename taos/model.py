@@ -137,12 +137,25 @@ class Structure:
 
     load_stiffness_N_per_m: float
     load_damping_ratio: float = 0.0
+    #: K_L of the yaw axis [N/m] (``[structure] load_stiffness_yaw``, optional): the yaw
+    #: actuator's load path when it differs from the pitch one; 0 (the key absent):
+    #: ``load_stiffness`` on both axes (a float, never None: the FMU exposes every field)
+    load_stiffness_yaw_N_per_m: float = 0.0
 
-    def load_damping_Ns_per_m(self, moment_arm_m, inertia_kgm2):
-        """c_L [N s/m] (works on CasADi expressions too, for fits)."""
+    def stiffness_N_per_m(self, axis: str = "pitch"):
+        """K_L of ``axis`` [N/m]: ``load_stiffness_yaw`` for yaw when the file gives it, else
+        ``load_stiffness`` (pitch, and yaw by default)."""
+        if axis == "yaw" and not (isinstance(self.load_stiffness_yaw_N_per_m, (int, float))
+                                  and self.load_stiffness_yaw_N_per_m == 0):
+            return self.load_stiffness_yaw_N_per_m
+        return self.load_stiffness_N_per_m
+
+    def load_damping_Ns_per_m(self, moment_arm_m, inertia_kgm2, axis: str = "pitch"):
+        """c_L = 2 zeta_L sqrt(K_L R^2 J) / R^2 [N s/m] with the K_L of ``axis``
+        (:meth:`stiffness_N_per_m`); works on CasADi expressions too, for fits."""
         if isinstance(self.load_damping_ratio, (int, float)) and self.load_damping_ratio == 0:
             return 0.0
-        return 2.0 * self.load_damping_ratio * (self.load_stiffness_N_per_m * moment_arm_m ** 2
+        return 2.0 * self.load_damping_ratio * (self.stiffness_N_per_m(axis) * moment_arm_m ** 2
                                                 * inertia_kgm2) ** 0.5 / moment_arm_m ** 2
 
 
@@ -178,9 +191,10 @@ class TvcModel:
 
     # -- derived figures ------------------------------------------------------------------
     def load_resonance_hz(self, axis: str = "pitch") -> float:
-        """w_L / 2 pi with w_L = sqrt((K_L R^2 + K_n) / J_n) (seed paper eq. 1) [Hz]."""
+        """w_L / 2 pi with w_L = sqrt((K_L R^2 + K_n) / J_n) (seed paper eq. 1) [Hz], K_L and J_n
+        of ``axis`` (:meth:`Structure.stiffness_N_per_m`)."""
         R = self.actuator.moment_arm_m
-        k = self.structure.load_stiffness_N_per_m * R * R + self.engine.rotational_stiffness_Nm_per_rad
+        k = self.structure.stiffness_N_per_m(axis) * R * R + self.engine.rotational_stiffness_Nm_per_rad
         return math.sqrt(k / self.engine.inertia(axis)) / (2 * math.pi)
 
     def breakaway_deflection_rad(self) -> float:
@@ -561,10 +575,12 @@ def load_model(path: str | Path, friction: str | None = None, overrides: Mapping
     atab = actuator_table_with_parameter_set(_section(doc, "actuator", src), p, src) | late.get("actuator", {})
     actuator = parse_actuator({"actuator": atab}, src)
     st = _section(doc, "structure", src)
-    _check_keys(st, {"load_stiffness", "load_damping_ratio"}, src, "structure")
+    _check_keys(st, {"load_stiffness", "load_damping_ratio", "load_stiffness_yaw"}, src, "structure")
     structure = Structure(_need(st, "load_stiffness", "stiffness", src, "structure", positive=True),
                           (_need(st, "load_damping_ratio", "dimensionless", src, "structure", nonnegative=True)
-                           if "load_damping_ratio" in st else 0.0))
+                           if "load_damping_ratio" in st else 0.0),
+                          (_need(st, "load_stiffness_yaw", "stiffness", src, "structure", positive=True)
+                           if "load_stiffness_yaw" in st else 0.0))
     ftab = friction_table_with_parameter_set(_section(doc, "friction", src), p, src) | late.get("friction", {})
     law = friction_from_table(ftab, src, model=friction)
     avionics = parse_avionics(doc, src)

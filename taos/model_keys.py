@@ -45,7 +45,8 @@ ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
 _ENGINE_KINDS = {"mass": "mass", "inertia_pitch": "inertia", "inertia_yaw": "inertia",
                  "rotational_stiffness": "rotational_stiffness", "thrust": "force", "gimbal_range": "angle",
                  "hard_stop_stiffness": "rotational_stiffness", "hard_stop_damping_ratio": "dimensionless"}
-_STRUCTURE_KINDS = {"load_stiffness": "stiffness", "load_damping_ratio": "dimensionless"}
+_STRUCTURE_KINDS = {"load_stiffness": "stiffness", "load_damping_ratio": "dimensionless",
+                    "load_stiffness_yaw": "stiffness"}
 _GIMBAL_KINDS = {"friction_coefficient": "dimensionless", "bearing_radius": "length",
                  "line_load_stiffness": "stiffness", "stiffness_file": None,
                  "upper_stiffness_scale": "dimensionless", "lower_stiffness_scale": "dimensionless"}

@@ -142,15 +142,16 @@ def test_taos3d_pack_fills_every_field(packed):
               "slip_gain": (2, 6), "bearing_compliance": (2, 2), "bearing_selection": (6, 2),
               "structure_attach_m": (2, 3), "engine_attach_m": (2, 3), "act_A": (na, na), "act_b_xc": (na,),
               "act_b_fl": (na,), "act_c_xp": (na,), "bearing_axes": (2, 3), "line_length0_m": (2,),
-              "torque_wrench": (6, 2)}
+              "torque_wrench": (6, 2), "line_stiffness_N_per_m": (2,), "line_damping_Ns_per_m": (2,)}
     for name in dy.TaosParams._fields:  # every field is documented in the class docstring
         assert f"\n    {name} " in dy.TaosParams.__doc__, name
     for name, shape in shapes.items():
         a = getattr(P, name)
         assert a.shape == shape and a.dtype == np.float64 and a.flags.c_contiguous, name
-    for name in ("line_stiffness_N_per_m", "moment_arm_m", "engine_stiffness_Nm_per_rad", "line_damping_Ns_per_m"):
+    for name in ("moment_arm_m", "engine_stiffness_Nm_per_rad"):
         assert isinstance(getattr(P, name), float), name
-    assert P.line_stiffness_N_per_m == tm.line_load_stiffness_N_per_m
+    assert np.array_equal(P.line_stiffness_N_per_m, tm.line_load_stiffnesses_N_per_m)
+    assert P.line_stiffness_N_per_m[0] == tm.line_load_stiffness_N_per_m
     assert P.moment_arm_m == tm.base.actuator.moment_arm_m
     assert P.engine_stiffness_Nm_per_rad == tm.base.engine.rotational_stiffness_Nm_per_rad
     act = actuator_state_space(tm.base.actuator)

@@ -170,7 +170,7 @@ def _free_engine(hot, law, halves=()):
         E += 0.5 * P.engine_stiffness_Nm_per_rad * ((P.bearing_axes[0] @ r) ** 2 + (P.bearing_axes[1] @ r) ** 2)
         for a in range(2):
             xa = x[13 + a * na:13 + (a + 1) * na]
-            E += 0.5 * aux[dy.AUX_FL + a] ** 2 / P.line_stiffness_N_per_m
+            E += 0.5 * aux[dy.AUX_FL + a] ** 2 / P.line_stiffness_N_per_m[a]
             E += 0.5 * M_p * xa[sts.index("v_p_m_s")] ** 2 + 0.5 * cvol * xa[sts.index("p_load_Pa")] ** 2
         return E
 

@@ -63,10 +63,13 @@ def _outputs(args, *names) -> None:
             check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
 
 
-def _parse_bounds(items) -> dict:
-    """--bounds 'NAME=LO:HI' (each with a unit) -> {name: (lo_si, hi_si)}."""
-    from taos.identify.surrogate import PARAMETERS
+def _parse_bounds(items, table=None) -> dict:
+    """--bounds 'NAME=LO:HI' (each with a unit) -> {name: (lo_si, hi_si)}; names from ``table``
+    (name -> an object with ``kind``; default the planar fit's parameters)."""
+    from taos.identify.surrogate import PARAMETERS as PLANAR
     from taos.units import to_si
+
+    PARAMETERS = PLANAR if table is None else table
 
     out = {}
     for it in items or []:
@@ -156,6 +159,7 @@ def cmd_fit(args) -> int:
     from taos.bounds import MAX_STARTS
 
     _outputs(args, "json", "plot", "out_model")
+    args.starts = 3 if args.starts is None else args.starts   # the planar fit's default
     if not 1 <= args.starts <= MAX_STARTS:
         raise InputError("command line", "--starts", f"a number of starts from 1 to {MAX_STARTS}", got=str(args.starts))
     if not 0.0 <= args.min_coherence <= 1.0:
@@ -303,6 +307,7 @@ def _cmd_compare_series(args) -> int:
         raise InputError("command line", "--records", f"{MIN_RECORDS} to {MAX_RECORDS} record files",
                          got=str(len(args.records)))
     from taos.bounds import MAX_STARTS
+    args.starts = 1 if args.starts is None else args.starts   # the series' default
     if not 1 <= args.starts <= MAX_STARTS:
         raise InputError("command line", "--starts", f"a number of starts from 1 to {MAX_STARTS}", got=str(args.starts))
     check_output_folder(args.out, SERIES_FILES)
@@ -391,11 +396,14 @@ def add_parsers(sub) -> None:
     add_friction_option(p, "swap the friction law before fitting (keeps the file's torque levels)")
     p.add_argument("--start", action="append", metavar="NAME=VALUE",
                    help="start value with unit, e.g. --start 'load_stiffness=150000 lbf/in' (repeatable)")
-    p.add_argument("--starts", type=int, default=3,
+    p.add_argument("--starts", type=int, default=None,
                    help="number of IPOPT starts (default 3): the best of the start values and the local minima of "
-                        "a describing-function grid over load_stiffness and coulomb_torque when either is free")
+                        "a describing-function grid over load_stiffness and coulomb_torque when either is free; "
+                        "--engine taos: local stages from the start and the STARTS-1 best cells of its global grid "
+                        "(default: the start, and the best cell when better)")
     p.add_argument("--no-engine", action="store_true", help="fit the piston responses only")
-    p.add_argument("--no-correction", action="store_true", help="skip the time-domain defect correction")
+    p.add_argument("--no-correction", action="store_true", help="skip the time-domain defect correction (the planar "
+                   "fit's; refused with --engine taos, which replays the nonlinear model and has none)")
     p.add_argument("--min-coherence", type=float, default=0.5)
     p.add_argument("--bounds", action="append", metavar="NAME=LOW:HIGH",
                    help="bounds with units, e.g. --bounds 'load_stiffness=50000 lbf/in:400000 lbf/in' (repeatable; "
@@ -425,7 +433,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--records", nargs="+", metavar="RECORD", help="series mode: two or more test records (.csv/.h5), "
                    "in test order (or sorted by their test_date metadata when every record carries one)")
     p.add_argument("--free", help="series mode: fitted parameters (default load_stiffness,coulomb_torque)")
-    p.add_argument("--starts", type=int, default=1, help="series mode: starts per fit (default 1)")
+    p.add_argument("--starts", type=int, default=None, help="series mode: starts per fit (default 1); --engine taos: "
+                   "local stages per fit from the start and the STARTS-1 best global-grid cells")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--labels", help="labels, comma-separated: two (default the model names), or one per record "
                    "(default the file names)")

@@ -49,9 +49,19 @@ def _parse_start3d(items) -> dict:
 
 
 def _refuse_planar_only(args) -> None:
-    if getattr(args, "bounds", None):
-        raise InputError("command line", "--bounds", "no --bounds with --engine taos (its bounds are physical: "
-                         "taos.identify.params3d)", got=" ".join(args.bounds))
+    """The planar fit's options the 3-D fit has no meaning for: one line, exit 2."""
+    if getattr(args, "no_correction", False):
+        raise InputError("command line", "--no-correction", "no --no-correction with --engine taos (the 3-D fit "
+                         "replays the nonlinear model itself: it has no defect correction to skip)", got="given")
+
+
+def _starts(args) -> int | None:
+    """--starts with --engine taos: local stages from the start and the STARTS-1 best grid cells."""
+    from taos.bounds import MAX_STARTS
+    n = getattr(args, "starts", None)
+    if n is not None and not 1 <= n <= MAX_STARTS:
+        raise InputError("command line", "--starts", f"a number of starts from 1 to {MAX_STARTS}", got=str(n))
+    return n
 
 
 def cmd_fit3d(args) -> int:
@@ -65,6 +75,10 @@ def cmd_fit3d(args) -> int:
     _refuse_planar_only(args)
     if not 0.0 <= args.min_coherence <= 1.0:
         raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
+    starts = _starts(args)
+    from taos.cli.identify import _parse_bounds
+    from taos.identify.params3d import PARAMETERS3D
+    bounds = _parse_bounds(args.bounds, PARAMETERS3D)
     tm = taos_model(load_model(args.model, friction=args.friction))
     free = _free(args.free)
     start = _parse_start3d(args.start)
@@ -72,7 +86,7 @@ def cmd_fit3d(args) -> int:
     axes = None if args.axis in (None, "both") else (args.axis,)
     res = fit_taos(tm, datas, free, start=start, method=args.method, axes=axes, nperseg=args.nperseg,
                    min_coherence=args.min_coherence, use_engine=not args.no_engine,
-                   refuse=not args.allow_unidentifiable)
+                   refuse=not args.allow_unidentifiable, starts=starts, bounds=bounds)
     d = res.to_dict()
     d["model_file"] = tm.base.source
     d["provenance"] = {**output_provenance([tm.base], [("data", p) for p in args.data]), "engine": "taos",
@@ -111,6 +125,7 @@ def cmd_compare3d(args) -> int:
         raise InputError("command line", "MODEL_A MODEL_B --data A_DATA B_DATA",
                          "two models and their records with --engine taos",
                          got=" ".join(x for x in (args.model_a, args.model_b) if x) or "none")
+    starts = _starts(args)
     check_output_folder(args.out, COMPARE3D_FILES)
     _outputs(args, "json")
     labels = tuple(x.strip() for x in args.labels.split(",")) if args.labels is not None else None
@@ -124,7 +139,7 @@ def cmd_compare3d(args) -> int:
                            else "load_stiffness"))
     axes = None if args.axis in (None, "both") else (args.axis,)
     cmp = compare_taos(models, datas, frees, labels or (models[0].base.name, models[1].base.name),
-                       method=args.method, axes=axes, nperseg=args.nperseg)
+                       method=args.method, axes=axes, nperseg=args.nperseg, starts=starts)
     payload = {**cmp.to_dict(), "provenance": {**output_provenance([m.base for m in models],
                                                                    [("data", p) for p in args.data]),
                                                "engine": "taos"}}

@@ -56,6 +56,8 @@ from taos.identify.params3d import (REPLAY_DT_S, Param3d, Unidentifiable, bounds
 
 MAX_REL_SE = 0.5
 MAX_CORR = 0.999
+#: the grid cells kept, best first, as further local starts (``starts``)
+MAX_GRID_STARTS = 10
 #: residual of every point when the model cannot be built or run there (a barrier far above any
 #: fitted cost, so neither the grid nor the optimiser ever prefers it)
 FAILED_RESIDUAL = 1e4
@@ -203,26 +205,33 @@ class _Evaluator:
 
 
 def _grid(ev, params, lo, hi, cells) -> dict | None:
-    """The global first stage over load_stiffness and the friction level (module docstring)."""
+    """The global first stage over load_stiffness and the friction level (module docstring); a
+    free ``load_stiffness_yaw`` moves with ``load_stiffness`` on the grid (the same factor), or
+    takes its place when that is held."""
     names = [p.name for p in params]
-    dims = [j for j, n in enumerate(names) if n in ("load_stiffness", "coulomb_torque", "friction_coefficient")]
+    kl = "load_stiffness" if "load_stiffness" in names else "load_stiffness_yaw"
+    dims = [j for j, n in enumerate(names) if n in (kl, "coulomb_torque", "friction_coefficient")]
+    tied = [j for j, n in enumerate(names) if n == "load_stiffness_yaw" and kl == "load_stiffness"]
     if not dims:
         return None
     t0 = time.perf_counter()
-    axes_x = [np.linspace(lo[j], hi[j], cells[0] if names[j] == "load_stiffness" else cells[1]) for j in dims]
+    axes_x = [np.linspace(lo[j], hi[j], cells[0] if names[j] == kl else cells[1]) for j in dims]
     mesh = np.meshgrid(*axes_x, indexing="ij")
     xs = []
     for idx in np.ndindex(mesh[0].shape):
         x = np.zeros(len(params))
         for k, j in enumerate(dims):
             x[j] = mesh[k][idx]
+        for j in tied:   # K_L,yaw by the factor of K_L (within its own bounds)
+            x[j] = min(max(x[names.index(kl)], lo[j]), hi[j])
         xs.append(x)
     rs = ev.many(xs)
     costs = np.array([0.5 * float(r @ r) for r in rs])
     b = int(np.argmin(costs))
     return {"parameters": [names[j] for j in dims], "grid": [a.size for a in axes_x], "cells": len(xs),
             "best_x": xs[b], "best_cost": float(costs[b]),
-            "best_si": {names[j]: float(ev.p0[j] * math.exp(xs[b][j])) for j in dims},
+            "ranked_x": np.array([xs[i] for i in np.argsort(costs, kind="stable")[:MAX_GRID_STARTS]]),
+            "best_si": {names[j]: float(ev.p0[j] * math.exp(xs[b][j])) for j in dims + tied},
             "wall_s": time.perf_counter() - t0}
 
 
@@ -230,7 +239,8 @@ def fit_taos(model, records: Sequence, free: Sequence[str], *, start: dict | Non
              axes=None, nperseg=None, min_coherence: float = 0.5, sigma_floor: float = 1e-3, use_engine: bool = True,
              global_stage: bool = True, grid=(9, 7), fd_step: float = 2e-3, max_nfev: int = 30,
              absolute_sigma: bool = False, refuse: bool = True, max_rel_se: float = MAX_REL_SE,
-             max_corr: float = MAX_CORR, threads: int | None = None):
+             max_corr: float = MAX_CORR, threads: int | None = None, starts: int | None = None,
+             bounds: dict | None = None):
     """Fit ``free`` parameters (:data:`taos.identify.params3d.PARAMETERS3D`) of the 3-D model to
     ``records`` (:class:`~taos.identify.data.TestData`) (module docstring).
 
@@ -238,7 +248,9 @@ def fit_taos(model, records: Sequence, free: Sequence[str], *, start: dict | Non
     a file with ``[gimbal]``/``[geometry]`` (built by :func:`taos.taos3d.taos_model`);
     ``start``: name -> SI value; ``grid``: cells of the global stage (K_L, friction level);
     ``fd_step``: the forward-difference step in ln p; ``max_nfev``: the local stage's
-    evaluations per start. Returns a :class:`taos.identify.fit3d_result.Fit3dResult`; raises
+    evaluations per start; ``starts``: local stages from the start and the ``starts`` - 1 best
+    grid cells (None: the start, and the best cell when it is better); ``bounds``: name ->
+    (lower, upper) [SI] replacing the physical bounds of those free parameters. Returns a :class:`taos.identify.fit3d_result.Fit3dResult`; raises
     :class:`Unidentifiable` when ``refuse`` and a parameter is not identified."""
     from taos.identify.fit3d_result import Fit3dResult
     from taos.taos3d import TaosModel, taos_model, with_values
@@ -260,6 +272,12 @@ def fit_taos(model, records: Sequence, free: Sequence[str], *, start: dict | Non
     freqs = np.concatenate([r.freq_hz for rp in replays for r in rp.responses])
     axs = [r.axis for rp in replays for r in rp.responses for _ in r.freq_hz]
     lo_si, hi_si, basis = bounds3d(tm0, params, freqs, axs)
+    for k, (b_lo, b_hi) in (bounds or {}).items():
+        if k not in {p.name for p in params}:
+            raise InputError("command line", "--bounds", "names among the free parameters " + ",".join(free),
+                             got=repr(k))
+        j = [p.name for p in params].index(k)
+        lo_si[j], hi_si[j], basis = b_lo, b_hi, basis[:j] + ("given (--bounds)",) + basis[j + 1:]
     bad = np.flatnonzero((p0 <= lo_si) | (p0 >= hi_si))
     if bad.size:
         k = int(bad[0])
@@ -268,12 +286,15 @@ def fit_taos(model, records: Sequence, free: Sequence[str], *, start: dict | Non
     lo, hi = np.log(lo_si / p0), np.log(hi_si / p0)
     ev = _Evaluator(tm0, params, p0, replays, threads)
     gs = _grid(ev, params, lo, hi, grid) if global_stage else None
-    starts = [np.zeros(len(params))]
-    if gs is not None and gs["best_cost"] < 0.5 * float(ev(starts[0]) @ ev(starts[0])):
-        starts.append(gs["best_x"])
+    x_starts = [np.zeros(len(params))]
+    if starts is not None:
+        x_starts += list(gs["ranked_x"][:max(0, starts - 1)]) if gs is not None else []
+        x_starts = x_starts[:starts]
+    elif gs is not None and gs["best_cost"] < 0.5 * float(ev(x_starts[0]) @ ev(x_starts[0])):
+        x_starts.append(gs["best_x"])
     import scipy.optimize as so
     best = None
-    for x0 in starts:
+    for x0 in x_starts:
         sol = so.least_squares(ev, x0, jac=lambda x: ev.jacobian(x, fd_step, lo, hi), bounds=(lo, hi),
                                method="trf", x_scale=1.0, max_nfev=max_nfev, xtol=1e-6, ftol=1e-8, gtol=1e-8)
         if best is None or sol.cost < best.cost:
@@ -283,4 +304,5 @@ def fit_taos(model, records: Sequence, free: Sequence[str], *, start: dict | Non
     J = ev.jacobian(x, fd_step, lo, hi)
     return Fit3dResult.build(tm0, params, p0, x, r, J, lo_si, hi_si, basis, replays, ev, gs,
                              absolute_sigma=absolute_sigma, refuse=refuse, max_rel_se=max_rel_se, max_corr=max_corr,
-                             wall_s=time.perf_counter() - t0, nfev=int(best.nfev), fd_step=fd_step)
+                             wall_s=time.perf_counter() - t0, nfev=int(best.nfev), fd_step=fd_step,
+                             local_starts=len(x_starts))

@@ -60,7 +60,7 @@ class Fit3dResult:
     # -- construction ------------------------------------------------------------------
     @classmethod
     def build(cls, tm0, params, p0, x, r, J, lo_si, hi_si, basis, replays, ev, gs, *, absolute_sigma, refuse,
-              max_rel_se, max_corr, wall_s, nfev, fd_step):
+              max_rel_se, max_corr, wall_s, nfev, fd_step, local_starts=1):
         from taos.identify.params3d import REPLAY_DT_S, Unidentifiable
 
         n, m = len(params), r.size
@@ -112,6 +112,7 @@ class Fit3dResult:
                    solver={"engine": "taos", "replay_dt_max_s": REPLAY_DT_S, "local": "scipy least_squares trf",
                            "jacobian": f"forward differences in ln p, step {fd_step:g}, runs on threads",
                            "rcond_JtJ": rcond, "max_rel_se": max_rel_se, "max_corr": max_corr,
+                           "local_starts": int(local_starts),
                            "integrator": "rk4, trapezoidal bearing torque + BDF2 bearing substeps"})
 
     # -- derived -----------------------------------------------------------------------
@@ -173,6 +174,7 @@ class Fit3dResult:
                 "cost": self.cost, "n_residuals": self.n_residuals, "dof": self.dof,
                 "residual_rms": math.sqrt(2 * self.cost / max(1, self.n_residuals)),
                 "line_load_stiffness_N_per_m": self.line_stiffness_N_per_m(),
+                "line_load_stiffness_yaw_N_per_m": float(self.taos.line_load_stiffnesses_N_per_m[1]),
                 "stiffness_source": self.taos.stiffness_source, "friction_model": self.model.friction.name,
                 "global_stage": None if self.global_search is None else
                 {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.global_search.items()},

@@ -11,6 +11,10 @@ name                       model-file key(s)                    meaning [SI]
                                                                 [N/m]; the actuator-line stiffness
                                                                 follows with the FEM gimbal in
                                                                 series (:mod:`taos.taos3d.calibrate`)
+``load_stiffness_yaw``     ``structure.load_stiffness_yaw``     K_L,yaw, the yaw axis' own total
+                                                                [N/m] (start: the file's, else
+                                                                ``load_stiffness``); the yaw
+                                                                line follows it
 ``upper_stiffness_scale``  ``gimbal.upper_stiffness_scale``     s_u [-] on the upper FEM half K_u
 ``lower_stiffness_scale``  ``gimbal.lower_stiffness_scale``     s_l [-] on the lower FEM half K_l
 ``coulomb_torque``         ``friction.coulomb_torque``          T_c, the friction LEVEL [N m]; the
@@ -25,7 +29,7 @@ name                       model-file key(s)                    meaning [SI]
 =========================  ===================================  ====================================
 
 Bounds (:func:`bounds3d`) come from physics and the record, never from the start value: K_L
-and T_c as the planar fit's (:mod:`taos.identify.physbounds`: the load resonance within the
+(and K_L,yaw) and T_c as the planar fit's (:mod:`taos.identify.physbounds`: the load resonance within the
 measured band widened by an octave; T_c from 1e-4 to 1 times the stall torque A P_s R), mu
 from those T_c over N r_b, the half scales 0.1 to 10 (a FEM correction within an order of
 magnitude), sigma_0 for a pre-sliding angle T_c / sigma_0 between 1e-3 and 1 deg, V_d from
@@ -67,6 +71,8 @@ class Param3d:
         b = tm.base
         if self.name == "load_stiffness":
             return b.structure.load_stiffness_N_per_m
+        if self.name == "load_stiffness_yaw":
+            return float(b.structure.stiffness_N_per_m("yaw"))
         if self.name == "upper_stiffness_scale":
             return tm.gimbal.upper_stiffness_scale
         if self.name == "lower_stiffness_scale":
@@ -80,6 +86,7 @@ class Param3d:
 
 PARAMETERS3D: dict[str, Param3d] = {p.name: p for p in (
     Param3d("load_stiffness", "structure.load_stiffness", "stiffness", "lbf/in"),
+    Param3d("load_stiffness_yaw", "structure.load_stiffness_yaw", "stiffness", "lbf/in"),
     Param3d("upper_stiffness_scale", "gimbal.upper_stiffness_scale", "dimensionless", ""),
     Param3d("lower_stiffness_scale", "gimbal.lower_stiffness_scale", "dimensionless", ""),
     Param3d("coulomb_torque", "friction.coulomb_torque", "torque", "in*lbf", True),
@@ -158,8 +165,8 @@ def bounds3d(tm, params, freq_hz, axes) -> tuple[np.ndarray, np.ndarray, tuple[s
     nrb = normal_load_N(tm.base) * tm.gimbal.bearing_radius_m
     lo, hi, basis = [], [], []
     for n in names:
-        if n in ("load_stiffness", "coulomb_torque"):
-            b = phys[n]
+        if n in ("load_stiffness", "coulomb_torque", "load_stiffness_yaw"):
+            b = phys[n.removesuffix("_yaw")]
             lo.append(b.lower), hi.append(b.upper), basis.append(b.basis)
         elif n == "friction_coefficient":
             b = phys["coulomb_torque"]

@@ -120,7 +120,7 @@ def simplex_state_space(model: TvcModel, axis: str = "pitch", *, structure_input
     """
     act = actuator_state_space(model.actuator)
     R = model.actuator.moment_arm_m
-    KL = model.structure.load_stiffness_N_per_m
+    KL = model.structure.stiffness_N_per_m(axis)   # the axis' own K_L ([structure] load_stiffness_yaw)
     Kn = model.engine.rotational_stiffness_Nm_per_rad
     J = model.engine.inertia(axis)
     sym = is_symbolic(act.A, R, KL, Kn, J, model.structure.load_damping_ratio)
@@ -139,7 +139,7 @@ def simplex_state_space(model: TvcModel, axis: str = "pitch", *, structure_input
     fl = zeros(n, sym)
     fl[:na] = [KL * c for c in cxp]   # element-wise: also for CasADi scalars
     fl[ith] = -KL * R
-    cL = model.structure.load_damping_Ns_per_m(R, J)  # structural damping on the load path
+    cL = model.structure.load_damping_Ns_per_m(R, J, axis)  # structural damping on the load path
     if not (isinstance(cL, float) and cL == 0.0):
         cvp = actC[act.output_index("v_p_m_s")]
         for i in range(na):

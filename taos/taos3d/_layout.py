@@ -36,13 +36,16 @@ class TaosParams(NamedTuple):
                                            [per N]
     act_c_xp                    (n_a,)     actuator output row of the piston position x_p
     bearing_axes                (2, 3)     pitch and yaw unit axes in the gimbal frame [-]
-    line_stiffness_N_per_m      scalar     actuator-line stiffness outside the gimbal [N/m], derived from the
-                                           total K_L with the FEM gimbal in series (taos.taos3d.calibrate)
+    line_stiffness_N_per_m      (2,)       K_line of the pitch and yaw actuator lines: each line's
+                                           stiffness outside the gimbal [N/m], derived from that
+                                           axis' total K_L with the FEM gimbal in series
+                                           (taos.taos3d.calibrate)
     moment_arm_m                scalar     R, the actuator moment arm [m]
     engine_stiffness_Nm_per_rad scalar     K_n, the feedline/gravity spring on pitch and yaw
                                            [N m/rad]
     line_length0_m              (2,)       L0, actuator line lengths at zero angle [m]
-    line_damping_Ns_per_m       scalar     c_L, the load path's structural damping [N s/m]
+    line_damping_Ns_per_m       (2,)       c_L of the pitch and yaw load paths, structural
+                                           damping [N s/m]
     act_vp_index                int        index of the piston rate v_p in the actuator state
     limits                      (k,)       actuator/gimbal limits over one actuator's state
                                            (:mod:`taos.planar.saturation`; empty: none)
@@ -69,11 +72,11 @@ class TaosParams(NamedTuple):
     act_b_fl: np.ndarray
     act_c_xp: np.ndarray
     bearing_axes: np.ndarray
-    line_stiffness_N_per_m: float
+    line_stiffness_N_per_m: np.ndarray
     moment_arm_m: float
     engine_stiffness_Nm_per_rad: float
     line_length0_m: np.ndarray
-    line_damping_Ns_per_m: float
+    line_damping_Ns_per_m: np.ndarray
     act_vp_index: int
     limits: np.ndarray
     torque_wrench: np.ndarray

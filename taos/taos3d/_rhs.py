@@ -74,8 +74,9 @@ def _rhs(x, T0, T1, u0, u1, P, dx, aux):
                              P.bearing_compliance, P.bearing_selection)
     Satt, Eatt, axes = P.structure_attach_m, P.engine_attach_m, P.bearing_axes
     Aa, bxc, bf, cxp = P.act_A, P.act_b_xc, P.act_b_fl, P.act_c_xp
-    KL, Rarm, Kn = P.line_stiffness_N_per_m, P.moment_arm_m, P.engine_stiffness_Nm_per_rad
-    cL, ivp, L0 = P.line_damping_Ns_per_m, P.act_vp_index, P.line_length0_m
+    KLs, Rarm, Kn = P.line_stiffness_N_per_m, P.moment_arm_m, P.engine_stiffness_Nm_per_rad
+    cLs, ivp, L0 = P.line_damping_Ns_per_m, P.act_vp_index, P.line_length0_m
+    KLt, cLt = (KLs[0], KLs[1]), (cLs[0], cLs[1])   # each actuator line's own (pitch, yaw)
     lim = P.limits  # actuator/gimbal limits packed over one actuator's state (taos.planar.saturation)
     na = Aa.shape[0]
     mlim = (lim.shape[0] - _lim.N_HEAD) // _lim.N_ROWS if lim.shape[0] > 0 else 0  # states lim is packed over
@@ -123,6 +124,7 @@ def _rhs(x, T0, T1, u0, u1, P, dx, aux):
         xp = 0.0
         for k in range(na):
             xp += cxp[k] * x[off + k]
+        KL, cL = KLt[a], cLt[a]
         F = KL * (xp - (L - L0[a]))
         if cL > 0.0:  # structural damping across the line: c_L (v_p - L')
             b0, b1, b2 = _cross3(wx, wy, wz, e0, e1, e2)

@@ -8,6 +8,11 @@ is derived the same way for every condition: the value for which the 3-D linear 
 piston notch sits on the planar load resonance of the fitted total, w_L = sqrt((K_L R^2 + K_n)/J)
 (paper eq. 1), with that condition's FEM gimbal in series.
 
+Per axis: ``[structure] load_stiffness_yaw`` (optional) is the yaw axis' own fitted total; the
+yaw actuator line's stiffness is then derived the same way for the yaw axis (its notch on
+w_L,yaw = sqrt((K_L,yaw R^2 + K_n)/J_yaw), the pitch line held), else it equals the pitch
+line's (the shipped files: one derivation, bit for bit as before the key).
+
 It is a derived key: :func:`taos_model`, the builder every command and the library use,
 derives it from ``[structure] load_stiffness`` and the gimbal when the file leaves it out (the
 shipped files do, so an edited load stiffness moves the 3-D notch with it), and checks it
@@ -39,25 +44,31 @@ def taos_notch_hz(tm: TaosModel, guess_hz: float, axis: str = "pitch") -> float:
     return float(res.x)
 
 
-def _line_stiffness(model: TvcModel, tm0: TaosModel, rtol: float) -> float:
-    """Line stiffness [N/m] putting the notch of ``tm0``'s gimbal on the planar load resonance
-    (SciPy and the compiled dynamics are imported here, after every cheap input check)."""
+def _line_stiffness(model: TvcModel, tm0: TaosModel, rtol: float, axis: str = "pitch") -> float:
+    """Line stiffness [N/m] of ``axis``' actuator putting that axis' 3-D command -> piston notch
+    (``tm0``'s gimbal in series) on the axis' planar load resonance
+    w_L = sqrt((K_L,axis R^2 + K_n) / J_axis) (SciPy and the compiled dynamics are imported
+    here, after every cheap input check). Pitch: the line stiffness of both lines while the
+    yaw one follows it (the key ``load_stiffness_yaw`` absent, as the shipped files); yaw: the
+    yaw line's alone, the pitch line's held at ``tm0``'s."""
     import scipy.optimize as so
 
-    target = model.load_resonance_hz()
-    K = model.structure.load_stiffness_N_per_m
+    target = model.load_resonance_hz(axis)
+    K = model.structure.stiffness_N_per_m(axis)
+    key = "line_load_stiffness_N_per_m" if axis == "pitch" else "line_load_stiffness_yaw_N_per_m"
+    field = "structure.load_stiffness" if axis == "pitch" else "structure.load_stiffness_yaw"
 
     def err(k_line):
-        tm = dataclasses.replace(tm0, gimbal=dataclasses.replace(tm0.gimbal, line_load_stiffness_N_per_m=k_line))
-        return taos_notch_hz(tm, target) / target - 1.0
+        tm = dataclasses.replace(tm0, gimbal=dataclasses.replace(tm0.gimbal, **{key: k_line}))
+        return taos_notch_hz(tm, target, axis) / target - 1.0
 
     lo, hi = 0.9 * K, 3.0 * K
     e_lo, e_hi = err(lo), err(hi)
     if not (np.sign(e_lo) != np.sign(e_hi)):
-        raise InputError(model.source, "gimbal.line_load_stiffness",
-                         f"a value derivable from structure.load_stiffness ({K:.6g} N/m): a line stiffness of "
+        raise InputError(model.source, "gimbal.line_load_stiffness" if axis == "pitch" else field,
+                         f"a value derivable from {field} ({K:.6g} N/m): a line stiffness of "
                          f"0.9 to 3 x that putting the 3-D command -> piston notch on the load resonance "
-                         f"{target:.4g} Hz with the gimbal {tm0.stiffness_source} in series",
+                         f"{target:.4g} Hz ({axis}) with the gimbal {tm0.stiffness_source} in series",
                          got=f"a notch {100 * e_lo:+.2g} % to {100 * e_hi:+.2g} % off over that range (a gimbal too "
                              f"soft, or a servo without a notch)")
     return float(so.brentq(err, lo, hi, rtol=rtol))
@@ -84,6 +95,7 @@ def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.n
     expected = _line_stiffness(model, tm0, rtol=1e-4)
     if given is None:
         tm = dataclasses.replace(tm0, gimbal=dataclasses.replace(tm0.gimbal, line_load_stiffness_N_per_m=expected))
+        tm = _with_yaw_line(model, tm)
         return dataclasses.replace(tm, gimbal=dataclasses.replace(tm.gimbal, line_stiffness_basis=line_stiffness_basis(tm)))
     if abs(given - expected) > DERIVED_RTOL * expected:
         K = model.structure.load_stiffness_N_per_m
@@ -94,7 +106,17 @@ def taos_model(model: TvcModel, K_upper: np.ndarray | None = None, K_lower: np.n
                          f"{tm0.stiffness_source} in series (3-D notch on the load resonance "
                          f"{model.load_resonance_hz():.4g} Hz); delete the key to have it derived",
                          got=f"{given:.6g} N/m ({given / lbf:.6g} lbf/in)")
-    return tm0
+    return _with_yaw_line(model, tm0)
+
+
+def _with_yaw_line(model: TvcModel, tm: TaosModel) -> TaosModel:
+    """``tm`` with the yaw actuator line's own stiffness when the file gives ``[structure]
+    load_stiffness_yaw`` (:func:`_line_stiffness` for yaw, the pitch line held); unchanged (the
+    yaw line = the pitch line, as before the key) when it is absent."""
+    if model.structure.load_stiffness_yaw_N_per_m == 0:
+        return tm
+    k = _line_stiffness(model, tm, 1e-4, "yaw")
+    return dataclasses.replace(tm, gimbal=dataclasses.replace(tm.gimbal, line_load_stiffness_yaw_N_per_m=k))
 
 
 def with_values(tm: TaosModel, values) -> TaosModel:

@@ -18,7 +18,10 @@ Model-file tables read here (the loader keeps them raw in ``TvcModel.extra``)::
                 line_load_stiffness   actuator-line stiffness outside the gimbal [N/m] [derived key:
                                       optional; when absent derived from [structure] load_stiffness
                                       with the FEM gimbal in series, when given checked against that
-                                      within 1 % (:mod:`taos.taos3d.calibrate`)]
+                                      within 1 % (:mod:`taos.taos3d.calibrate`)]; the pitch line's.
+                                      The yaw line's is always derived: from [structure]
+                                      load_stiffness_yaw when the file gives it, else equal to the
+                                      pitch line's
                 upper_stiffness_scale s_u [-], factor on the upper half's 6x6 stiffness K_upper
                 lower_stiffness_scale s_l [-], factor on the lower half's K_lower [optional, default
                                       1: the FEM matrices as computed; a fit's handle on the FEM
@@ -85,6 +88,9 @@ class GimbalParams:
     #: :func:`line_stiffness_basis` of the model the line stiffness was derived for ('' when
     #: given by the file): a model changed since is refused, never run on a stale value
     line_stiffness_basis: str = ""
+    #: the yaw actuator line's stiffness [N/m], derived from ``[structure] load_stiffness_yaw``
+    #: (:mod:`taos.taos3d.calibrate`); None: the pitch line's (the key absent)
+    line_load_stiffness_yaw_N_per_m: float | None = None
     #: s_u, s_l [-]: factors on the upper and lower halves' FEM stiffness (``[gimbal]
     #: upper_stiffness_scale``/``lower_stiffness_scale``, default 1; applied by
     #: :func:`assemble_taos_model` to the matrices of ``stiffness_file``)
@@ -178,6 +184,16 @@ class TaosModel:
             else g.line_load_stiffness_N_per_m
 
     @property
+    def line_load_stiffnesses_N_per_m(self) -> np.ndarray:
+        """(pitch, yaw) actuator-line stiffnesses outside the gimbal [N/m] (2,): the pitch one
+        :attr:`line_load_stiffness_N_per_m`, the yaw one derived from ``[structure]
+        load_stiffness_yaw`` (:mod:`taos.taos3d.calibrate`), the pitch one when the file leaves
+        that key out; stale values refused as :attr:`line_load_stiffness_N_per_m`."""
+        kp = self.line_load_stiffness_N_per_m
+        ky = self.gimbal.line_load_stiffness_yaw_N_per_m
+        return np.array([kp, kp if ky is None else ky], dtype=np.float64)
+
+    @property
     def chain_stiffness(self) -> np.ndarray:
         """K_s = (K_upper^-1 + K_lower^-1)^-1: the two halves in series at O (6, 6)."""
         C = np.linalg.inv(self.K_upper) + np.linalg.inv(self.K_lower)
@@ -214,13 +230,14 @@ class TaosModel:
 
 
 def line_stiffness_basis(tm: "TaosModel") -> str:
-    """Fingerprint of everything the derived line stiffness depends on: the total load
-    stiffness, the engine, the moment arm, the geometry and both gimbal halves."""
+    """Fingerprint of everything the derived line stiffnesses depend on: the total load
+    stiffness of each axis (``load_stiffness``, ``load_stiffness_yaw``), the engine, the moment
+    arm, the geometry and both gimbal halves."""
     import hashlib
 
     b = tm.base
     h = hashlib.sha256(repr((b.structure.load_stiffness_N_per_m, b.engine, b.actuator.moment_arm_m,
-                             tm.geometry.engine_roll_inertia_kgm2)).encode())
+                             tm.geometry.engine_roll_inertia_kgm2, b.structure.load_stiffness_yaw_N_per_m)).encode())
     for a in (tm.geometry.structure_attach_m, tm.geometry.engine_attach_m, tm.geometry.engine_cg_m,
               tm.K_upper, tm.K_lower):
         h.update(np.ascontiguousarray(a, float).tobytes())

@@ -81,10 +81,11 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
         act_A=f64(act.A), act_b_xc=f64(act.B[:, act.input_index("x_c_m")]),
         act_b_fl=f64(act.B[:, act.input_index("f_load_N")]), act_c_xp=f64(act.C[act.output_index("x_p_m")]),
         bearing_axes=f64(np.vstack([PITCH_AXIS, YAW_AXIS])),
-        line_stiffness_N_per_m=float(tm.line_load_stiffness_N_per_m), moment_arm_m=float(R),
+        line_stiffness_N_per_m=f64(tm.line_load_stiffnesses_N_per_m), moment_arm_m=float(R),
         engine_stiffness_Nm_per_rad=float(tm.base.engine.rotational_stiffness_Nm_per_rad),
         line_length0_m=f64([np.linalg.norm(geo.engine_attach_m[i] - geo.structure_attach_m[i]) for i in range(2)]),
-        line_damping_Ns_per_m=float(tm.base.structure.load_damping_Ns_per_m(R, tm.base.engine.inertia("pitch"))),
+        line_damping_Ns_per_m=f64([tm.base.structure.load_damping_Ns_per_m(R, tm.base.engine.inertia("pitch"), ax)
+                                   for ax in AXES]),
         act_vp_index=act.states.index("v_p_m_s"), limits=f64(actuator_limits(tm)),
         torque_wrench=f64(Ks @ S @ Kc), act_pl_index=act.states.index("p_load_Pa"),
         act_q_index=act.states.index("q_m_s"))

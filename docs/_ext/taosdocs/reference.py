@@ -36,6 +36,7 @@ MEANINGS: dict[str, str] = {
     # [structure]
     "structure.load_stiffness": "load stiffness K_L: all compliance outside the actuator loop",
     "structure.load_damping_ratio": "structural damping ratio of the load path (finite notch depth)",
+    "structure.load_stiffness_yaw": "the yaw axis' own load stiffness K_L,yaw (optional; absent: load_stiffness on both axes); the planar yaw axis and the 3-D yaw actuator line use it",
     "actuator.max_rate": "piston rate limit: valve flow saturation (time domain only)",
     "actuator.pressure_limited": "whether the load pressure is limited to the supply pressure (stall force): the valve's square-root law and the relief valve",
     "actuator.relief_pressure": "cracking pressure P_r of the cross-port relief valve (P_s to 1.5 P_s)",
@@ -162,7 +163,8 @@ def model_key_table() -> dict[str, list[tuple[str, str, str]]]:
     if not any(k == "pressure_limited" for k, _, _ in act):
         act.append(("pressure_limited", "true or false", "optional"))
     out["actuator"] = act
-    out["structure"] = [("load_stiffness", _si("stiffness"), "positive"), ("load_damping_ratio", "1", "optional")]
+    out["structure"] = [("load_stiffness", _si("stiffness"), "positive"), ("load_damping_ratio", "1", "optional"),
+                        ("load_stiffness_yaw", _si("stiffness"), "optional, positive")]
     out["friction"] = [("model", "name", ""), ("parameter_set", "path", "shared set")] + friction_keys()
     out["avionics"] = [("quantization_bits", "bits", "0 to 32"), ("command_range", _si("angle"), "positive"),
                        ("rounding", "'truncate' / 'round'", ""), ("crossover_command", f"list, {_si('angle')}", ""),
