@@ -132,6 +132,9 @@ def check_input_file(path, what: str, max_bytes: int = MAX_DATA_BYTES, field: st
     import os
     import stat
 
+    if isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):   # os.stat(1) would stat a descriptor
+        raise InputError(repr(path)[:40], field, what + " (a path: text or a pathlib.Path)",
+                         got=type(path).__name__)
     try:
         st = os.stat(path)
     except (OSError, ValueError) as e:
@@ -448,6 +451,7 @@ def read_toml(path: "str | os.PathLike", what: str) -> tuple[bytes, dict]:
     if key is None:   # not a regular file: read_input_bytes says what is wrong with it
         return _read_toml(str(path), what)
     raw, doc = _read_toml_cached(key, what)
+    note_input(path)   # an input of this run, even when its table comes from the cache (issue 40)
     sys.audit("open", str(path), "rb", os.O_RDONLY)   # read, as far as anyone recording inputs can tell
     return raw, copy.deepcopy(doc)
 
