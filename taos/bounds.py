@@ -319,13 +319,19 @@ def check_axis(axis, field: str = "axis", source: str = "argument") -> str:
 
 def check_grid(values, field: str, unit: str, lo: float = 0.0, hi: float = math.inf,
                source: str = "argument") -> np.ndarray:
-    """A non-empty 1-D grid of finite values in (``lo``, ``hi``] (frequencies [Hz], amplitudes
-    [rad]) as a float array; InputError naming ``field`` for an empty grid, a NaN, a zero or
-    negative value: the API never answers them with NaN or a silent result."""
+    """A non-empty grid (a number or a 1-D sequence) of finite real values in (``lo``, ``hi``]
+    (frequencies [Hz], amplitudes [rad]) as a float array; InputError naming ``field`` for an
+    empty grid, text, booleans or None, a nested array, a NaN, a zero or negative value: the
+    API never answers them with NaN or a silent result."""
     try:
-        a = np.atleast_1d(np.asarray(values, float)).ravel()
+        raw = np.asarray(values)
     except (TypeError, ValueError):
         raise InputError(source, field, f"numbers in {unit}", got=repr(values)[:60]) from None
+    if raw.dtype.kind not in "iuf":   # text ('1'), booleans (True is not 1 Hz), None, objects
+        raise InputError(source, field, f"numbers in {unit} (not text, booleans or None)", got=repr(values)[:60])
+    if raw.ndim > 1:
+        raise InputError(source, field, f"a number or a 1-D sequence of numbers in {unit}", got=f"shape {raw.shape}")
+    a = np.atleast_1d(raw.astype(float))
     if a.size == 0:
         raise InputError(source, field, f"at least one value in {unit}", got="an empty grid")
     bad = np.flatnonzero(~(np.isfinite(a) & (a > lo) & (a <= hi)))
@@ -333,6 +339,86 @@ def check_grid(values, field: str, unit: str, lo: float = 0.0, hi: float = math.
         raise InputError(source, field, f"finite values above {lo:g} {unit}" + ("" if hi == math.inf else
                          f" and at most {hi:g} {unit}"), got=f"{a[bad[0]]:g} {unit}")
     return a
+
+
+def check_number(value, field: str, lo: float = -math.inf, hi: float = math.inf, unit: str = "",
+                 *, lo_open: bool = False, optional: bool = False, source: str = "argument") -> float | None:
+    """A finite real number in [``lo``, ``hi``] (``(lo, hi]`` with ``lo_open``) as a float, or
+    None when ``optional``; InputError naming ``field`` for text, booleans, None, arrays, NaN,
+    infinities and values out of range."""
+    if value is None and optional:
+        return None
+    u = f" {unit}" if unit else ""
+    if lo > -math.inf:
+        rng = (f"above {lo:g}" + (f" and at most {hi:g}" if hi < math.inf else "") if lo_open else
+               f"from {lo:g}" + (f" to {hi:g}" if hi < math.inf else " up"))
+    else:
+        rng = f"at most {hi:g}" if hi < math.inf else ""
+    want = f"{'None or ' if optional else ''}a finite number{(' ' + rng) if rng else ''}{u}"
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputError(source, field, want, got=repr(value)[:40])
+    v = float(value)
+    if not (math.isfinite(v) and (v > lo if lo_open else v >= lo) and v <= hi):
+        raise InputError(source, field, want, got=repr(value)[:40])
+    return v
+
+
+def check_count(value, field: str, lowest: int, highest: int = MAX_CYCLES, source: str = "argument") -> int:
+    """A whole number from ``lowest`` to ``highest`` (cycles, steps per cycle, record interval,
+    runs): never a boolean, a float or text."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not lowest <= value <= highest:
+        raise InputError(source, field, f"a whole number from {lowest} to {highest}", got=repr(value)[:40])
+    return int(value)
+
+
+def check_flag(value, field: str, source: str = "argument") -> bool:
+    """True or False (never 'no', 0.5 or None, which Python would take as true or false)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(source, field, "True or False", got=repr(value)[:40])
+    return bool(value)
+
+
+def check_choice(value, field: str, choices, source: str = "argument") -> str:
+    """One of the names ``choices``."""
+    if not isinstance(value, str) or value not in choices:
+        raise InputError(source, field, "one of " + ", ".join(repr(c) for c in choices), got=repr(value)[:40])
+    return value
+
+
+def check_instance(value, field: str, cls, what: str, source: str = "argument"):
+    """``value`` is a ``cls`` (``what`` names it, e.g. "a TvcModel (taos.load_model)")."""
+    if not isinstance(value, cls):
+        raise InputError(source, field, what, got=f"{type(value).__name__} {repr(value)[:30]}")
+    return value
+
+
+def check_profile(profile, field: str = "profile", source: str = "argument"):
+    """A command profile (:mod:`taos.profiles`, ``taos.load_profile``): callable on times, with a
+    finite duration of at most :data:`MAX_DURATION_S`."""
+    T = getattr(profile, "duration_s", None)
+    if not callable(profile) or isinstance(T, bool) or not isinstance(T, (int, float)) \
+            or not (math.isfinite(T) and 0 <= T <= MAX_DURATION_S):
+        raise InputError(source, field, f"a profile (taos.load_profile) of at most {MAX_DURATION_S:g} s",
+                         got=f"{type(profile).__name__} {repr(profile)[:30]}")
+    return profile
+
+
+#: integration steps of one sine-dwell job of the API (as taos.planar.envelope.MAX_DWELL_STEPS)
+MAX_DWELL_STEPS = 5e7
+
+
+def check_step(dt_s, field: str, duration_s: float | None = None, hi: float = math.inf,
+               source: str = "argument") -> float:
+    """A finite positive step [s] of at most ``hi`` (and, with ``duration_s``, a job within the
+    step and memory limits :data:`MAX_STEPS`, :data:`MAX_JOB_BYTES`, estimated as the command
+    line does)."""
+    dt = check_number(dt_s, field, 0.0, hi, "s", lo_open=True, source=source)
+    if duration_s is not None:
+        n = duration_s / dt
+        if n > MAX_STEPS or n * 8 * 12 > MAX_JOB_BYTES:   # time, two commands and their copies, float64
+            raise InputError(source, field, f"at most {MAX_STEPS:.0e} steps within {MAX_JOB_BYTES / 2 ** 30:g} GiB "
+                             f"for the {duration_s:g} s run", got=f"{dt:g} s")
+    return dt
 
 
 def check_response_args(freq_hz, amplitudes_rad=None, axis: str = "pitch") -> None:

@@ -132,6 +132,9 @@ def check_input_file(path, what: str, max_bytes: int = MAX_DATA_BYTES, field: st
     import os
     import stat
 
+    if isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):   # os.stat(1) would stat a descriptor
+        raise InputError(repr(path)[:40], field, what + " (a path: text or a pathlib.Path)",
+                         got=type(path).__name__)
     try:
         st = os.stat(path)
     except (OSError, ValueError) as e:
@@ -247,30 +250,82 @@ def check_not_input(path, field: str, inputs=()) -> None:
 class _Signals:
     """SIGINT/SIGTERM handling of one command-line run: the handler records the signal before it
     raises, so a run whose exception was swallowed somewhere (a library's cleanup) still ends
-    with 130/143, never 0."""
+    with 130/143, never 0.
+
+    The handler raises once; a later signal is only recorded (a second Ctrl-C while the first
+    unwinds never lands in a clean-up, an ``except`` clause or the unraisable hook, where it would
+    print a traceback), unless it is the redelivery of an interrupt that was swallowed
+    (:meth:`unraisable`). Nothing about it depends on when the signals arrive."""
 
     def __init__(self):
         self.received: int | None = None
+        self.raised = False      # an interrupt is on its way up the main thread
+        self.due = False         # the next signal is a redelivery: raise it
+        self.scheduled = False   # a redelivery thread is waiting
+        self.closing = False     # run_cli is restoring the handlers: record only
+        self._hook_code = None
 
     def unraisable(self, previous):
         """A ``sys.unraisablehook`` for the run: the interrupt this handler raised inside a
         callback that cannot pass it on (llvmlite's ctypes object-cache callback while numba
         loads a kernel) is not printed as "Exception ignored ..." but delivered again, from
-        another thread, so that it lands in ordinary code of the main thread and ends the run."""
-        import os
-        import threading
+        another thread once the hook has returned, so that it lands in ordinary code of the main
+        thread and ends the run. A signal arriving while the hook runs is recorded, never raised
+        inside it."""
 
         def hook(u):
             if isinstance(u.exc_value, (KeyboardInterrupt, Interrupted)) and self.received is not None:
-                threading.Timer(0.0, os.kill, (os.getpid(), self.received)).start()
+                self.schedule()
                 return
             previous(u)
+        self._hook_code = hook.__code__
         return hook
+
+    def _hook_on_stack(self, frame) -> bool:
+        while frame is not None:
+            if frame.f_code is self._hook_code:
+                return True
+            frame = frame.f_back
+        return False
+
+    def schedule(self) -> None:
+        """Deliver the recorded signal again from another thread, once the main thread is out
+        of the unraisable hook (at most one redelivery waits at a time)."""
+        import threading
+
+        if self.scheduled or self.closing:
+            return
+        self.scheduled = True
+        threading.Thread(target=self._redeliver, name="taos-signal-redelivery", daemon=True).start()
+
+    def _redeliver(self) -> None:
+        import os
+        import threading
+        import time
+
+        main = threading.main_thread().ident
+        for _ in range(10000):   # the hook returns within microseconds; 10 s at most
+            if self.closing or not self._hook_on_stack(sys._current_frames().get(main)):
+                break
+            time.sleep(0.001)
+        self.scheduled = False
+        if not self.closing and self.received is not None:
+            self.due = True
+            os.kill(os.getpid(), self.received)
 
     def __call__(self, signum, frame):
         import signal
 
         self.received = signum
+        if self.closing:
+            return
+        if self._hook_on_stack(frame):   # never raise inside the unraisable hook
+            self.due = False
+            self.schedule()
+            return
+        if self.raised and not self.due:   # the first interrupt is already unwinding: record only
+            return
+        self.raised, self.due = True, False
         if signum == signal.SIGINT:
             raise KeyboardInterrupt
         raise Interrupted(signum)
@@ -355,6 +410,7 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
               file=sys.stderr)
         rc = 1
     finally:
+        handler.closing = True   # from here a signal is recorded, never raised
         for s, h in old.items():
             signal.signal(s, h)
         sys.unraisablehook = old_unraisable
@@ -395,6 +451,7 @@ def read_toml(path: "str | os.PathLike", what: str) -> tuple[bytes, dict]:
     if key is None:   # not a regular file: read_input_bytes says what is wrong with it
         return _read_toml(str(path), what)
     raw, doc = _read_toml_cached(key, what)
+    note_input(path)   # an input of this run, even when its table comes from the cache (issue 40)
     sys.audit("open", str(path), "rb", os.O_RDONLY)   # read, as far as anyone recording inputs can tell
     return raw, copy.deepcopy(doc)
 

@@ -265,6 +265,49 @@ def test_startup_handlers_are_not_installed_for_a_library_user():
 
 
 
+_SIGNAL_IN_HOOK = """
+import argparse, os, signal, sys, threading, time
+from taos.errors import run_cli
+
+SIG = int(sys.argv[1])
+real_start = threading.Thread.start
+
+def start(self):   # a second signal lands while the unraisable hook starts its redelivery
+    os.kill(os.getpid(), SIG)
+    real_start(self)
+
+class Callback:    # a callback that cannot pass an exception on (llvmlite's ctypes cache callback)
+    def __del__(self):
+        os.kill(os.getpid(), SIG)   # the handler's interrupt is raised here, and swallowed
+
+def cmd(args):
+    threading.Thread.start = start
+    x = Callback()
+    del x
+    for _ in range(1000):   # the redelivered interrupt lands here
+        time.sleep(0.01)
+    print("not interrupted", file=sys.stderr)
+    return 0
+
+ap = argparse.ArgumentParser(prog="taos")
+ap.set_defaults(func=cmd)
+sys.exit(run_cli(ap, []))
+"""
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_second_signal_inside_the_unraisable_hook_is_not_a_traceback(signum):
+    """Issue 40: an interrupt swallowed by a callback reaches ``sys.unraisablehook``, which
+    delivers it again; a second signal landing while the hook starts that delivery (made to land
+    exactly there, not by timing) is recorded, never raised inside the hook ("Exception ignored in
+    sys.unraisablehook" and a traceback); the run still stops in ordinary code with one line."""
+    r = subprocess.run([sys.executable, "-c", _SIGNAL_IN_HOOK, str(int(signum))], capture_output=True,
+                       text=True, env=_env(), timeout=120)
+    want = ("taos: interrupted (Ctrl-C); no partial output written" if signum == signal.SIGINT
+            else f"taos: terminated (signal {int(signum)}); no partial output written")
+    assert r.returncode == 128 + signum and r.stderr.splitlines() == [want], r.stderr
+
+
 _IGNORED_INT = """
 import argparse, os, signal, sys
 signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from taos.bounds import check_response_args
+from taos.bounds import check_instance, check_response_args
 from taos.planar.freqresp import sine_dwell_points
 from taos.linear import StateSpace, gain_db, phase_deg
 from taos.model import Structure, TvcModel
@@ -163,6 +163,8 @@ def describing_function_map(model: TvcModel, amplitudes_rad: np.typing.ArrayLike
         How each dwell reaches its periodic orbit (:func:`taos.planar.freqresp.sine_dwell_points`;
         'shoot': the periodic steady state by shooting, :mod:`taos.planar.steady`).
     """
+    check_instance(model, "model", TvcModel, "a TvcModel (taos.load_model)")
+    check_response_args(freq_hz, amplitudes_rad, axis)   # as given: text or booleans are refused, not converted
     amps = np.sort(np.atleast_1d(np.asarray(amplitudes_rad, float)))
     f = np.sort(np.atleast_1d(np.asarray(freq_hz, float)))
     check_response_args(f, amps, axis)   # the grid of taos.planar.freqresp.sine_dwell_grid, with its solver's account

@@ -32,7 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import SimulationUnstable
+from ..bounds import check_axis, check_choice, check_instance
+from ..errors import InputError, SimulationUnstable
 from ..linear import gain_db, phase_deg_continuous
 from ..model import TvcModel
 from .simplex import simplex_plant, simplex_state_space
@@ -167,6 +168,7 @@ def linear_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, axis: str = "
     """Exact response of the linear simplex block (no friction, unity avionics)."""
     from taos.bounds import check_response_args
 
+    check_instance(model, "model", TvcModel, "a TvcModel (taos.load_model)")
     check_response_args(freq_hz, None, axis)
     R = model.actuator.moment_arm_m
     f = np.atleast_1d(np.asarray(freq_hz, float))
@@ -211,6 +213,43 @@ class DwellPoints:
     solver: dict = field(default_factory=dict)
 
 
+def _check_dwell_settings(model, amplitudes_rad, freq_hz, axis, dt_max_s, settle_cycles, measure_cycles, settle_s,
+                          min_steps_per_cycle, tol, k_rre, max_cycles) -> None:
+    """The settings of :func:`sine_dwell_points`, checked at the API's boundary as the command
+    line checks its values: a TvcModel, paired amplitude and frequency grids, a positive step the
+    RK4 rule allows, whole cycle counts, a settling time of at most 1e4 s, a job within
+    :data:`taos.planar.envelope.MAX_DWELL_STEPS` integration steps (bounded work: a settle
+    count of 1e12 is refused, not run forever)."""
+    from taos.bounds import (MAX_DURATION_S, MAX_DWELL_STEPS, check_count, check_grid, check_number, check_step)
+    from .simplex import check_rk4_step
+
+    check_instance(model, "model", TvcModel, "a TvcModel (taos.load_model)")
+    check_axis(axis)
+    A = check_grid(amplitudes_rad, "amplitudes_rad", "rad", 0.0, math.pi / 2)
+    F = check_grid(freq_hz, "freq_hz", "Hz", 0.0, 1e4)
+    if A.size != F.size:
+        raise InputError("argument", "freq_hz", f"as many frequencies as amplitudes ({A.size})", got=str(F.size))
+    dt = check_step(dt_max_s, "dt_max_s")
+    check_rk4_step(dt, model, "dt_max_s")
+    check_count(settle_cycles, "settle_cycles", 0)
+    check_count(measure_cycles, "measure_cycles", 1)
+    check_count(min_steps_per_cycle, "min_steps_per_cycle", 8, 10 ** 5)
+    check_number(settle_s, "settle_s", 0.0, MAX_DURATION_S, "s", optional=True)
+    check_number(tol, "tol", 0.0, 1.0, lo_open=True)
+    check_count(k_rre, "k_rre", 1, 64)
+    check_count(max_cycles, "max_cycles", 1, 10 ** 4)
+    ts = settle_time_s(model, axis) if settle_s is None else float(settle_s)
+    npc = np.maximum(np.ceil(1.0 / (F * dt)), min_steps_per_cycle)
+    settle = np.maximum(np.ceil(ts * F), settle_cycles)
+    total = float(np.sum((settle + measure_cycles) * npc))
+    if total > MAX_DWELL_STEPS:
+        field = ("settle_cycles" if np.any(settle_cycles * npc > MAX_DWELL_STEPS / 2) else
+                 "measure_cycles" if np.any(measure_cycles * npc > MAX_DWELL_STEPS / 2) else
+                 "settle_s" if settle_s is not None else "freq_hz")
+        raise InputError("argument", field, f"sine dwells needing at most {MAX_DWELL_STEPS:.0e} integration steps "
+                         "(settling, then the measured cycles, per point)", got=f"{total:.3g} steps")
+
+
 def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pitch", *,
                       dt_max_s: float | None = None, settle_cycles: int = 2, measure_cycles: int | None = None,
                       settle_s: float | None = None, min_steps_per_cycle: int = 64, method: str = "settle",
@@ -235,15 +274,15 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     linear orbit reaches the rate limit or the hard stops); ``"rk4"`` the fixed-step RK4
     kernel at ``dt_max_s`` (default :data:`taos.planar.simulate.DEFAULT_DT_S`).
     Shooting integrates its periods with the same integrator."""
-    if method not in STEADY_METHODS:
-        raise ValueError(f"method must be one of {STEADY_METHODS}, got {method!r}")
-    if integrator not in INTEGRATORS:
-        raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
+    check_choice(method, "method", STEADY_METHODS)
+    check_choice(integrator, "integrator", INTEGRATORS)
     use_exp = integrator == "exp"
     if dt_max_s is None:
         dt_max_s = DEFAULT_DT_S
     if measure_cycles is None:
         measure_cycles = 2 if method == "settle" else 1
+    _check_dwell_settings(model, amplitudes_rad, freq_hz, axis, dt_max_s, settle_cycles, measure_cycles, settle_s,
+                          min_steps_per_cycle, tol, k_rre, max_cycles)
     # own copies (writable, C order: the kernels' compiled signature, whatever the caller passed)
     A = np.array(amplitudes_rad, float, ndmin=1)
     F = np.array(freq_hz, float, ndmin=1)

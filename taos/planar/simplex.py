@@ -238,3 +238,20 @@ def load_resonance_from_notch(model: TvcModel, axis: str = "pitch",
     ``f_lo`` and ``f_hi`` [Hz] (:func:`taos.linear.notch_hz`: dense log grid, bounded search)."""
     ss = simplex_state_space(model, axis)
     return notch_hz(lambda f: np.abs(ss.freqresp(f, "command_rad", "x_p_m")), f_lo, f_hi)
+
+
+def check_rk4_step(dt_s: float, model, field: str, source: str = "argument") -> None:
+    """The explicit step's rule of the command line's ``--dt`` (dt |lambda|max <=
+    :data:`taos.bounds.RK4_STEP_LIMIT`, over the linear modes of both axes and the supply-pressure limit's
+    rate: :func:`taos.planar.envelope.fastest_mode_rad_s`)."""
+    import math
+
+    from ..bounds import AXES, RK4_STEP_LIMIT
+    from ..errors import InputError
+    from .saturation import pressure_limit_rate_per_s
+
+    lam = max(float(np.max(np.abs(simplex_state_space(model, ax).poles()))) for ax in AXES)
+    lam = max(lam, pressure_limit_rate_per_s(model.actuator))
+    if dt_s * lam > RK4_STEP_LIMIT:
+        raise InputError(source, field, f"a step at most {RK4_STEP_LIMIT / lam:.3g} s (dt |lambda|max <= "
+                         f"{RK4_STEP_LIMIT:g}, fastest mode {lam / (2 * math.pi):.4g} Hz)", got=f"{dt_s:g} s")

@@ -268,9 +268,20 @@ def simulate(model: TvcModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, r
     """
     from ._parallel import run_tasks
 
-    if integrator not in ("rk4", "exp"):
-        raise ValueError(f"integrator: 'rk4' or 'exp', got {integrator!r}")
-    T = (profile.duration_s + 1.0) if duration_s is None else duration_s
+    from ..bounds import (MAX_DURATION_S, check_choice, check_count, check_flag, check_instance, check_number,
+                          check_profile, check_step)
+    from .simplex import check_rk4_step
+
+    check_instance(model, "model", TvcModel, "a TvcModel (taos.load_model)")
+    check_profile(profile)
+    check_choice(integrator, "integrator", ("rk4", "exp"))
+    check_number(duration_s, "duration_s", 0.0, MAX_DURATION_S, "s", lo_open=True, optional=True)
+    T = (profile.duration_s + 1.0) if duration_s is None else float(duration_s)
+    check_step(dt_s, "dt_s", duration_s=T)
+    if integrator == "rk4":   # the explicit step's rule, as the command line's --dt
+        check_rk4_step(float(dt_s), model, "dt_s")
+    check_count(record_every, "record_every", 1)
+    check_flag(progress, "progress")
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
     cmd = np.atleast_2d(profile(t))

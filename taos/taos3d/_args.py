@@ -8,7 +8,8 @@ import math
 
 import numpy as np
 
-from ..bounds import MAX_DURATION_S, MAX_JOB_BYTES, MAX_STEPS, RESPONSE_FREQ_HZ, check_axis, check_grid
+from ..bounds import MAX_DURATION_S, RESPONSE_FREQ_HZ, check_axis, check_count, check_grid, check_number, check_step
+from ..planar.simplex import check_rk4_step
 from ..errors import InputError
 
 SRC = "argument"
@@ -18,22 +19,12 @@ MAX_AMPLITUDE_RAD = math.pi / 2
 MAX_DWELL_STEPS = 5e7
 
 
-def check_step(dt_s, field: str, duration_s: float | None = None) -> float:
-    """A finite positive step [s] (and, with ``duration_s``, a job within the step and memory
-    limits :data:`taos.bounds.MAX_STEPS`, :data:`~taos.bounds.MAX_JOB_BYTES`, estimated as the
-    command line does)."""
-    try:
-        dt = float(dt_s)
-    except (TypeError, ValueError):
-        raise InputError(SRC, field, "a positive step in seconds", got=repr(dt_s)[:40]) from None
-    if not (math.isfinite(dt) and dt > 0):
-        raise InputError(SRC, field, "a positive step in seconds", got=repr(dt_s)[:40])
-    if duration_s is not None:
-        n = duration_s / dt
-        if n > MAX_STEPS or n * 8 * 12 > MAX_JOB_BYTES:   # time, two commands and their copies, float64
-            raise InputError(SRC, field, f"at most {MAX_STEPS:.0e} steps within {MAX_JOB_BYTES / 2 ** 30:g} GiB for "
-                             f"the {duration_s:g} s run", got=f"{dt:g} s")
-    return dt
+def check_tm(tm) -> None:
+    """A TAOS model (:func:`taos.taos_model`)."""
+    from .model import TaosModel
+    from ..bounds import check_instance
+
+    check_instance(tm, "tm", TaosModel, "a TaosModel (taos.taos_model)")
 
 
 def check_dwell_steps(total: int) -> None:
@@ -43,30 +34,23 @@ def check_dwell_steps(total: int) -> None:
                          "steps (settling, then the measured cycles, per amplitude)", got=f"{total:.3g} steps")
 
 
-def check_count(value, field: str, lowest: int) -> int:
-    """A whole number of at least ``lowest`` (cycles, steps per cycle, record interval)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < lowest:
-        raise InputError(SRC, field, f"a whole number of at least {lowest}", got=repr(value)[:40])
-    return int(value)
-
-
 def check_dwell_args(tm, freq_hz, amplitudes_rad, axis: str, amp_field: str, dt_max_s, settle_cycles,
                      measure_cycles, settle_s, min_steps_per_cycle) -> tuple[np.ndarray, np.ndarray | None]:
     """(frequencies, amplitudes or None) of a frequency-response call, checked: a known axis, a
     non-empty grid of frequencies in (0, 1e4] Hz and of amplitudes in (0, 90] deg, a positive
     step, whole cycle counts, a job within the dwell step budget."""
+    check_tm(tm)
     check_axis(axis)
     f = check_grid(freq_hz, "freq_hz", "Hz", 0.0, RESPONSE_FREQ_HZ[1], source=SRC)
     if amplitudes_rad is None:
         return f, None
     a = check_grid(amplitudes_rad, amp_field, "rad", 0.0, MAX_AMPLITUDE_RAD, source=SRC)
     dt = check_step(dt_max_s, "dt_max_s")
+    check_rk4_step(dt, tm.base, "dt_max_s")   # the explicit step's rule, as --dt
     check_count(settle_cycles, "settle_cycles", 0)
     check_count(measure_cycles, "measure_cycles", 1)
     check_count(min_steps_per_cycle, "min_steps_per_cycle", 8)
-    if settle_s is not None and not (isinstance(settle_s, (int, float)) and 0 <= settle_s <= MAX_DURATION_S):
-        raise InputError(SRC, "settle_s", f"None or a settling time from 0 to {MAX_DURATION_S:g} s",
-                         got=repr(settle_s)[:40])
+    check_number(settle_s, "settle_s", 0.0, MAX_DURATION_S, "s", optional=True)
     return f, a
 
 

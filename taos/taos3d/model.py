@@ -394,8 +394,15 @@ def parse_geometry(model: TvcModel) -> ActuatorGeometry:
 
 
 def check_stiffness(K, src: str, field: str) -> np.ndarray:
-    """A 6x6 symmetric positive-definite stiffness, else InputError."""
-    K = np.asarray(K, float)
+    """A 6x6 symmetric positive-definite stiffness of real numbers, else InputError (a complex,
+    text or boolean matrix is refused, never cast)."""
+    try:
+        raw = np.asarray(K)
+    except (TypeError, ValueError):
+        raise InputError(src, field, "a finite 6x6 stiffness matrix", got=repr(K)[:40]) from None
+    if raw.dtype.kind not in "iuf":
+        raise InputError(src, field, "a finite 6x6 stiffness matrix of real numbers", got=f"dtype {raw.dtype}")
+    K = raw.astype(float)
     if K.shape != (6, 6) or not np.all(np.isfinite(K)):
         raise InputError(src, field, "a finite 6x6 stiffness matrix", got=f"shape {K.shape}")
     if not np.allclose(K, K.T, rtol=1e-6, atol=1e-9 * np.abs(K).max()):
@@ -426,6 +433,13 @@ def assemble_taos_model(model: TvcModel, K_upper: np.ndarray | None = None,
     stiffness matrices, the friction coefficient) and the line stiffness as given (None when the
     file leaves it to be derived: :func:`taos.taos3d.calibrate.taos_model` derives or checks it;
     use that). ``K_upper``/``K_lower`` override the ``[gimbal] stiffness_file``."""
+    from ..bounds import check_instance
+
+    check_instance(model, "model", TvcModel, "a TvcModel (taos.load_model)")
+    if (K_upper is None) != (K_lower is None):   # one matrix alone would be silently ignored
+        given, other = ("K_upper", "K_lower") if K_lower is None else ("K_lower", "K_upper")
+        raise InputError("argument", other, f"a 6x6 matrix with {given} (both halves, or neither for the "
+                         "model file's gimbal.stiffness_file)", got="None")
     gim = parse_gimbal(model)
     geo = parse_geometry(model)
     if K_upper is None or K_lower is None:

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..planar.actuator import actuator_state_space
+from ..bounds import check_flag
 from ..errors import SimulationUnstable
 from ..planar._parallel import run_each
 from ..planar.freqresp import LINEAR_SOLVER, FrequencyResponse, settle_time_s
@@ -143,6 +144,7 @@ def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S
     """Run ``profile`` (a single-axis profile drives pitch; two-axis drives both) through the
     TAOS model from rest; ``dt_s`` integration step [s]; ``duration_s`` default the profile's
     duration plus 1 s."""
+    _args.check_tm(tm)
     _args.check_simulate_args(profile, dt_s, record_every, duration_s)
     T = (profile.duration_s + 1.0) if duration_s is None else duration_s
     n = int(math.ceil(T / dt_s))
@@ -268,6 +270,7 @@ def taos_freqresp(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitude_rad: fl
     an amplitude outside (0, 90] deg, an unknown axis or a non-positive step."""
     f, _ = _args.check_dwell_args(tm, freq_hz, amplitude_rad, axis, "amplitude_rad", dt_max_s, settle_cycles,
                                   measure_cycles, settle_s, min_steps_per_cycle)
+    check_flag(cross, "cross")
     i = AXES.index(axis)
     o = 1 - i if cross else i
     R = tm.base.actuator.moment_arm_m
@@ -307,6 +310,7 @@ def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = Fal
     any dwell runs; an unstable dwell raises for the first in (axis, amplitude, frequency) order."""
     from ..errors import InputError
 
+    check_flag(cross, "cross")
     parts = []
     for axis, (freq_hz, amplitudes_rad) in grids.items():
         if amplitudes_rad is None:
