@@ -112,7 +112,7 @@ def _taos_meta(model, engine: str) -> dict:
     from taos.taos3d import taos_model
     tm = taos_model(model)
     return {"stiffness_file": Path(tm.stiffness_source).name,
-            "true_line_load_stiffness": f"{tm.line_load_stiffness_N_per_m / 175.126835:.6g} lbf/in",
+            "true_line_load_stiffness": f"{tm.line_load_stiffness_N_per_m / N_PER_M_PER_LBF_PER_IN:.6g} lbf/in",
             "true_friction_coefficient": f"{tm.gimbal.friction_coefficient:.6g}",
             "integration_step": f"{DT_S:g} s"}
 

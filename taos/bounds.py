@@ -279,9 +279,9 @@ def check_model_bounds(src: str, engine, actuator, structure, avionics, friction
         elif sec == "friction" and key in friction_table:
             check_bound(to_si(friction_table[key], "torque", source=src, field=field), field, src)
         elif sec in ("gimbal", "geometry") and isinstance(extra.get(sec), Mapping) and key in extra[sec]:
-            from .model_keys import key_kind   # the 3-D model's keys, bounded at load like every other
-
-            check_bound(to_si(extra[sec][key], key_kind(field), source=src, field=field), field, src)
+            # the 3-D model's keys, bounded at load like every other (their kind from the bound's unit)
+            kind = {"1": "dimensionless", "m": "length", "N/m": "stiffness"}[MODEL_BOUNDS[field][2]]
+            check_bound(to_si(extra[sec][key], kind, source=src, field=field), field, src)
     check_bound(avionics.command_range_rad, "avionics.command_range", src)
     if "static_torque" in friction_table and "coulomb_torque" in friction_table:
         ts = to_si(friction_table["static_torque"], "torque", source=src, field="friction.static_torque")

@@ -125,6 +125,32 @@ MAX_DATA_BYTES = 4 * 2 ** 30
 MAX_TOML_DEPTH = 16
 
 
+#: resolved path -> (bytes or None, SHA-256) of the input files a model was read from, while one
+#: of its variants is loaded (:func:`stored_inputs`): read from here, never from the disk
+_STORED: ContextVar[Mapping[str, tuple] | None] = ContextVar("taos_stored_inputs", default=None)
+
+
+@contextmanager
+def stored_inputs(files: Mapping[str, tuple]):
+    """Within the block, the files ``files`` (resolved path -> (bytes or None, SHA-256)) are read,
+    checked, hashed and found from these contents instead of the disk: a model's variant is
+    parsed from the very files the model was read from, wherever it runs (a Dask worker that
+    cannot open a project file) and whatever happened to the files since."""
+    token = _STORED.set(dict(files))
+    try:
+        yield
+    finally:
+        _STORED.reset(token)
+
+
+def stored(path) -> tuple | None:
+    """(bytes or None, SHA-256) of ``path`` when it is a stored input (:func:`stored_inputs`)."""
+    table = _STORED.get()
+    if not table or isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):
+        return None
+    return table.get(os.fspath(path))
+
+
 def check_input_file(path, what: str, max_bytes: int = MAX_DATA_BYTES, field: str = "(file)") -> int:
     """Refuse, without opening it, an input that is not a regular file (a folder, a device such
     as ``/dev/zero``, a FIFO that would block, a socket) or is larger than ``max_bytes``; returns
@@ -135,6 +161,11 @@ def check_input_file(path, what: str, max_bytes: int = MAX_DATA_BYTES, field: st
     if isinstance(path, bool) or not isinstance(path, (str, os.PathLike)):   # os.stat(1) would stat a descriptor
         raise InputError(repr(path)[:40], field, what + " (a path: text or a pathlib.Path)",
                          got=type(path).__name__)
+    kept = stored(path)
+    if kept is not None and kept[0] is not None:   # checked when the model was loaded
+        return len(kept[0])
+    if kept is not None:   # a stored file known by its hash only (a stiffness file): not read here
+        return 0
     try:
         st = os.stat(path)
     except (OSError, ValueError) as e:
@@ -447,6 +478,10 @@ def read_toml(path: "str | os.PathLike", what: str) -> tuple[bytes, dict]:
     :data:`taos.errors.MAX_TOML_DEPTH`. A FIFO or device never blocks or floods the run."""
     import copy
 
+    kept = stored(path)
+    if kept is not None and kept[0] is not None:
+        raw = kept[0]
+        return raw, parse_toml(raw, str(path))
     key = stat_key(path)
     if key is None:   # not a regular file: read_input_bytes says what is wrong with it
         return _read_toml(str(path), what)

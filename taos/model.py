@@ -186,8 +186,10 @@ class TvcModel:
                                               compare=False, repr=False)
     extra: Mapping[str, Any] = field(default_factory=lambda: types.MappingProxyType({}),
                                      compare=False, repr=False)
-    #: the model file's bytes as read: variants parse these (the file may be gone or replaced since)
-    source_bytes: bytes = field(default=b"", compare=False, repr=False)
+    #: path -> bytes of every TOML file it was read from (model file, parameter sets): its variants
+    #: are parsed from these, never from the disk (:func:`taos.errors.stored_inputs`)
+    input_bytes: Mapping[str, bytes] = field(default_factory=lambda: types.MappingProxyType({}),
+                                             compare=False, repr=False)
 
     # -- derived figures ------------------------------------------------------------------
     def load_resonance_hz(self, axis: str = "pitch") -> float:
@@ -207,6 +209,7 @@ class TvcModel:
         """The model file with the keys ``values`` (``{"structure.load_stiffness": "160000
         lbf/in", ...}``; a plain number is SI) given other values, through the loader and its
         bounds: the one way to make a variant (:mod:`taos.variants`)."""
+        from .errors import stored_inputs
         from .variants import (check_unchanged, check_variant_source, code_changes, keep_code_changes,
                                merge_overrides, variant_sha256)
 
@@ -217,8 +220,10 @@ class TvcModel:
 
         def load(over):
             table = dict(over)
-            return load_model(self.source, friction=table.pop("friction.model", None), overrides=table,
-                              source_bytes=self.source_bytes or None)
+            kept = {f: (self.input_bytes.get(f), h) for f, h in self.input_files.values()}
+            with stored_inputs(kept):   # the very files it was read from, wherever this runs
+                return load_model(self.source, friction=table.pop("friction.model", None), overrides=table,
+                                  source_bytes=self.input_bytes.get(self.source))
         out = load(overrides)
         check_unchanged(self, out)
         if not code:
@@ -463,24 +468,6 @@ def actuator_table_with_parameter_set(atab: Mapping, model_path: Path, src: str)
     return table
 
 
-def inline_actuator_parameter_set(doc, model_path: Path, src: str) -> bool:
-    """Replace ``[actuator] parameter_set`` in a tomlkit document of a model file by the set's
-    keys, so the file describes its own actuator (a fitted or edited actuator is a different
-    piece of hardware, hence no longer the shared set). Returns False if there was no set."""
-    import tomlkit
-
-    tab = doc.get("actuator")
-    if tab is None or PARAMETER_SET_KEY not in tab:
-        return False
-    ref = tab[PARAMETER_SET_KEY]
-    ppath, shared = _parameter_set(str(ref), Path(model_path), src, "actuator")
-    del tab[PARAMETER_SET_KEY]
-    tab.add(tomlkit.comment(f"inlined from the shared actuator set {ppath.as_posix()}: this file's own actuator"))
-    for k, v in shared.items():
-        tab[k] = v
-    return True
-
-
 def _scale_to_torque_level(table: dict, ref_torque, set_src: str, src: str) -> None:
     """Scale the set's load-proportional parameters (bristle stiffness and damping, viscous and
     stick damping: the torque-like fields other than the torque levels) from the set's
@@ -598,4 +585,7 @@ def load_model(path: str | Path, friction: str | None = None, overrides: Mapping
                     sha256=variant_sha256(combined_sha256(files), recorded), overrides=recorded,
                     base_sha256=combined_sha256(files), input_files=types.MappingProxyType(files),
                     friction_table=types.MappingProxyType(dict(ftab)),
-                    extra=types.MappingProxyType(extra), source_bytes=raw)
+                    extra=types.MappingProxyType(extra),
+                    input_bytes=types.MappingProxyType(
+                        {src: raw} | {f: read_toml(f, "a parameter set")[0] for r, (f, _) in files.items()
+                                      if r.endswith("_parameter_set")}))

@@ -114,6 +114,11 @@ def base_provenance() -> dict:
 def file_sha256(path: str | Path) -> str:
     """SHA-256 of a file's bytes (hex), or '' when it cannot be read. A regular file's hash is
     remembered under its :func:`stat_key` (model variants hash the same files again and again)."""
+    from .errors import stored
+
+    kept = stored(path)
+    if kept is not None:
+        return kept[1]
     key = stat_key(path)
     if key is None:
         return _file_sha256(path)

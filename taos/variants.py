@@ -23,10 +23,10 @@ The result records that it was modified and how: :attr:`~taos.model.TvcModel.ove
 accumulated ``(key, value)`` pairs, values as a model file would hold them),
 :attr:`~taos.model.TvcModel.base_sha256` (the files' combined hash) and its own
 :attr:`~taos.model.TvcModel.sha256` (the files' hash and the overrides), all of which
-:func:`taos.results.model_provenance` puts in every output. A model keeps its file's bytes, which its variants parse (a model file deleted or rewritten
-since changes nothing); the files it names (parameter sets, stiffness file) are read again and
-must be unchanged since the model was loaded (:class:`~taos.errors.InputError` otherwise), so a
-variant never mixes an old model with new hardware files.
+:func:`taos.results.model_provenance` puts in every output. A model carries the bytes of every TOML file it was read from (model file, parameter sets) and
+the hashes of the others (stiffness file); its variants are parsed from those, never from the
+disk (:func:`taos.errors.stored_inputs`): the same on a Dask worker that cannot open a project
+file, and unaffected by files deleted or rewritten since.
 """
 
 from __future__ import annotations

@@ -78,7 +78,7 @@ def inline_actuator_set(text: str, path: Path = MODELS / "rs25_ambient.toml") ->
     can edit an actuator value in a copy (the shared set itself may not be overridden)."""
     import tomlkit
 
-    from taos.model import inline_actuator_parameter_set
+    from taos.identify.model_file import inline_actuator_parameter_set
 
     doc = tomlkit.parse(text)
     inline_actuator_parameter_set(doc, path, str(path))

@@ -76,7 +76,7 @@ def cmd_fit3d(args) -> int:
     if not 0.0 <= args.min_coherence <= 1.0:
         raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
     starts = _starts(args)
-    from taos.cli.identify import _parse_bounds
+    from taos.cli._bounds_arg import _parse_bounds
     from taos.identify.params3d import PARAMETERS3D
     bounds = _parse_bounds(args.bounds, PARAMETERS3D)
     tm = taos_model(load_model(args.model, friction=args.friction))

@@ -49,7 +49,8 @@ from taos.errors import InputError
 from taos.identify.estimation import MeasuredResponse
 from taos.identify.globalstage import grid_search
 from taos.identify.surrogate import PARAMETERS, apply_values, build_surrogate, check_free, solve_implicit
-from taos.model import TvcModel, inline_actuator_parameter_set, load_model, resolve_parameter_set
+from taos.identify.model_file import inline_actuator_parameter_set
+from taos.model import TvcModel, load_model, resolve_parameter_set
 from taos.results import atomic_write
 from taos.units import from_si
 

@@ -114,7 +114,8 @@ def planar_model_text(result) -> str:
     """The reduced planar model file's text (module docstring)."""
     import tomlkit
 
-    from taos.model import inline_actuator_parameter_set, resolve_parameter_set
+    from taos.identify.model_file import inline_actuator_parameter_set
+    from taos.model import resolve_parameter_set
     from taos.results import toml_set
 
     src = result.source.source

@@ -61,7 +61,15 @@ def shipped_names(kind: str = "model") -> list[str]:
 def resolve(path: str | Path, kind: str = "model") -> Path:
     """``path`` itself when it exists (or has a folder part or a suffix); otherwise the shipped
     file of that name and kind when there is one; otherwise ``path`` unchanged (the caller's
-    reader then reports it as missing)."""
+    reader then reports it as missing). Anything but a path (text or ``os.PathLike``) is
+    :class:`~taos.errors.InputError`, as a bad path on the command line is."""
+    from taos.errors import InputError
+
+    if isinstance(path, bool) or not isinstance(path, (str, os.PathLike)) or path in ("", b""):
+        raise InputError(repr(path)[:40], "(file)", f"a {kind} file: a path (text or a pathlib.Path) or a "
+                         "shipped name", got="an empty path" if isinstance(path, str) else type(path).__name__)
+    if isinstance(path, str) and "\x00" in path:
+        raise InputError(repr(path)[:40], "(file)", f"a {kind} file path", got="a path with a NUL character")
     p = Path(path)
     if p.exists() or p.suffix or len(p.parts) != 1:
         return p
@@ -115,8 +123,10 @@ def resolve_reference(ref, referring_file: str | Path, *, field: str, what: str 
     if not isinstance(ref, str) or not ref:
         raise InputError(str(referring_file), field, f"a path to {what}", got=repr(ref)[:60])
     here, shipped = reference_places(ref, referring_file, kind)
+    from taos.errors import stored
+
     for place in (here, shipped):
-        if place is not None and os.path.lexists(place):
+        if place is not None and (os.path.lexists(place) or stored(place.resolve()) is not None):
             return place.resolve()
     here = here.resolve()
     where = f"{here}" if shipped is None else f"{here} (beside the file) or {shipped.resolve()} (shipped)"

@@ -1,0 +1,31 @@
+"""``--bounds 'NAME=LOW:HIGH'`` of ``taos fit`` (planar and 3-D): one parser."""
+
+from __future__ import annotations
+
+from taos.errors import InputError
+
+
+def _parse_bounds(items, table=None) -> dict:
+    """--bounds 'NAME=LO:HI' (each with a unit) -> {name: (lo_si, hi_si)}; names from ``table``
+    (name -> an object with ``kind``; default the planar fit's parameters)."""
+    from taos.identify.surrogate import PARAMETERS as PLANAR
+    from taos.units import to_si
+
+    PARAMETERS = PLANAR if table is None else table
+
+    out = {}
+    for it in items or []:
+        if "=" not in it or ":" not in it.split("=", 1)[1]:
+            raise InputError("command line", "--bounds", "NAME=LOW:HIGH with units, like "
+                             "load_stiffness='50000 lbf/in:400000 lbf/in'", got=repr(it))
+        k, v = (x.strip() for x in it.split("=", 1))
+        if k not in PARAMETERS:
+            raise InputError("command line", "--bounds", "a name from " + ", ".join(PARAMETERS), got=repr(k))
+        p = PARAMETERS[k]
+        lo_s, hi_s = (x.strip() for x in v.split(":", 1))
+        lo, hi = (to_si(x if p.kind != "dimensionless" else float(x), p.kind, source="command line",
+                        field=f"--bounds {k}", positive=True) for x in (lo_s, hi_s))
+        if not lo < hi:
+            raise InputError("command line", f"--bounds {k}", "LOW below HIGH", got=repr(v))
+        out[k] = (lo, hi)
+    return out
