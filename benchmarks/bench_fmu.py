@@ -15,7 +15,11 @@ Green Run profile (models/profiles/greenrun_two_axis.toml) over ``--duration`` s
   ``os._exit``, as tests/test_fmu.py runs it), at h = dt with ``command_hold = 1`` (its output at
   t + h against ``taos simulate`` at t) and at h = 10 dt with ``command_hold = 0``;
 * simplex only: the standalone FMU (``taos fmu --standalone``, C, no Python) the same two ways in
-  FMPy (in this process: it holds no Python), and its bare per-step cost in a C master (the
+  FMPy (in this process: it holds no Python; ``command_mode`` 1 ramp at h = dt, 2 hold at
+  h = 10 dt), in its default ``command_mode = 0`` (exact) at h = 5, 10, 25 dt against ``taos
+  simulate`` of the same held command (the held profile of
+  ``tests/test_fmu_standalone_params.held_profile``, one more ``taos simulate`` run per host
+  step), and its bare per-step cost in a C master (the
   FMU's ``fmi2DoStep`` and ``fmi2GetReal`` of every output in a loop, no FMPy; held command,
   h = dt, timed inside the master with ``clock_gettime``). ``--skip-pythonfmu`` leaves out the
   pythonfmu FMU's rows (the slowest).
@@ -152,16 +156,28 @@ def standalone_rows(prof, th, dt: float, T: float, tmp: str) -> list:
     t0 = time.perf_counter()
     fmu = build_standalone_fmu(ROOT / "models" / "rs25_hotfire.toml", Path(tmp) / "standalone.fmu").path
     rows = [("simplex", "standalone FMU: taos fmu --standalone (build)", dt, float("nan"), time.perf_counter() - t0)]
-    for every, hold in ((1, 1), (10, 0)):
+    for every, mode in ((1, 1), (10, 2), (5, 0), (10, 0), (25, 0)):
         h = every * dt
         sig = profile_input(prof, dt, T + h)[::every]
+        ref = th
+        if mode == 0:   # taos simulate of the command held over each host step
+            from taos.planar.simulate import simulate
+            from taos.profiles import TwoAxis
+            from tests.test_fmu_standalone_params import held_profile
+
+            tj = sig["time"]
+            ref = simulate(load_model(ROOT / "models" / "rs25_hotfire.toml"),
+                           TwoAxis(held_profile(tj, sig["pitch_command_rad"], dt),
+                                   held_profile(tj, sig["yaw_command_rad"], dt)), dt_s=dt, record_every=1,
+                           duration_s=float(tj[-1]))
         t0 = time.perf_counter()
         res = fmpy.simulate_fmu(str(fmu), input=sig, stop_time=float(sig["time"][-1]), step_size=h, output_interval=h,
-                                start_values={"command_hold": hold})
+                                start_values={"command_mode": mode})
         wall = time.perf_counter() - t0
         eng = np.vstack([res["pitch_engine_rad"], res["yaw_engine_rad"]])
-        rows.append(("simplex", f"standalone FMU in FMPy, h = {every} dt, command_hold {hold}", h,
-                     worst_deg(eng, th, every, shift=1 if hold == 1 else 0), wall))
+        what = {0: "exact (default), against taos simulate of the held command", 1: "ramp", 2: "hold"}[mode]
+        rows.append(("simplex", f"standalone FMU in FMPy, h = {every} dt, command_mode {mode} {what}", h,
+                     worst_deg(eng, ref, every, shift=1 if mode == 1 else 0), wall))
     steps = int(round(T / dt))
     per = c_master_per_step(fmu, tmp, steps, dt)
     rows.append(("simplex", f"standalone FMU in a C master, h = dt ({per * 1e6:.2f} us/step)", dt, float("nan"),

@@ -401,3 +401,14 @@ def load_profile(path: str | Path) -> Profile:
         prof = profile_from_table(doc, src, "profile")
     check_duration(prof.duration_s, src, "(total duration)")
     return prof
+
+
+def dwell_segments(profile) -> list[tuple[float, SineDwell]]:
+    """(start time [s], SineDwell) of each sine-dwell part of a single-axis profile."""
+    parts = profile.parts if isinstance(profile, Sequence) else (profile,)
+    out, t0 = [], 0.0
+    for p in parts:
+        if isinstance(p, SineDwell):
+            out.append((t0, p))
+        t0 += p.duration_s
+    return out

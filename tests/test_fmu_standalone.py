@@ -60,10 +60,17 @@ def test_fmpy_validates_it_and_it_declares_what_it_does(cfmu, md, hotfire):
     assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate and not cs.providesDirectionalDerivative
     assert not cs.needsExecutionTool and cs.canHandleVariableCommunicationStepSize
     assert all(v.description for v in md.modelVariables)
-    assert [v.name for v in md.modelVariables if v.causality == "output"] == list(BlockOutputs.signal_names())
+    from taos.cosim._standalone_params import VEHICLE_OUTPUTS
+    assert [v.name for v in md.modelVariables if v.causality == "output"] == [*BlockOutputs.signal_names(),
+                                                                              *VEHICLE_OUTPUTS]
+    assert {v.name: v.variability for v in md.modelVariables if v.causality == "parameter"} == {
+        "internal_step_s": "fixed", "load_stiffness_N_per_m": "fixed", "avionics_gain": "tunable",
+        "vehicle_moment_arm_m": "tunable", "command_mode": "fixed",
+        **{f"friction_{k}": "tunable" for k in ("coulomb_torque_Nm", "static_torque_Nm", "bristle_stiffness_Nm_per_rad",
+                                                 "bristle_damping_Nms_per_rad", "viscous_damping_Nms_per_rad")}}
     assert all(u.dependencies == [] for u in md.outputs)
     assert hotfire.sha256 in md.description and package_version() in md.description
-    assert sorted(md.buildConfigurations[0].sourceFileSets[0].sourceFiles) == ["fmi2_glue.c", "taos_kernels.c"]
+    assert sorted(md.buildConfigurations[0].sourceFileSets[0].sourceFiles) == ["fmi2_glue.c", "taos_kernels.c", "taos_params.c"]
     (bc,) = read_build_description(str(cfmu), validate=True)
     assert bc.modelIdentifier == cs.modelIdentifier
     with zipfile.ZipFile(cfmu) as z:
@@ -162,7 +169,7 @@ def test_generated_derivative_equals_the_kernels(law, tmp_path):
 
 def test_greenrun_segment_equals_taos_simulate(cfmu, hotfire):
     """FMPy runs the FMU through the first 4 s of the two-axis Green Run at the internal step
-    with ``command_hold = 1`` (its output at t + h is taos simulate's at t): every signal equals
+    with ``command_mode = 1`` (ramp; its output at t + h is taos simulate's at t): every signal equals
     ``taos simulate``'s, the engine angles within 1e-6 deg (achieved about 1e-16 deg; the whole
     profile: benchmarks/bench_fmu.py)."""
     prof = load_profile("greenrun_two_axis")
@@ -170,7 +177,7 @@ def test_greenrun_segment_equals_taos_simulate(cfmu, hotfire):
     th = simulate(hotfire, prof, dt_s=dt, record_every=1, duration_s=T)
     sig = profile_input(prof, dt, T + dt)
     res = fmpy.simulate_fmu(str(cfmu), input=sig, stop_time=float(sig["time"][-1]), step_size=dt, output_interval=dt,
-                            start_values={"command_hold": 1})
+                            start_values={"command_mode": 1})
     n = th.t_s.size
     worst = 0.0
     for i, ax in enumerate(th.axes):
@@ -186,7 +193,7 @@ def test_greenrun_segment_equals_taos_simulate(cfmu, hotfire):
 
 @pytest.mark.parametrize("every", [1, 5, 10, 25])
 def test_held_command_at_multiples_of_the_internal_step_equals_the_kernel(cfmu, hotfire, every):
-    """``command_hold = 0`` (the default) at communication steps of 1, 5, 10 and 25 internal
+    """``command_mode = 2`` (hold, a staircase) at communication steps of 1, 5, 10 and 25 internal
     steps, a staircase of the Green Run's first 1.5 s: equal to the Python block holding the same
     commands (taos simulate's kernel over the held samples) within 1e-6 deg, every output."""
     prof = load_profile("greenrun_two_axis")
@@ -197,7 +204,8 @@ def test_held_command_at_multiples_of_the_internal_step_equals_the_kernel(cfmu, 
     c = np.atleast_2d(prof(t))
     sig = np.zeros(t.size, dtype=[("time", float), ("pitch_command_rad", float), ("yaw_command_rad", float)])
     sig["time"], sig["pitch_command_rad"], sig["yaw_command_rad"] = t, c[0], c[1]
-    res = fmpy.simulate_fmu(str(cfmu), input=sig, stop_time=float(t[-1]), step_size=h, output_interval=h)
+    res = fmpy.simulate_fmu(str(cfmu), input=sig, stop_time=float(t[-1]), step_size=h, output_interval=h,
+                            start_values={"command_mode": 2})
     b = TvcBlock(hotfire)
     ref = [b.reset(c[0, 0], c[1, 0])] + [b.step(h, c[0, k], c[1, k]) for k in range(steps)]
     for name in BlockOutputs.signal_names():
@@ -252,14 +260,14 @@ def test_fmu_state_get_set_and_serialise_restore_the_run(cfmu, md, tmp_path):
 
 def test_host_mistakes_are_errors_not_fatal_and_change_nothing(cfmu, md, tmp_path):
     """A communication point that is not the FMU's time, a step that is no multiple of the
-    internal step, a NaN or out-of-range command, command_hold set after initialisation, an
+    internal step, a NaN or out-of-range command, command_mode or a fixed parameter set after initialisation, an
     unknown value reference: each is fmi2Error (never fmi2Fatal) with one log line, and the run
     goes on as if the call had not been made."""
     vr = {v.name: v.valueReference for v in md.modelVariables}
     s = _slave(cfmu, md, tmp_path)
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
-    s.setInteger([vr["command_hold"]], [1])
+    s.setInteger([vr["command_mode"]], [1])
     s.setReal([vr["pitch_command_rad"]], [0.2 * DEG])
     s.exitInitializationMode()
     s.doStep(0.0, 2e-3)
@@ -268,13 +276,15 @@ def test_host_mistakes_are_errors_not_fatal_and_change_nothing(cfmu, md, tmp_pat
                 lambda: s.setReal([vr["pitch_command_rad"]], [float("nan")]),
                 lambda: s.setReal([vr["yaw_command_rad"]], [11 * DEG]),
                 lambda: s.setReal([vr["pitch_engine_rad"]], [0.0]),
-                lambda: s.setInteger([vr["command_hold"]], [0]), lambda: s.getReal([999])]
+                lambda: s.setInteger([vr["command_mode"]], [0]), lambda: s.getReal([999]),
+                lambda: s.setReal([vr["internal_step_s"]], [1e-4]), lambda: s.setInteger([vr["command_mode"]], [3]),
+                lambda: s.setReal([vr["avionics_gain"]], [2.0]), lambda: s.setReal([vr["vehicle_force_x_N"]], [0.0])]
     for call in mistakes:
         with pytest.raises(FMICallException) as e:
             call()
         assert e.value.status == 3   # fmi2Error
     assert s.getReal([vr["pitch_engine_rad"]]) == before
-    assert s.getInteger([vr["command_hold"]]) == [1]
+    assert s.getInteger([vr["command_mode"]]) == [1]
     s.doStep(2e-3, 2e-3)   # still running
     s.terminate()
     s.freeInstance()

@@ -60,7 +60,7 @@ def add_friction_option(parser: argparse.ArgumentParser,
 
 #: subcommand modules, in help order
 COMMANDS = ["taos.cli.basic", "taos.cli.view", "taos.cli.identify", "taos.cli.reduce", "taos.cli.lco", "taos.cli.export",
-            "taos.cli.montecarlo", "taos.cli.sweep", "taos.cli.fmu"]
+            "taos.cli.montecarlo", "taos.cli.pti", "taos.cli.sweep", "taos.cli.fmu"]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -50,7 +50,12 @@ AXES = ("pitch", "yaw")
 DEFAULT_DT_S = 5e-4
 #: recorded signals of an ascent run, per axis (SI)
 SIGNALS = ("attitude_rad", "rate_rad_s", "command_rad", "engine_rad", "engine_rate_rad_s", "piston_m",
-           "friction_torque_Nm", "booster_deflection_rad", "pti_rad", "disturbance_rad_s2")
+           "friction_torque_Nm", "booster_deflection_rad", "pti_rad", "disturbance_rad_s2",
+           "piston_rate_m_s", "load_pressure_Pa", "valve_flow_m_s")
+#: the hydraulic signals (the actuator states v_p, P_L and q, the valve's no-load flow over the
+#: piston area; :mod:`taos.planar.actuator`) -> their state names, for the duty cycle
+#: (:mod:`taos.flight.duty`)
+HYDRAULIC = {"piston_rate_m_s": "v_p_m_s", "load_pressure_Pa": "p_load_Pa", "valve_flow_m_s": "q_m_s"}
 MAX_STEPS = 50_000_000
 #: the integrator of every ascent run (the compiled RK4 kernel of :mod:`taos.planar.dynamics`), as
 #: the runs' provenance names it
@@ -256,7 +261,7 @@ _RECORDED = ("attitude_rad", "rate_rad_s", "delta_cmd_rad", "theta_rad", "omega_
 def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
     """Fly ``lanes`` (equal keys) in one call of
     :func:`taos.planar.dynamics.integrate_segments_lanes`; per lane (the first 8 :data:`SIGNALS`
-    at the records (n_rec, 8), the external inputs there (n_rec, 2)) or the
+    then the :data:`HYDRAULIC` ones at the records (n_rec, 11), the external inputs there (n_rec, 2)) or the
     :class:`~taos.errors.SimulationUnstable` it ended with."""
     from taos.errors import SimulationUnstable
     from taos.planar import dynamics as _dy
@@ -304,7 +309,8 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
                     Y[sl, j] = y
         Y[:, 2] += ln.r[::rec, 0]  # the FCS command: the PTI is added to it
         Y[:, 6] = aux[:, _dy.AUX_TF, q]
-        out.append((Y, ln.r[::rec]))
+        Yh = np.column_stack([Xq[:, si(v)] for v in HYDRAULIC.values()])
+        out.append((np.column_stack([Y, Yh]), ln.r[::rec]))
     return out
 
 
@@ -367,6 +373,8 @@ def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tu
             out[k].append(Y[:, j])
         out["pti_rad"].append(Rr[:, 0])
         out["disturbance_rad_s2"].append(Rr[:, 1])
+        for j, k in enumerate(HYDRAULIC):
+            out[k].append(Y[:, 8 + j])
     prov = {**model_provenance(model), "ascent_file": ascent.source,
             "ascent_sha256": ascent.sha256, "flight_file": ascent.flight.source,
             "flight_sha256": ascent.flight.sha256, "package_version": package_version(),

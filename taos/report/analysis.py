@@ -45,7 +45,7 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.harmonics import fit_sines
-from taos.profiles import Sequence, SineDwell, TwoAxis
+from taos.profiles import Sequence, SineDwell, TwoAxis, dwell_segments  # noqa: F401 (re-exported)
 from taos.shipped import models_dir
 
 from .summary import greenrun_summary, model_summary
@@ -71,17 +71,6 @@ LINEAR_GRID_HZ = np.logspace(-1, math.log10(30.0), 240)
 
 
 # -- the run's own responses -------------------------------------------------------------------
-
-def dwell_segments(profile) -> list[tuple[float, SineDwell]]:
-    """(start time [s], SineDwell) of each sine-dwell part of a single-axis profile."""
-    parts = profile.parts if isinstance(profile, Sequence) else (profile,)
-    out, t0 = [], 0.0
-    for p in parts:
-        if isinstance(p, SineDwell):
-            out.append((t0, p))
-        t0 += p.duration_s
-    return out
-
 
 def run_dwell_response(t_s, command_amp_rad: float, freq_hz: float, t0_s: float, cycles: int, y,
                        fit_cycles: int = 2) -> complex:

@@ -333,7 +333,7 @@ def concurrent_dwells(profile) -> dict[str, list[tuple[float, float, float, floa
     """Per axis of a two-axis profile, each dwell segment as (frequency [Hz], amplitude [rad],
     the other axis' frequency [Hz], amplitude [rad]): the other axis' dwell segment overlapping
     it longest in time, (0, 0) when the other axis runs none meanwhile."""
-    from .analysis import dwell_segments
+    from taos.profiles import dwell_segments
 
     spans = {}
     for ax in ("pitch", "yaw"):
