@@ -81,7 +81,7 @@ print("reduction within tolerance:", red.within_tolerance)
 # hot-fire 205,000 lbf/in. The friction is the hot-fire test's (sea-level thrust on the bearing);
 # the flight bounding model (``rs25_flight``) carries the larger flight friction.
 flight = taos.load_flight("core_stage")
-grid = dict(amplitudes_rad=[a * deg for a in (0.03, 0.1, 0.3)], freq_hz=[0.05, 0.08, 0.12, 0.18, 0.27, 0.4])
+grid = {"amplitudes_rad": [a * deg for a in (0.03, 0.1, 0.3)], "freq_hz": [0.05, 0.08, 0.12, 0.18, 0.27, 0.4]}
 v = taos.analyse_lco(flight, red.model, time_domain=False, **grid).verdict()
 print(v.text)
 ks = [60000.0 * LBF_IN, 115000.0 * LBF_IN, red.model.structure.load_stiffness_N_per_m, 205000.0 * LBF_IN]

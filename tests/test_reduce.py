@@ -65,7 +65,12 @@ def test_reduced_model_meets_the_acceptance_tolerance(reduced):
 @pytest.mark.slow
 def test_flight_model_plain_lugre_is_within_tolerance_after_the_worst_point_refinement():
     """rs25_flight (plain LuGre): least squares alone left 0.54-0.57 dB between grid points."""
-    from taos.identify.reduce import TOLERANCE_DB, TOLERANCE_DEG, match_table, reduce_to_planar
+    from taos.identify.reduce import (
+        TOLERANCE_DB,
+        TOLERANCE_DEG,
+        match_table,
+        reduce_to_planar,
+    )
     from taos.taos3d import load_taos_model
 
     tm = load_taos_model(FLIGHT_MODEL)
@@ -86,7 +91,7 @@ def test_minimax_reaches_the_worst_point_optimum_least_squares_misses():
     from taos.identify.minimax import minimax
 
     t, y = np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 0.0, 0.0, 1.0])
-    fun = lambda x: x[0] + x[1] * t - y   # noqa: E731
+    fun = lambda x: x[0] + x[1] * t - y
     ls = so.least_squares(fun, [0.0, 0.0])
     mm = minimax(fun, ls.x, [-5.0, -5.0], [5.0, 5.0], step=1e-6, min_delta=1e-9, ftol=1e-9, max_nfev=60)
     assert np.max(np.abs(ls.fun)) == pytest.approx(0.4, rel=1e-6)
