@@ -12,6 +12,7 @@ The public API, by task (each name is importable from ``taos``)::
     study.runs, study.summary()                            # one flown ascent per TVC, their windows
     taos.fit_frequency_response(model, responses, ["load_stiffness"])
     taos.compare_models(model_a, model_b)
+    planar = taos.reduce_to_planar("rs25_hotfire").model   # the 3-D model's planar-equivalent friction
     taos.write_html(run, "run.html")                       # offline 3-D view
     res = taos.greenrun(model, out="out/greenrun")         # the Green Run report (GreenRunResult)
     res.summary()["figures_of_merit"]                      # its numbers (summary.json)
@@ -85,6 +86,7 @@ _API = {
     "analyse_lco": "taos.flight.lco", "predict_lco": "taos.flight.lco",
     "load_test_data": "taos.identify.data", "estimate": "taos.identify.estimation",
     "fit_frequency_response": "taos.identify.fit", "compare_models": "taos.identify.compare",
+    "reduce_to_planar": "taos.identify.reduce",
     "load_ascent": "taos.flight.ascent", "simulate_ascent": "taos.flight.ascent_sim",
     "fly_ascent": "taos.flight.ascent_sim", "AscentStudy": "taos.flight.ascent_sim",
     "load_campaign": "taos.montecarlo", "run_campaign": "taos.montecarlo",

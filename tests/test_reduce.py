@@ -2,8 +2,13 @@
 low-frequency engine response, written as a model file that ``taos lco`` takes unchanged.
 
 Acceptance: the reduced model's engine dwells within 0.5 dB / 5 deg of the 3-D model's over
-0.1-2 Hz x 0.02-0.5 deg (here a 3 x 3 grid on both axes, away from the fit grid's points where
-it can be; the full 9 x 9 figure is in docs/guide/reduce.md)."""
+0.1-2 Hz x 0.02-0.5 deg, for every shipped 3-D model (hot fire, modified LuGre; flight bounding,
+plain LuGre, whose least-squares reduction was outside it between grid points until the
+worst-point refinement). Here the reduction's own check grid is 3 x 3 (both axes) and the
+acceptance is tested on ANOTHER 3 x 3 grid the reduction never saw, away from the fit and check
+points where it can be (the edges 2 Hz and 0.5 deg kept); the full 9 x 9 figures are in
+docs/guide/reduce.md and benchmarks/RESULTS.md. A reduction outside the tolerance is refused
+(exit 4, one line naming the worst point, nothing written) unless --allow-outside."""
 
 from __future__ import annotations
 
@@ -18,6 +23,11 @@ from tests.inprocess import taos_main
 HOTFIRE = MODELS / "rs25_hotfire.toml"
 RECORD = MODELS / "data" / "greenrun_hotfire_synthetic.csv"
 FLIGHT = MODELS / "flight" / "core_stage.toml"
+FLIGHT_MODEL = MODELS / "rs25_flight.toml"
+#: the reduction's check grid here (the default is the 9 x 9 acceptance grid)
+CHECK = ("--check-freq-hz", "0.15,0.7,2", "--check-amplitudes-deg", "0.03,0.15,0.5")
+#: the acceptance grid of the test, apart from the fit and check grids
+ACCEPT_F, ACCEPT_A = [0.12, 0.35, 1.4], [0.02, 0.07, 0.3]
 
 
 @pytest.fixture(scope="module")
@@ -25,7 +35,7 @@ def reduced(tmp_path_factory):
     """``taos reduce`` of the shipped hot-fire 3-D model (default grid), in this process."""
     d = tmp_path_factory.mktemp("reduce")
     out, js = d / "planar.toml", d / "reduce.json"
-    rc = taos_main("reduce", HOTFIRE, "--out", out, "--records", RECORD, "--json", js)
+    rc = taos_main("reduce", HOTFIRE, "--out", out, "--records", RECORD, "--json", js, *CHECK)
     assert rc == 0
     return out, json.loads(js.read_text())
 
@@ -39,12 +49,69 @@ def test_reduced_model_meets_the_acceptance_tolerance(reduced):
     assert d["match"]["max_phase_error_deg"] <= TOLERANCE_DEG
     # the reduction is worth having: the unreduced planar model is outside the tolerance
     assert d["match_before"]["max_phase_error_deg"] > TOLERANCE_DEG
-    m = match_table(HOTFIRE, load_model(out), [0.15, 0.7, 2.0], [0.02, 0.07, 0.5], ("pitch", "yaw"))
+    c = d["check"]   # its own check grid, both axes
+    assert c["max_gain_error_db"] <= TOLERANCE_DB and c["max_phase_error_deg"] <= TOLERANCE_DEG
+    assert {p["axis"] for p in c["points"]} == {"pitch", "yaw"} and len(c["points"]) == 18
+    r = d["refine"]   # the worst-point refinement does not make the worst point worse
+    assert r["worst"] <= r["least_squares_worst"] + 1e-9 and r["nfev"] > 0
+    m = match_table(HOTFIRE, load_model(out), ACCEPT_F, ACCEPT_A, ("pitch", "yaw"))
     assert m.max_gain_error_db <= TOLERANCE_DB, m.to_dict()
     assert m.max_phase_error_deg <= TOLERANCE_DEG, m.to_dict()
     g = d["greenrun"]["engine"]   # the Green Run dwell match it keeps (0.4 deg up to 7 Hz)
     assert g["max_gain_error_db"] <= 1.0 and g["max_phase_error_deg"] <= 5.0
     assert max(p["freq_hz"] for p in g["points"]) == 7.0 and g["points"][0]["amplitude_deg"] == 0.4
+
+
+@pytest.mark.slow
+def test_flight_model_plain_lugre_is_within_tolerance_after_the_worst_point_refinement():
+    """rs25_flight (plain LuGre): least squares alone left 0.54-0.57 dB between grid points."""
+    from taos.identify.reduce import (
+        TOLERANCE_DB,
+        TOLERANCE_DEG,
+        match_table,
+        reduce_to_planar,
+    )
+    from taos.taos3d import load_taos_model
+
+    tm = load_taos_model(FLIGHT_MODEL)
+    red = reduce_to_planar(tm, axes=("pitch",), check_freq_hz=[0.15, 0.7, 2.0], check_amplitudes_deg=[0.03, 0.15, 0.5])
+    assert red.within_tolerance, red.summary_lines()
+    assert red.refine["worst"] <= red.refine["least_squares_worst"] + 1e-9
+    m = match_table(tm, red.model, ACCEPT_F, ACCEPT_A, ("pitch", "yaw"))
+    assert m.max_gain_error_db <= TOLERANCE_DB and m.max_phase_error_deg <= TOLERANCE_DEG, m.to_dict()
+
+
+def test_minimax_reaches_the_worst_point_optimum_least_squares_misses():
+    """min_x max_i |r_i| of a line through four points (one off the line): least squares leaves
+    a worst error of 0.4, the minimax (Chebyshev) line 1/3, equal errors of alternating sign at
+    t = 0, 2, 3."""
+    import numpy as np
+    import scipy.optimize as so
+
+    from taos.identify.minimax import minimax
+
+    t, y = np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 0.0, 0.0, 1.0])
+    fun = lambda x: x[0] + x[1] * t - y
+    ls = so.least_squares(fun, [0.0, 0.0])
+    mm = minimax(fun, ls.x, [-5.0, -5.0], [5.0, 5.0], step=1e-6, min_delta=1e-9, ftol=1e-9, max_nfev=60)
+    assert np.max(np.abs(ls.fun)) == pytest.approx(0.4, rel=1e-6)
+    assert mm.max_abs == pytest.approx(1.0 / 3.0, rel=1e-6)
+    assert mm.x == pytest.approx([-1.0 / 3.0, 1.0 / 3.0], abs=1e-6)   # y = (t - 1) / 3
+
+
+def test_reduction_outside_tolerance_is_refused_exit_4_unless_allowed(tmp_path):
+    """Only the friction level free, one fit dwell: the check grid sees it outside -> exit 4,
+    one line naming the worst point, nothing written; --allow-outside writes it, with a WARNING."""
+    out = tmp_path / "p.toml"
+    args = (FLIGHT_MODEL, "--out", out, "--free", "coulomb_torque", "--freq-hz", "0.5", "--amplitudes-deg", "0.1",
+            "--check-freq-hz", "2", "--check-amplitudes-deg", "0.02")
+    r = run_cli("reduce", *args)
+    assert r.returncode == 4, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and "NOT within" in r.stderr and " Hz: " in r.stderr, r.stderr
+    assert not out.exists()
+    r = run_cli("reduce", *args, "--allow-outside")
+    assert r.returncode == 0, r.stderr
+    assert "WARNING" in r.stderr and out.is_file() and "NOT within" in out.read_text()
 
 
 def test_written_file_is_a_planar_model_naming_its_3d_source(reduced):
