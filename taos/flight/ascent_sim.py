@@ -523,6 +523,8 @@ class AscentStudy:
     start_s: float
     end_s: float
     avionics: str
+    #: the flown TVC of each run (for the duty cycle; empty: no duty cycle in the summary)
+    models: tuple = ()
 
     @property
     def zoom_s(self) -> float:
@@ -532,12 +534,15 @@ class AscentStudy:
     def summary(self) -> dict:
         """The ``summary.json`` of ``taos ascent`` (JSON-ready): the ascent file and hash, the
         avionics setting, the axes, and per run its law, its file name (:func:`run_file`), its
-        windows (:meth:`WindowResult.to_dict`) and provenance."""
+        windows (:meth:`WindowResult.to_dict`), its hydraulic duty cycle over the whole run
+        (:func:`taos.flight.duty.duty_summary`) and provenance."""
+        from taos.flight.duty import duty_summary
+        duty = [duty_summary(h, m) for h, m in zip(self.runs, self.models)] or [None] * len(self.runs)
         return {"ascent_file": self.ascent.source, "ascent_sha256": self.ascent.sha256, "avionics": self.avionics,
                 "axes": list(self.axes),
                 "runs": [{"friction_model": h.friction_model, "file": run_file(h.friction_model),
-                          "windows": [w.to_dict() for w in wins], "provenance": h.provenance}
-                         for h, wins in zip(self.runs, self.windows)]}
+                          "windows": [w.to_dict() for w in wins], "duty": d, "provenance": h.provenance}
+                         for h, wins, d in zip(self.runs, self.windows, duty)]}
 
     to_dict = summary
 
@@ -567,4 +572,5 @@ def fly_ascent(ascent: Ascent, models: Sequence[TvcModel], *, reference: TvcMode
         h = ref if m.friction.name == "none" else simulate_ascent(ascent, m, **fly)
         runs.append(h)
         windows.append(tuple(analyse_ascent(h, ref)))
-    return AscentStudy(ascent, tuple(runs), tuple(windows), ref, axes, float(start_s), end, avionics)
+    return AscentStudy(ascent, tuple(runs), tuple(windows), ref, axes, float(start_s), end, avionics,
+                       tuple(models))
