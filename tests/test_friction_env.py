@@ -100,3 +100,23 @@ def test_vibration_level_mappings():
                 {"psd_g2_per_hz": 0.01, "band_hz": (20, 10), "arm_m": 3.0}, {"rate_rms_rad_s": 1, "rate_amplitude_rad_s": 1}):
         with pytest.raises(InputError):
             vibration_velocity(**bad)
+
+
+def test_three_explanations_study_on_the_shipped_models():
+    """The study (taos.flight.friction_study): each explanation is the flight model with one
+    difference; less dither, less vibration and more thrust each lower the low-frequency engine
+    gain (more effective friction), and dither on the stand keeps the flight loop out of the LCO
+    that its absence gives."""
+    import taos
+    from taos.flight.friction_study import friction_explanations
+
+    res = friction_explanations(taos.load_flight("core_stage"), load_model("rs25_flight"))
+    by = {e.name: e for e in res.explanations}
+    assert set(by) == {"cross-axis dither", "vibration environment", "thrust"}
+    for e in res.explanations:
+        assert e.gain_change_db < 0, e.name
+    d = by["cross-axis dither"]
+    assert d.lco == (False, True) and d.margin_db[0] > 0 and d.margin_change_db is None
+    v = by["vibration environment"]
+    assert v.margin_change_db is not None and v.margin_change_db < 0
+    assert res.to_dict()["explanations"][2]["lco_engine_amplitude_deg"][1] > 0
