@@ -180,6 +180,8 @@ MODEL_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "actuator.pressure_feedback_time_constant": (0.0, 100.0, "s", "washout of 0.01-1 s"),
     "actuator.max_rate": (1e-4, 10.0, "m/s", "TVC piston rates are 0.1-0.5 m/s"),
     "actuator.relief_flow_coefficient": (0.0, 1e-4, "m**3/s/Pa", "a relief valve passes at most the pump flow"),
+    "actuator.rated_flow": (1e-7, 0.1, "m**3/s", "servovalves 0.1-1000 gal/min; 0: no limit"),
+    "actuator.pump_capacity": (1e-7, 0.1, "m**3/s", "TVC hydraulic pumps 10-200 gal/min; 0: no limit"),
     "structure.load_stiffness": (1e4, 1e11, "N/m", "57 lbf/in to 5.7e8 lbf/in; RS-25 load path "
                                  "1.15e5-2.05e5 lbf/in"),
     "structure.load_stiffness_yaw": (1e4, 1e11, "N/m", "as structure.load_stiffness (the yaw axis' own)"),
@@ -272,7 +274,7 @@ def check_model_bounds(src: str, engine, actuator, structure, avionics, friction
             attr = next((a for a in vars(obj) if a == key or a.startswith(key + "_")), None)
             value = getattr(obj, attr) if attr is not None else None
             optional_zero = key in ("gimbal_range", "hard_stop_stiffness", "max_rate", "relief_flow_coefficient",
-                                    "load_stiffness_yaw")
+                                    "load_stiffness_yaw", "rated_flow", "pump_capacity")
             if value is None or (optional_zero and value == 0.0):
                 continue
             check_bound(float(value), field, src)

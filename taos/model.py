@@ -1,23 +1,21 @@
 """Model files: TOML parameter sets with units, loaded into frozen SI dataclasses.
 
-A model file (``models/rs25_ambient.toml`` and friends) holds the sections below; every
-physical value is a string with its unit, parsed by pint (:mod:`taos.units`). The DESIGN
-contract keys (model files written for one release load in the next) are ``[engine] mass,
-inertia_pitch, inertia_yaw, rotational_stiffness``, ``[actuator] moment_arm``, ``[structure]
-load_stiffness``, ``[friction] model, coulomb_torque``, ``[avionics] quantization_bits,
-command_range, rounding``; every key a file may hold, with its unit kind, is in one table,
-:mod:`taos.model_keys` (the docs' key reference is generated from the loader and it).
-A variant of a model, any key with another value, goes through this loader too
+A model file (``models/rs25_ambient.toml`` and friends) holds the sections below; every physical value
+is a string with its unit, parsed by pint (:mod:`taos.units`). The DESIGN contract keys (model files
+written for one release load in the next) are ``[engine] mass, inertia_pitch, inertia_yaw,
+rotational_stiffness``, ``[actuator] moment_arm``, ``[structure] load_stiffness``, ``[friction] model,
+coulomb_torque``, ``[avionics] quantization_bits, command_range, rounding``; every key a file may hold,
+with its unit kind, is in one table, :mod:`taos.model_keys` (the docs' key reference is generated from
+the loader and it). A variant of a model, any key with another value, goes through this loader too
 (:meth:`TvcModel.with_values`, :mod:`taos.variants`).
 
-Shared hardware: ``[actuator] parameter_set`` and ``[friction] parameter_set`` name one TOML
-file per piece of hardware (``models/actuators/tvc_actuator.toml``,
-``models/friction/rs25_gimbal.toml``) whose table is merged into the section; a key given in
-both places is an error (:func:`actuator_table_with_parameter_set`,
-:func:`friction_table_with_parameter_set`).
+Shared hardware: ``[actuator] parameter_set`` and ``[friction] parameter_set`` name one TOML file per
+piece of hardware (``models/actuators/tvc_actuator.toml``, ``models/friction/rs25_gimbal.toml``) whose
+table is merged into the section; a key given in both places is an error
+(:func:`actuator_table_with_parameter_set`, :func:`friction_table_with_parameter_set`).
 
-Other sections (``[gimbal]``, ``[geometry]``) belong to the 3-D model and are kept as raw
-tables in :attr:`TvcModel.extra` for it to validate.
+Other sections (``[gimbal]``, ``[geometry]``) belong to the 3-D model and are kept as raw tables in
+:attr:`TvcModel.extra` for it to validate.
 """
 
 from __future__ import annotations
@@ -45,11 +43,10 @@ class Engine:
     """Gimballed engine (rigid body about the gimbal point).
 
     mass_kg : gimballed mass [kg]; inertia_pitch/yaw_kgm2 : J_n about the gimbal [kg m^2];
-    rotational_stiffness_Nm_per_rad : K_n, feedlines and gravity [N m/rad];
-    thrust_N : thrust pressing the gimbal bearing [N] (0 when hanging);
-    gimbal_range_rad : hard stops at +-theta_max [rad] (0: none); hard_stop_stiffness_Nm_per_rad :
-    contact stiffness k_s [N m/rad]; hard_stop_damping_ratio : zeta_s of the contact on J_n [-]
-    (:mod:`taos.planar.saturation`).
+    rotational_stiffness_Nm_per_rad : K_n, feedlines and gravity [N m/rad]; thrust_N : thrust pressing
+    the gimbal bearing [N] (0 when hanging); gimbal_range_rad : hard stops at +-theta_max [rad] (0: none);
+    hard_stop_stiffness_Nm_per_rad : contact stiffness k_s [N m/rad]; hard_stop_damping_ratio : zeta_s of
+    the contact on J_n [-] (:mod:`taos.planar.saturation`).
     """
 
     mass_kg: float
@@ -81,18 +78,17 @@ class Actuator:
         continuity:  (V_t / 4 beta) P_L' = A q - (K_c + C_l) P_L - A v_p
         piston:      M_p v_p' = A P_L - F_L - B_p v_p
 
-    q is the valve's no-load flow divided by the piston area [m/s]; K_v = K_q K_fb / A is the
-    position loop gain [1/s]; K_dpf [m/(s Pa)] with time constant tau_dpf [s] is the dynamic
-    pressure feedback that damps the load resonance without softening the static stiffness
-    (a velocity servo with oil compressibility alone gives the load mode negative damping
-    unless K_c > A^2 K_v / K_h). Limits (:mod:`taos.planar.saturation`, nonlinear, time domain only):
+    q is the valve's no-load flow divided by the piston area [m/s]; K_v = K_q K_fb / A is the position
+    loop gain [1/s]; K_dpf [m/(s Pa)] with time constant tau_dpf [s] is the dynamic pressure feedback
+    that damps the load resonance without softening the static stiffness (a velocity servo with oil
+    compressibility alone gives the load mode negative damping unless K_c > A^2 K_v / K_h). Limits (:mod:`taos.planar.saturation`, nonlinear, time domain only):
     ``max_rate_m_per_s`` the valve flow saturation as a no-load piston rate [m/s] (0: none);
-    ``pressure_limited`` the supply-pressure limit, stall force A P_s: the critical-centre
-    valve's square-root pressure-drop law Q = K_q x_v sqrt((P_s - sgn(x_v) P_L) / P_s) (K_q the
-    no-load flow gain, so the null linearisation is the linear model above) with a cross-port
-    relief valve, Q_r = K_r (|P_L| - P_r) sgn(P_L) for |P_L| > P_r:
-    ``relief_pressure_Pa`` P_r [Pa] (>= P_s; 0: no relief) and
-    ``relief_flow_coefficient_m3_per_s_Pa`` K_r [m^3/(s Pa)] (Merritt 1967, ch. 3).
+    ``pressure_limited`` the supply-pressure limit, stall force A P_s: the critical-centre valve's
+    square-root pressure-drop law Q = K_q x_v sqrt((P_s - sgn(x_v) P_L) / P_s) (K_q the no-load flow
+    gain, so the null linearisation is the linear model above) with a cross-port relief valve,
+    Q_r = K_r (|P_L| - P_r) sgn(P_L) for |P_L| > P_r: ``relief_pressure_Pa`` P_r [Pa] (>= P_s; 0: no
+    relief) and ``relief_flow_coefficient_m3_per_s_Pa`` K_r [m^3/(s Pa)] (Merritt 1967, ch. 3).
+    Duty-cycle limits (:mod:`taos.flight.duty`; 0: none): servovalve rated flow, pump capacity [m^3/s].
     """
 
     moment_arm_m: float
@@ -114,6 +110,8 @@ class Actuator:
     pressure_limited: bool = False
     relief_pressure_Pa: float = 0.0
     relief_flow_coefficient_m3_per_s_Pa: float = 0.0
+    rated_flow_m3_per_s: float = 0.0
+    pump_capacity_m3_per_s: float = 0.0
 
     @property
     def oil_column_stiffness_N_per_m(self) -> float:
@@ -311,7 +309,7 @@ def parse_actuator(doc: Mapping, src: str) -> Actuator:
     s = _section(doc, "actuator", src)
     _check_keys(s, set(_ACTUATOR_FIELDS) | {"valve_order", "pressure_limited"}, src, "actuator")
     optional = {"pressure_feedback_gain", "pressure_feedback_time_constant", "max_rate", "relief_pressure",
-                "relief_flow_coefficient"}
+                "relief_flow_coefficient", "rated_flow", "pump_capacity"}
     kw = {_ACTUATOR_SI[k]: _need(s, k, kind, src, "actuator", **{chk: True})
           for k, (kind, chk) in _ACTUATOR_FIELDS.items() if k not in optional or k in s}
     from .bounds import MODEL_BOUNDS, check_bound

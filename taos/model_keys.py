@@ -29,6 +29,8 @@ ACTUATOR_FIELDS = {  # key -> (kind, check)
     "max_rate": ("velocity", "positive"),
     "relief_pressure": ("pressure", "positive"),
     "relief_flow_coefficient": ("flow_pressure", "positive"),
+    "rated_flow": ("flow", "nonnegative"),
+    "pump_capacity": ("flow", "nonnegative"),
 }
 ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "supply_pressure": "supply_pressure_Pa", "oil_bulk_modulus": "oil_bulk_modulus_Pa",
@@ -41,7 +43,8 @@ ACTUATOR_SI = {"moment_arm": "moment_arm_m", "piston_area": "piston_area_m2",
                 "pressure_feedback_gain": "pressure_feedback_gain_m_per_s_Pa",
                 "pressure_feedback_time_constant": "pressure_feedback_time_constant_s",
                 "max_rate": "max_rate_m_per_s", "relief_pressure": "relief_pressure_Pa",
-                "relief_flow_coefficient": "relief_flow_coefficient_m3_per_s_Pa"}
+                "relief_flow_coefficient": "relief_flow_coefficient_m3_per_s_Pa",
+                "rated_flow": "rated_flow_m3_per_s", "pump_capacity": "pump_capacity_m3_per_s"}
 _ENGINE_KINDS = {"mass": "mass", "inertia_pitch": "inertia", "inertia_yaw": "inertia",
                  "rotational_stiffness": "rotational_stiffness", "thrust": "force", "gimbal_range": "angle",
                  "hard_stop_stiffness": "rotational_stiffness", "hard_stop_damping_ratio": "dimensionless"}

@@ -192,6 +192,7 @@ DIMENSIONS: dict[str, tuple[str, str, str]] = {
     "time": ("s", "s", "'0.02 s'"),
     "damping": ("N*s/m", "N*s/m", "'20000 N*s/m'"),
     "rotational_damping": ("N*m*s/rad", "N*m*s/rad", "'1e6 N*m*s/rad'"),
+    "flow": ("m**3/s", "m**3/s", "'20 gal/min'"),
     "flow_pressure": ("m**3/s/Pa", "m**3/s/Pa", "'1e-12 m**3/s/Pa'"),
     "velocity_per_pressure": ("m/s/Pa", "m/s/Pa", "'4e-8 m/s/Pa'"),
     "dimensionless": ("dimensionless", "1", "'0.95'"),

@@ -194,6 +194,10 @@ def test_fly_ascent_is_the_cli_study(tmp_path, ascent):
     assert [h.friction_model for h in study.runs] == ["dahl", "none"] and study.axes == ("yaw",)
     assert study.summary() == json.loads((out / "summary.json").read_text())
     assert {p.name for p in out.iterdir()} >= {f["file"] for f in study.summary()["runs"]}
+    duty = study.summary()["runs"][0]["duty"]   # the hydraulic duty cycle against the model's limits
+    yaw = duty["axes"]["yaw"]
+    assert yaw["flow_limit_m3_s"] == tvc("dahl").actuator.rated_flow_m3_per_s > 0
+    assert 0 < yaw["peak_flow_fraction_of_limit"] and duty["engine"]["mean_flow_fraction_of_pump"] > 0
 
 
 @pytest.mark.parametrize("patch, field", [

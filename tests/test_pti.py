@@ -146,6 +146,7 @@ def test_duty_cycle_flow_integrates_to_piston_travel_times_area(ascent):
     travel = float(np.sum(np.abs(np.diff(x))))
     A = m.actuator.piston_area_m2
     assert A * d.piston_travel_m == pytest.approx(A * travel, rel=0.01)
+    assert d.piston_volume_m3 == pytest.approx(A * travel, rel=0.01)   # the acceptance sentence, verbatim
     act = m.actuator
     P = h.signal("load_pressure_Pa", "yaw")[sel]
     q = h.signal("valve_flow_m_s", "yaw")[sel]
@@ -155,6 +156,27 @@ def test_duty_cycle_flow_integrates_to_piston_travel_times_area(ascent):
     scale = float(np.trapezoid(np.abs(A * q), h.t_s[sel]))
     assert abs(net - expect) < 0.01 * scale
     assert d.reversals > 0 and d.peak_flow_m3_s > d.mean_flow_m3_s > 0 and d.mean_supply_power_W > 0
+    # the limits are the model's ([actuator] rated_flow, pump_capacity), read against
+    assert d.flow_limit_m3_s == act.rated_flow_m3_per_s > 0
+    assert d.to_dict()["peak_flow_fraction_of_limit"] == pytest.approx(d.peak_flow_m3_s / act.rated_flow_m3_per_s)
+    from taos.flight.duty import duty_summary
+    s = duty_summary(h, m, 380.0, 440.0)
+    assert s["engine"]["mean_flow_fraction_of_pump"] == pytest.approx(d.mean_flow_m3_s / act.pump_capacity_m3_per_s)
+    assert s["axes"]["yaw"]["piston_volume_m3"] == d.piston_volume_m3
+
+
+def test_duty_limits_are_model_keys():
+    """[actuator] rated_flow and pump_capacity: optional (0: no limit), with units, bounded."""
+    from taos.model import load_model
+    m = load_model("rs25_flight")
+    a = m.actuator
+    assert a.rated_flow_m3_per_s == pytest.approx(a.piston_area_m2 * a.max_rate_m_per_s)
+    v = m.with_values({"actuator.pump_capacity": "20 gal/min"})
+    assert v.actuator.pump_capacity_m3_per_s == pytest.approx(20 * 3.785411784e-3 / 60)
+    assert m.with_values({"actuator.rated_flow": "0 m**3/s"}).actuator.rated_flow_m3_per_s == 0.0
+    for bad in ("20 psi", "1e-300 m**3/s", "5 m**3/s"):
+        with pytest.raises(InputError):
+            m.with_values({"actuator.rated_flow": bad})
 
 
 def test_reversal_counter():

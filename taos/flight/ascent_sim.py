@@ -14,7 +14,10 @@ The vehicle properties and the scheduled FCS gains are held constant over each u
 (zero-order hold; the file's ``update_interval``, 1 s) and the state is carried from interval to
 interval: the attitude and rate are kept continuous across a change of the tail-wags-dog
 coefficient b (xi = theta - b delta is re-based), the friction state is carried as it is. At
-separation the attitude rate receives the file's ``separation_rate_kick``.
+separation the attitude rate receives the file's ``separation_rate_kick``. With
+``friction_follows_thrust`` the friction level is held likewise: the law's torque-like parameters
+times N(t) / N_model, the trajectory's core thrust per engine over the model's bearing load
+(:func:`taos.flight.friction_env.friction_scale`, T_c = mu N r_b).
 
 An axis is one call of :func:`taos.planar.dynamics.integrate_segments_lanes` through all its
 intervals (each interval's plant as data, the re-basing and the kick as state jumps);
@@ -35,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from taos.flight.ascent import Ascent, aero_instability, control_acceleration, pti_command, wind_speed
+from taos.flight.friction_env import friction_scale
 from taos.flight.lco import FlightHistory, flown_model, measure_oscillation
 from taos.flight.vehicle import FlightModel, PlantParts, flight_plant
 from taos.harmonics import fit_sines
@@ -43,7 +47,7 @@ from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
 from taos.planar import saturation as sat
 from taos.planar.simplex import LurePlant, extend_plant
-from taos.planar.simulate import check_friction_step, kernel_args
+from taos.planar.simulate import kernel_args
 from taos.results import model_provenance
 
 AXES = ("pitch", "yaw")
@@ -201,6 +205,8 @@ class _Lane:
     x0: np.ndarray
     r: np.ndarray
     model: TvcModel
+    #: (n_seg, NPARAM) the friction law packed per segment (its level following the thrust or not)
+    fpack: np.ndarray
 
     @property
     def key(self) -> tuple:
@@ -210,7 +216,7 @@ class _Lane:
 
 
 def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple, rec: int, dt_s: float,
-          start_s: float, attitude0_rad: float, r: np.ndarray) -> _Lane:
+          start_s: float, attitude0_rad: float, r: np.ndarray, follow: bool = False) -> _Lane:
     """Each segment's plant is :func:`ascent_plant` frozen at the segment's middle (the parts
     that do not change, built once); theta = xi + b delta and theta' are kept continuous across a
     change of b by re-basing xi; the separation kick lands on xi' at the separation."""
@@ -224,7 +230,12 @@ def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple
     p0 = plants[0]
     si = p0.ss.state_index
     n, ne = p0.ss.A.shape[0], p0.n_ext
-    check_friction_step(model, p0.inertia_kgm2, dt_s)
+    mids = [t[k0] + 0.5 * (t[k1] - t[k0]) for k0, k1 in zip(bounds[:-1], bounds[1:])]
+    scale = (friction_scale(model, ascent.trajectory.at("core_thrust_per_engine_N", np.array(mids)))
+             if follow else np.ones(len(mids)))
+    laws = [model.friction.scaled(float(f)) if follow else model.friction for f in scale]
+    for law in {id(x): x for x in (laws[int(np.argmax(scale))], model.friction)}.values():
+        law.check_step(p0.inertia_kgm2, dt_s, model.source)   # (check_friction_step on the stiffest level)
     mats = np.zeros((len(plants), n + 3 + 5, n + ne + 5))
     heads = np.zeros((len(plants), sat.N_HEAD))
     iu = n + ne
@@ -250,7 +261,7 @@ def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple
             kick[s_, si("xi_rate_rad_s")] = ascent.boosters.separation_rate_kick_rad_s
     x0 = np.zeros(n)
     x0[si("xi_rad")] = attitude0_rad
-    return _Lane(plants, mats, heads, jcoef, kick, x0, r, model)
+    return _Lane(plants, mats, heads, jcoef, kick, x0, r, model, np.stack([law.pack() for law in laws]))
 
 
 #: recorded outputs of the ascent plant, in the order of SIGNALS[:8] (friction torque from aux)
@@ -286,7 +297,7 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
     status = np.empty(nl, np.int64)
     m0 = lanes[0].model
     _dy.integrate_segments_lanes(ip, ix, mx, heads, m0.friction.entry.rates,
-                                 np.stack([ln.model.friction.pack() for ln in lanes]),
+                                 np.ascontiguousarray(np.stack([ln.fpack for ln in lanes], axis=1)),
                                  np.stack([ln.model.avionics.pack() for ln in lanes]),
                                  np.asarray(bounds, np.int64), jdst, jsrc, jcoef, kick, x0, np.zeros(nl), r, dt_s,
                                  rec, X, aux, status)
@@ -327,7 +338,7 @@ def _lane_bytes(ln: _Lane, n_t: int, rec: int) -> int:
 
 def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, start_s: float = 0.0,
                      end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,
-                     attitude0_rad: float = 0.0) -> list:
+                     attitude0_rad: float = 0.0, friction_follows_thrust: bool = False) -> list:
     """Fly many ascents on one ``axis``: ``runs`` is a list of (ascent, TVC model, seed); returns,
     per run, its :class:`AscentHistory` (as :func:`simulate_ascent` with ``axes=(axis,)``) or the
     exception it ended with (:class:`~taos.errors.SimulationUnstable`,
@@ -344,7 +355,7 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
         try:
             end, rec, t, bounds = _grid(asc, start_s, end_s, dt_s, record_interval_s)
             r = _external_inputs(asc, axis, t, seed, dt_s)
-            ln = _lane(asc, model, axis, t, bounds, rec, dt_s, start_s, attitude0_rad, r)
+            ln = _lane(asc, model, axis, t, bounds, rec, dt_s, start_s, attitude0_rad, r, friction_follows_thrust)
         except (SimulationUnstable, InputError, ValueError, ArithmeticError) as e:
             res[i] = e
             continue
@@ -360,12 +371,13 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
                     res[i] = flown
                     continue
                 asc, model, seed = runs[i]
-                res[i] = _history(asc, model, (axis,), [flown], grids[i], dt_s, seed, start_s, attitude0_rad)
+                res[i] = _history(asc, model, (axis,), [flown], grids[i], dt_s, seed, start_s, attitude0_rad,
+                                  friction_follows_thrust)
     return res
 
 
 def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tuple, dt_s: float, seed: int,
-             start_s: float, attitude0_rad: float) -> AscentHistory:
+             start_s: float, attitude0_rad: float, follow: bool = False) -> AscentHistory:
     end, rec, t, _ = grid
     out = {k: [] for k in SIGNALS}
     for Y, Rr in flown:
@@ -380,7 +392,7 @@ def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tu
             "flight_sha256": ascent.flight.sha256, "package_version": package_version(),
             "solver": {"method": INTEGRATOR, "dt_s": dt_s, "record_every": rec},
             "seed": int(seed), "start_s": start_s, "end_s": end, "attitude0_rad": attitude0_rad,
-            "friction_model": model.friction.name}
+            "friction_model": model.friction.name} | ({"friction_follows_thrust": True} if follow else {})
     return AscentHistory(t_s=t[::rec], axes=tuple(axes), signals={k: np.vstack(v) for k, v in out.items()},
                          separation_time_s=ascent.boosters.separation_time_s,
                          pti_windows={ax: ascent.pti_windows(ax) for ax in axes}, friction_model=model.friction.name,
@@ -389,13 +401,16 @@ def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tu
 
 def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = AXES, start_s: float = 0.0,
                     end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,
-                    seed: int = 0, attitude0_rad: float = 0.0, progress: bool = False) -> AscentHistory:
+                    seed: int = 0, attitude0_rad: float = 0.0, progress: bool = False,
+                    friction_follows_thrust: bool = False) -> AscentHistory:
     """Fly ``ascent`` from ``start_s`` to ``end_s`` [s] (default the trajectory's end) with the
     TVC ``model`` on each of ``axes``.
 
     ``dt_s`` RK4 step [s]; ``record_interval_s`` output spacing [s] (a whole number of steps);
     ``seed`` draws the turbulence (axis k uses the stream SeedSequence([seed, k])), so a run is a
-    pure function of its inputs; ``attitude0_rad`` initial attitude error [rad]. Each axis is
+    pure function of its inputs; ``attitude0_rad`` initial attitude error [rad];
+    ``friction_follows_thrust``: the friction level follows the trajectory's thrust (module
+    docstring; recorded in the provenance). Each axis is
     one call of the compiled kernel through all the segments (:func:`simulate_ascents`' kernel,
     one lane). Raises :class:`~taos.errors.SimulationUnstable` on a non-finite state."""
     grid = _grid(ascent, start_s, end_s, dt_s, record_interval_s)
@@ -405,7 +420,7 @@ def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = 
         from tqdm import tqdm
         it = tqdm(it, desc="ascent", unit="axis")
     lanes = [_lane(ascent, model, ax, t, bounds, rec, dt_s, start_s, attitude0_rad,
-                   _external_inputs(ascent, ax, t, seed, dt_s)) for ax in it]
+                   _external_inputs(ascent, ax, t, seed, dt_s), friction_follows_thrust) for ax in it]
     if len({ln.key for ln in lanes}) == 1:  # the axes side by side in one kernel call
         flown = _fly_lanes(lanes, t, bounds, rec, dt_s)
     else:
@@ -413,7 +428,8 @@ def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = 
     for f in flown:
         if isinstance(f, Exception):
             raise f
-    return _history(ascent, model, tuple(axes), flown, grid, dt_s, seed, start_s, attitude0_rad)
+    return _history(ascent, model, tuple(axes), flown, grid, dt_s, seed, start_s, attitude0_rad,
+                    friction_follows_thrust)
 
 
 # -- windows --------------------------------------------------------------------------------
@@ -523,6 +539,8 @@ class AscentStudy:
     start_s: float
     end_s: float
     avionics: str
+    #: the flown TVC of each run (for the duty cycle; empty: no duty cycle in the summary)
+    models: tuple = ()
 
     @property
     def zoom_s(self) -> float:
@@ -532,33 +550,39 @@ class AscentStudy:
     def summary(self) -> dict:
         """The ``summary.json`` of ``taos ascent`` (JSON-ready): the ascent file and hash, the
         avionics setting, the axes, and per run its law, its file name (:func:`run_file`), its
-        windows (:meth:`WindowResult.to_dict`) and provenance."""
+        windows (:meth:`WindowResult.to_dict`), its hydraulic duty cycle over the whole run
+        (:func:`taos.flight.duty.duty_summary`) and provenance."""
+        from taos.flight.duty import duty_summary
+        duty = [duty_summary(h, m) for h, m in zip(self.runs, self.models)] or [None] * len(self.runs)
         return {"ascent_file": self.ascent.source, "ascent_sha256": self.ascent.sha256, "avionics": self.avionics,
                 "axes": list(self.axes),
                 "runs": [{"friction_model": h.friction_model, "file": run_file(h.friction_model),
-                          "windows": [w.to_dict() for w in wins], "provenance": h.provenance}
-                         for h, wins in zip(self.runs, self.windows)]}
+                          "windows": [w.to_dict() for w in wins], "duty": d, "provenance": h.provenance}
+                         for h, wins, d in zip(self.runs, self.windows, duty)]}
 
     to_dict = summary
 
 
 def fly_ascent(ascent: Ascent, models: Sequence[TvcModel], *, reference: TvcModel, avionics: str = "bounding",
                axes: tuple[str, ...] = ("yaw",), start_s: float = 0.0, end_s: float | None = None,
-               dt_s: float = DEFAULT_DT_S, seed: int = 0, progress: bool = False) -> AscentStudy:
+               dt_s: float = DEFAULT_DT_S, seed: int = 0, progress: bool = False,
+               friction_follows_thrust: bool = False) -> AscentStudy:
     """Fly ``ascent`` from ``start_s`` to ``end_s`` [s] (default the trajectory's end) on ``axes``
     with each TVC of ``models`` (typically one per friction law) and with ``reference``, the same
     TVC without friction (law ``none``; a model of law ``none`` in ``models`` is that run), and
     analyse each run's post-separation windows against the reference (:func:`analyse_ascent`).
 
     ``avionics``: ``"bounding"`` flies every model with the paper's bounding avionics gain,
-    ``"model"`` with the models' own avionics (:func:`taos.flight.lco.flown_model`). ``dt_s``, ``seed``: as :func:`simulate_ascent` (the same seed for every run, so the
+    ``"model"`` with the models' own avionics (:func:`taos.flight.lco.flown_model`). ``dt_s``, ``seed``,
+    ``friction_follows_thrust``: as :func:`simulate_ascent` (the same seed for every run, so the
     runs differ by their TVC only). ``progress``: a bar over the models. Raises
     :class:`~taos.errors.SimulationUnstable` when a run diverges."""
     models = [flown_model(m, avionics) for m in models]   # (ValueError for an unknown setting)
     reference = flown_model(reference, avionics)
     axes = tuple(axes)
     end = ascent.end_time_s if end_s is None else float(end_s)
-    fly = {"axes": axes, "start_s": start_s, "end_s": end, "dt_s": dt_s, "seed": seed}
+    fly = {"axes": axes, "start_s": start_s, "end_s": end, "dt_s": dt_s, "seed": seed,
+           "friction_follows_thrust": friction_follows_thrust}
     ref = simulate_ascent(ascent, reference, **fly)
     from tqdm import tqdm
 
@@ -567,4 +591,5 @@ def fly_ascent(ascent: Ascent, models: Sequence[TvcModel], *, reference: TvcMode
         h = ref if m.friction.name == "none" else simulate_ascent(ascent, m, **fly)
         runs.append(h)
         windows.append(tuple(analyse_ascent(h, ref)))
-    return AscentStudy(ascent, tuple(runs), tuple(windows), ref, axes, float(start_s), end, avionics)
+    return AscentStudy(ascent, tuple(runs), tuple(windows), ref, axes, float(start_s), end, avionics,
+                       tuple(models))

@@ -400,9 +400,10 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
         the limit rows and columns of :mod:`taos.planar.saturation`).
     head : (n_seg, R, N_HEAD) float64
         The packed limits' head (slots ``LIM_*``; zeros: no limits).
-    fid : friction law kernel; fp : (R, NPARAM) float64; avp : (R, .) float64
-        The law's ``rates`` kernel (module docstring), each lane's packed friction parameters and
-        packed avionics.
+    fid : friction law kernel; fp : (n_seg, R, NPARAM) float64; avp : (R, .) float64
+        The law's ``rates`` kernel (module docstring), each segment's and lane's packed friction
+        parameters (a level following the thrust: :mod:`taos.flight.friction_env`) and packed
+        avionics.
     bounds : (n_seg + 1,) int64
         Segment s covers steps bounds[s] .. bounds[s + 1]; bounds[0] = 0, bounds[-1] = n_steps.
     jdst, jsrc : (m_j,) int64; jcoef : (n_seg, m_j, R) float64; kick : (n_seg, n, R) [x]
@@ -454,6 +455,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
     seg = 0
     M = mx[0]
     L = H[0]
+    F = fp[0]
     h2 = 0.5 * dt
     for k in range(nsteps + 1):
         if seg < nseg and k == bounds[seg]:
@@ -465,6 +467,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
                     X[i, q] += kick[seg, i, q]
             M = mx[seg]
             L = H[seg]
+            F = fp[seg]
             seg += 1
         k1n = min(k + 1, nsteps)
         for j in range(nr):
@@ -479,7 +482,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
             for q in range(nl):
                 V[i, q] = X[i, q]
         # the derivative at the step start (K1), with T_f and u there for the record
-        _rates_lanes(Z, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D1, K1)
+        _rates_lanes(Z, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D1, K1)
         if k % rec_every == 0:
             for i in range(n):
                 for q in range(nl):
@@ -499,13 +502,13 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
                 V[i, q] = X[i, q] + h2 * K1[i, q]
         for q in range(nl):
             ZT[q] = Z[q] + h2 * D1[q]
-        _rates_lanes(ZT, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D2, K2)
+        _rates_lanes(ZT, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D2, K2)
         for i in range(n):
             for q in range(nl):
                 V[i, q] = X[i, q] + h2 * K2[i, q]
         for q in range(nl):
             ZT[q] = Z[q] + h2 * D2[q]
-        _rates_lanes(ZT, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D3, K3)
+        _rates_lanes(ZT, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D3, K3)
         for j in range(nr):
             for q in range(nl):
                 V[n + j, q] = R1[j, q]
@@ -514,7 +517,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
                 V[i, q] = X[i, q] + dt * K3[i, q]
         for q in range(nl):
             ZT[q] = Z[q] + dt * D3[q]
-        _rates_lanes(ZT, ip, ix, M, L, fid, fp, AVP, V, C, S, U, TF, D4, K4)
+        _rates_lanes(ZT, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D4, K4)
         for i in range(n):
             for q in range(nl):
                 X[i, q] += dt * (K1[i, q] + 2.0 * K2[i, q] + 2.0 * K3[i, q] + K4[i, q]) / 6.0

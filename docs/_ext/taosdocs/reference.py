@@ -41,6 +41,8 @@ MEANINGS: dict[str, str] = {
     "actuator.pressure_limited": "whether the load pressure is limited to the supply pressure (stall force): the valve's square-root law and the relief valve",
     "actuator.relief_pressure": "cracking pressure P_r of the cross-port relief valve (P_s to 1.5 P_s)",
     "actuator.relief_flow_coefficient": "flow coefficient K_r of the relief valve: Q_r = K_r (abs(P_L) - P_r)",
+    "actuator.rated_flow": "servovalve rated flow Q_r: the duty cycle's limit on one actuator's peak valve flow (optional; 0: none; not simulated)",
+    "actuator.pump_capacity": "hydraulic pump capacity Q_pump of one engine (both actuators): the duty cycle's limit on their mean flow (optional; 0: none)",
     "engine.gimbal_range": "gimbal range: the hard stops, modelled as a stiff damped contact",
     "engine.hard_stop_stiffness": "rotational stiffness of the hard-stop contact",
     "engine.hard_stop_damping_ratio": "damping ratio of the hard-stop contact",

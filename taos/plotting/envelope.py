@@ -1,0 +1,41 @@
+"""A flight record against its Monte Carlo envelope (:mod:`taos.montecarlo.envelope`): the
+percentile bands of the stored command over time, the median, the record overlaid and the samples
+outside marked, the fraction of time outside in the title. Drawing only."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from taos.plotting import _common  # noqa: F401  (sets the headless backend)
+
+
+def plot_envelope(env, comparison=None):
+    """The envelope ``env`` (:class:`taos.montecarlo.envelope.Envelope`) in degrees: the outer band
+    shaded, inner pairs of percentiles shaded darker, the middle percentile as a line; with a
+    ``comparison`` (:class:`taos.montecarlo.envelope.EnvelopeComparison`) the record and its
+    samples outside. Returns the figure."""
+    fig, ax = plt.subplots(figsize=(11, 4.5))
+    b = np.degrees(env.bands_rad)
+    k = len(env.percentiles)
+    for i in range(k // 2):
+        lo, hi = env.percentiles[i], env.percentiles[k - 1 - i]
+        ax.fill_between(env.t_s, b[i], b[k - 1 - i], color="tab:blue", alpha=0.15 + 0.15 * i, lw=0,
+                        label=f"{lo:g}-{hi:g} % of {env.runs_ok} runs")
+    if k % 2:
+        ax.plot(env.t_s, b[k // 2], color="tab:blue", lw=1.0, label=f"{env.percentiles[k // 2]:g} %")
+    title = f"{env.quantity} envelope" + (f", {env.axis} axis" if env.axis else "")
+    if comparison is not None:
+        c = comparison
+        v = np.degrees(c.value_rad)
+        out = (c.value_rad > c.hi_rad) | (c.value_rad < c.lo_rad)
+        ax.plot(c.t_s, v, "k-", lw=1.0, label=f"record {c.source}")
+        ax.plot(c.t_s[out], v[out], "r.", ms=4, label="outside")
+        title += f": record outside {100 * c.fraction_outside:.1f} % of the time"
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(f"{env.quantity} [deg]")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    return fig
