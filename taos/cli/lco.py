@@ -78,6 +78,9 @@ def cmd_lco(args) -> int:
     td = d["time_domain"] or {}
     v = d["verdict"]
     print(v["text"], file=out)
+    for w in d["grid_warnings"]:
+        print(f"warning: a cycle may lie outside the describing-function map (after extending it): {w}",
+              file=sys.stderr)
     if v["nearest_margin"]:
         print(f"margin meant: {v['margin_meaning']}", file=out)
     if td:
@@ -154,6 +157,8 @@ def _sweep(args, flight, model, amps, freqs) -> int:
         pred = (f"LCO engine {m.engine_amplitude_deg[idx]:.4f} deg at {m.frequency_hz[idx]:.3f} Hz"
                 if (m.prediction_lco[idx] if m.prediction_lco is not None else m.lco[idx])
                 else f"no LCO, margin {m.margin_db[idx]:.2f} dB")
+        if m.grid_may_miss_cycle is not None and m.grid_may_miss_cycle[idx]:
+            pred += " (WARNING: a cycle may lie outside the describing-function map)"
         if td is None:
             print(f"{where}: {pred}", file=out)
             continue
