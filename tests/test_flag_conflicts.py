@@ -43,3 +43,14 @@ def test_refused_before_any_work(name, tmp_path):
     assert len(lines) == 1 and opt in lines[0], p.stderr
     assert list(tmp_path.iterdir()) == []                       # nothing written
     assert all(q.read_bytes() == b for q, b in shipped.items())   # no input replaced
+
+
+def test_a_flight_file_whose_tvc_model_is_itself_is_refused(tmp_path):
+    from taos.errors import InputError
+    from taos.flight.vehicle import load_flight
+    text = (ROOT / "models/flight/core_stage.toml").read_text()
+    f = tmp_path / "self.toml"
+    f.write_text("\n".join('tvc_model = "self.toml"' if ln.startswith("tvc_model") else ln
+                           for ln in text.splitlines()) + "\n")
+    with pytest.raises(InputError, match="tvc_model"):
+        load_flight(f)
