@@ -28,9 +28,13 @@ print(v.table_text())
 # Sensitivity: the verdict over the load stiffness (prediction only).
 ks = [to_si(f"{k} lbf/in", "stiffness", source="example", field="K_L") for k in (80000, 115000, 205000)]
 m = lco_map(flight, model, [SweepAxis("load_stiffness", tuple(ks))], **grid)
-for k, lco, a, mg in zip(ks, m.lco, m.engine_amplitude_deg, m.margin_db):
+# Where the loop is still unstable at the grid's largest amplitude the cycle lies above it: the
+# analysis extends the amplitudes (a few rows, :func:`taos.flight.lco.extend_to_cover`) and flags a
+# point it still cannot settle (``grid_may_miss_cycle``) instead of stating a margin there.
+for k, lco, a, mg, miss in zip(ks, m.lco, m.engine_amplitude_deg, m.margin_db, m.grid_may_miss_cycle):
     print(f"K_L = {from_si(k, 'N/m', 'lbf/in'):7.0f} lbf/in: "
-          + (f"LCO, engine {a:.3f} deg" if lco else f"no LCO, margin {mg:.2f} dB"))
+          + (f"LCO, engine {a:.3f} deg" if lco else f"no LCO, margin {mg:.2f} dB")
+          + (" (WARNING: a cycle may lie outside the map)" if miss else ""))
 for flip in m.flips():
     lo, hi = (from_si(x, "N/m", "lbf/in") for x in flip["between"])
     print(f"the verdict flips between {lo:.0f} and {hi:.0f} lbf/in")

@@ -521,17 +521,7 @@ _OUTPUT_FILE_OPTIONS = {"json": (), "html": (".html", ".htm"), "df_out": (), "ou
                         "plot_map": (".png", ".svg")}
 
 
-def _input_paths(args) -> list[str]:
-    """Every argument value (positional or option, lists included) other than an output option
-    that names an existing path: the run's inputs as the user gave them."""
-    out = []
-    for k, v in vars(args).items():
-        if k in OUTPUT_OPTIONS or k == "func":
-            continue
-        for x in (v if isinstance(v, (list, tuple)) else [v]):
-            if isinstance(x, str) and x and len(x) < 4096 and "\0" not in x and os.path.exists(x):
-                out.append(x)
-    return out
+from taos.argpaths import input_paths as _input_paths, same_place as _same_place  # noqa: E402
 
 
 def check_arguments(args) -> None:
@@ -541,7 +531,8 @@ def check_arguments(args) -> None:
     seed = getattr(args, "seed", None)
     if isinstance(seed, int) and not 0 <= seed < 2 ** 32:
         raise InputError("command line", "--seed", "a whole number from 0 to 4294967295", got=str(seed))
-    inputs = _input_paths(args)
+    inputs = _input_paths(args, OUTPUT_OPTIONS)
+    named = []   # (option, value) of every output named so far: no two outputs are one file
     for k in OUTPUT_OPTIONS:
         v = getattr(args, k, None)
         if v is None or v == "-":
@@ -550,5 +541,9 @@ def check_arguments(args) -> None:
         if not isinstance(v, str) or not v.strip():
             raise InputError("command line", opt, "a file or folder name", got=repr(v))
         check_not_input(v, opt, inputs)
+        for o, w in named:
+            if _same_place(v, w):
+                raise InputError("command line", opt, f"a place of its own (not the {o} output's)", got=repr(v))
+        named.append((opt, v))
         if k in _OUTPUT_FILE_OPTIONS:
             check_output_file(v, opt, _OUTPUT_FILE_OPTIONS[k])

@@ -50,6 +50,19 @@ def test_model_made_log_sweep_is_detected_as_a_sweep_not_a_dwell(sweep_record):
     assert "pitch: sweep -- instantaneous frequency rises" in p.stdout
 
 
+def test_a_sweeps_estimate_points_lie_in_its_excited_band(sweep_record):
+    """Issue 40: the window's leakage put H1 points below a sweep's start (then a fit's bounds)."""
+    from taos.identify.data import load_test_data
+    from taos.identify.estimation import estimate_h1
+    d = load_test_data(sweep_record)
+    f0, f1 = classify_excitation(d.t_s, d.command_rad[0]).freq_range_hz
+    assert estimate_h1(d, nperseg=4096)[0].freq_hz.min() < f0       # the leakage this guards against
+    for r in (estimate(d)[0], estimate(d, "h1")[0], estimate(d, "h1", nperseg=4096)[0]):
+        assert len(r) > 10 and f0 <= r.freq_hz.min() and r.freq_hz.max() <= f1, (r.freq_hz.min(), f0)
+    with pytest.raises(InputError, match="excited band"):
+        estimate_h1(d, band_hz=(3.0, 3.01))
+
+
 def test_green_run_dwells_and_a_multisine_are_named_with_their_evidence():
     from taos.identify.data import load_test_data
     d = load_test_data(HOTFIRE_DATA)

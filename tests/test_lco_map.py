@@ -169,7 +169,7 @@ def test_map_as_a_stored_resumable_campaign(tmp_path, map_json):
     assert ds.sizes["run"] == 2 and list(ds["status"].values) == [1, 1]
     assert ds["td_lco"].values.tolist() == [False, True]
     man = json.loads((out / "map.json").read_text())
-    assert man["format"] == "taos-lco-map-1" and len(man["inputs_sha256"]) == 64
+    assert man["format"] == "taos-lco-map-2" and len(man["inputs_sha256"]) == 64
     assert any(f["file"].endswith("rs25_flight.toml") for f in man["input_files"])
     again = run_cli(*LCO, "--out", out, "--json", tmp_path / "x.json")
     assert again.returncode == 2 and "--resume" in again.stderr and not (tmp_path / "x.json").exists()

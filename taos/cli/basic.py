@@ -87,6 +87,9 @@ def _check_freqresp_flags(args) -> None:
     if args.linear and args.amplitude_deg is not None:
         raise InputError("command line", "--amplitude-deg", "no amplitude with --linear (the linear response "
                          "has none)", got=repr(args.amplitude_deg))
+    if args.linear and args.friction:
+        raise InputError("command line", "--friction", "no friction law with --linear (the linear response has no "
+                         "friction)", got=repr(args.friction))
     if args.steady is not None and args.amplitude_deg is None:
         raise InputError("command line", "--steady", "--amplitude-deg too (--steady chooses how a sine dwell "
                          "settles; the linear response has no dwell)", got=args.steady)

@@ -17,12 +17,29 @@ from taos.results import write_json
 MAX_MAP_POINTS = 400
 
 
+def check_lco_flags(args) -> None:
+    """Flag combinations refused before any work: an empty grid option (it would silently mean
+    the default grid), ``--td-start`` without ``--sweep``, one parameter swept twice."""
+    for opt, v in (("--amplitudes-deg", args.amplitudes_deg), ("--freq-hz", args.freq_hz)):
+        if v is not None and not v.replace(",", "").strip():
+            raise InputError("command line", opt, "a comma-separated list of values (omit it for the default grid)",
+                             got=repr(v))
+    if args.td_start is not None and not args.sweep:
+        raise InputError("command line", "--td-start", "--sweep too (it starts a verdict map's confirmation runs)",
+                         got=args.td_start)
+    names = [s.partition("=")[0].strip() for s in args.sweep or ()]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise InputError("command line", "--sweep", "each parameter swept once", got=f"{dup[0]} twice")
+
+
 def cmd_lco(args) -> int:
     from taos.flight.vehicle import load_flight
     from taos.flight.lco import analyse_lco
     from taos.model import load_model
     from taos.units import to_si
 
+    check_lco_flags(args)
     flight = load_flight(args.flight)
     model = load_model(args.model, friction=args.friction)
     if args.load_stiffness:
@@ -78,6 +95,9 @@ def cmd_lco(args) -> int:
     td = d["time_domain"] or {}
     v = d["verdict"]
     print(v["text"], file=out)
+    for w in d["grid_warnings"]:
+        print(f"warning: a cycle may lie outside the describing-function map (after extending it): {w}",
+              file=sys.stderr)
     if v["nearest_margin"]:
         print(f"margin meant: {v['margin_meaning']}", file=out)
     if td:
@@ -109,7 +129,7 @@ def _sweep(args, flight, model, amps, freqs) -> int:
     if args.axis:
         flight = dataclasses.replace(flight, axis=args.axis)
     settings = MapSettings(None if amps is None else tuple(amps), None if freqs is None else tuple(freqs),
-                           args.avionics, not args.no_time_domain, args.td_start, args.duration,
+                           args.avionics, not args.no_time_domain, args.td_start or "predicted", args.duration,
                            min(120.0, 0.5 * args.duration))
     failed = []
     if args.out:
@@ -154,6 +174,8 @@ def _sweep(args, flight, model, amps, freqs) -> int:
         pred = (f"LCO engine {m.engine_amplitude_deg[idx]:.4f} deg at {m.frequency_hz[idx]:.3f} Hz"
                 if (m.prediction_lco[idx] if m.prediction_lco is not None else m.lco[idx])
                 else f"no LCO, margin {m.margin_db[idx]:.2f} dB")
+        if m.grid_may_miss_cycle is not None and m.grid_may_miss_cycle[idx]:
+            pred += " (WARNING: a cycle may lie outside the describing-function map)"
         if td is None:
             print(f"{where}: {pred}", file=out)
             continue
@@ -192,7 +214,7 @@ def add_parsers(sub) -> None:
                    help="verdict map over one or two parameters (repeat for two), each point confirmed in the time "
                    "domain unless --no-time-domain: bristle_stiffness, coulomb_torque, load_stiffness, integral_gain, "
                    "attitude_gain, rate_gain; values in SI or each with its unit")
-    p.add_argument("--td-start", choices=("predicted", "rest"), default="predicted",
+    p.add_argument("--td-start", choices=("predicted", "rest"), default=None,
                    help="with --sweep: start each confirmation run on the describing function's periodic solution "
                    "(default; a few cycles decide) or from rest as the single analysis does (--duration long)")
     p.add_argument("--out", metavar="DIR", help="with --sweep: run the map as a stored campaign (DIR/map.json, "

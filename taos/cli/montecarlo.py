@@ -131,6 +131,13 @@ def cmd_montecarlo(args) -> int:
                          got=repr(args.scheduler))
     if args.workers is not None and args.workers < 1:
         raise InputError("command line", "--workers", "1 or more workers", got=str(args.workers))
+    if args.resume:   # before any work: a resume with nothing to continue would start afresh silently
+        from pathlib import Path
+
+        from taos.montecarlo.executor import MANIFEST
+        if not (Path(args.out) / MANIFEST).is_file():
+            raise InputError("command line", "--resume", f"a --out folder holding a campaign ({MANIFEST}) to continue",
+                             got=f"none in {args.out}")
     c = load_campaign(args.campaign)
     res = run_campaign(c, args.out, runs=args.runs, case=args.case, friction=args.friction, workers=args.workers,
                        scheduler=args.scheduler, resume=args.resume, progress=not args.no_progress,

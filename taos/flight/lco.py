@@ -23,6 +23,7 @@ the spectral peak frequency.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -88,6 +89,14 @@ class LcoPrediction:
     margins_by_amplitude: tuple[Margins, ...]
     flight: FlightModel = field(repr=False)
     axis: str = "yaw"
+    #: why a cycle may lie outside the map's amplitudes (:func:`grid_edge_warnings`); empty: none
+    grid_warnings: tuple[str, ...] = ()
+
+    @property
+    def grid_may_miss_cycle(self) -> bool:
+        """True when the harmonic-balance condition is still unmet and moving towards a cycle at
+        an edge of the map's amplitudes: a cycle may lie beyond it (:func:`grid_edge_warnings`)."""
+        return bool(self.grid_warnings)
 
     @property
     def stable_cycle(self) -> LimitCycle | None:
@@ -116,7 +125,10 @@ class LcoPrediction:
                 "engine_amplitude_deg": None if c is None else math.degrees(c.engine_amplitude_rad),
                 "frequency_hz": None if c is None else c.freq_hz,
                 "stable": None if c is None else c.stable,
-                "margin_db": self.margin_db if math.isfinite(self.margin_db) else None,
+                # no margin is stated when a cycle may lie outside the map: it would be the map's, not the loop's
+                "margin_db": (self.margin_db if math.isfinite(self.margin_db) and not self.grid_may_miss_cycle
+                              else None),
+                "grid_may_miss_cycle": self.grid_may_miss_cycle, "grid_warnings": list(self.grid_warnings),
                 "cycles": [x.to_dict() for x in self.cycles]}
 
 
@@ -193,8 +205,77 @@ def predict_lco(flight: FlightModel, df: DescribingFunctionMap, axis: str | None
             dist.append(abs(G[i, j] + t * (G[i, j + 1] - G[i, j])))
     margin = 0.0 if cycles else (float(min(dist)) if dist else float("inf"))
     per_amp = tuple(margins(f, L0 * df(a, f)) for a in df.amplitude_rad)
-    return LcoPrediction(df=df, cycles=tuple(cycles), margin_db=margin,
+    pred = LcoPrediction(df=df, cycles=tuple(cycles), margin_db=margin,
                          margins_by_amplitude=per_amp, flight=flight, axis=axis)
+    return dataclasses.replace(pred, grid_warnings=grid_edge_warnings(pred))
+
+
+def grid_edge_warnings(pred: LcoPrediction) -> tuple[str, ...]:
+    """Why a cycle may lie outside the map's command amplitudes (empty: no sign of one).
+
+    * largest amplitude: the loop with the TVC there is still unstable (a negative phase margin
+      or a negative signed low-frequency gain margin, :func:`taos.flight.lco_verdict.grows_beyond_map`):
+      motion grows past the map, so a stable cycle (or divergence) lies above it;
+    * smallest amplitude: the loop there is stable, no cycle is found in the map, and the signed
+      gain distance from harmonic balance shrinks towards the smallest amplitude: extrapolated, it
+      reaches 0 dB below the map, where a cycle may lie."""
+    from taos.flight.lco_verdict import grows_beyond_map, low_frequency_crossing_hz, signed_low_gain_margin
+    out = []
+    top = grows_beyond_map(pred)
+    if top:
+        out.append(top)
+    a = pred.df.amplitude_rad
+    if not pred.cycles and a.size >= 2:
+        f0 = low_frequency_crossing_hz(pred)
+        g0 = signed_low_gain_margin(pred, float(a[0]), f0)[0] if f0 is not None else None
+        g1 = signed_low_gain_margin(pred, float(a[1]), f0)[0] if f0 is not None else None
+        pm0 = pred.margins_by_amplitude[0].phase_margin_deg
+        if g0 is not None and g1 is not None and 0 <= g0 < g1 and (pm0 is None or pm0 >= 0):
+            out.append(f"the loop's low-frequency gain margin falls towards the map's smallest amplitude "
+                       f"{math.degrees(a[0]):.3g} deg ({g1:.3g} dB at {math.degrees(a[1]):.3g} deg, {g0:.3g} dB "
+                       f"there): a cycle may lie below it")
+    return tuple(out)
+
+
+#: automatic extension of a describing-function map whose edges may hide a cycle: rounds per edge
+#: and the factor of each round (the largest amplitude times 2, the smallest divided by 3)
+EXTEND_ROUNDS = 3
+EXTEND_UP, EXTEND_DOWN = 2.0, 3.0
+
+
+def extend_to_cover(flight: FlightModel, flown: TvcModel, df: DescribingFunctionMap, axis: str,
+                    rounds: int = EXTEND_ROUNDS) -> LcoPrediction:
+    """:func:`predict_lco`, with the map's amplitudes extended (at most ``rounds`` rows per edge,
+    the dwells of the map's own settings on the flown model ``flown``) while its edge warnings say
+    a cycle may lie beyond. The prediction returned carries the map as extended and, when the
+    bounded extension did not settle it, its warnings."""
+    pred = predict_lco(flight, df, axis)
+    lsb = flown.avionics.lsb_rad
+    for _ in range(max(int(rounds), 0)):
+        if not pred.grid_warnings:
+            break
+        a = df.amplitude_rad
+        new = []
+        if any("largest" in w for w in pred.grid_warnings):
+            new.append(float(a[-1]) * EXTEND_UP)
+        if any("smallest" in w for w in pred.grid_warnings) and float(a[0]) / EXTEND_DOWN >= 0.5 * lsb:
+            new.append(float(a[0]) / EXTEND_DOWN)
+        if not new:
+            break
+        pv = df.provenance
+        rows = describing_function_map(flown, new, df.freq_hz, axis, settle_cycles=pv.get("settle_cycles", 1),
+                                       measure_cycles=pv.get("measure_cycles", 1),
+                                       settle_s=pv.get("settle_s"), dt_max_s=pv.get("dt_max_s", DEFAULT_DT_S),
+                                       method=pv.get("steady_state", "settle"))
+        amps = np.concatenate([a, rows.amplitude_rad])
+        k = np.argsort(amps)
+        df = dataclasses.replace(df, amplitude_rad=amps[k], engine=np.concatenate([df.engine, rows.engine])[k],
+                                 piston=np.concatenate([df.piston, rows.piston])[k],
+                                 provenance={**df.provenance, "extended_amplitudes_deg":
+                                             [*df.provenance.get("extended_amplitudes_deg", []),
+                                              *np.degrees(new).tolist()]})
+        pred = predict_lco(flight, df, axis)
+    return pred
 
 
 # -- time domain ---------------------------------------------------------------------------
@@ -414,7 +495,7 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
                 duration_s: float = 300.0, window_s: float = 120.0,
                 attitude0_rad: float = 0.2 * DEG, settle_cycles: int = 1, measure_cycles: int = 1,
                 avionics: str = "bounding", time_domain: bool = True, steady: str = "settle",
-                df: DescribingFunctionMap | None = None) -> LcoReport:
+                df: DescribingFunctionMap | None = None, extend: int = EXTEND_ROUNDS) -> LcoReport:
     """Describing-function map, harmonic-balance prediction and (optionally) the time-domain
     run for one flight file and TVC model. Defaults: :data:`DEFAULT_AMPLITUDES_DEG` x
     :data:`DEFAULT_FREQ_HZ`, one settling and one measured cycle beyond the linear settling
@@ -426,7 +507,8 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
     :func:`taos.planar.freqresp.sine_dwell_points`). ``df``: a describing-function map already
     made for this TVC model, avionics and axis (:func:`describing_function_map_for`), reused
     instead of computed: the map depends on the TVC only, so a sweep over the flight loop's gains
-    makes it once."""
+    makes it once. ``extend``: at most this many amplitude rows added per edge of the map while
+    a cycle may lie beyond it (:func:`extend_to_cover`; 0: none, the prediction then only warns)."""
     axis = axis or flight.axis
     model = flown_model(model, avionics)
     if df is None:
@@ -441,7 +523,7 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
         if df.axis != axis or got != want:
             raise InputError("describing-function map", "df", f"a map made for this flown model and settings "
                              f"({axis} axis, {want})", got=f"one for the {df.axis} axis, {got}")
-    pred = predict_lco(flight, df, axis)
+    pred = extend_to_cover(flight, model, df, axis, extend)
     hist = meas = None
     if time_domain:
         hist = simulate_flight(flight, model, duration_s, attitude0_rad=attitude0_rad, axis=axis)

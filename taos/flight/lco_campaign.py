@@ -35,7 +35,7 @@ from taos.flight.lco_map import POINT_FLAGS, POINT_SCALARS, SWEEPABLE, LcoMap, M
 from taos.flight.vehicle import FlightModel
 from taos.model import TvcModel
 
-FORMAT = "taos-lco-map-1"
+FORMAT = "taos-lco-map-2"   # 2: the grid_may_miss_cycle flag, maps extended at their edges
 MANIFEST = "map.json"
 STORE = "map.zarr"
 OUTPUT_NAMES = (MANIFEST, STORE)

@@ -106,7 +106,7 @@ STARTS = ("predicted", "rest")
 #: per-point outputs (:func:`map_points`): floats (NaN where there is none) and yes/no flags
 POINT_SCALARS = ("amplitude_deg", "engine_amplitude_deg", "frequency_hz", "margin_db", "td_amplitude_deg",
                  "td_engine_amplitude_deg", "td_frequency_hz", "td_simulated_s", "td_outcome")
-POINT_FLAGS = ("lco", "prediction_lco", "td_lco")
+POINT_FLAGS = ("lco", "prediction_lco", "td_lco", "grid_may_miss_cycle")
 
 
 @dataclass(frozen=True)
@@ -180,13 +180,15 @@ def map_points(flight: FlightModel, model: TvcModel, names, rows, settings: MapS
         rep = analyse_lco(fl, m, amplitudes_rad=amps, freq_hz=freqs, avionics=settings.avionics,
                           time_domain=False, df=maps[key])
         pred = rep.prediction
+        maps[key] = pred.df   # as extended where a cycle lay beyond it (taos.flight.lco.extend_to_cover)
         c = pred.stable_cycle
         out["prediction_lco"][i] = c is not None
+        out["grid_may_miss_cycle"][i] = pred.grid_may_miss_cycle
         if c is not None:
             out["amplitude_deg"][i], out["engine_amplitude_deg"][i] = (math.degrees(c.amplitude_rad),
                                                                         math.degrees(c.engine_amplitude_rad))
             out["frequency_hz"][i], out["margin_db"][i] = c.freq_hz, 0.0
-        elif math.isfinite(pred.margin_db):
+        elif math.isfinite(pred.margin_db) and not pred.grid_may_miss_cycle:   # no margin of the map's edge
             out["margin_db"][i] = pred.margin_db
         if not settings.time_domain:
             continue
@@ -241,6 +243,9 @@ class LcoMap:
     prediction_lco: np.ndarray | None = None
     td: dict | None = None
     td_start: str | None = None
+    #: per point: a cycle may lie outside the describing-function map even after its bounded
+    #: extension (:func:`taos.flight.lco.extend_to_cover`); the verdict there is the map's, not the loop's
+    grid_may_miss_cycle: np.ndarray | None = None
 
     @classmethod
     def from_points(cls, axes, points: dict, friction_model: str, lgm: dict, settings: MapSettings) -> "LcoMap":
@@ -251,7 +256,8 @@ class LcoMap:
               else None)
         return cls(tuple(axes), g["lco"].astype(bool), g["amplitude_deg"], g["engine_amplitude_deg"],
                    g["frequency_hz"], g["margin_db"], friction_model, lgm, g["prediction_lco"].astype(bool), td,
-                   settings.start if settings.time_domain else None)
+                   settings.start if settings.time_domain else None,
+                   g["grid_may_miss_cycle"].astype(bool) if "grid_may_miss_cycle" in g else None)
 
     def flips(self) -> list[dict]:
         """Neighbouring grid points whose verdicts differ (where the verdict flips)."""
@@ -281,7 +287,9 @@ class LcoMap:
              "prediction_lco": pl.tolist(), "amplitude_deg": grid(self.amplitude_deg),
              "engine_amplitude_deg": grid(self.engine_amplitude_deg), "frequency_hz": grid(self.frequency_hz),
              "margin_db": grid(self.margin_db), "loop_low_gain_margin_db": self.loop_low_gain_margin_db,
-             "flips": self.flips(), "time_domain": None}
+             "flips": self.flips(), "time_domain": None,
+             "grid_may_miss_cycle": (None if self.grid_may_miss_cycle is None
+                                     else self.grid_may_miss_cycle.astype(bool).tolist())}
         if self.td is not None:
             oc = np.array([None if not np.isfinite(x) else OUTCOMES[int(x)] for x in np.ravel(self.td["td_outcome"])],
                           dtype=object).reshape(shape).tolist()

@@ -196,6 +196,9 @@ def lco_verdict(report) -> LcoVerdict:
         if td is not None:
             text += ("; the time-domain run confirms it" if td.lco else
                      "; the time-domain run did NOT settle into it (check the seed and duration)")
+        if pred.grid_warnings:
+            text += "; WARNING: another cycle may lie outside the describing-function map: " + \
+                "; ".join(pred.grid_warnings)
         return LcoVerdict("limit-cycle", text, table, None, tuple(motion))
     near = nearest_margin(pred)
     if pred.cycles:
@@ -214,6 +217,9 @@ def lco_verdict(report) -> LcoVerdict:
         if near is not None:
             text += (f": the loop gain would have to {near.direction} by {near.margin_db:.2f} dB for one to appear "
                      f"(closest at {math.degrees(near.amplitude_rad):.3g} deg command, {near.freq_hz:.3g} Hz)")
+    extra = [w for w in pred.grid_warnings if kind != "grows-beyond-map" or "largest" not in w]
+    if extra:   # a cycle may lie outside the map: the verdict above is the map's, not the loop's
+        text += "; WARNING: a cycle may lie outside the describing-function map: " + "; ".join(extra)
     if td is not None and td.lco:
         text += (f"; BUT the time-domain run oscillates at {math.degrees(td.amplitude_rad):.3g} deg, "
                  f"{td.freq_hz:.3g} Hz")

@@ -37,6 +37,7 @@ use it.
 from __future__ import annotations
 
 import hashlib
+import os
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -239,6 +240,8 @@ def load_flight(path: str | Path) -> FlightModel:
     tvc = doc.get("tvc_model", "")
     if tvc:
         tvc = str(resolve_reference(tvc, p, field="tvc_model", kind="flight", what="a TVC model file"))
+        if os.path.realpath(tvc) == os.path.realpath(p):
+            raise InputError(src, "tvc_model", "a TVC model file, not this flight file itself", got=repr(doc["tvc_model"]))
     return FlightModel(name=str(doc.get("name", p.stem)), vehicle=Vehicle(engine_count=n, **vkw),
                        fcs=FlightControl(pade_order=order, **fkw), axis=axis, tvc_model=tvc,
                        source=src, sha256=hashlib.sha256(raw).hexdigest())

@@ -223,11 +223,14 @@ def h1(u, y, fs_hz: float, nperseg: int, window="hann", noverlap=None):
 
 
 def estimate_h1(data: TestData, axes=None, *, nperseg: int | None = None, window="hann", noverlap=None,
-                freq_hz=None, excitation_threshold: float = 1e-2) -> list[MeasuredResponse]:
+                freq_hz=None, excitation_threshold: float = 1e-2, band_hz=None) -> list[MeasuredResponse]:
     """H1 responses of each axis at its excited bins (see the module docstring).
 
     ``nperseg`` defaults to an eighth of the record (a power of two); ``freq_hz`` (list or
-    dict axis -> list) picks the nearest bins instead of the excited ones."""
+    dict axis -> list) picks the nearest bins instead of the excited ones. ``band_hz``: (f0, f1)
+    [Hz] (or dict axis -> (f0, f1)), the excited band (a sweep's start and end frequencies): bins
+    outside it are dropped, whatever the window's leakage puts there (a point below a sweep's start
+    is not a measurement of the response there)."""
     axes = data.axes if axes is None else tuple(axes)
     fs = data.sample_rate_hz
     n = data.t_s.size
@@ -244,6 +247,14 @@ def estimate_h1(data: TestData, axes=None, *, nperseg: int | None = None, window
             idx = np.unique([int(np.argmin(np.abs(f - fk))) for fk in fl])
         else:
             idx = np.flatnonzero((Puu > excitation_threshold * Puu.max()) & (f > 0))
+        band = band_hz.get(ax) if isinstance(band_hz, dict) else band_hz
+        if band is not None and all(math.isfinite(x) for x in band):
+            lo, hi = min(band), max(band)
+            idx = idx[(f[idx] >= lo) & (f[idx] <= hi)]
+            if not idx.size:
+                raise InputError(data.source, f"{ax}_command", f"spectral bins within the excited band "
+                                 f"{lo:.4g}-{hi:.4g} Hz (a longer record or a smaller nperseg)",
+                                 got=f"none at {f[1] - f[0]:.4g} Hz resolution")
         He = ce = se = None
         if data.engine_rad is not None:
             _, He_, ce_, _, _ = h1(u, data.engine_rad[i], fs, nps, window, noverlap)
@@ -305,7 +316,8 @@ def estimate_by_segment(data: TestData, axes=None, *, nperseg: int | None = None
             if nps is not None and nps > sub.t_s.size:
                 raise InputError("command line", "--nperseg", f"a segment length within the {sub.t_s.size} samples "
                                  f"of {ax} segment #{s.index} ({s.kind} {s.t0_s:.2f}-{s.t1_s:.2f} s)", got=str(nps))
-            r = estimate_h1(sub, (ax,), nperseg=nps)[0]
+            r = estimate_h1(sub, (ax,), nperseg=nps,   # a sweep's points lie within its start and end
+                            band_hz=s.freq_range_hz if s.kind == "sweep" else None)[0]
             if s.kind == "sweep":  # the envelope is the amplitude the describing function sees
                 r = replace(r, amplitude_rad=np.full(r.freq_hz.shape, s.amplitude_rad))
             parts.append(replace(r, segment_index=np.full(r.freq_hz.shape, s.index, int)))
@@ -363,8 +375,10 @@ def estimate(data: TestData, method: str = "auto", **kwargs: Any) -> list[Measur
                                                           "segments": r.meta["segments"]},
                                  "method_forced": False, **extra}) for r in out]
     chosen, exc = choose_method(data, method)
-    out = estimate_dwells(data, **kwargs) if chosen == "dwell" else estimate_h1(data, **kwargs)
     by_axis = {e.axis: e for e in exc}
+    if chosen == "h1" and "band_hz" not in kwargs and "freq_hz" not in kwargs:   # a sweep's excited band
+        kwargs = {**kwargs, "band_hz": {e.axis: e.freq_range_hz for e in exc if e.kind == "sweep"}}
+    out = estimate_dwells(data, **kwargs) if chosen == "dwell" else estimate_h1(data, **kwargs)
     res = []
     for r in out:
         e = by_axis[r.axis]
