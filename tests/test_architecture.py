@@ -153,7 +153,7 @@ def test_nothing_below_the_cli_imports_it():
 
 #: the layers of taos/__init__.py's docstring, bottom (1) to top; masv sits on taos
 LAYERS = {
-    "taos.units": 1, "taos.errors": 1, "taos.results": 1, "taos.shipped": 1, "taos.bounds": 1,
+    "taos.units": 1, "taos.errors": 1, "taos.results": 1, "taos.shipped": 1, "taos.bounds": 1, "taos.argpaths": 1,
     "taos.harmonics": 1, "taos.descfcn": 1,
     "taos.friction": 2, "taos.linear": 2, "taos.stability": 2, "taos.model": 2,
     "taos.model_keys": 2, "taos.variants": 2,
