@@ -5,6 +5,7 @@ file's bare name, a file an input TOML names), and whether two output names are 
 from __future__ import annotations
 
 import os
+import stat
 
 
 def input_paths(args, output_options=()) -> list[str]:
@@ -43,12 +44,14 @@ def _referenced_files(paths, depth: int = 3, limit: int = 200) -> list[str]:
         p, d = todo.pop()
         try:
             rp = os.path.realpath(p)
-            if rp in seen or not rp.endswith(".toml") or os.path.getsize(rp) > (1 << 20):
+            st = os.stat(rp)
+            # a regular file only: a FIFO given as an input would block this open (its reader refuses it)
+            if rp in seen or not rp.endswith(".toml") or not stat.S_ISREG(st.st_mode) or st.st_size > (1 << 20):
                 continue
             seen.add(rp)
             with open(rp, "rb") as fh:
                 doc = tomllib.load(fh)
-        except (OSError, ValueError):
+        except (OSError, ValueError, RecursionError):   # nested beyond reason: its loader refuses it
             continue
         stack = [doc]
         while stack:

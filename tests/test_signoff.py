@@ -91,7 +91,7 @@ def test_signoff_over_dispersions_fails_the_soft_load_path_and_passes_the_stiff_
     ck = _checks(soft)
     # the soft load path: the loop lacks low-frequency gain even at the map's largest amplitude
     assert ck["low-frequency gain margin"]["value"] < 0 and ck["phase margin"]["value"] < 0
-    assert not ck["LCO engine amplitude"]["pass"] and "grows beyond" in ck["LCO engine amplitude"]["where"]
+    assert not ck["LCO engine amplitude"]["pass"]   # the map, extended past its largest amplitude, finds the cycle
     assert "FAIL in 1 of 2 case(s)" in s["text"]
 
 
@@ -141,8 +141,8 @@ def test_a_loop_unstable_at_the_largest_amplitude_is_not_called_cycle_free(tmp_p
     limit cycle expected"); the map extended to 3 deg finds the cycle above 0.3 deg, and the
     time-domain run (another method) oscillates near it."""
     soft = ("--load-stiffness", "60000 lbf/in")
-    v = taos_json(tmp_path / "map.json", *LCO, *soft)["verdict"]
-    assert v["kind"] == "grows-beyond-map" and "motion grows beyond it" in v["text"]
+    m = taos_json(tmp_path / "map.json", *LCO, *soft)   # the map is extended past 0.3 deg by itself (issue 40)
+    assert m["verdict"]["kind"] == "limit-cycle" and m["amplitude_deg"] > 0.3
     d = taos_json(tmp_path / "extended.json", "lco", "rs25_flight", "--flight", "core_stage",
                   "--amplitudes-deg", "0.03,0.1,0.3,1,3", "--freq-hz", GRID[3], "--duration", "100", *soft)
     assert d["verdict"]["kind"] == "limit-cycle" and d["amplitude_deg"] > 0.3

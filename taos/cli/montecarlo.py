@@ -132,8 +132,6 @@ def cmd_montecarlo(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise InputError("command line", "--workers", "1 or more workers", got=str(args.workers))
     if args.resume:   # before any work: a resume with nothing to continue would start afresh silently
-        from pathlib import Path
-
         from taos.montecarlo.executor import MANIFEST
         if not (Path(args.out) / MANIFEST).is_file():
             raise InputError("command line", "--resume", f"a --out folder holding a campaign ({MANIFEST}) to continue",

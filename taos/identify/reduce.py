@@ -433,8 +433,8 @@ def _refine(fun_for, fit_pts, check_pts, x, lo, hi, r0, jac0, budget):
                "message": msg}
 
 
-def reduce_to_planar(source, *, freq_hz: Sequence[float] = DEFAULT_FREQ_HZ,
-                     amplitudes_deg: Sequence[float] = DEFAULT_AMPLITUDES_DEG, axes=("pitch",),
+def reduce_to_planar(source: object, *, freq_hz: Sequence[float] = DEFAULT_FREQ_HZ,
+                     amplitudes_deg: Sequence[float] = DEFAULT_AMPLITUDES_DEG, axes: Sequence[str] = ("pitch",),
                      free: Sequence[str] | None = None, records: Sequence[str] = (),
                      greenrun_freq_hz: Sequence[float] = GREENRUN_FREQ_HZ, max_nfev: int = 60,
                      check_freq_hz: Sequence[float] = DEFAULT_CHECK_FREQ_HZ,
