@@ -429,10 +429,16 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
     except OSError as e:   # a file or folder the user named that the system refuses
         if debug:
             traceback.print_exc()
-        where = e.filename if e.filename is not None else "(file system)"
-        print(f"{parser.prog}: {where}: expected a place this program can read or write, got "
-              f"{e.strerror or type(e).__name__}", file=sys.stderr)
-        rc = 2
+        ctx = e.__context__
+        if isinstance(ctx, (KeyboardInterrupt, Interrupted)):
+            # raised by a clean-up while an interrupt unwound (a store's removal racing its own I/O
+            # threads): the interrupt is what happened, reported alone, whenever it landed
+            handler.received = getattr(ctx, "signum", signal.SIGINT)
+        else:
+            where = e.filename if e.filename is not None else "(file system)"
+            print(f"{parser.prog}: {where}: expected a place this program can read or write, got "
+                  f"{e.strerror or type(e).__name__}", file=sys.stderr)
+            rc = 2
     except Exception as e:  # a bug: still one line unless --debug
         if debug:
             traceback.print_exc()

@@ -439,3 +439,25 @@ def test_output_name_fuzz_never_touches_another_file(name, tmp_path_factory):
 
 # keep names used (the fixtures module documents every shipped input these tests read)
 _ = (DATA, FLIGHT, MODELS, PROFILE)
+
+
+def test_a_clean_up_failing_while_an_interrupt_unwinds_is_the_interrupt_alone(capsys):
+    """Deterministic form of a case the signal fuzz once caught (SIGINT during `taos sweep`): the
+    interrupt unwinds through a clean-up whose removal of a partial store fails (its own I/O
+    threads still writing: 'Directory not empty'); the run reports the interrupt, one line, 130."""
+    import argparse
+    import errno
+
+    from taos.errors import run_cli
+
+    def job(args):
+        try:
+            raise KeyboardInterrupt
+        finally:
+            raise OSError(errno.ENOTEMPTY, "Directory not empty", "sweep.zarr")
+
+    parser = argparse.ArgumentParser(prog="taos")
+    parser.set_defaults(func=job)
+    rc = run_cli(parser, [])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 130 and len(err) == 1 and "interrupted" in err[0], err
