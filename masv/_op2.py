@@ -1,0 +1,283 @@
+"""Read the normal modes of a Nastran OP2 file: real eigenvalues (LAMA) and real eigenvectors
+(OUGV1 / BOUGV1 / OUG1) of a SOL 103 run, 32-bit words, little- or big-endian.
+
+Sources for the layout: the MSC Nastran DMAP Programmer's Guide (OUTPUT2 / OP2 table format,
+OFP table codes) and pyNastran's reader (``pyNastran/op2/op2_interface/op2_reader.py``,
+``op2_common.py`` ``_set_approach_code``, ``tables/oug/oug.py`` and
+``tables/lama_eigenvalues/lama.py``), which is the reference the tests compare against.
+
+Layout (``[n]`` is a Fortran record holding the one word n; every Fortran record is
+``<len> bytes <len>`` with 4-byte lengths):
+
+* optional header (``PARAM,POST,-1``): ``[3] date(3 words) [7] 'NASTRAN FORT TAPE ID CODE - '
+  [2] label(8 chars) [-1] [0]``;
+* each table: ``[2] name(8 chars) [-1] [7] trailer(7 words) [-2] [1] [0] [n] name-record
+  [-3] [1] [0]``, then logical records each followed by ``[-k] [1] [0]`` (k = 4, 5, ...) and
+  a closing ``[0]``. A logical record is ``[n] data(n words)`` possibly continued by more
+  ``[n'] data`` pairs while the next one-word record is positive;
+* in a results table the logical records alternate: the 146-word IDENT record (word 1 approach
+  code = 10 analysis code + device code, word 2 table code (+1000 sort code), word 4 subcase,
+  word 5 mode, word 6 eigenvalue, word 9 format code, word 10 words per entry, word 23
+  thermal flag) and the data record;
+* OUG data, SORT1 real (num_wide 8): per grid ``10 grid + device, grid type, T1 T2 T3 R1 R2 R3``
+  (ints, then 32-bit floats); real normal modes have analysis code 2 and table code 7;
+* LAMA data: per mode ``mode, extraction order, eigenvalue [rad^2/s^2], omega [rad/s], f [Hz],
+  generalised mass, generalised stiffness`` (2 ints, 5 floats).
+
+Other tables are skipped by their Fortran record lengths only, so any content between is
+accepted. The eigenvectors are in the frame of the table: BOUGV1 the basic frame (preferred
+when present), OUGV1/OUG1 each grid's displacement (CD) frame. Bad or unsupported content
+(64-bit words, complex or SORT2 eigenvectors, several subcases, a broken record structure)
+raises :class:`taos.errors.InputError` naming the file.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from taos.errors import InputError
+
+#: largest logical record read into memory [bytes] (256 MiB: 8 million grids x 8 words)
+MAX_RECORD_BYTES = 1 << 28
+#: most modes taken from one file
+MAX_MODES = 100_000
+#: eigenvector tables, in order of preference (basic frame first)
+EIGENVECTOR_TABLES = ("BOUGV1", "OUGV1", "OUG1")
+IDENT_WORDS = 146
+
+
+@dataclass(frozen=True)
+class Op2Modes:
+    """Real normal modes read from an OP2 file (the FE model's units)."""
+
+    mode: np.ndarray                    # (n,) Nastran mode numbers
+    eigenvalue_rad2_s2: np.ndarray      # (n,) lambda = omega^2 [rad^2/s^2]
+    generalised_mass: np.ndarray | None  # (n,) from LAMA, None without a LAMA table
+    generalised_stiffness: np.ndarray | None
+    grids: np.ndarray                   # (G,) grid ids, ascending
+    phi: np.ndarray                     # (n, G, 6) T1 T2 T3 R1 R2 R3
+    table: str                          # the eigenvector table read
+    endian: str                         # "<" or ">"
+
+    @property
+    def freq_hz(self) -> np.ndarray:
+        return np.sqrt(np.maximum(self.eigenvalue_rad2_s2, 0.0)) / (2.0 * np.pi)
+
+
+class _Reader:
+    def __init__(self, f, src: str, size: int):
+        self.f, self.src, self.size = f, src, size
+        head = f.read(4)
+        if len(head) < 4:
+            raise InputError(src, "(file)", "a Nastran OP2 file", got="an empty or truncated file")
+        le, be = struct.unpack("<i", head)[0], struct.unpack(">i", head)[0]
+        if le == 8 or be == 8:
+            raise InputError(src, "(file)", "a 32-bit OP2 (64-bit OP2 words are not read; ask Nastran for "
+                             "the punch file or a 32-bit OP2)", got="64-bit words")
+        if le != 4 and be != 4:
+            raise InputError(src, "(file)", "a Nastran OP2 file (first Fortran record of 4 bytes)",
+                             got=f"first record length {le}")
+        self.e = "<" if le == 4 else ">"
+        f.seek(0)
+
+    def bad(self, what: str, got: str):
+        return InputError(self.src, f"byte {self.f.tell()}", what, got=got)
+
+    def record(self, keep: int) -> tuple[int, bytes | None] | None:
+        """Next Fortran record: (length, its bytes if length <= keep else None); None at the end."""
+        h = self.f.read(4)
+        if not h:
+            return None
+        if len(h) < 4:
+            raise self.bad("a Fortran record length", "the file truncated")
+        n = struct.unpack(self.e + "i", h)[0]
+        if n < 0 or self.f.tell() + n + 4 > self.size:
+            raise self.bad("a Fortran record within the file", f"length {n}")
+        if n <= keep:
+            data = self.f.read(n)
+        else:
+            data = None
+            self.f.seek(n, 1)
+        if struct.unpack(self.e + "i", self.f.read(4))[0] != n:
+            raise self.bad("matching Fortran record lengths", "a mismatch (not an OP2 or a corrupt one)")
+        return n, data
+
+    def marker(self) -> int:
+        r = self.record(4)
+        if r is None or r[0] != 4:
+            raise self.bad("a one-word OP2 marker", "the end of the file" if r is None else f"{r[0]} bytes")
+        return struct.unpack(self.e + "i", r[1])[0]
+
+    def peek_marker(self) -> int | None:
+        pos = self.f.tell()
+        r = self.record(4)
+        self.f.seek(pos)
+        return None if r is None or r[0] != 4 else struct.unpack(self.e + "i", r[1])[0]
+
+    def expect(self, *vals: int) -> None:
+        for v in vals:
+            m = self.marker()
+            if m != v:
+                raise self.bad(f"the OP2 marker {v}", str(m))
+
+    def logical(self, keep: bool) -> bytes | None:
+        """A logical record ``[n] data`` plus its continuations; its bytes if ``keep``."""
+        parts, total = [], 0
+        while True:
+            n = self.marker()
+            if n <= 0:
+                raise self.bad("a record word count", str(n))
+            total += 4 * n
+            if keep and total > MAX_RECORD_BYTES:
+                raise self.bad(f"records up to {MAX_RECORD_BYTES} bytes", f"{total} bytes")
+            r = self.record(4 * n if keep else 0)
+            if r is None or r[0] != 4 * n:
+                raise self.bad(f"a record of {n} words", "the end of the file" if r is None else f"{r[0]} bytes")
+            if keep:
+                parts.append(r[1])
+            nxt = self.peek_marker()
+            if nxt is None or nxt <= 0:
+                return b"".join(parts) if keep else None
+
+    def table(self, keep: bool) -> list[bytes]:
+        """The body of a table whose name record was just read: its logical records after [-3]."""
+        self.expect(-1)
+        self.logical(False)
+        self.expect(-2, 1, 0)
+        self.logical(False)
+        self.expect(-3, 1, 0)
+        out, k = [], -3
+        while self.peek_marker() != 0:
+            rec = self.logical(keep)
+            if keep:
+                out.append(rec)
+            k -= 1
+            self.expect(k, 1, 0)
+        self.expect(0)
+        return out
+
+
+def _tables(path, src: str, wanted: set[str]) -> tuple[dict[str, list[list[bytes]]], str]:
+    """Every table of the file whose name is in ``wanted``: name -> [records of each occurrence]."""
+    size = Path(path).stat().st_size
+    found: dict[str, list[list[bytes]]] = {}
+    with open(path, "rb") as f:
+        rd = _Reader(f, src, size)
+        prev: tuple[int, bytes | None] | None = None
+        while True:
+            r = rd.record(32)
+            if r is None:
+                break
+            # a table starts with [2] name(8 chars) (or [8] name(32 chars)) then [-1] [7]
+            if prev is not None and prev[0] == 4 and r[0] in (8, 32) and r[1] is not None:
+                nw = struct.unpack(rd.e + "i", prev[1])[0]
+                pos = f.tell()
+                if 4 * nw == r[0] and rd.peek_marker() == -1:
+                    rd.record(4)
+                    seven = rd.peek_marker()
+                    f.seek(pos)
+                    if seven == 7:
+                        name = r[1][:8].decode("latin-1").strip()
+                        if name in wanted:
+                            found.setdefault(name, []).append(rd.table(True))
+                        else:
+                            try:
+                                rd.table(False)
+                            except InputError:      # a table of another layout: go on record by record
+                                f.seek(pos)
+                        prev = None
+                        continue
+            prev = r
+    return found, rd.e
+
+
+def _ident(rec: bytes, e: str) -> dict:
+    w = np.frombuffer(rec[:4 * IDENT_WORDS], dtype=e + "i4")
+    fl = np.frombuffer(rec[:4 * IDENT_WORDS], dtype=e + "f4")
+    return {"approach": int(w[0]), "tcode": int(w[1]), "subcase": int(w[3]), "mode": int(w[4]),
+            "eigenvalue": float(fl[5]), "num_wide": int(w[9]), "thermal": int(w[22])}
+
+
+def read_op2_modes(path) -> Op2Modes:
+    """Real normal modes of the OP2 file ``path`` (module docstring for the layout)."""
+    src = str(path)
+    try:
+        tabs, e = _tables(path, src, set(EIGENVECTOR_TABLES) | {"LAMA", "CLAMA"})
+    except FileNotFoundError:
+        raise InputError(src, "(file)", "an existing Nastran OP2 file", got="no such file") from None
+    except IsADirectoryError:
+        raise InputError(src, "(file)", "a Nastran OP2 file", got="a directory") from None
+    except OSError as ex:
+        raise InputError(src, "(file)", "a readable Nastran OP2 file", got=type(ex).__name__) from None
+    name = next((t for t in EIGENVECTOR_TABLES if t in tabs), None)
+    if name is None:
+        got = "complex eigenvalues (CLAMA) only" if "CLAMA" in tabs else "none"
+        raise InputError(src, "OUGV1", "a real eigenvector table (BOUGV1, OUGV1 or OUG1 of a SOL 103 run with "
+                         "DISP = ALL)", got=got)
+    recs = [r for occ in tabs[name] for r in occ]
+    if len(recs) % 2:
+        raise InputError(src, name, "IDENT and data records in pairs", got=f"{len(recs)} records")
+    modes: dict[int, tuple[float, np.ndarray, np.ndarray]] = {}
+    subcases = set()
+    for i in range(0, len(recs), 2):
+        idn, data = recs[i], recs[i + 1]
+        if len(idn) != 4 * IDENT_WORDS:
+            raise InputError(src, f"{name} IDENT", f"{IDENT_WORDS} words", got=f"{len(idn) // 4}")
+        h = _ident(idn, e)
+        acode, tcode = h["approach"] // 10, h["tcode"] % 1000
+        if tcode != 7:
+            continue                                     # not an eigenvector (e.g. displacements)
+        if acode != 2 or h["num_wide"] != 8 or (h["tcode"] // 1000) & 2 or h["thermal"]:
+            kind = ("complex eigenvectors (SOL 107/110)" if acode == 9 or h["num_wide"] != 8 else
+                    "SORT2 eigenvectors" if (h["tcode"] // 1000) & 2 else
+                    f"analysis code {acode}, thermal {h['thermal']}")
+            raise InputError(src, name, "real normal modes in SORT1 (SOL 103)", got=kind)
+        subcases.add(h["subcase"])
+        if len(data) % 32:
+            raise InputError(src, f"{name} mode {h['mode']}", "8 words per grid", got=f"{len(data) // 4} words")
+        ints = np.frombuffer(data, dtype=e + "i4").reshape(-1, 8)
+        vals = np.frombuffer(data, dtype=e + "f4").reshape(-1, 8)[:, 2:8].astype(float)
+        if h["mode"] in modes:
+            raise InputError(src, f"{name} mode {h['mode']}", "each mode once (one subcase)", got="twice")
+        modes[h["mode"]] = (h["eigenvalue"], ints[:, 0] // 10, vals)
+        if len(modes) > MAX_MODES:
+            raise InputError(src, name, f"at most {MAX_MODES} modes", got="more")
+    if not modes:
+        raise InputError(src, name, "eigenvectors (table code 7)", got="none")
+    if len(subcases) > 1:
+        raise InputError(src, name, "the modes of one subcase", got=f"subcases {sorted(subcases)}")
+    order = sorted(modes)
+    grids = modes[order[0]][1]
+    if np.unique(grids).size != grids.size:
+        raise InputError(src, name, "each grid once per mode", got="a grid repeated")
+    srt = np.argsort(grids)
+    phi = np.zeros((len(order), grids.size, 6))
+    lam = np.zeros(len(order))
+    for j, m in enumerate(order):
+        lm, g, v = modes[m]
+        if not np.array_equal(g, grids):
+            raise InputError(src, f"{name} mode {m}", "the same grids in every mode")
+        lam[j], phi[j] = lm, v[srt]
+    gm = gk = None
+    lama = [r for occ in tabs.get("LAMA", []) for r in occ[1::2]]
+    if lama:
+        if len(lama) > 1:
+            raise InputError(src, "LAMA", "the eigenvalues of one subcase", got=f"{len(lama)} tables")
+        if len(lama[0]) % 28:
+            raise InputError(src, "LAMA", "7 words per mode", got=f"{len(lama[0]) // 4} words")
+        dt = np.dtype([("mode", e + "i4"), ("order", e + "i4"), ("eig", e + "f4"), ("rad", e + "f4"),
+                       ("cyc", e + "f4"), ("gm", e + "f4"), ("gk", e + "f4")])
+        la = np.frombuffer(lama[0], dtype=dt)
+        row = {int(m): k for k, m in enumerate(la["mode"])}
+        missing = [m for m in order if m not in row]
+        if missing:
+            raise InputError(src, "LAMA", "every eigenvector's mode", got=f"mode {missing[0]} missing")
+        k = [row[m] for m in order]
+        if not np.allclose(la["eig"][k], lam, rtol=1e-5, atol=1e-6 * max(1.0, float(np.abs(lam).max()))):
+            raise InputError(src, "LAMA", f"the eigenvalues of {name}", got="different eigenvalues")
+        gm, gk = la["gm"][k].astype(float), la["gk"][k].astype(float)
+    return Op2Modes(np.array(order), lam, gm, gk, grids[srt].astype(np.int64), phi, name, e)
