@@ -7,7 +7,7 @@ Format (every physical value with its unit, parsed by pint; paths relative to th
                                  # that ``masv coupling`` compares this one with
     [structure]
     modes = "../../fem_data/thrust_structure_modes.npz"   # or "rigid" (no modes), or an FE file
-                                 # (.uff/.unv Universal File 55, .pch Nastran punch) with the
+                                 # (.uff/.unv Universal File 55, .pch Nastran punch, .op2) with the
                                  # keys nodes, length_unit, mass_unit, modal_mass, fe_to_vehicle
                                  # (masv.fe_import; docs/reference/masv_files.md)
     damping_ratio = 0.005        # every mode (default, paper sec. 3.3); "file" keeps the file's
@@ -217,11 +217,11 @@ def _structure(doc: Mapping, src: str) -> tuple[ModalStructure, dict]:
     extra = sorted(k for k in FE_KEYS if k in st)
     if extra and not fe:
         raise InputError(src, f"structure.{extra[0]}", "no FE import key with a .npz modal file or \"rigid\" "
-                         "(FE files: .uff, .unv, .pch)", got=repr(modes))
+                         "(FE files: .uff, .unv, .pch, .op2)", got=repr(modes))
     if modes == "rigid":
         return rigid_structure(), {}
     path = resolve_reference(modes, src, field="structure.modes", kind="masv",
-                             what="a modal file (.npz, .uff/.unv or .pch)")
+                             what="a modal file (.npz, .uff/.unv, .pch or .op2)")
     info: dict = {}
     if fe:
         s, info = load_fe_modes(path, st, src)
@@ -234,9 +234,9 @@ def _structure(doc: Mapping, src: str) -> tuple[ModalStructure, dict]:
         from dataclasses import replace
         s = replace(s, engine_mass_in_modes=True)
     z = st.get("damping_ratio", DEFAULT_DAMPING_RATIO)
-    if z == "file" and info.get("format") == "nastran-punch":
-        raise InputError(src, "structure.damping_ratio", "a damping ratio (a Nastran punch file holds none)",
-                         got='"file"')
+    if z == "file" and info.get("format") in ("nastran-punch", "nastran-op2"):
+        raise InputError(src, "structure.damping_ratio", "a damping ratio (a Nastran punch or OP2 file holds "
+                         "none)", got='"file"')
     if z != "file":
         zeta = to_si(z, "dimensionless", source=src, field="structure.damping_ratio", nonnegative=True)
         if zeta >= 1:

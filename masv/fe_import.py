@@ -1,4 +1,4 @@
-"""Import mode shapes from finite-element results: Universal File dataset 55 and Nastran punch.
+"""Import mode shapes from finite-element results: Universal File dataset 55, Nastran punch and OP2.
 
 A MASV configuration names its structure's nodes and the FE grid ids they are
 (``[structure.nodes]``, format in ``docs/reference/masv_files.md``); the importer reads the
@@ -7,7 +7,7 @@ normal modes of the FE file, keeps the named grids' six components, and returns 
 
 * **Normalisation.** MASV's shapes are mass-normalised (phi_i^T M phi_i = 1). Each mode is
   divided by sqrt(m_i), m_i its generalised mass in the FE file's units: the file's own (UFF 55
-  record 8 "modal mass", ``modal_mass = "file"``) or the configuration's (``modal_mass`` a
+  record 8 "modal mass", the OP2's LAMA generalised masses: ``modal_mass = "file"``) or the configuration's (``modal_mass`` a
   number or a list, e.g. 1 for Nastran's default EIGRL NORM=MASS). A missing, zero, negative or
   non-finite generalised mass is an InputError: shapes normalised otherwise (NORM=MAX, unit
   displacement) cannot be used without their masses.
@@ -37,8 +37,12 @@ Formats:
   ``$EIGENVECTOR`` ... ``$EIGENVALUE = lambda MODE = i`` followed by a line per grid
   ``<id> G <T1> <T2> <T3>`` and its ``-CONT- <R1> <R2> <R3>`` (free-field, the 80-column line
   counter ignored); lambda = (2 pi f)^2 [rad^2/s^2]. The punch file holds no generalised
-  masses: ``modal_mass`` must be given (1 for NORM=MASS). Nastran OP2 is not read (pyNastran
-  1.4 requires numpy < 2); ask Nastran for the punch file beside it.
+  masses: ``modal_mass`` must be given (1 for NORM=MASS).
+* **Nastran OP2** (``.op2``; ``DISP = ALL`` in a SOL 103 run, ``PARAM,POST,-1`` or ``-2``, 32-bit
+  words, either byte order; read by :mod:`masv._op2`): the real eigenvector table (BOUGV1 in the
+  basic frame when present, else OUGV1/OUG1) and, when present, the LAMA eigenvalue table whose
+  generalised masses are the file's (``modal_mass = "file"``, the default with a LAMA table);
+  lambda = (2 pi f)^2 [rad^2/s^2]; no damping.
 """
 
 from __future__ import annotations
@@ -53,12 +57,14 @@ import numpy as np
 from taos.errors import InputError, check_keys
 from taos.units import to_si
 
+from ._op2 import read_op2_modes
 from .structure import ModalStructure, validate_modes
 
 #: file suffixes of each FE format
 UFF_SUFFIXES = (".uff", ".unv")
 PUNCH_SUFFIXES = (".pch", ".pun", ".punch")
-FE_SUFFIXES = UFF_SUFFIXES + PUNCH_SUFFIXES
+OP2_SUFFIXES = (".op2",)
+FE_SUFFIXES = UFF_SUFFIXES + PUNCH_SUFFIXES + OP2_SUFFIXES
 #: keys of [structure] that only an FE file takes
 FE_KEYS = {"nodes", "length_unit", "mass_unit", "modal_mass", "fe_to_vehicle", "min_frequency"}
 
@@ -222,17 +228,21 @@ def load_fe_modes(path: Path, st: Mapping, src: str) -> tuple[ModalStructure, di
     if suffix in UFF_SUFFIXES:
         freq, file_mass, zeta, grids, phi = read_uff55(path)
         fmt = "uff55"
+    elif suffix in OP2_SUFFIXES:
+        op2 = read_op2_modes(path)
+        freq, file_mass, grids, phi = op2.freq_hz, op2.generalised_mass, op2.grids, op2.phi
+        zeta, fmt = np.zeros(freq.size), "nastran-op2"
     else:
         freq, grids, phi = read_punch(path)
         file_mass, zeta, fmt = None, np.zeros(freq.size), "nastran-punch"
     mm = st.get("modal_mass", "file" if file_mass is not None else None)
     if mm == "file":
         if file_mass is None:
-            raise InputError(src, "structure.modal_mass", "the generalised masses (the punch file has none): 1 "
+            raise InputError(src, "structure.modal_mass", f"the generalised masses (the {fmt} file has none): 1 "
                              "for EIGRL NORM=MASS, or a list", got='"file"')
         gm, how = file_mass, "file"
     elif mm is None:
-        raise InputError(src, "structure.modal_mass", "the generalised masses (the punch file has none): 1 for "
+        raise InputError(src, "structure.modal_mass", f"the generalised masses (the {fmt} file has none): 1 for "
                          "EIGRL NORM=MASS, or a list", got="nothing (key missing)")
     else:
         try:
@@ -257,4 +267,6 @@ def load_fe_modes(path: Path, st: Mapping, src: str) -> tuple[ModalStructure, di
     prov = {"format": fmt, "length_unit_m": L, "mass_unit_kg": M, "generalised_mass_from": how,
             "generalised_mass_range": [float(gm[keep].min()), float(gm[keep].max())] if keep.any() else [],
             "rigid_modes_dropped": int((~keep).sum()), "grids": dict(zip(names, ids))}
+    if fmt == "nastran-op2":
+        prov["op2_table"] = op2.table
     return s, prov

@@ -166,7 +166,7 @@ LAYERS = {
     "taos.plotting": 5, "taos.viewer": 5, "taos.report.analysis": 5, "taos.report.html": 5,
     "taos.cli": 6, "taos.__main__": 6,
     "masv.structure": 7, "masv.config": 7, "masv.system": 7, "masv.synthetic": 7,
-    "masv.fe_import": 7, "masv.provenance": 7, "masv.coupled": 7, "masv._kernel": 7,
+    "masv.fe_import": 7, "masv._op2": 7, "masv.provenance": 7, "masv.coupled": 7, "masv._kernel": 7,
     "masv.analysis": 8, "masv.timedomain": 8, "masv": 8, "masv.plotting": 9, "masv.cli": 10,
 }
 
