@@ -20,7 +20,9 @@ Layout (``[n]`` is a Fortran record holding the one word n; every Fortran record
   word 5 mode, word 6 eigenvalue, word 9 format code, word 10 words per entry, word 23
   thermal flag) and the data record;
 * OUG data, SORT1 real (num_wide 8): per grid ``10 grid + device, grid type, T1 T2 T3 R1 R2 R3``
-  (ints, then 32-bit floats); real normal modes have analysis code 2 and table code 7;
+  (ints, then 32-bit floats); real normal modes have analysis code 2 and table code 7
+  (eigenvector; pyNastran's writer uses 1, displacement, which with analysis code 2 is the same
+  mode shape and is accepted too);
 * LAMA data: per mode ``mode, extraction order, eigenvalue [rad^2/s^2], omega [rad/s], f [Hz],
   generalised mass, generalised stiffness`` (2 ints, 5 floats).
 
@@ -229,8 +231,8 @@ def read_op2_modes(path) -> Op2Modes:
             raise InputError(src, f"{name} IDENT", f"{IDENT_WORDS} words", got=f"{len(idn) // 4}")
         h = _ident(idn, e)
         acode, tcode = h["approach"] // 10, h["tcode"] % 1000
-        if tcode != 7:
-            continue                                     # not an eigenvector (e.g. displacements)
+        if tcode not in (1, 7):
+            continue                                     # not a displacement/eigenvector table
         if acode != 2 or h["num_wide"] != 8 or (h["tcode"] // 1000) & 2 or h["thermal"]:
             kind = ("complex eigenvectors (SOL 107/110)" if acode == 9 or h["num_wide"] != 8 else
                     "SORT2 eigenvectors" if (h["tcode"] // 1000) & 2 else
@@ -247,7 +249,7 @@ def read_op2_modes(path) -> Op2Modes:
         if len(modes) > MAX_MODES:
             raise InputError(src, name, f"at most {MAX_MODES} modes", got="more")
     if not modes:
-        raise InputError(src, name, "eigenvectors (table code 7)", got="none")
+        raise InputError(src, name, "eigenvectors (table code 7, or 1 with analysis code 2)", got="none")
     if len(subcases) > 1:
         raise InputError(src, name, "the modes of one subcase", got=f"subcases {sorted(subcases)}")
     order = sorted(modes)
