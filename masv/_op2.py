@@ -145,28 +145,28 @@ class _Reader:
             if nxt is None or nxt <= 0:
                 return b"".join(parts) if keep else None
 
-    def table(self, keep: bool) -> list[bytes]:
-        """The body of a table whose name record was just read: its logical records after [-3]."""
+    def table(self, sink) -> None:
+        """The body of a table whose name record was just read: its logical records after [-3],
+        each passed to ``sink`` (None: skipped by their lengths)."""
         self.expect(-1)
         self.logical(False)
         self.expect(-2, 1, 0)
         self.logical(False)
         self.expect(-3, 1, 0)
-        out, k = [], -3
+        k = -3
         while self.peek_marker() != 0:
-            rec = self.logical(keep)
-            if keep:
-                out.append(rec)
+            rec = self.logical(sink is not None)
+            if sink is not None:
+                sink(rec)
             k -= 1
             self.expect(k, 1, 0)
         self.expect(0)
-        return out
 
 
-def _tables(path, src: str, wanted: set[str]) -> tuple[dict[str, list[list[bytes]]], str]:
-    """Every table of the file whose name is in ``wanted``: name -> [records of each occurrence]."""
+def _tables(path, src: str, wanted: set[str], sink) -> None:
+    """Pass every logical record of the tables named in ``wanted`` to ``sink(name, record,
+    endian)``, in file order; skip the others."""
     size = Path(path).stat().st_size
-    found: dict[str, list[list[bytes]]] = {}
     with open(path, "rb") as f:
         rd = _Reader(f, src, size)
         prev: tuple[int, bytes | None] | None = None
@@ -185,87 +185,119 @@ def _tables(path, src: str, wanted: set[str]) -> tuple[dict[str, list[list[bytes
                     if seven == 7:
                         name = r[1][:8].decode("latin-1").strip()
                         if name in wanted:
-                            found.setdefault(name, []).append(rd.table(True))
+                            rd.table(lambda rec, name=name: sink(name, rec, rd.e))
                         else:
                             try:
-                                rd.table(False)
+                                rd.table(None)
                             except InputError:      # a table of another layout: go on record by record
                                 f.seek(pos)
                         prev = None
                         continue
             prev = r
-    return found, rd.e
 
 
 def _ident(rec: bytes, e: str) -> dict:
-    w = np.frombuffer(rec[:4 * IDENT_WORDS], dtype=e + "i4")
-    fl = np.frombuffer(rec[:4 * IDENT_WORDS], dtype=e + "f4")
+    w = np.frombuffer(rec, dtype=e + "i4")
+    fl = np.frombuffer(rec, dtype=e + "f4")
     return {"approach": int(w[0]), "tcode": int(w[1]), "subcase": int(w[3]), "mode": int(w[4]),
             "eigenvalue": float(fl[5]), "num_wide": int(w[9]), "thermal": int(w[22])}
 
 
-def read_op2_modes(path) -> Op2Modes:
-    """Real normal modes of the OP2 file ``path`` (module docstring for the layout)."""
+class _Collector:
+    """Sink of :func:`_tables`: the LAMA records, and per eigenvector table its modes (only the
+    grids asked for, when given)."""
+
+    def __init__(self, src: str, grids):
+        self.src = src
+        self.want = None if grids is None else np.unique(np.asarray(list(grids), dtype=np.int64))
+        self.lama: list[bytes] = []
+        self.clama = False
+        self.e = "<"
+        self.pending: dict[str, dict | None] = {t: None for t in EIGENVECTOR_TABLES}
+        self.modes: dict[str, dict[int, tuple[float, np.ndarray, np.ndarray]]] = {t: {} for t in EIGENVECTOR_TABLES}
+        self.subcases: dict[str, set[int]] = {t: set() for t in EIGENVECTOR_TABLES}
+        self.present: set[str] = set()
+
+    def __call__(self, name: str, rec: bytes, e: str) -> None:
+        self.e = e
+        if name == "CLAMA":
+            self.clama = True
+            return
+        if name == "LAMA":
+            self.lama.append(rec)
+            return
+        self.present.add(name)
+        idn = self.pending[name]
+        if idn is None:                                  # an IDENT record
+            if len(rec) != 4 * IDENT_WORDS:
+                raise InputError(self.src, f"{name} IDENT", f"{IDENT_WORDS} words", got=f"{len(rec) // 4}")
+            self.pending[name] = _ident(rec, e)
+            return
+        self.pending[name] = None                        # its data record
+        acode, tcode, sort = idn["approach"] // 10, idn["tcode"] % 1000, idn["tcode"] // 1000
+        if tcode not in (1, 7) or (tcode == 1 and acode not in (2, 9)):
+            return                                       # not a mode shape (e.g. static displacements)
+        if acode != 2 or idn["num_wide"] != 8 or sort & 2 or idn["thermal"]:
+            kind = ("complex eigenvectors (SOL 107/110)" if acode == 9 or idn["num_wide"] != 8 else
+                    "SORT2 eigenvectors" if sort & 2 else f"analysis code {acode}, thermal {idn['thermal']}")
+            raise InputError(self.src, name, "real normal modes in SORT1 (SOL 103)", got=kind)
+        if len(rec) % 32:
+            raise InputError(self.src, f"{name} mode {idn['mode']}", "8 words per grid", got=f"{len(rec) // 4} words")
+        ids = np.frombuffer(rec, dtype=e + "i4").reshape(-1, 8)[:, 0] // 10
+        vals = np.frombuffer(rec, dtype=e + "f4").reshape(-1, 8)[:, 2:8]
+        if self.want is not None:
+            keep = np.isin(ids, self.want)
+            ids, vals = ids[keep], vals[keep]
+        modes = self.modes[name]
+        if idn["mode"] in modes:
+            raise InputError(self.src, f"{name} mode {idn['mode']}", "each mode once (one subcase)", got="twice")
+        if len(modes) >= MAX_MODES:
+            raise InputError(self.src, name, f"at most {MAX_MODES} modes", got="more")
+        modes[idn["mode"]] = (idn["eigenvalue"], ids.astype(np.int64), vals.astype(float))
+        self.subcases[name].add(idn["subcase"])
+
+
+def read_op2_modes(path, grids=None) -> Op2Modes:
+    """Real normal modes of the OP2 file ``path`` (module docstring for the layout); with
+    ``grids``, only those grids' components are kept (the others are read and dropped)."""
     src = str(path)
+    c = _Collector(src, grids)
     try:
-        tabs, e = _tables(path, src, set(EIGENVECTOR_TABLES) | {"LAMA", "CLAMA"})
+        _tables(path, src, set(EIGENVECTOR_TABLES) | {"LAMA", "CLAMA"}, c)
     except FileNotFoundError:
         raise InputError(src, "(file)", "an existing Nastran OP2 file", got="no such file") from None
     except IsADirectoryError:
         raise InputError(src, "(file)", "a Nastran OP2 file", got="a directory") from None
     except OSError as ex:
         raise InputError(src, "(file)", "a readable Nastran OP2 file", got=type(ex).__name__) from None
-    name = next((t for t in EIGENVECTOR_TABLES if t in tabs), None)
+    e = c.e
+    name = next((t for t in EIGENVECTOR_TABLES if c.modes[t]), None)
     if name is None:
-        got = "complex eigenvalues (CLAMA) only" if "CLAMA" in tabs else "none"
+        if c.present:
+            raise InputError(src, sorted(c.present)[0], "eigenvectors (table code 7, or 1 with analysis code 2)",
+                             got="none")
+        got = "complex eigenvalues (CLAMA) only" if c.clama else "none"
         raise InputError(src, "OUGV1", "a real eigenvector table (BOUGV1, OUGV1 or OUG1 of a SOL 103 run with "
                          "DISP = ALL)", got=got)
-    recs = [r for occ in tabs[name] for r in occ]
-    if len(recs) % 2:
-        raise InputError(src, name, "IDENT and data records in pairs", got=f"{len(recs)} records")
-    modes: dict[int, tuple[float, np.ndarray, np.ndarray]] = {}
-    subcases = set()
-    for i in range(0, len(recs), 2):
-        idn, data = recs[i], recs[i + 1]
-        if len(idn) != 4 * IDENT_WORDS:
-            raise InputError(src, f"{name} IDENT", f"{IDENT_WORDS} words", got=f"{len(idn) // 4}")
-        h = _ident(idn, e)
-        acode, tcode = h["approach"] // 10, h["tcode"] % 1000
-        if tcode not in (1, 7):
-            continue                                     # not a displacement/eigenvector table
-        if acode != 2 or h["num_wide"] != 8 or (h["tcode"] // 1000) & 2 or h["thermal"]:
-            kind = ("complex eigenvectors (SOL 107/110)" if acode == 9 or h["num_wide"] != 8 else
-                    "SORT2 eigenvectors" if (h["tcode"] // 1000) & 2 else
-                    f"analysis code {acode}, thermal {h['thermal']}")
-            raise InputError(src, name, "real normal modes in SORT1 (SOL 103)", got=kind)
-        subcases.add(h["subcase"])
-        if len(data) % 32:
-            raise InputError(src, f"{name} mode {h['mode']}", "8 words per grid", got=f"{len(data) // 4} words")
-        ints = np.frombuffer(data, dtype=e + "i4").reshape(-1, 8)
-        vals = np.frombuffer(data, dtype=e + "f4").reshape(-1, 8)[:, 2:8].astype(float)
-        if h["mode"] in modes:
-            raise InputError(src, f"{name} mode {h['mode']}", "each mode once (one subcase)", got="twice")
-        modes[h["mode"]] = (h["eigenvalue"], ints[:, 0] // 10, vals)
-        if len(modes) > MAX_MODES:
-            raise InputError(src, name, f"at most {MAX_MODES} modes", got="more")
-    if not modes:
-        raise InputError(src, name, "eigenvectors (table code 7, or 1 with analysis code 2)", got="none")
-    if len(subcases) > 1:
-        raise InputError(src, name, "the modes of one subcase", got=f"subcases {sorted(subcases)}")
+    if any(v is not None for v in c.pending.values()):
+        raise InputError(src, name, "IDENT and data records in pairs", got="an IDENT record alone")
+    if len(c.subcases[name]) > 1:
+        raise InputError(src, name, "the modes of one subcase", got=f"subcases {sorted(c.subcases[name])}")
+    modes = c.modes[name]
     order = sorted(modes)
-    grids = modes[order[0]][1]
-    if np.unique(grids).size != grids.size:
+    gids = modes[order[0]][1]
+    if np.unique(gids).size != gids.size:
         raise InputError(src, name, "each grid once per mode", got="a grid repeated")
-    srt = np.argsort(grids)
-    phi = np.zeros((len(order), grids.size, 6))
+    srt = np.argsort(gids)
+    phi = np.zeros((len(order), gids.size, 6))
     lam = np.zeros(len(order))
     for j, m in enumerate(order):
         lm, g, v = modes[m]
-        if not np.array_equal(g, grids):
+        if not np.array_equal(g, gids):
             raise InputError(src, f"{name} mode {m}", "the same grids in every mode")
         lam[j], phi[j] = lm, v[srt]
     gm = gk = None
-    lama = [r for occ in tabs.get("LAMA", []) for r in occ[1::2]]
+    lama = c.lama[1::2]
     if lama:
         if len(lama) > 1:
             raise InputError(src, "LAMA", "the eigenvalues of one subcase", got=f"{len(lama)} tables")
@@ -279,7 +311,10 @@ def read_op2_modes(path) -> Op2Modes:
         if missing:
             raise InputError(src, "LAMA", "every eigenvector's mode", got=f"mode {missing[0]} missing")
         k = [row[m] for m in order]
-        if not np.allclose(la["eig"][k], lam, rtol=1e-5, atol=1e-6 * max(1.0, float(np.abs(lam).max()))):
+        eig = la["eig"][k].astype(float)
+        with np.errstate(invalid="ignore"):
+            same = np.allclose(eig, lam, rtol=1e-5, atol=1e-6 * max(1.0, float(np.nanmax(np.abs(lam), initial=0))))
+        if not same:
             raise InputError(src, "LAMA", f"the eigenvalues of {name}", got="different eigenvalues")
         gm, gk = la["gm"][k].astype(float), la["gk"][k].astype(float)
-    return Op2Modes(np.array(order), lam, gm, gk, grids[srt].astype(np.int64), phi, name, e)
+    return Op2Modes(np.array(order), lam, gm, gk, gids[srt], phi, name, e)

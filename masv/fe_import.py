@@ -229,7 +229,7 @@ def load_fe_modes(path: Path, st: Mapping, src: str) -> tuple[ModalStructure, di
         freq, file_mass, zeta, grids, phi = read_uff55(path)
         fmt = "uff55"
     elif suffix in OP2_SUFFIXES:
-        op2 = read_op2_modes(path)
+        op2 = read_op2_modes(path, grids=ids)
         freq, file_mass, grids, phi = op2.freq_hz, op2.generalised_mass, op2.grids, op2.phi
         zeta, fmt = np.zeros(freq.size), "nastran-op2"
     else:
