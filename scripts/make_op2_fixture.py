@@ -11,7 +11,7 @@ It writes into tests/data/op2/:
   PARAM,POST,-1 header: pyNastran's OP2 writer given the real normal modes of the axial bar of
   tests/test_masv_nengine.py (eight linear elements, consistent mass, tip mass, clamped at
   x = 0; the same constants, copied below because this script cannot import the project). The
-  model is in inches and lbf s^2/in with the bar along the FE y axis; ``beam_le`` has shapes
+  model is in centimetres and grams (CGS) with the bar along the FE y axis; ``beam_le`` has shapes
   normalised to a unit largest component (EIGRL NORM=MAX), ``beam_be`` mass-normalised
   (NORM=MASS). Grids 101..108 are the bar's nodes, 201..206 grounded points (zero shapes) for
   gimbals. pyNastran 1.4's writer skips the LAMA table (op2_writer.py ``skip_tables``), so these
@@ -43,7 +43,7 @@ import scipy.linalg
 OUT = Path(__file__).resolve().parents[1] / "tests" / "data" / "op2"
 # tests/test_masv_nengine.py's bar (SI)
 N_EL, L_M, EA_N, RHOA_KG_M, TIP_MASS_KG = 8, 6.0, 1.2e9, 80.0, 20000.0
-IN_M, LBF_S2_IN_KG = 0.0254, 4.4482216152605 / 0.0254
+KG_PER_G = 1e-3                     # the OP2 is in the CGS system: cm, g, s, dyn
 PYNASTRAN_MODELS = ("beam_modes_m1.op2", "beam_modes_m2.op2")
 
 
@@ -69,10 +69,10 @@ def write_beam_op2(path: Path, endian: bytes, post: int, norm_max: bool) -> None
     n = w2.size
     grids = np.array([100 + i for i in range(1, N_EL + 1)] + [200 + e for e in range(1, 7)])
     phi = np.zeros((n, grids.size, 6))
-    phi[:, :N_EL, 1] = V * math.sqrt(LBF_S2_IN_KG)         # mass-normalised in lbf s^2/in, along FE y
+    phi[:, :N_EL, 1] = V * math.sqrt(KG_PER_G)              # mass-normalised in g, along FE y
     scale = np.abs(phi).reshape(n, -1).max(axis=1) if norm_max else np.ones(n)
     phi /= scale[:, None, None]                             # NORM=MAX (or NORM=MASS)
-    gen_mass = 1.0 / scale ** 2                             # phi^T M phi of the NORM=MAX shapes [lbf s^2/in]
+    gen_mass = 1.0 / scale ** 2                             # phi^T M phi of the NORM=MAX shapes [g]
     cycles = np.sqrt(w2) / (2 * math.pi)
     model = OP2(debug=None, mode="msc")
     node_gridtype = np.column_stack([grids, np.ones_like(grids)]).astype("int32")

@@ -19,7 +19,9 @@ from masv.fe_import import load_fe_modes
 from masv.system import build_system
 from taos.errors import InputError
 
-from .test_masv_nengine import LBF_S2_IN_KG, IN_M, N_EL, beam_modes, config, write_npz, write_punch, write_uff
+from taos.units import M_PER_IN, N_PER_LBF
+
+from .test_masv_nengine import N_EL, beam_modes, config, write_npz, write_punch, write_uff
 
 DATA = Path(__file__).resolve().parent / "data" / "op2"
 REF = np.load(DATA / "reference_pynastran.npz")
@@ -57,6 +59,7 @@ def test_real_nastran_post1_and_post2_files_give_the_same_modes():
 
 def test_real_nastran_lama_masses_normalise_the_shapes():
     """modal_mass defaults to the file's LAMA generalised masses; SI scaling of the module docstring."""
+    lbf_s2_in_kg = N_PER_LBF / M_PER_IN
     st = {"nodes": {"root": {"grid": 2, "xyz": ["0 m", "0 m", "0 m"]}, "tip": {"grid": 11, "xyz": ["1 m", "0 m", "0 m"]}},
           "length_unit": "in", "mass_unit": "lbf*s**2/in"}
     s, prov = load_fe_modes(DATA / "beam_modes_m1.op2", st, "test.toml")
@@ -68,13 +71,13 @@ def test_real_nastran_lama_masses_normalise_the_shapes():
     cols = [list(m.grids).index(2), list(m.grids).index(11)]
     raw = m.phi[k][:, cols] / np.sqrt(m.generalised_mass[k])[:, None, None]
     assert np.allclose(s.freq_hz, m.freq_hz[k], rtol=1e-12)
-    assert np.allclose(s.phi[..., :3], raw[..., :3] / math.sqrt(LBF_S2_IN_KG), rtol=1e-12, atol=0)
-    assert np.allclose(s.phi[..., 3:], raw[..., 3:] / (math.sqrt(LBF_S2_IN_KG) * IN_M), rtol=1e-12, atol=0)
+    assert np.allclose(s.phi[..., :3], raw[..., :3] / math.sqrt(lbf_s2_in_kg), rtol=1e-12, atol=0)
+    assert np.allclose(s.phi[..., 3:], raw[..., 3:] / (math.sqrt(lbf_s2_in_kg) * M_PER_IN), rtol=1e-12, atol=0)
 
 
 def _op2_config(tmp_path, stem, extra):
     shutil.copyfile(DATA / f"{stem}.op2", tmp_path / f"{stem}.op2")
-    p = config(tmp_path, 2, f"{stem}.op2", 'length_unit = "in"\nmass_unit = "lbf*s**2/in"\n'
+    p = config(tmp_path, 2, f"{stem}.op2", 'length_unit = "cm"\nmass_unit = "g"\n'
                f"fe_to_vehicle = {FE_TO_VEHICLE}\n" + extra, fe_nodes=True, damping="0.02")
     return p
 
@@ -89,9 +92,9 @@ def test_op2_round_trips_into_the_punch_uff_and_npz_modes(tmp_path):
                              "modal_mass = 1.0", fe_nodes=True, damping="0.02"))
     uff = load_config(config(tmp_path, n, "beam.unv", 'length_unit = "mm"\nmass_unit = "tonne"\n'
                              "fe_to_vehicle = [[0, 0, 1], [0, 1, 0], [-1, 0, 0]]", fe_nodes=True, damping="0.02"))
-    # beam_le: NORM=MAX shapes, so m_i = 1 / max|phi_i|^2 of the mass-normalised shape in lbf s^2/in
+    # beam_le (CGS): NORM=MAX shapes, so m_i = 1 / max|phi_i|^2 of the mass-normalised shape in g
     _, _, V = beam_modes()
-    gm = 1.0 / (np.abs(V).max(axis=1) * math.sqrt(LBF_S2_IN_KG)) ** 2
+    gm = 1.0 / (np.abs(V).max(axis=1) * math.sqrt(1e-3)) ** 2
     le = load_config(_op2_config(tmp_path, "beam_le", f"modal_mass = {gm.tolist()}"))
     be = load_config(_op2_config(tmp_path, "beam_be", "modal_mass = 1.0"))
     assert le.structure_import["format"] == be.structure_import["format"] == "nastran-op2"
