@@ -1,5 +1,5 @@
 """Read the normal modes of a Nastran OP2 file: real eigenvalues (LAMA) and real eigenvectors
-(OUGV1 / BOUGV1 / OUG1) of a SOL 103 run, 32-bit words, little- or big-endian.
+(OUGV1 / BOUGV1 / OUG1) of a SOL 103 run, 32- or 64-bit words, little- or big-endian.
 
 Sources for the layout: the MSC Nastran DMAP Programmer's Guide (OUTPUT2 / OP2 table format,
 OFP table codes) and pyNastran's reader (``pyNastran/op2/op2_interface/op2_reader.py``,
@@ -7,7 +7,9 @@ OFP table codes) and pyNastran's reader (``pyNastran/op2/op2_interface/op2_reade
 ``tables/lama_eigenvalues/lama.py``), which is the reference the tests compare against.
 
 Layout (``[n]`` is a Fortran record holding the one word n; every Fortran record is
-``<len> bytes <len>`` with 4-byte lengths):
+``<len> bytes <len>`` with 4-byte lengths; a word is 4 bytes, or 8 in a 64-bit OP2 (integers
+int64, reals float64, characters 4 per word padded with 4 blanks, or 8 per word), the word size
+and byte order known from the first record, one word 3 (POST -1) or 2 (POST -2)):
 
 * optional header (``PARAM,POST,-1``): ``[3] date(3 words) [7] 'NASTRAN FORT TAPE ID CODE - '
   [2] label(8 chars) [-1] [0]``;
@@ -20,7 +22,7 @@ Layout (``[n]`` is a Fortran record holding the one word n; every Fortran record
   word 5 mode, word 6 eigenvalue, word 9 format code, word 10 words per entry, word 23
   thermal flag) and the data record;
 * OUG data, SORT1 real (num_wide 8): per grid ``10 grid + device, grid type, T1 T2 T3 R1 R2 R3``
-  (ints, then 32-bit floats); real normal modes have analysis code 2 and table code 7
+  (ints, then reals); real normal modes have analysis code 2 and table code 7
   (eigenvector; pyNastran's writer uses 1, displacement, which with analysis code 2 is the same
   mode shape and is accepted too);
 * LAMA data: per mode ``mode, extraction order, eigenvalue [rad^2/s^2], omega [rad/s], f [Hz],
@@ -29,7 +31,7 @@ Layout (``[n]`` is a Fortran record holding the one word n; every Fortran record
 Other tables are skipped by their Fortran record lengths only, so any content between is
 accepted. The eigenvectors are in the frame of the table: BOUGV1 the basic frame (preferred
 when present), OUGV1/OUG1 each grid's displacement (CD) frame. Bad or unsupported content
-(64-bit words, complex or SORT2 eigenvectors, several subcases, a broken record structure)
+(complex or SORT2 eigenvectors, several subcases, a broken record structure)
 raises :class:`taos.errors.InputError` naming the file.
 """
 
@@ -64,6 +66,7 @@ class Op2Modes:
     phi: np.ndarray                     # (n, G, 6) T1 T2 T3 R1 R2 R3
     table: str                          # the eigenvector table read
     endian: str                         # "<" or ">"
+    word_bytes: int                     # 4 (32-bit OP2) or 8 (64-bit)
 
     @property
     def freq_hz(self) -> np.ndarray:
@@ -77,13 +80,12 @@ class _Reader:
         if len(head) < 4:
             raise InputError(src, "(file)", "a Nastran OP2 file", got="an empty or truncated file")
         le, be = struct.unpack("<i", head)[0], struct.unpack(">i", head)[0]
-        if le == 8 or be == 8:
-            raise InputError(src, "(file)", "a 32-bit OP2 (64-bit OP2 words are not read; ask Nastran for "
-                             "the punch file or a 32-bit OP2)", got="64-bit words")
-        if le != 4 and be != 4:
-            raise InputError(src, "(file)", "a Nastran OP2 file (first Fortran record of 4 bytes)",
+        if le not in (4, 8) and be not in (4, 8):
+            raise InputError(src, "(file)", "a Nastran OP2 file (first Fortran record of one 4- or 8-byte word)",
                              got=f"first record length {le}")
-        self.e = "<" if le == 4 else ">"
+        self.e = "<" if le in (4, 8) else ">"
+        self.w = le if le in (4, 8) else be                  # bytes per word: 4 (32-bit) or 8 (64-bit)
+        self.wfmt = self.e + ("i" if self.w == 4 else "q")
         f.seek(0)
 
     def bad(self, what: str, got: str):
@@ -109,16 +111,16 @@ class _Reader:
         return n, data
 
     def marker(self) -> int:
-        r = self.record(4)
-        if r is None or r[0] != 4:
+        r = self.record(self.w)
+        if r is None or r[0] != self.w:
             raise self.bad("a one-word OP2 marker", "the end of the file" if r is None else f"{r[0]} bytes")
-        return struct.unpack(self.e + "i", r[1])[0]
+        return struct.unpack(self.wfmt, r[1])[0]
 
     def peek_marker(self) -> int | None:
         pos = self.f.tell()
-        r = self.record(4)
+        r = self.record(self.w)
         self.f.seek(pos)
-        return None if r is None or r[0] != 4 else struct.unpack(self.e + "i", r[1])[0]
+        return None if r is None or r[0] != self.w else struct.unpack(self.wfmt, r[1])[0]
 
     def expect(self, *vals: int) -> None:
         for v in vals:
@@ -133,11 +135,11 @@ class _Reader:
             n = self.marker()
             if n <= 0:
                 raise self.bad("a record word count", str(n))
-            total += 4 * n
+            total += self.w * n
             if keep and total > MAX_RECORD_BYTES:
                 raise self.bad(f"records up to {MAX_RECORD_BYTES} bytes", f"{total} bytes")
-            r = self.record(4 * n if keep else 0)
-            if r is None or r[0] != 4 * n:
+            r = self.record(self.w * n if keep else 0)
+            if r is None or r[0] != self.w * n:
                 raise self.bad(f"a record of {n} words", "the end of the file" if r is None else f"{r[0]} bytes")
             if keep:
                 parts.append(r[1])
@@ -171,21 +173,21 @@ def _tables(path, src: str, wanted: set[str], sink) -> None:
         rd = _Reader(f, src, size)
         prev: tuple[int, bytes | None] | None = None
         while True:
-            r = rd.record(32)
+            r = rd.record(8 * rd.w)
             if r is None:
                 break
             # a table starts with [2] name(8 chars) (or [8] name(32 chars)) then [-1] [7]
-            if prev is not None and prev[0] == 4 and r[0] in (8, 32) and r[1] is not None:
-                nw = struct.unpack(rd.e + "i", prev[1])[0]
+            if prev is not None and prev[0] == rd.w and r[0] in (2 * rd.w, 8 * rd.w) and r[1] is not None:
+                nw = struct.unpack(rd.wfmt, prev[1])[0]
                 pos = f.tell()
-                if 4 * nw == r[0] and rd.peek_marker() == -1:
-                    rd.record(4)
+                if rd.w * nw == r[0] and rd.peek_marker() == -1:
+                    rd.record(rd.w)
                     seven = rd.peek_marker()
                     f.seek(pos)
                     if seven == 7:
-                        name = r[1][:8].decode("latin-1").strip()
+                        name = _name(r[1], rd.w)
                         if name in wanted:
-                            rd.table(lambda rec, name=name: sink(name, rec, rd.e))
+                            rd.table(lambda rec, name=name: sink(name, rec, rd.e, rd.w))
                         else:
                             try:
                                 rd.table(None)
@@ -196,9 +198,17 @@ def _tables(path, src: str, wanted: set[str], sink) -> None:
             prev = r
 
 
-def _ident(rec: bytes, e: str) -> dict:
-    w = np.frombuffer(rec, dtype=e + "i4")
-    fl = np.frombuffer(rec, dtype=e + "f4")
+def _name(b: bytes, w: int) -> str:
+    """A table name: 8 characters, or with 8-byte words either 16 characters or two words of 4
+    characters and 4 blanks each."""
+    if w == 8 and b[4:8] == b"    " and b[12:16] == b"    ":
+        b = b[0:4] + b[8:12]
+    return b[:8].decode("latin-1").strip()
+
+
+def _ident(rec: bytes, e: str, nb: int) -> dict:
+    w = np.frombuffer(rec, dtype=f"{e}i{nb}")
+    fl = np.frombuffer(rec, dtype=f"{e}f{nb}")
     return {"approach": int(w[0]), "tcode": int(w[1]), "subcase": int(w[3]), "mode": int(w[4]),
             "eigenvalue": float(fl[5]), "num_wide": int(w[9]), "thermal": int(w[22])}
 
@@ -212,14 +222,14 @@ class _Collector:
         self.want = None if grids is None else np.unique(np.asarray(list(grids), dtype=np.int64))
         self.lama: list[bytes] = []
         self.clama = False
-        self.e = "<"
+        self.e, self.w = "<", 4
         self.pending: dict[str, dict | None] = {t: None for t in EIGENVECTOR_TABLES}
         self.modes: dict[str, dict[int, tuple[float, np.ndarray, np.ndarray]]] = {t: {} for t in EIGENVECTOR_TABLES}
         self.subcases: dict[str, set[int]] = {t: set() for t in EIGENVECTOR_TABLES}
         self.present: set[str] = set()
 
-    def __call__(self, name: str, rec: bytes, e: str) -> None:
-        self.e = e
+    def __call__(self, name: str, rec: bytes, e: str, nb: int) -> None:
+        self.e, self.w = e, nb
         if name == "CLAMA":
             self.clama = True
             return
@@ -229,9 +239,9 @@ class _Collector:
         self.present.add(name)
         idn = self.pending[name]
         if idn is None:                                  # an IDENT record
-            if len(rec) != 4 * IDENT_WORDS:
-                raise InputError(self.src, f"{name} IDENT", f"{IDENT_WORDS} words", got=f"{len(rec) // 4}")
-            self.pending[name] = _ident(rec, e)
+            if len(rec) != nb * IDENT_WORDS:
+                raise InputError(self.src, f"{name} IDENT", f"{IDENT_WORDS} words", got=f"{len(rec) // nb}")
+            self.pending[name] = _ident(rec, e, nb)
             return
         self.pending[name] = None                        # its data record
         acode, tcode, sort = idn["approach"] // 10, idn["tcode"] % 1000, idn["tcode"] // 1000
@@ -241,10 +251,11 @@ class _Collector:
             kind = ("complex eigenvectors (SOL 107/110)" if acode == 9 or idn["num_wide"] != 8 else
                     "SORT2 eigenvectors" if sort & 2 else f"analysis code {acode}, thermal {idn['thermal']}")
             raise InputError(self.src, name, "real normal modes in SORT1 (SOL 103)", got=kind)
-        if len(rec) % 32:
-            raise InputError(self.src, f"{name} mode {idn['mode']}", "8 words per grid", got=f"{len(rec) // 4} words")
-        ids = np.frombuffer(rec, dtype=e + "i4").reshape(-1, 8)[:, 0] // 10
-        vals = np.frombuffer(rec, dtype=e + "f4").reshape(-1, 8)[:, 2:8]
+        if len(rec) % (8 * nb):
+            raise InputError(self.src, f"{name} mode {idn['mode']}", "8 words per grid",
+                             got=f"{len(rec) // nb} words")
+        ids = np.frombuffer(rec, dtype=f"{e}i{nb}").reshape(-1, 8)[:, 0] // 10
+        vals = np.frombuffer(rec, dtype=f"{e}f{nb}").reshape(-1, 8)[:, 2:8]
         if self.want is not None:
             keep = np.isin(ids, self.want)
             ids, vals = ids[keep], vals[keep]
@@ -270,7 +281,7 @@ def read_op2_modes(path, grids=None) -> Op2Modes:
         raise InputError(src, "(file)", "a Nastran OP2 file", got="a directory") from None
     except OSError as ex:
         raise InputError(src, "(file)", "a readable Nastran OP2 file", got=type(ex).__name__) from None
-    e = c.e
+    e, nb = c.e, c.w
     name = next((t for t in EIGENVECTOR_TABLES if c.modes[t]), None)
     if name is None:
         if c.present:
@@ -301,10 +312,10 @@ def read_op2_modes(path, grids=None) -> Op2Modes:
     if lama:
         if len(lama) > 1:
             raise InputError(src, "LAMA", "the eigenvalues of one subcase", got=f"{len(lama)} tables")
-        if len(lama[0]) % 28:
-            raise InputError(src, "LAMA", "7 words per mode", got=f"{len(lama[0]) // 4} words")
-        dt = np.dtype([("mode", e + "i4"), ("order", e + "i4"), ("eig", e + "f4"), ("rad", e + "f4"),
-                       ("cyc", e + "f4"), ("gm", e + "f4"), ("gk", e + "f4")])
+        if len(lama[0]) % (7 * nb):
+            raise InputError(src, "LAMA", "7 words per mode", got=f"{len(lama[0]) // nb} words")
+        i, r = f"{e}i{nb}", f"{e}f{nb}"
+        dt = np.dtype([("mode", i), ("order", i), ("eig", r), ("rad", r), ("cyc", r), ("gm", r), ("gk", r)])
         la = np.frombuffer(lama[0], dtype=dt)
         row = {int(m): k for k, m in enumerate(la["mode"])}
         missing = [m for m in order if m not in row]
@@ -317,4 +328,4 @@ def read_op2_modes(path, grids=None) -> Op2Modes:
         if not same:
             raise InputError(src, "LAMA", f"the eigenvalues of {name}", got="different eigenvalues")
         gm, gk = la["gm"][k].astype(float), la["gk"][k].astype(float)
-    return Op2Modes(np.array(order), lam, gm, gk, gids[srt], phi, name, e)
+    return Op2Modes(np.array(order), lam, gm, gk, gids[srt], phi, name, e, nb)

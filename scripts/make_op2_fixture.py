@@ -22,6 +22,8 @@ It writes into tests/data/op2/:
   and real word byte-swapped and the character words (table names, tape code, IDENT words
   51-146) kept, :func:`to_big_endian`; pyNastran's reading of it (in the reference file) is
   the check that the result is a valid big-endian OP2.
+* ``beam_64.op2``: ``beam_le.op2`` with 64-bit words (:func:`to_64bit`; pyNastran writes no
+  64-bit OP2, its reading of this one is the check of the conversion).
 * ``beam_modes_m1.op2`` and ``beam_modes_m2.op2``, copied from pyNastran's
   models/beam_modes/ (``--pynastran-models``; BSD-3-Clause, see README.md): real Nastran
   SOL 103 output (PARAM,POST,-1 and -2) of a clamped rod with a tip mass, NORM=MAX, with LAMA.
@@ -112,6 +114,49 @@ def to_big_endian(le: bytes) -> bytes:
     return b"".join(out)
 
 
+def to_64bit(le: bytes) -> bytes:
+    """The little-endian 32-bit OP2 ``le`` written by :func:`write_beam_op2` (header and OUGV1
+    only) with 64-bit words, as MSC Nastran writes them: Fortran record lengths stay 4 bytes;
+    integers int64, reals float64; character words 4 characters and 4 blanks (tape code, label,
+    IDENT title words 51-146), table names 8 characters and 8 blanks. Word types by record:
+    markers, the date, the trailer and OUG grid/type words integers; IDENT words 6-7 (eigenvalue,
+    cycles) and the OUG components reals."""
+    import struct
+
+    def ints(b):
+        return np.frombuffer(b, dtype="<i4").astype("<i8").tobytes()
+
+    def reals(b):
+        return np.frombuffer(b, dtype="<f4").astype("<f8").tobytes()
+
+    def chars(b):
+        return b"".join(b[j:j + 4] + b"    " for j in range(0, len(b), 4))
+
+    out, i, after_ident = [], 0, False
+    while i < len(le):
+        n = struct.unpack("<i", le[i:i + 4])[0]
+        d = le[i + 4:i + 4 + n]
+        if d == b"NASTRAN FORT TAPE ID CODE - " or d == b"XXXXXXXX":
+            body = chars(d)
+        elif n == 8:
+            body = d + b" " * 8                                    # a table name
+        elif n == 28 and d[:8].strip().isalnum():
+            body = d[:8] + b" " * 8 + ints(d[8:])                  # name + 5 ints of a -2 record
+        elif n == 584:
+            body = ints(d[:20]) + reals(d[20:28]) + ints(d[28:200]) + chars(d[200:])
+        elif after_ident and n > 4:                                # OUG data: 2 ints, 6 reals per grid
+            g = np.frombuffer(d, dtype="<i4").reshape(-1, 8)
+            body = np.hstack([g[:, :2].astype("<i8").view("<u8"),
+                              g[:, 2:].view("<f4").astype("<f8").view("<u8")]).astype("<u8").tobytes()
+        else:
+            body = ints(d)
+        if n > 4:
+            after_ident = n == 584
+        out.append(struct.pack("<i", len(body)) + body + struct.pack("<i", len(body)))
+        i += 8 + n
+    return b"".join(out)
+
+
 def reference(paths) -> dict:
     from pyNastran.op2.op2 import read_op2
 
@@ -138,6 +183,7 @@ def main() -> None:
     write_beam_op2(OUT / "beam_le.op2", b"<", -1, norm_max=True)
     write_beam_op2(OUT / "beam_be.op2", b"<", -1, norm_max=False)
     (OUT / "beam_be.op2").write_bytes(to_big_endian((OUT / "beam_be.op2").read_bytes()))
+    (OUT / "beam_64.op2").write_bytes(to_64bit((OUT / "beam_le.op2").read_bytes()))
     if args.pynastran_models:
         for name in PYNASTRAN_MODELS:
             shutil.copyfile(args.pynastran_models / name, OUT / name)

@@ -25,7 +25,7 @@ from .test_masv_nengine import N_EL, beam_modes, config, write_npz, write_punch,
 
 DATA = Path(__file__).resolve().parent / "data" / "op2"
 REF = np.load(DATA / "reference_pynastran.npz")
-FILES = ["beam_le", "beam_be", "beam_modes_m1", "beam_modes_m2"]
+FILES = ["beam_le", "beam_be", "beam_64", "beam_modes_m1", "beam_modes_m2"]
 #: rows: vehicle x, y, z in the FE frame of beam_*.op2 (bar along FE y)
 FE_TO_VEHICLE = "[[0, 1, 0], [1, 0, 0], [0, 0, -1]]"
 
@@ -35,6 +35,7 @@ def test_op2_reader_equals_pynastran(stem):
     m = read_op2_modes(DATA / f"{stem}.op2")
     r = {k.split("__", 1)[1]: REF[k] for k in REF.files if k.startswith(stem + "__")}
     assert m.endian == (">" if stem == "beam_be" else "<")
+    assert m.word_bytes == (8 if stem == "beam_64" else 4)
     assert m.table == str(r["table"])
     assert np.array_equal(m.mode, r["vector_modes"])
     assert np.array_equal(m.grids, r["grids"])
@@ -97,8 +98,9 @@ def test_op2_round_trips_into_the_punch_uff_and_npz_modes(tmp_path):
     gm = 1.0 / (np.abs(V).max(axis=1) * math.sqrt(1e-3)) ** 2
     le = load_config(_op2_config(tmp_path, "beam_le", f"modal_mass = {gm.tolist()}"))
     be = load_config(_op2_config(tmp_path, "beam_be", "modal_mass = 1.0"))
+    w64 = load_config(_op2_config(tmp_path, "beam_64", f"modal_mass = {gm.tolist()}"))
     assert le.structure_import["format"] == be.structure_import["format"] == "nastran-op2"
-    for cfg in (le, be):
+    for cfg in (le, be, w64):
         st = cfg.structure
         assert st.n_modes == N_EL and st.node_names == ref.structure.node_names
         # measured: float32 OP2 words against .npz and punch 3e-8 (freq) and 2e-8 (shapes, of the
@@ -109,7 +111,7 @@ def test_op2_round_trips_into_the_punch_uff_and_npz_modes(tmp_path):
             assert np.allclose(st.phi, o.phi, rtol=0, atol=tp * np.abs(o.phi).max())
     f = [1.0, 2.0, 9.0, 20.0]
     th_pch = build_system(pch).frf(f)[1]
-    for cfg in (le, be):
+    for cfg in (le, be, w64):
         th = build_system(cfg).frf(f)[1]
         assert np.allclose(th, th_pch, rtol=0, atol=1e-8 * np.abs(th_pch).max())     # measured 2e-9
         assert np.abs(th[:, 1, 0]).max() > 1e-2          # the engines couple through the bar
@@ -134,7 +136,7 @@ def _first_ident(b) -> int:
     ("truncated", "byte"),
     ("length", "Fortran record"),
     ("text", "first record length"),
-    ("64bit", "64-bit"),
+    ("64bit_header_only", "real eigenvector table"),
     ("no_vectors", "real eigenvector table"),
     ("missing", "existing"),
 ])
@@ -155,7 +157,7 @@ def test_bad_op2_is_one_line_input_error(tmp_path, case, expect):
     elif case == "text":
         p = tmp_path / "t.op2"
         p.write_text("$EIGENVECTOR\n")
-    elif case == "64bit":
+    elif case == "64bit_header_only":
         p = tmp_path / "t.op2"
         p.write_bytes(struct.pack("<iqi", 8, 3, 8))
     elif case == "no_vectors":
@@ -213,7 +215,7 @@ def test_grid_selection_keeps_the_named_grids_only():
     assert np.array_equal(sel.phi, full.phi[:, cols]) and np.array_equal(sel.generalised_mass, full.generalised_mass)
 
 
-@pytest.mark.parametrize("stem", ["beam_le", "beam_be", "beam_modes_m1"])
+@pytest.mark.parametrize("stem", ["beam_le", "beam_be", "beam_64", "beam_modes_m1"])
 def test_corrupted_op2_reads_or_is_one_line_input_error(tmp_path, stem):
     """Random byte edits, aligned small words and truncations: the reader returns or raises
     InputError (one line), never another exception (a 1200-case run: 604 errors, 596 reads)."""
