@@ -5,7 +5,7 @@ masv imports taos; taos never imports masv.
 Modules: :mod:`masv.structure` (modal model, file contract, validation, static correction),
 :mod:`masv.config` (TOML configuration: engines, actuators, structure, band of interest;
 every key: docs/reference/masv_files.md), :mod:`masv.fe_import` (mode shapes from Universal
-File 55 and Nastran punch files),
+File 55, Nastran punch and Nastran OP2 files; the OP2 reader ``masv._op2``),
 :mod:`masv.system` (assembly of taos.planar.simplex.simplex_state_space engine-axis blocks, the engines'
 mass and c.g. offset, and the modes; one StateSpace of the whole, and a fast block-elimination
 frequency response),

@@ -38,8 +38,8 @@ Formats:
   ``<id> G <T1> <T2> <T3>`` and its ``-CONT- <R1> <R2> <R3>`` (free-field, the 80-column line
   counter ignored); lambda = (2 pi f)^2 [rad^2/s^2]. The punch file holds no generalised
   masses: ``modal_mass`` must be given (1 for NORM=MASS).
-* **Nastran OP2** (``.op2``; ``DISP = ALL`` in a SOL 103 run, ``PARAM,POST,-1`` or ``-2``, 32-bit
-  words, either byte order; read by :mod:`masv._op2`): the real eigenvector table (BOUGV1 in the
+* **Nastran OP2** (``.op2``; ``DISP = ALL`` in a SOL 103 run, ``PARAM,POST,-1`` or ``-2``, 32- or
+  64-bit words, either byte order; read by ``masv._op2``): the real eigenvector table (BOUGV1 in the
   basic frame when present, else OUGV1/OUG1) and, when present, the LAMA eigenvalue table whose
   generalised masses are the file's (``modal_mass = "file"``, the default with a LAMA table);
   lambda = (2 pi f)^2 [rad^2/s^2]; no damping.
