@@ -45,7 +45,7 @@ import numpy as np
 
 from taos.errors import InputError
 
-#: largest logical record read into memory [bytes] (256 MiB: 8 million grids x 8 words)
+#: largest logical record read into memory [bytes] (256 MiB: 8 million grids of a 32-bit OP2)
 MAX_RECORD_BYTES = 1 << 28
 #: most modes taken from one file
 MAX_MODES = 100_000
@@ -167,7 +167,7 @@ class _Reader:
 
 def _tables(path, src: str, wanted: set[str], sink) -> None:
     """Pass every logical record of the tables named in ``wanted`` to ``sink(name, record,
-    endian)``, in file order; skip the others."""
+    endian, bytes per word)``, in file order; skip the others."""
     size = Path(path).stat().st_size
     with open(path, "rb") as f:
         rd = _Reader(f, src, size)

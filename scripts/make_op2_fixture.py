@@ -24,6 +24,8 @@ It writes into tests/data/op2/:
   the check that the result is a valid big-endian OP2.
 * ``beam_64.op2``: ``beam_le.op2`` with 64-bit words (:func:`to_64bit`; pyNastran writes no
   64-bit OP2, its reading of this one is the check of the conversion).
+* ``beam_split.op2``: ``beam_le.op2`` with each eigenvector data record split in two Fortran
+  records (:func:`split_records`), as Nastran writes long records.
 * ``beam_modes_m1.op2`` and ``beam_modes_m2.op2``, copied from pyNastran's
   models/beam_modes/ (``--pynastran-models``; BSD-3-Clause, see README.md): real Nastran
   SOL 103 output (PARAM,POST,-1 and -2) of a clamped rod with a tip mass, NORM=MAX, with LAMA.
@@ -157,6 +159,34 @@ def to_64bit(le: bytes) -> bytes:
     return b"".join(out)
 
 
+def split_records(le: bytes) -> bytes:
+    """The little-endian 32-bit OP2 ``le`` with every data record after an IDENT record (the
+    OUG eigenvector data) written as two Fortran records, ``[n1] data1 [n2] data2``, the way
+    Nastran splits a logical record longer than its buffer."""
+    import struct
+
+    recs, i = [], 0
+    while i < len(le):
+        n = struct.unpack("<i", le[i:i + 4])[0]
+        recs.append(le[i + 4:i + 4 + n])
+        i += 8 + n
+
+    def rec(d):
+        return struct.pack("<i", len(d)) + d + struct.pack("<i", len(d))
+
+    out, after_ident = [], False
+    for k, d in enumerate(recs):
+        if after_ident and len(d) > 4 and len(d) % 8 == 0:
+            h = (len(d) // 8) * 4                       # at a grid boundary when the length allows
+            out[-1] = rec(struct.pack("<i", h // 4))     # the word count before it, now of the first part
+            out += [rec(d[:h]), rec(struct.pack("<i", (len(d) - h) // 4)), rec(d[h:])]
+        else:
+            out.append(rec(d))
+        if len(d) > 4:
+            after_ident = len(d) == 584
+    return b"".join(out)
+
+
 def reference(paths) -> dict:
     from pyNastran.op2.op2 import read_op2
 
@@ -184,6 +214,7 @@ def main() -> None:
     write_beam_op2(OUT / "beam_be.op2", b"<", -1, norm_max=False)
     (OUT / "beam_be.op2").write_bytes(to_big_endian((OUT / "beam_be.op2").read_bytes()))
     (OUT / "beam_64.op2").write_bytes(to_64bit((OUT / "beam_le.op2").read_bytes()))
+    (OUT / "beam_split.op2").write_bytes(split_records((OUT / "beam_le.op2").read_bytes()))
     if args.pynastran_models:
         for name in PYNASTRAN_MODELS:
             shutil.copyfile(args.pynastran_models / name, OUT / name)

@@ -25,7 +25,7 @@ from .test_masv_nengine import N_EL, beam_modes, config, write_npz, write_punch,
 
 DATA = Path(__file__).resolve().parent / "data" / "op2"
 REF = np.load(DATA / "reference_pynastran.npz")
-FILES = ["beam_le", "beam_be", "beam_64", "beam_modes_m1", "beam_modes_m2"]
+FILES = ["beam_le", "beam_be", "beam_64", "beam_split", "beam_modes_m1", "beam_modes_m2"]
 #: rows: vehicle x, y, z in the FE frame of beam_*.op2 (bar along FE y)
 FE_TO_VEHICLE = "[[0, 1, 0], [1, 0, 0], [0, 0, -1]]"
 
