@@ -87,6 +87,7 @@ class FlightRuns:
     def run_batch(self, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray) -> dict:
         n, m = len(seeds), len(self.trace_t_s)
         out = {"status": np.zeros(n, np.int8), "error": [""] * n, "trace": np.full((n, m), np.nan),
+               "engine_trace": np.full((n, m), np.nan),
                **{k: np.full(n, np.nan) for k in self.scalars}, **{k: np.zeros(n, bool) for k in self.flags}}
         c = self.campaign
         runs, rows = [], []
@@ -128,9 +129,10 @@ class FlightRuns:
         for k, v in vals.items():
             out[k][i] = v
         _, step, _ = self._grid()
-        tr = h.signal("command_rad", c.axis)[::step]
-        mm = min(len(tr), out["trace"].shape[1])
-        out["trace"][i, :mm] = tr[:mm]
+        for k, sig in (("trace", "command_rad"), ("engine_trace", "engine_rad")):   # at the trace interval
+            tr = h.signal(sig, c.axis)[::step]
+            mm = min(len(tr), out[k].shape[1])
+            out[k][i, :mm] = tr[:mm]
         bound = self.gimbal_range_deg
         worst = vals["peak_engine_deg"]
         if not math.isfinite(worst) or worst >= bound:

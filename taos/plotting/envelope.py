@@ -1,5 +1,5 @@
 """A flight record against its Monte Carlo envelope (:mod:`taos.montecarlo.envelope`): the
-percentile bands of the stored command over time, the median, the record overlaid and the samples
+percentile bands of the stored command (or engine angle) over time, the median, the record overlaid and the samples
 outside marked, the fraction of time outside in the title. Drawing only."""
 
 from __future__ import annotations
@@ -10,12 +10,26 @@ import numpy as np
 from taos.plotting import _common  # noqa: F401  (sets the headless backend)
 
 
-def plot_envelope(env, comparison=None):
+def plot_envelopes(pairs):
+    """Several envelopes one above the other on a shared time axis: ``pairs`` of (envelope,
+    comparison or None), each drawn as :func:`plot_envelope`. Returns the figure."""
+    pairs = list(pairs)
+    fig, axs = plt.subplots(len(pairs), 1, figsize=(11, 4.0 * len(pairs)), sharex=True, squeeze=False)
+    for ax, (env, cmp) in zip(axs[:, 0], pairs):
+        plot_envelope(env, cmp, ax=ax)
+    fig.tight_layout()
+    return fig
+
+
+def plot_envelope(env, comparison=None, ax=None):
     """The envelope ``env`` (:class:`taos.montecarlo.envelope.Envelope`) in degrees: the outer band
     shaded, inner pairs of percentiles shaded darker, the middle percentile as a line; with a
     ``comparison`` (:class:`taos.montecarlo.envelope.EnvelopeComparison`) the record and its
-    samples outside. Returns the figure."""
-    fig, ax = plt.subplots(figsize=(11, 4.5))
+    samples outside. Returns the figure (drawn on ``ax`` when given)."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(11, 4.5))
+    else:
+        fig = ax.figure
     b = np.degrees(env.bands_rad)
     k = len(env.percentiles)
     for i in range(k // 2):
@@ -37,5 +51,6 @@ def plot_envelope(env, comparison=None):
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
+    if len(fig.axes) == 1:
+        fig.tight_layout()
     return fig
