@@ -6,6 +6,7 @@ is exactly the level, so the largest |T_f| of each update interval with sliding 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -51,3 +52,39 @@ def test_coulomb_level_along_the_ascent_follows_the_thrust_profile(tmp_path, fol
                 assert t1 / t0 == pytest.approx(n1 / n0, rel=1e-9)
             else:
                 assert t1 == t0 == pytest.approx(MU * m.engine.thrust_N * RB, rel=2e-5)
+
+
+def test_campaign_key_flies_the_runs_with_the_level_following_the_thrust(tmp_path):
+    """``friction_follows_thrust = true`` in a campaign file: each run is flown as
+    simulate_ascents(..., friction_follows_thrust=True) flies it (its stored traces are that run's),
+    and differs from the default where the thrust is not the model's; not a boolean: named."""
+    from taos.errors import InputError
+    from taos.flight.ascent_sim import simulate_ascents
+    from taos.montecarlo import load_campaign
+    from taos.montecarlo.campaign import apply_factors, base_models
+    from taos.montecarlo.executor import flight_runs
+
+    src = (Path(__file__).resolve().parent / "data" / "mc_short.toml").read_text()
+    asc = (Path(__file__).resolve().parent.parent / "models" / "flight" / "ascent.toml").as_posix()
+    src = src.replace('"../../models/flight/ascent.toml"', json.dumps(asc)).replace('"120 s"', '"30 s"')
+    kinds = {}
+    for follow in (False, True):
+        p = tmp_path / f"c{follow}.toml"
+        p.write_text(src.replace('axis = "yaw"', f'axis = "yaw"\nfriction_follows_thrust = {str(follow).lower()}'))
+        kinds[follow] = flight_runs(load_campaign(p), "soft", None)[0]
+    c = kinds[True].campaign
+    assert c.friction_follows_thrust and not kinds[False].campaign.friction_follows_thrust
+    names = tuple(d.name for d in c.dispersions)
+    ones, seeds = np.ones((1, len(names))), np.array([3])
+    out = {f: k.run_batch(names, ones, seeds) for f, k in kinds.items()}
+    asc_, m = base_models(c)
+    a2, m2, _ = apply_factors(asc_, m, c.cases["soft"], dict(zip(names, [1.0] * len(names))))
+    h = simulate_ascents([(a2, m2, 3)], axis="yaw", start_s=30.0, end_s=70.0, dt_s=c.dt_s, record_interval_s=0.02,
+                         friction_follows_thrust=True)[0]
+    t = kinds[True].trace_t_s
+    assert np.array_equal(out[True]["engine_trace"][0], np.interp(t, h.t_s, h.signal("engine_rad", "yaw")))
+    assert not np.array_equal(out[True]["trace"][0], out[False]["trace"][0])
+    bad = tmp_path / "bad.toml"
+    bad.write_text(src.replace('axis = "yaw"', 'axis = "yaw"\nfriction_follows_thrust = "yes"'))
+    with pytest.raises(InputError, match="friction_follows_thrust"):
+        load_campaign(bad)

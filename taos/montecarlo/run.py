@@ -103,7 +103,8 @@ class FlightRuns:
         # the batch's runs in lockstep (taos.flight.ascent_sim.simulate_ascents): each run's
         # numbers are its own, whatever else is in the batch
         flown = simulate_ascents(runs, axis=c.axis, start_s=c.start_s, end_s=c.start_s + c.duration_s, dt_s=c.dt_s,
-                                 record_interval_s=max(RECORD_INTERVAL_S, c.dt_s))
+                                 record_interval_s=max(RECORD_INTERVAL_S, c.dt_s),
+                                 friction_follows_thrust=c.friction_follows_thrust)
         for i, h in zip(rows, flown):
             if isinstance(h, (SimulationUnstable, InputError, ValueError, ArithmeticError)):
                 self._failed(out, i, h)
