@@ -17,6 +17,8 @@ def plot_envelopes(pairs):
     fig, axs = plt.subplots(len(pairs), 1, figsize=(11, 4.0 * len(pairs)), sharex=True, squeeze=False)
     for ax, (env, cmp) in zip(axs[:, 0], pairs):
         plot_envelope(env, cmp, ax=ax)
+    for ax in axs[:-1, 0]:
+        ax.set_xlabel("")
     fig.tight_layout()
     return fig
 
@@ -38,7 +40,8 @@ def plot_envelope(env, comparison=None, ax=None):
                         label=f"{lo:g}-{hi:g} % of {env.runs_ok} runs")
     if k % 2:
         ax.plot(env.t_s, b[k // 2], color="tab:blue", lw=1.0, label=f"{env.percentiles[k // 2]:g} %")
-    title = f"{env.quantity} envelope" + (f", {env.axis} axis" if env.axis else "")
+    name = {"command": "FCS command", "engine": "engine angle"}.get(env.quantity, env.quantity)
+    title = f"{name} envelope" + (f", {env.axis} axis" if env.axis else "")
     if comparison is not None:
         c = comparison
         v = np.degrees(c.value_rad)
@@ -47,7 +50,7 @@ def plot_envelope(env, comparison=None, ax=None):
         ax.plot(c.t_s[out], v[out], "r.", ms=4, label="outside")
         title += f": record outside {100 * c.fraction_outside:.1f} % of the time"
     ax.set_xlabel("time [s]")
-    ax.set_ylabel(f"{env.quantity} [deg]")
+    ax.set_ylabel(f"{name} [deg]")
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
