@@ -106,6 +106,11 @@ def cmd_lco(args) -> int:
                   f"at {td['frequency_hz']:.4f} Hz", file=out)
         else:
             print(f"time domain:   no sustained oscillation (final {td['final_amplitude_deg']:.2g} deg)", file=out)
+        if td.get("duty"):
+            du = td["duty"]["axes"][d["axis"]]
+            print(f"duty cycle:    peak flow {du['peak_flow_m3_s']:.3g} m^3/s, mean {du['mean_flow_m3_s']:.3g} m^3/s, "
+                  f"supply power {du['mean_supply_power_W']:.3g} W, piston travel {du['piston_travel_m']:.3g} m, "
+                  f"{du['reversals_per_s']:.3g} reversals/s over the last {td['window_s']:g} s", file=out)
     print("loop margins of L0 N(A, .) over the command amplitude A (low GM: how far the gain may fall):", file=out)
     print(rep.verdict().table_text(), file=out)
     return 0

@@ -94,7 +94,8 @@ def cmd_ascent(args) -> int:
     # --
     out = _out_folder(args.out, [run_file(m.friction.name) for m in models] + ["summary.json", "ascent.png"])
     study = fly_ascent(ascent, models, reference=reference, avionics=args.avionics, axes=axes, start_s=start,
-                       end_s=end, dt_s=args.dt, seed=args.seed, progress=args.progress)
+                       end_s=end, dt_s=args.dt, seed=args.seed, progress=args.progress,
+                       friction_follows_thrust=args.friction_follows_thrust)
     summary = study.summary()
     text = json.dumps(summary, indent=1, allow_nan=False) + "\n"  # checked before anything is written
     out.mkdir(parents=True, exist_ok=True)
@@ -200,6 +201,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--end", type=float, help="end of the flown segment [s] (default the trajectory's end)")
     p.add_argument("--dt", type=float, default=2e-4, help="RK4 step [s] (default 2e-4: the switching Coulomb stick band needs it)")
     p.add_argument("--seed", type=int, default=0, help="turbulence seed (default 0)")
+    p.add_argument("--friction-follows-thrust", action="store_true", help="the friction level follows the "
+                   "trajectory's core thrust per engine, T_c = mu N(t) r_b (default: the model's level throughout)")
     p.add_argument("--out", help="output folder: ascent_<law>.h5, ascent.png, summary.json (required to fly)")
     p.add_argument("--json", metavar="PATH", help="write the window analysis here ('-' for standard output)")
     p.add_argument("--progress", action="store_true", help="show a progress bar")

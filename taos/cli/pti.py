@@ -35,23 +35,26 @@ def cmd_pti(args) -> int:
     if args.out:
         from taos.cli.montecarlo import _out_folder
         out = _out_folder(args.out, ["pti.json", "pti.png"] + (["envelope.png"] if args.envelope else []))
-    env = cmp = None
-    if args.envelope:   # the record against a Monte Carlo campaign's envelope (taos.montecarlo.envelope)
-        from taos.montecarlo.envelope import compare_to_envelope, envelope
-        env = envelope(args.envelope)
-        cmp = compare_to_envelope(rec, env)
+    envs = {}
+    if args.envelope:   # the record against a Monte Carlo campaign's envelopes (taos.montecarlo.envelope)
+        from taos.montecarlo.envelope import record_against_campaign
+        envs = record_against_campaign(rec, args.envelope)
     res = analyse_ptis(rec, ascent, model, axes=axes, tail_s=args.tail, describing=not args.no_df,
                        low_band_hz=args.low_band)
-    summary = res.summary() | ({"envelope": {**cmp.to_dict(), "campaign": env.provenance}} if cmp else {})
+    summary = res.summary()
+    if envs:
+        summary["envelope"] = {"campaign": envs["command"][0].provenance,
+                               **{q: (c.to_dict() if c is not None else {"quantity": q, "not_compared": why})
+                                  for q, (_, c, why) in envs.items()}}
     text = json.dumps(summary, indent=1, allow_nan=False) + "\n"  # checked before anything is written
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         from taos.plotting import save
         from taos.plotting.pti import plot_pti
         save(plot_pti(res), out / "pti.png")
-        if cmp is not None:
-            from taos.plotting.envelope import plot_envelope
-            save(plot_envelope(env, cmp), out / "envelope.png")
+        if envs:
+            from taos.plotting.envelope import plot_envelopes
+            save(plot_envelopes([(e, c) for e, c, _ in envs.values() if e is not None]), out / "envelope.png")
         atomic_write(out / "pti.json", lambda p: p.write_text(text))
     if args.json:
         write_json(args.json, summary)
@@ -59,8 +62,11 @@ def cmd_pti(args) -> int:
     for r in res.responses:
         print(f"{r.axis:>5s} {r.kind:9s} {r.start_s:6.0f}-{r.end_s:4.0f} s, {r.amplitude_deg:.3f} deg: "
               f"{r.friction()['verdict']}")
-    if cmp is not None:
-        print(f"command outside the campaign's {cmp.band_percentiles[0]:g}-{cmp.band_percentiles[1]:g} % "
+    for q, (_, cmp, why) in envs.items():
+        if cmp is None:
+            print(f"{q}: not compared with the campaign ({why})")
+            continue
+        print(f"{q} outside the campaign's {cmp.band_percentiles[0]:g}-{cmp.band_percentiles[1]:g} % "
               f"envelope {100 * cmp.fraction_outside:.1f} % of the time ({cmp.t_s.size} samples)")
     if out is not None:
         print(f"PTI analysis written to {out}")
@@ -82,7 +88,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--no-df", action="store_true", help="no describing-function overlay (faster)")
     p.add_argument("--out", metavar="DIR", help="write DIR/pti.json and DIR/pti.png")
     p.add_argument("--json", metavar="PATH", help="write the analysis here ('-' for standard output)")
-    p.add_argument("--envelope", metavar="CAMPAIGN_DIR", help="also the record's command against the 5/50/95 %% "
-                   "envelope of a taos montecarlo campaign (its --out folder): fraction of time outside, "
-                   "DIR/envelope.png")
+    p.add_argument("--envelope", metavar="CAMPAIGN_DIR", help="also the record's command and engine angle against "
+                   "the 5/50/95 %% envelopes of a taos montecarlo campaign (its --out folder): fraction of time "
+                   "outside, DIR/envelope.png")
     p.set_defaults(func=cmd_pti)

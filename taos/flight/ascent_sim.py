@@ -555,7 +555,8 @@ class AscentStudy:
         from taos.flight.duty import duty_summary
         duty = [duty_summary(h, m) for h, m in zip(self.runs, self.models)] or [None] * len(self.runs)
         return {"ascent_file": self.ascent.source, "ascent_sha256": self.ascent.sha256, "avionics": self.avionics,
-                "axes": list(self.axes),
+                "axes": list(self.axes), "friction_follows_thrust": bool(self.reference.provenance.get(
+                    "friction_follows_thrust", False)),
                 "runs": [{"friction_model": h.friction_model, "file": run_file(h.friction_model),
                           "windows": [w.to_dict() for w in wins], "duty": d, "provenance": h.provenance}
                          for h, wins, d in zip(self.runs, self.windows, duty)]}

@@ -33,7 +33,7 @@ from taos.errors import InputError
 from taos.harmonics import harmonic_amplitudes as _fit
 from taos.flight.describing import DescribingFunctionMap, describing_function_map
 from taos.flight.vehicle import FlightModel, Margins, flight_plant, loop_freqresp, margins
-from taos.linear import gain_db, phase_deg
+from taos.linear import StateSpace, gain_db, phase_deg
 from taos.model import TvcModel
 from taos.results import atomic_write, model_provenance, package_version, write_provenance
 from taos.planar.avionics import Avionics
@@ -294,14 +294,38 @@ class FlightHistory:
     friction_model: str
     load_stiffness_N_per_m: float
     provenance: dict = field(default_factory=dict)
+    #: the loop's axis, and the hydraulic signals (None when not recorded): piston rate v_p [m/s],
+    #: load pressure P_L [Pa], valve no-load flow over piston area q [m/s] (as
+    #: :data:`taos.flight.ascent_sim.HYDRAULIC`), for the duty cycle (:mod:`taos.flight.duty`)
+    axis: str = ""
+    piston_rate_m_s: np.ndarray | None = None
+    load_pressure_Pa: np.ndarray | None = None
+    valve_flow_m_s: np.ndarray | None = None
 
     ARRAYS = ("t_s", "attitude_rad", "command_rad", "engine_rad", "piston_m", "friction_torque_Nm", "pti_rad")
+    HYDRAULIC = ("piston_rate_m_s", "load_pressure_Pa", "valve_flow_m_s")
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """The one axis, so the duty cycle (:func:`taos.flight.duty.duty_summary`) reads this run
+        as it reads an ascent's."""
+        return (self.axis,)
+
+    @property
+    def has_hydraulics(self) -> bool:
+        return all(getattr(self, k) is not None for k in self.HYDRAULIC)
+
+    def signal(self, name: str, axis: str) -> np.ndarray:
+        """The recorded signal ``name`` (an array field) of ``axis`` (this run's)."""
+        if axis != self.axis or getattr(self, name, None) is None:
+            raise KeyError(f"{name} of the {axis} axis is not recorded")
+        return getattr(self, name)
 
     def to_hdf5(self, path) -> None:
         def write(tmp):
             import h5py
             with h5py.File(tmp, "w") as h5:
-                for k in self.ARRAYS:
+                for k in self.ARRAYS + (self.HYDRAULIC if self.has_hydraulics else ()):
                     h5.create_dataset(k, data=getattr(self, k), compression="gzip")
                 h5.attrs["friction_model"] = self.friction_model
                 h5.attrs["load_stiffness_N_per_m"] = self.load_stiffness_N_per_m
@@ -327,8 +351,13 @@ def simulate_flight(flight: FlightModel, model: TvcModel, duration_s: float = 30
     r = np.zeros((n + 1, 1)) if pti is None else np.asarray(pti(t), float).reshape(-1, 1)
     x0 = np.zeros(plant.ss.A.shape[0])
     x0[plant.ss.state_index("xi_rad")] = attitude0_rad
-    y, aux = integrate_plant(plant, model, r, dt_s, record_every, x0)
-    o = plant.ss.output_index
+    ss = plant.ss   # recorded besides the outputs: the actuator states of the duty cycle (rows of C only)
+    hyd = ("v_p_m_s", "p_load_Pa", "q_m_s")
+    C = np.vstack([ss.C, np.eye(ss.A.shape[0])[[ss.state_index(k) for k in hyd]]])
+    rec_plant = dataclasses.replace(plant, ss=StateSpace(ss.A, ss.B, C, np.vstack([ss.D, np.zeros((3, ss.D.shape[1]))]),
+                                                         ss.states, ss.inputs, ss.outputs + hyd))
+    y, aux = integrate_plant(rec_plant, model, r, dt_s, record_every, x0)
+    o = rec_plant.ss.output_index
     prov = {**model_provenance(model), "flight_file": flight.source,
             "flight_sha256": flight.sha256, "package_version": package_version(), "dt_s": dt_s,
             "record_every": record_every, "attitude0_rad": attitude0_rad, "axis": axis}
@@ -337,7 +366,9 @@ def simulate_flight(flight: FlightModel, model: TvcModel, duration_s: float = 30
                          engine_rad=y[:, o("theta_rad")], piston_m=y[:, o("x_p_m")],
                          friction_torque_Nm=aux[:, 0], pti_rad=r[::record_every, 0],
                          friction_model=model.friction.name,
-                         load_stiffness_N_per_m=model.structure.load_stiffness_N_per_m, provenance=prov)
+                         load_stiffness_N_per_m=model.structure.load_stiffness_N_per_m, provenance=prov,
+                         axis=axis, piston_rate_m_s=y[:, o("v_p_m_s")], load_pressure_Pa=y[:, o("p_load_Pa")],
+                         valve_flow_m_s=y[:, o("q_m_s")])
 
 
 @dataclass(frozen=True)
@@ -423,7 +454,7 @@ class LcoReport:
             "axis": self.prediction.axis,
             "margins_at_largest_amplitude": {"amplitude_deg": math.degrees(self.prediction.df.amplitude_rad[-1]),
                                              **big.to_dict()},
-            "time_domain": None if self.time_domain is None else self.time_domain.to_dict(),
+            "time_domain": None if self.time_domain is None else {**self.time_domain.to_dict(), "duty": self.duty()},
             "verdict": {**decision(d, None if self.time_domain is None else self.time_domain.to_dict()),
                         **self.verdict().to_dict()},
             "describing_function": {"amplitude_deg": np.degrees(self.prediction.df.amplitude_rad).tolist(),
@@ -433,6 +464,16 @@ class LcoReport:
                            "package_version": package_version()},
         })
         return d
+
+    def duty(self) -> dict | None:
+        """The hydraulic duty cycle of the time-domain run over its measurement window (the settled
+        oscillation; :func:`taos.flight.duty.duty_summary` with the flown model's limits), or None
+        without a run that recorded the actuator states."""
+        h = self.history
+        if self.time_domain is None or h is None or not h.has_hydraulics:
+            return None
+        from taos.flight.duty import duty_summary
+        return duty_summary(h, self.model, float(h.t_s[-1]) - self.time_domain.window_s)
 
     def verdict(self):
         """The verdict in plain words with its margin table (:mod:`taos.flight.lco_verdict`)."""

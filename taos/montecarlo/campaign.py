@@ -18,6 +18,8 @@ of each run as ``taos lco`` does. Format::
     update_interval = "5 s"                 # optional: override the ascent's zero-order-hold interval
     ptis = false                            # optional: fly the ascent's PTIs in the segment (default true)
     avionics = "bounding"                   # "bounding" (flat -1 dB, as taos lco) or "model" (quantiser)
+    friction_follows_thrust = false         # optional: the friction level follows the trajectory's thrust,
+                                            # T_c = mu N(t) r_b (taos.flight.friction_env; default false)
     default_case = "soft"
 
     [cases.soft]                            # named cases: TVC parameter overrides, with units
@@ -72,7 +74,8 @@ FLIGHT_PARAMETERS = {
 }
 DISTRIBUTIONS = ("normal", "uniform")
 TOP_KEYS = {"name", "description", "ascent", "tvc_model", "friction", "seed", "start", "duration", "dt", "axis",
-            "analysis_window", "trace_interval", "default_case", "cases", "dispersions", "update_interval", "ptis", "avionics"}
+            "analysis_window", "trace_interval", "default_case", "cases", "dispersions", "update_interval", "ptis", "avionics",
+            "friction_follows_thrust"}
 MAX_SEGMENT_STEPS = 2_000_000
 
 
@@ -118,6 +121,7 @@ class Campaign:
     update_interval_s: float | None = None
     ptis: bool = True
     avionics: str = "bounding"
+    friction_follows_thrust: bool = False
 
 
 def _nearest(key: str, allowed) -> str:
@@ -239,6 +243,9 @@ def load_campaign(path: str | Path) -> Campaign:
     ptis = doc.get("ptis", True)
     if not isinstance(ptis, bool):
         raise InputError(src, "ptis", "true or false", got=repr(ptis))
+    follow = doc.get("friction_follows_thrust", False)
+    if not isinstance(follow, bool):
+        raise InputError(src, "friction_follows_thrust", "true or false", got=repr(follow))
     c = Campaign(name=str(doc.get("name", p.stem)), source=src, sha256=hashlib.sha256(raw).hexdigest(),
                  ascent_file=str(resolve_reference(asc, p, field="ascent", kind="campaign", what="an ascent file")),
                  tvc_model_file=(str(resolve_reference(tvc, p, field="tvc_model", kind="campaign",
@@ -246,7 +253,7 @@ def load_campaign(path: str | Path) -> Campaign:
                  friction=fr, seed=seed, start_s=start, duration_s=dur, dt_s=dt, axis=axis,
                  analysis_window_s=win, trace_interval_s=trace, default_case=str(default), cases=cases,
                  dispersions=disp, update_interval_s=upd, ptis=ptis,
-                 avionics=avionics)
+                 avionics=avionics, friction_follows_thrust=follow)
     from taos.bounds import check_campaign_bounds
     check_campaign_bounds(c, {k: f"{q.section}.{q.toml_key}" for k, q in PARAMETERS.items()})   # before any work
     return c

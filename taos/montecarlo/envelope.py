@@ -1,16 +1,18 @@
 """A flight against its Monte Carlo envelope (issue 43): percentile envelopes of the stored
-actuator command over time, and a flight record overlaid with the fraction of time outside.
+actuator command and engine angle over time, and a flight record overlaid with the fraction of
+time outside.
 
-A campaign stores, per run, the FCS command [rad] (the TVC command, PTI included) of its axis at
-the trace interval (``trace`` (run, time) of :mod:`taos.montecarlo.store`, ``time`` [s] the
-ascent clock). :func:`envelope` reads the ok runs of a campaign folder and gives, at each stored
+A campaign stores, per run, the FCS command [rad] (the TVC command, PTI included) and the engine
+angle theta [rad] of its axis at the trace interval (``trace`` and ``engine_trace`` (run, time) of
+:mod:`taos.montecarlo.store`, ``time`` [s] the ascent clock): the :data:`QUANTITIES` ``command``
+and ``engine``. :func:`envelope` reads the ok runs of a campaign folder and gives, at each stored
 time t_j, the percentiles P_p(t_j) over the runs (``numpy.percentile``, linear interpolation
-between order statistics). Engine angles are not stored (only the command trace is; a campaign
-that stored them would be read the same way): asking for them is bad input, named.
+between order statistics). A store written before the engine angle was stored has no engine
+trace: asking it for the engine envelope is bad input, named (run the campaign again).
 
 :func:`compare_to_envelope` puts a record on the envelope's times (linear interpolation of the
-record's command of the campaign's axis over the times both cover) and counts the samples outside
-the outermost band [P_lo, P_hi]:
+record's signal of the envelope's quantity, ``command_rad`` or ``engine_rad``, on the campaign's
+axis over the times both cover) and counts the samples outside the outermost band [P_lo, P_hi]:
 
     fraction_outside = #{j : x(t_j) < P_lo(t_j) or x(t_j) > P_hi(t_j)} / #{j}
 
@@ -29,8 +31,8 @@ import numpy as np
 
 from taos.errors import InputError
 
-#: stored quantity -> store variable (the campaign stores the FCS command only)
-QUANTITIES = {"command": "trace"}
+#: stored quantity -> (store variable, the record's signal)
+QUANTITIES = {"command": ("trace", "command_rad"), "engine": ("engine_trace", "engine_rad")}
 DEFAULT_PERCENTILES = (5.0, 50.0, 95.0)
 
 
@@ -77,20 +79,25 @@ def envelope(campaign_dir, quantity: str = "command", percentiles=DEFAULT_PERCEN
 
     ps = _check_percentiles(percentiles)
     if quantity not in QUANTITIES:
-        raise InputError("envelope", "quantity", f"one of {', '.join(QUANTITIES)} (a campaign stores the FCS "
-                         "command trace only; engine angles are not stored)", got=repr(quantity))
+        raise InputError("envelope", "quantity", f"one of {', '.join(QUANTITIES)} (the stored traces: FCS "
+                         "command, engine angle)", got=repr(quantity))
     p = Path(campaign_dir)
     zpath = p if p.suffix == ".zarr" else p / "campaign.zarr"
     folder = zpath.parent
     try:
         ds = open_store(zpath, consolidated=False, dask=False)
         st = np.asarray(ds["status"].values, np.int8)
-        tr = np.asarray(ds[QUANTITIES[quantity]].values, float)
+        var = QUANTITIES[quantity][0]
+        missing = var not in ds and "trace" in ds
+        tr = None if missing else np.asarray(ds[var].values, float)
         t = np.asarray(ds["time"].values, float)
         attrs = dict(ds.attrs)
     except (OSError, KeyError, ValueError, FileNotFoundError) as e:
         raise InputError(str(campaign_dir), "campaign", "a Monte Carlo campaign folder (taos montecarlo --out)",
                          got=type(e).__name__) from None
+    if missing:
+        raise InputError(str(zpath), var, f"a campaign that stored the {quantity} trace (this store was written "
+                         "before it was stored: run the campaign again)", got="a store without it")
     ok = st == STATUS["ok"]
     if ok.sum() < 2 or t.size < 2:
         raise InputError(str(campaign_dir), "campaign", "at least two completed runs with a trace",
@@ -123,9 +130,10 @@ class EnvelopeComparison:
     fraction_below: float
     band_percentiles: tuple[float, float]
     source: str = ""
+    quantity: str = "command"
 
     def to_dict(self) -> dict:
-        return {"record": self.source, "samples": int(self.t_s.size), "t_start_s": float(self.t_s[0]),
+        return {"quantity": self.quantity, "record": self.source, "samples": int(self.t_s.size), "t_start_s": float(self.t_s[0]),
                 "t_end_s": float(self.t_s[-1]), "band_percentiles": list(self.band_percentiles),
                 "fraction_outside": self.fraction_outside, "fraction_above": self.fraction_above,
                 "fraction_below": self.fraction_below,
@@ -135,8 +143,9 @@ class EnvelopeComparison:
 
 def compare_to_envelope(record, env: Envelope, axis: str | None = None) -> EnvelopeComparison:
     """The fraction of time ``record`` (a :class:`taos.flight.pti_record.FlightRecord`, or a pair
-    (t [s], command [rad])) spends outside ``env``'s outermost band (module docstring), on the
-    campaign's ``axis`` (default the envelope's)."""
+    (t [s], value [rad]) of ``env``'s quantity) spends outside ``env``'s outermost band (module
+    docstring), on the campaign's ``axis`` (default the envelope's)."""
+    sig = QUANTITIES[env.quantity][1]
     if isinstance(record, tuple):
         t, x = (np.asarray(a, float) for a in record)
         src = "<arrays>"
@@ -145,9 +154,12 @@ def compare_to_envelope(record, env: Envelope, axis: str | None = None) -> Envel
         if ax not in record.axes:
             raise InputError(getattr(record, "source", "record"), "axis", f"one of the record's axes "
                              f"{', '.join(record.axes)} (the campaign's)", got=repr(ax))
-        t, x, src = np.asarray(record.t_s, float), record.signal("command_rad", ax), record.source
+        t, x, src = np.asarray(record.t_s, float), record.signal(sig, ax), record.source
+        if x is None:
+            raise InputError(src, f"{ax}_{sig}", f"the record's {env.quantity} signal for its {env.quantity} envelope",
+                             got="a record without it")
     if t.ndim != 1 or t.shape != x.shape or t.size < 2 or not np.all(np.isfinite(x)):
-        raise InputError(src, "command", "a finite command sampled at increasing times", got=f"{t.shape} samples")
+        raise InputError(src, sig, f"a finite {env.quantity} sampled at increasing times", got=f"{t.shape} samples")
     sel = (env.t_s >= t[0]) & (env.t_s <= t[-1])
     if sel.sum() < 1:
         raise InputError(src, "t_s", f"a record overlapping the envelope's {env.t_s[0]:g}-{env.t_s[-1]:g} s",
@@ -158,4 +170,23 @@ def compare_to_envelope(record, env: Envelope, axis: str | None = None) -> Envel
     above, below = v > hi, v < lo
     n = te.size
     return EnvelopeComparison(te, v, lo, hi, float((above | below).sum() / n), float(above.sum() / n),
-                              float(below.sum() / n), (env.percentiles[0], env.percentiles[-1]), src)
+                              float(below.sum() / n), (env.percentiles[0], env.percentiles[-1]), src, env.quantity)
+
+
+def record_against_campaign(record, campaign_dir, percentiles=DEFAULT_PERCENTILES, axis: str | None = None
+                            ) -> dict[str, tuple[Envelope, EnvelopeComparison | None, str | None]]:
+    """Every stored quantity of a campaign against ``record``: quantity -> (envelope, comparison,
+    why there is no comparison). The command is required (bad input when it cannot be compared);
+    the engine angle is compared when both the store and the record carry it, else its comparison
+    is None with the reason (and its envelope None too for a store written before it)."""
+    env = envelope(campaign_dir, "command", percentiles)
+    out = {"command": (env, compare_to_envelope(record, env, axis), None)}
+    try:
+        eng = envelope(campaign_dir, "engine", percentiles)
+    except InputError as e:
+        return out | {"engine": (None, None, str(e))}
+    try:
+        out["engine"] = (eng, compare_to_envelope(record, eng, axis), None)
+    except InputError as e:
+        out["engine"] = (eng, None, str(e))
+    return out

@@ -87,6 +87,7 @@ class FlightRuns:
     def run_batch(self, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray) -> dict:
         n, m = len(seeds), len(self.trace_t_s)
         out = {"status": np.zeros(n, np.int8), "error": [""] * n, "trace": np.full((n, m), np.nan),
+               "engine_trace": np.full((n, m), np.nan),
                **{k: np.full(n, np.nan) for k in self.scalars}, **{k: np.zeros(n, bool) for k in self.flags}}
         c = self.campaign
         runs, rows = [], []
@@ -102,7 +103,8 @@ class FlightRuns:
         # the batch's runs in lockstep (taos.flight.ascent_sim.simulate_ascents): each run's
         # numbers are its own, whatever else is in the batch
         flown = simulate_ascents(runs, axis=c.axis, start_s=c.start_s, end_s=c.start_s + c.duration_s, dt_s=c.dt_s,
-                                 record_interval_s=max(RECORD_INTERVAL_S, c.dt_s))
+                                 record_interval_s=max(RECORD_INTERVAL_S, c.dt_s),
+                                 friction_follows_thrust=c.friction_follows_thrust)
         for i, h in zip(rows, flown):
             if isinstance(h, (SimulationUnstable, InputError, ValueError, ArithmeticError)):
                 self._failed(out, i, h)
@@ -128,9 +130,10 @@ class FlightRuns:
         for k, v in vals.items():
             out[k][i] = v
         _, step, _ = self._grid()
-        tr = h.signal("command_rad", c.axis)[::step]
-        mm = min(len(tr), out["trace"].shape[1])
-        out["trace"][i, :mm] = tr[:mm]
+        for k, sig in (("trace", "command_rad"), ("engine_trace", "engine_rad")):   # at the trace interval
+            tr = h.signal(sig, c.axis)[::step]
+            mm = min(len(tr), out[k].shape[1])
+            out[k][i, :mm] = tr[:mm]
         bound = self.gimbal_range_deg
         worst = vals["peak_engine_deg"]
         if not math.isfinite(worst) or worst >= bound:

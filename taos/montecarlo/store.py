@@ -13,7 +13,9 @@ Layout (``OUT/campaign.zarr``, Zarr format 2, readable with ``xarray.open_zarr``
     inputs_sha256 (run) str        the content hash of the inputs the worker flew the run with
     <scalar>   (run)  float        the run kind's scalar outputs (NaN when not ok)
     <flag>     (run)  bool         the run kind's yes/no outputs
-    trace      (run, time)         the run kind's trace (NaN when not ok)
+    trace      (run, time)         the run kind's trace (NaN when not ok): the FCS command [rad] of a flight run
+    engine_trace (run, time)       the engine angle [rad] of a flight run at the same times (NaN when not ok or
+                                   the run kind has none; absent from stores written before it)
 
 A second group (``group="nominal"``) holds the nominal run(s) in the same layout. The arrays are
 chunked along ``run`` by the batch size, so a batch is whole chunks: writing it costs the same at
@@ -30,6 +32,8 @@ from typing import Mapping
 import numpy as np
 
 STATUS = {"pending": 0, "ok": 1, "failed": 2, "diverged": 3}
+#: the (run, time) variables
+TRACES = ("trace", "engine_trace")
 TEXT_WIDTH = 160
 
 
@@ -53,8 +57,9 @@ def create(path: Path, *, labels: np.ndarray, names: tuple[str, ...], factors: n
         "error": (("run",), _lazy((n,), f"<U{TEXT_WIDTH}", ch, "")),
         "cpu": (("run",), _lazy((n,), "<U64", ch, "")),
         "inputs_sha256": (("run",), _lazy((n,), "<U64", ch, "")),
-        "trace": (("run", "time"), _lazy((n, m), float, (ch[0], max(m, 1)), np.nan)),
     }
+    for k in TRACES:
+        data[k] = (("run", "time"), _lazy((n, m), float, (ch[0], max(m, 1)), np.nan))
     for s in scalars:
         data[s] = (("run",), _lazy((n,), float, ch, np.nan))
     for f in flags:
@@ -69,7 +74,10 @@ def write_batch(path: Path, start: int, out: Mapping[str, np.ndarray], group: st
     import xarray as xr
     n = len(out["status"])
     region = {"run": slice(start, start + n)}
-    body = {k: ((("run", "time") if k == "trace" else ("run",)), np.asarray(v)) for k, v in out.items() if k != "status"}
+    # (a store written before a variable existed, resumed: that variable is not stored)
+    old = [k for k in TRACES[1:] if k in out and not (Path(path) / (group or "") / k / ".zarray").exists()]
+    body = {k: ((("run", "time") if k in TRACES else ("run",)), np.asarray(v)) for k, v in out.items()
+            if k != "status" and k not in old}
     if "error" in body:
         body["error"] = (("run",), np.asarray([e[:TEXT_WIDTH] for e in out["error"]], f"<U{TEXT_WIDTH}"))
     for k in ("cpu", "inputs_sha256"):
