@@ -27,7 +27,6 @@ pytest.importorskip("pythonfmu")
 from fmpy.validation import validate_fmu  # noqa: E402
 
 from taos.cosim import BlockOutputs, TvcBlock, build_fmu  # noqa: E402
-from taos.model import load_model  # noqa: E402
 from taos.planar.simulate import simulate  # noqa: E402
 from taos.profiles import Step, TwoAxis, load_profile  # noqa: E402
 

@@ -1,9 +1,9 @@
-"""``taos fmu MODEL --out FILE.fmu [--python]``: the nonlinear TVC of one engine as an FMI 2.0
-co-simulation FMU. By default in C, no Python at run time
-(:func:`taos.cosim._standalone.build_standalone_fmu`, the planar simplex model, both axes);
-with ``--python`` through pythonfmu, running taos in the host's Python
-(:func:`taos.cosim.build_fmu`, either engine; the only route for the 3-D model), an FMU that
-lacks the host behaviours :data:`PYTHON_LACKS` lists."""
+"""``taos fmu MODEL --out FILE.fmu [--engine simplex|taos] [--python]``: the nonlinear TVC of one
+engine as an FMI 2.0 co-simulation FMU. By default in C, no Python at run time: the planar
+simplex model (:func:`taos.cosim._standalone.build_standalone_fmu`) or the 3-D TAOS model
+(:func:`taos.cosim._standalone3d.build_standalone_fmu_3d`); with ``--python`` through
+pythonfmu, running taos in the host's Python (:func:`taos.cosim.build_fmu`), an FMU that lacks
+the host behaviours :data:`PYTHON_LACKS` lists."""
 
 from __future__ import annotations
 
@@ -25,14 +25,12 @@ def cmd_fmu(args) -> int:
         raise InputError("command line", "--python, --standalone", "one of them (--standalone is the default)",
                          got="both")
     if not args.python:
-        from taos.cosim._standalone import build_standalone_fmu
-
-        if args.engine != "simplex":
-            raise InputError("command line", "--engine", "simplex for the standalone FMU (the 3-D model has none; "
-                             "--python builds a pythonfmu FMU of it, which " + PYTHON_LACKS + ")",
-                             got=repr(args.engine))
-        b = build_standalone_fmu(args.model, args.out, friction=args.friction, avionics=args.avionics, dt_s=args.dt,
-                                 allow_unstable=args.allow_unstable)
+        if args.engine == "taos":
+            from taos.cosim._standalone3d import build_standalone_fmu_3d as build
+        else:
+            from taos.cosim._standalone import build_standalone_fmu as build
+        b = build(args.model, args.out, friction=args.friction, avionics=args.avionics, dt_s=args.dt,
+                  allow_unstable=args.allow_unstable)
         runs = "standalone C, linux64 binary and sources; no Python at run time"
     else:
         from taos.cosim import build_fmu
@@ -53,19 +51,18 @@ def add_parsers(sub) -> None:
     p.add_argument("model", help="model file (TOML), e.g. models/rs25_hotfire.toml")
     p.add_argument("--out", required=True, help="FMU file to write (*.fmu)")
     p.add_argument("--standalone", action="store_true",
-                   help="C sources and a linux64 binary, no Python at run time (the default; simplex engine; needs "
+                   help="C sources and a linux64 binary, no Python at run time (the default, either engine; needs "
                    "a C compiler and FMPy's FMI headers at build time)")
     p.add_argument("--python", action="store_true",
-                   help="instead a pythonfmu FMU that runs taos in the host's Python (either engine; the only FMU of "
-                   "the 3-D model). It " + PYTHON_LACKS)
+                   help="instead a pythonfmu FMU that runs taos in the host's Python (either engine). It " + PYTHON_LACKS)
     p.add_argument("--engine", choices=ENGINES, default="simplex",
-                   help="simplex (planar, per axis) or taos (3-D, with --python only)")
+                   help="simplex (planar, per axis) or taos (3-D: the standalone FMU has no tunable parameters)")
     add_friction_option(p)
     p.add_argument("--avionics", choices=AVIONICS, default="model",
                    help="model: the file's quantisation and crossover curve (default); bounding: the paper's "
                    "-1 dB gain without quantisation (as taos lco --avionics bounding)")
     p.add_argument("--dt", type=float, default=None, help="internal step [s] (default: the engine's, 2e-4 s "
-                   "simplex, 4e-4 s taos); communication steps must be multiples of it (the standalone FMU's "
-                   "internal_step_s parameter can change it before initialisation)")
+                   "simplex, 4e-4 s taos, at most 1e-3 s); communication steps must be multiples of it (the standalone "
+                   "FMU's internal_step_s parameter can change it before initialisation)")
     p.add_argument("--allow-unstable", action="store_true", help="build a model whose linear block is unstable")
     p.set_defaults(func=cmd_fmu)
