@@ -117,38 +117,64 @@ def test_discard_reports_terminated_only_when_the_fmu_cannot_go_on(cfmu, vr, tmp
     assert r["time"][-1] < 0.1 and any(st == 2 and "not finite" in m for st, m in msgs), msgs
 
 
-def test_libcosimpy_chains_two_instances_as_fmpy_runs_them(cfmu, vr, tmp_path):
-    """libcosimpy (OSP libcosim, fixed 2 ms steps): instance a holds a 0.3 deg pitch command,
-    instance b's pitch command is a's engine angle. a's engine angle equals an FMPy run of the
-    same FMU; b's equals an FMPy run fed a's samples at the start of each step (libcosim's
-    fixed-step transfer): both bit for bit at the 250 samples the observer keeps (0 to 0.498 s). Each instance is freed and the library
-    unloaded by libcosim at the end (in this process, no Python in the FMU)."""
-    lc = pytest.importorskip("libcosimpy")
-    from libcosimpy.CosimEnums import CosimVariableType
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy.CosimSlave import CosimLocalSlave
+#: libcosimpy run in a child process: a libcosim execution left in this process (its worker
+#: threads, its FMI library) is not this suite's to keep; args: JSON {"fmus": [[path, name], ...],
+#: "initial": [[slave, vr, value], ...], "connect": [[a, vr_out, b, vr_in], ...], "observe": vr,
+#: "h": step [s], "n": steps}; prints JSON [[sample steps, values] per slave]
+_COSIM_CHILD = r"""
+import json, sys
+from libcosimpy.CosimEnums import CosimVariableType
+from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+from libcosimpy.CosimObserver import CosimObserver
+from libcosimpy.CosimSlave import CosimLocalSlave
+a = json.loads(sys.argv[1])
+log_output_level(CosimLogLevel.ERROR)
+ns = int(round(a["h"] * 1e9))
+ex = CosimExecution.from_step_size(step_size=ns)
+idx = [ex.add_local_slave(CosimLocalSlave(fmu_path=p, instance_name=nm)) for p, nm in a["fmus"]]
+for sl, vr, v in a["initial"]:
+    ex.real_initial_value(idx[sl], vr, v)
+for sa, vo, sb, vi in a["connect"]:
+    assert ex.connect_real_variables(idx[sa], vo, idx[sb], vi) == 0   # libcosim: 0 = success
+ts = CosimObserver.create_time_series()
+ex.add_observer(ts)
+for i in idx:
+    ts.start_time_series(i, a["observe"], CosimVariableType.REAL)
+assert ex.simulate_until(target_time=a["n"] * ns)
+out = []
+for i in idx:
+    t, _, y = ts.time_series_real_samples(i, a["observe"], 0, a["n"] + 1)
+    out.append([[round(x / ns) for x in t], list(y)])
+print(json.dumps(out))
+"""
 
-    assert lc
-    log_output_level(CosimLogLevel.ERROR)
+
+def cosim_child(fmus, initial, connect, observe, h, n):
+    """libcosimpy's fixed-step co-simulation of ``fmus`` in a child process (:data:`_COSIM_CHILD`):
+    per slave (sample step numbers, values of ``observe``)."""
+    import json
+    import subprocess
+
+    pytest.importorskip("libcosimpy")
+    arg = json.dumps({"fmus": fmus, "initial": initial, "connect": connect, "observe": observe, "h": h, "n": n})
+    r = subprocess.run([sys.executable, "-c", _COSIM_CHILD, arg], capture_output=True, text=True, timeout=600,
+                       check=False)
+    assert r.returncode == 0, r.stderr[-3000:]
+    return [(np.array(k), np.array(y)) for k, y in json.loads(r.stdout.strip().splitlines()[-1])]
+
+
+def test_libcosimpy_chains_two_instances_as_fmpy_runs_them(cfmu, vr, tmp_path):
+    """libcosimpy (OSP libcosim, fixed 2 ms steps; in a child process): instance a holds a
+    0.3 deg pitch command, instance b's pitch command is a's engine angle. a's engine angle
+    equals an FMPy run of the same FMU; b's equals an FMPy run fed a's samples at the start of
+    each step (libcosim's fixed-step transfer): both bit for bit at the 250 samples the observer
+    keeps (0 to 0.498 s); the child exits 0 after libcosim frees the instances."""
     h, n = 2e-3, 250
-    ex = CosimExecution.from_step_size(step_size=int(round(h * 1e9)))
-    a = ex.add_local_slave(CosimLocalSlave(fmu_path=cfmu, instance_name="a"))
-    b = ex.add_local_slave(CosimLocalSlave(fmu_path=cfmu, instance_name="b"))
-    ex.real_initial_value(a, vr["pitch_command_rad"], 0.3 * DEG)
-    assert ex.connect_real_variables(a, vr["pitch_engine_rad"], b, vr["pitch_command_rad"]) == 0   # libcosim: 0 = success
-    ts = CosimObserver.create_time_series()
-    ex.add_observer(ts)
-    for s in (a, b):
-        ts.start_time_series(s, vr["pitch_engine_rad"], CosimVariableType.REAL)
-    assert ex.simulate_until(target_time=int(round(n * h * 1e9)))
-    sa, sb = (ts.time_series_real_samples(s, vr["pitch_engine_rad"], 0, n + 1) for s in (a, b))
-    ka = np.rint(np.array(sa[0]) / (h * 1e9)).astype(int)   # the samples' times [ns] as step counts
-    kb = np.rint(np.array(sb[0]) / (h * 1e9)).astype(int)
-    ya, yb = np.array(sa[2]), np.array(sb[2])
+    (ka, ya), (kb, yb) = cosim_child([[cfmu, "a"], [cfmu, "b"]], [[0, vr["pitch_command_rad"], 0.3 * DEG]],
+                                     [[0, vr["pitch_engine_rad"], 1, vr["pitch_command_rad"]]], vr["pitch_engine_rad"],
+                                     h, n)
     assert ka.size == kb.size == n and ka[-1] == kb[-1] == n - 1 and abs(ya[-1]) > 0.2 * DEG
-    del ex
 
     def fmpy_run(cmds, name):
         s = _slave(cfmu, tmp_path, name)

@@ -234,37 +234,20 @@ def test_cli_builds_the_3d_standalone_fmu(tmp_path):
 
 
 def test_libcosimpy_chains_the_planar_and_the_3d_fmu(fmu3, tmp_path):
-    """libcosimpy (fixed 2 ms steps): the planar FMU holds a 0.3 deg pitch command, the 3-D FMU's
-    pitch command is the planar engine angle. Each equals an FMPy run of the same FMU fed the
-    same samples (libcosim's fixed-step transfer: the value at the step's start), bit for bit."""
-    lc = pytest.importorskip("libcosimpy")
-    from libcosimpy.CosimEnums import CosimVariableType
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy.CosimSlave import CosimLocalSlave
-
+    """libcosimpy (fixed 2 ms steps, in a child process: tests/test_fmu_hosts.cosim_child): the
+    planar FMU holds a 0.3 deg pitch command, the 3-D FMU's pitch command is the planar engine
+    angle. Each equals an FMPy run of the same FMU fed the same samples (libcosim's fixed-step
+    transfer: the value at the step's start), bit for bit."""
     from taos.cosim._standalone import build_standalone_fmu
 
-    assert lc
+    from .test_fmu_hosts import cosim_child
+
     planar = str(build_standalone_fmu(MODELS / "rs25_hotfire.toml", tmp_path / "p.fmu").path)
-    log_output_level(CosimLogLevel.ERROR)
     h, n = 2e-3, 150
-    ex = CosimExecution.from_step_size(step_size=int(round(h * 1e9)))
-    a = ex.add_local_slave(CosimLocalSlave(fmu_path=planar, instance_name="planar"))
-    b = ex.add_local_slave(CosimLocalSlave(fmu_path=fmu3, instance_name="taos3d"))
-    ex.real_initial_value(a, 0, 0.3 * DEG)
-    assert ex.connect_real_variables(a, 2, b, 0) == 0   # planar pitch_engine_rad -> 3-D pitch_command_rad
-    ts = CosimObserver.create_time_series()
-    ex.add_observer(ts)
-    for sl in (a, b):
-        ts.start_time_series(sl, 2, CosimVariableType.REAL)
-    assert ex.simulate_until(target_time=int(round(n * h * 1e9)))
-    sa, sb = (ts.time_series_real_samples(sl, 2, 0, n + 1) for sl in (a, b))
-    ka, kb = (np.rint(np.array(x[0]) / (h * 1e9)).astype(int) for x in (sa, sb))
-    ya, yb = np.array(sa[2]), np.array(sb[2])
+    # value reference 0: pitch_command_rad, 2: pitch_engine_rad, in both FMUs
+    (ka, ya), (kb, yb) = cosim_child([[planar, "planar"], [fmu3, "taos3d"]], [[0, 0, 0.3 * DEG]], [[0, 2, 1, 0]], 2,
+                                     h, n)
     assert ka[-1] == kb[-1] == n - 1 and abs(yb[-1]) > 0.1 * DEG
-    del ex
 
     def fmpy_run(path, cmds, name):
         s, _ = _slave(path, tmp_path, name)
