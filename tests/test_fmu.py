@@ -27,7 +27,6 @@ pytest.importorskip("pythonfmu")
 from fmpy.validation import validate_fmu  # noqa: E402
 
 from taos.cosim import BlockOutputs, TvcBlock, build_fmu  # noqa: E402
-from taos.model import load_model  # noqa: E402
 from taos.planar.simulate import simulate  # noqa: E402
 from taos.profiles import Step, TwoAxis, load_profile  # noqa: E402
 
@@ -231,10 +230,10 @@ def test_bad_parameter_is_refused_at_initialisation(simplex_fmu, tmp_path):
 
 
 def test_cli_builds_and_refuses_bad_input_without_writing(tmp_path):
-    """``taos fmu``: exit 0 and a valid FMU; a bad model, a bad --out, an impossible --dt, an
+    """``taos fmu --python`` (the pythonfmu route): exit 0 and a valid FMU; a bad model, a bad --out, an impossible --dt, an
     existing file it did not write at --out: exit 2, one line, no file written or replaced; its
     own FMU is replaced."""
-    ok = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu", "--friction", "dahl",
+    ok = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu", "--python", "--friction", "dahl",
                  "--avionics", "bounding")
     assert ok.returncode == 0, ok.stderr
     md = fmpy.read_model_description(str(tmp_path / "a.fmu"))
@@ -245,12 +244,12 @@ def test_cli_builds_and_refuses_bad_input_without_writing(tmp_path):
     keep.write_bytes(b"not mine")
     for args in ([bad, "--out", keep], [MODELS / "rs25_ambient.toml", "--out", tmp_path / "x.zip"],
                  [MODELS / "rs25_ambient.toml", "--out", tmp_path / "y.fmu", "--dt", "0.01"]):
-        r = run_cli("fmu", *args)
+        r = run_cli("fmu", *args, "--python")
         assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
-    r = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", keep)   # a good model, a foreign file
+    r = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", keep, "--python")   # a good model, a foreign file
     assert r.returncode == 2 and "did not write" in r.stderr
     assert keep.read_bytes() == b"not mine"
-    again = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu")   # its own FMU: replaced
+    again = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu", "--python")   # its own FMU: replaced
     assert again.returncode == 0, again.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == [".taos-output.json", "a.fmu", "bad.toml", "keep.fmu"]
 

@@ -357,22 +357,32 @@ def test_a_c_master_runs_the_whole_life_cycle_and_exits_cleanly(cfmu, md, tmp_pa
     assert abs(got - out.pitch_engine_rad) <= 1e-6 * DEG
 
 
-def test_cli_standalone_and_its_refusals(tmp_path):
-    """``taos fmu --standalone``: exit 0 and a valid FMU with the friction law asked for; with
-    ``--engine taos`` or a foreign file at ``--out``: exit 2, one line (never offering
-    ``--force``), nothing written or replaced."""
-    ok = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu", "--standalone", "--friction", "dahl")
+def test_cli_standalone_by_default_and_its_refusals(tmp_path):
+    """``taos fmu`` builds the standalone FMU by default (``--standalone`` says so explicitly):
+    exit 0 and a valid FMU with the friction law asked for, no Python file in it; with both
+    ``--python`` and ``--standalone``, a 3-D step beyond 1 ms, or a foreign file at ``--out``:
+    exit 2, one line (never offering ``--force``), nothing written or replaced. (The 3-D
+    standalone FMU from the command line: tests/test_fmu_taos3d.py.)"""
+    ok = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "a.fmu", "--friction", "dahl")
     assert ok.returncode == 0, ok.stderr
+    assert "no Python at run time" in ok.stdout
     assert validate_fmu(str(tmp_path / "a.fmu")) == []
-    assert "friction dahl" in fmpy.read_model_description(str(tmp_path / "a.fmu")).description
-    r = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "b.fmu", "--standalone", "--engine", "taos")
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "--engine" in r.stderr
+    md = fmpy.read_model_description(str(tmp_path / "a.fmu"))
+    assert "friction dahl" in md.description and "standalone C" in md.description
+    with zipfile.ZipFile(tmp_path / "a.fmu") as z:
+        assert "sources/buildDescription.xml" in z.namelist() and not any(n.endswith(".py") for n in z.namelist())
+    ok = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "s.fmu", "--standalone")
+    assert ok.returncode == 0 and "no Python at run time" in ok.stdout, ok.stderr
+    for extra in (["--python", "--standalone"], ["--engine", "taos", "--dt", "2e-3"]):
+        r = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", tmp_path / "b.fmu", *extra)
+        assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+        assert "--force" not in r.stderr
     keep = tmp_path / "keep.fmu"
     keep.write_bytes(b"not mine")
-    r = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", keep, "--standalone")
+    r = run_cli("fmu", MODELS / "rs25_ambient.toml", "--out", keep)
     assert r.returncode == 2 and "did not write" in r.stderr and "--force" not in r.stderr
     assert keep.read_bytes() == b"not mine"
-    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == ["a.fmu", "keep.fmu"]
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == ["a.fmu", "keep.fmu", "s.fmu"]
 
 
 def test_a_model_variant_is_built_with_its_provenance(tmp_path, hotfire):

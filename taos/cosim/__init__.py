@@ -5,12 +5,14 @@ FMI 2.0 co-simulation FMU built from it.
   :class:`BlockOutputs`): one engine's nonlinear TVC, both axes, computing exactly what
   ``taos simulate`` computes (the same compiled kernels, stepped in chunks;
   :mod:`taos.cosim._block`);
+* the standalone FMU (``taos fmu``, the default): in C emitted from the kernels' own Python
+  source (:mod:`taos.cosim._ccode`), no Python at run time; the planar model
+  (:mod:`taos.cosim._standalone`, tunable parameters) or the 3-D model
+  (:mod:`taos.cosim._standalone3d`, ``--engine taos``);
 * :func:`build_fmu`: the block as an FMI 2.0 co-simulation FMU through ``pythonfmu``
-  (``taos fmu``; :mod:`taos.cosim._fmu`). Such an FMU runs the block in a Python with ``taos``
-  importable on the importing machine;
-* the standalone FMU (``taos fmu --standalone``; :mod:`taos.cosim._standalone`): the planar
-  model in C emitted from the kernels' own Python source (:mod:`taos.cosim._ccode`), no Python
-  at run time.
+  (``taos fmu --python``; :mod:`taos.cosim._fmu`). Such an FMU runs the block in a Python with
+  ``taos`` importable on the importing machine and lacks host behaviours the standalone one
+  has (:data:`taos.cli.fmu.PYTHON_LACKS`).
 """
 
 from __future__ import annotations

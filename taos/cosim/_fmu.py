@@ -1,4 +1,5 @@
-"""An FMI 2.0 co-simulation FMU of :class:`~taos.cosim.TvcBlock`, built with ``pythonfmu``.
+"""An FMI 2.0 co-simulation FMU of :class:`~taos.cosim.TvcBlock`, built with ``pythonfmu`` (``taos fmu
+--python``; the default ``taos fmu`` builds the standalone C FMU, :mod:`taos.cosim._standalone`).
 
 What the FMU holds (``resources/``): a two-line entry script whose class is
 :class:`taos.cosim._slave.TvcSlave`, ``taos_fmu/config.json`` (engine, friction law, avionics,

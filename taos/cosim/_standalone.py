@@ -1,5 +1,5 @@
-"""The standalone FMU (``taos fmu MODEL --out F.fmu --standalone``): FMI 2.0 co-simulation in C,
-no Python at run time.
+"""The standalone planar FMU (``taos fmu MODEL --out F.fmu``, the default): FMI 2.0
+co-simulation in C, no Python at run time (the 3-D one: :mod:`taos.cosim._standalone3d`).
 
 What the FMU holds:
 
@@ -36,7 +36,7 @@ Parameters (:mod:`taos.cosim._standalone_params`): the internal step and the loa
 (fixed), the friction levels, the avionics gain and the vehicle moment arm (tunable),
 ``command_mode`` (fixed: 0 exact, 1 ramp, 2 hold); the thrust is an input. Every other model
 value is compiled in: a change to it is a new FMU built from the model variant
-(``model.with_values``, or a changed model file). The 3-D model has no standalone FMU.
+(``model.with_values``, or a changed model file).
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 #: the output rows of y = C x per axis, in the glue's order (its TAOS_NY rows)
 OUTPUT_ROWS = ("theta_rad", "omega_rad_s", "x_p_m", "load_force_N", "p_load_Pa")
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden")
-SOURCE = "taos fmu --standalone"
+SOURCE = "taos fmu"
 
 
 def kernel_sources(model) -> tuple[str, str]:

@@ -92,7 +92,7 @@ def model_description(model, dt_s: float, guid: str, prov: dict, avionics: str) 
                         f"{model.friction.name}, avionics {avionics}; internal step {dt_s:g} s (communication steps: "
                         f"whole multiples of it); commands within +-{rng:.6g} rad, envelope +-{stop:.6g} rad, "
                         f"{force:.6g} N; taos {version}."),
-        "author": "taos", "version": str(version), "generationTool": f"taos {version} (taos fmu --standalone)",
+        "author": "taos", "version": str(version), "generationTool": f"taos {version} (taos fmu)",
         "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
     cs = SubElement(root, "CoSimulation", {
         "modelIdentifier": IDENTIFIER, "needsExecutionTool": "false",
