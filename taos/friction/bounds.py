@@ -96,10 +96,15 @@ def key_kinds() -> dict[str, str]:
     return out
 
 
-def _range_text(lo: float, hi: float, unit: str) -> str:
+def _shown(v: float, unit: str) -> str:
+    """``v`` (SI) as the bounds page shows it: rates in deg/s, a plain number when dimensionless."""
     if unit == "rad/s":
-        return f"from {lo / DEG:.4g} to {hi / DEG:.4g} deg/s"
-    return f"from {lo:.4g} to {hi:.4g} {unit}".rstrip()
+        return f"{v / DEG:.4g} deg/s"
+    return f"{v:.4g}" if unit == "1" else f"{v:.4g} {unit}"
+
+
+def _range_text(lo: float, hi: float, unit: str) -> str:
+    return f"from {_shown(lo, unit)} to {_shown(hi, unit)}"
 
 
 def check_friction_value(key: str, value, src: str, section: str = "friction") -> float | None:
@@ -113,8 +118,7 @@ def check_friction_value(key: str, value, src: str, section: str = "friction") -
     field = f"{section}.{key}"
     v = to_si(value, key_kinds()[key], source=src, field=field)
     if not (math.isfinite(v) and lo <= v <= hi):
-        shown = f"{v / DEG:.4g} deg/s" if unit == "rad/s" else f"{v:.4g} {unit}".rstrip()
-        raise InputError(src, field, f"a value {_range_text(lo, hi, unit)} ({why})", got=shown)
+        raise InputError(src, field, f"a value {_range_text(lo, hi, unit)} ({why})", got=_shown(v, unit))
     return v
 
 
@@ -135,3 +139,13 @@ def check_friction_law(law, src: str, section: str = "friction") -> None:
         lo, hi, unit, why = FRICTION_BOUNDS["friction.damping_decay_velocity"]
         raise InputError(src, f"{section}.damping_decay_velocity", f"a value {_range_text(lo, hi, unit)} with "
                          f"bristle_damping > 0 ({why})", got="nothing (key missing)")
+
+
+def loader_bound(field: str) -> tuple[float, float] | None:
+    """(lowest, highest) [SI] the model loader holds ``field`` ("section.key") to, from
+    :data:`FRICTION_BOUNDS` or :data:`taos.bounds.MODEL_BOUNDS`; None when it has none. A fit or
+    reduction clips its search to it, so it never returns a value the loader refuses."""
+    from ..bounds import MODEL_BOUNDS
+
+    b = FRICTION_BOUNDS.get(field) or MODEL_BOUNDS.get(field)
+    return None if b is None else (b[0], b[1])
