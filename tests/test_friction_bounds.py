@@ -287,3 +287,28 @@ def test_the_theory_page_says_what_the_loader_does():
     text = (ROOT / "docs" / "theory" / "friction.md").read_text()
     assert "allowed *below*" not in text
     assert r"$T_s \ge T_c$ as for every" in text and "friction.static_torque" in text
+
+
+def test_fit_bounds_beyond_the_loaders_are_refused():
+    """``taos fit --bounds`` (planar and 3-D) may not reach past the model file's bounds."""
+    from taos.cli._bounds_arg import _parse_bounds
+    from taos.identify.params3d import PARAMETERS3D
+
+    with pytest.raises(InputError, match="--bounds bristle_stiffness"):
+        _parse_bounds(["bristle_stiffness=1e5 N*m/rad:1e13 N*m/rad"])
+    assert _parse_bounds(["bristle_stiffness=1e5 N*m/rad:1e9 N*m/rad"])["bristle_stiffness"] == (1e5, 1e9)
+    with pytest.raises(InputError, match="--bounds vibration_velocity"):
+        _parse_bounds(["vibration_velocity=0.1 deg/s:1000 deg/s"], PARAMETERS3D)
+
+
+def test_the_3d_fit_bounds_lie_within_the_loaders():
+    from taos.identify.params3d import PARAMETERS3D, bounds3d
+    from taos.taos3d import taos_model
+
+    tm = taos_model(taos.load_model(MODELS / "rs25_hotfire.toml"))
+    params = [PARAMETERS3D[n] for n in ("load_stiffness", "coulomb_torque", "bristle_stiffness",
+                                        "vibration_velocity", "static_torque")]
+    lo, hi, _ = bounds3d(tm, params, np.array([0.5, 5.0]), ("pitch",))
+    for p, a, b in zip(params, lo, hi):
+        blo, bhi = loader_bound(p.key)
+        assert blo <= a < b <= bhi, (p.name, a, b)

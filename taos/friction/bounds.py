@@ -124,7 +124,14 @@ def check_friction_value(key: str, value, src: str, section: str = "friction") -
 
 def check_friction_values(table: Mapping, src: str, section: str = "friction") -> None:
     """Every bounded key of a ``[friction]`` table or parameter set within :data:`FRICTION_BOUNDS`
-    (:func:`check_friction_value`); other keys are left to the loader."""
+    (:func:`check_friction_value`), the torque levels first (within :data:`taos.bounds.MODEL_BOUNDS`:
+    the set's values are scaled to ``coulomb_torque``, so a level beyond its bound is named as
+    the cause, not the scaled value); other keys are left to the loader."""
+    from ..bounds import MODEL_BOUNDS, check_bound
+
+    for key in ("coulomb_torque", "static_torque"):
+        if key in table and f"friction.{key}" in MODEL_BOUNDS:
+            check_bound(to_si(table[key], "torque", source=src, field=f"{section}.{key}"), f"friction.{key}", src)
     for key in sorted(k for k in table if isinstance(k, str)):
         check_friction_value(key, table[key], src, section)
 
