@@ -31,6 +31,8 @@ from typing import Any, Mapping
 from .planar.avionics import Avionics
 from .errors import InputError, read_toml  # noqa: F401  (read_toml: model files and the 3-D loader)
 from .friction import FrictionLaw, friction_from_table
+#: REFERENCE_TORQUE_KEY: key of a parameter set, the torque level its load-proportional values hold at
+from .friction.bounds import REFERENCE_TORQUE_KEY, check_friction_values
 from .shipped import resolve
 from .units import to_si
 
@@ -375,8 +377,6 @@ def parse_avionics(doc: Mapping, src: str) -> Avionics:
 
 #: ``[friction]`` key naming the shared friction parameter set of one piece of hardware
 PARAMETER_SET_KEY = "parameter_set"
-#: key of a parameter set: the torque level its load-proportional values hold at
-REFERENCE_TORQUE_KEY = "reference_torque"
 
 
 def resolve_parameter_set(ref: str, model_path: Path, section: str | None = None) -> Path:
@@ -435,6 +435,7 @@ def friction_table_with_parameter_set(ftab: Mapping, model_path: Path, src: str)
     if ref is None:
         return table
     ppath, shared = _parameter_set(ref, model_path, src, "friction")
+    check_friction_values(shared, str(ppath))   # the set's own values, naming the set (issue 40)
     ref_torque = shared.pop(REFERENCE_TORQUE_KEY, None)
     _merge_parameter_set(table, shared, {"model"}, ppath, ref, src, "friction")
     if ref_torque is not None:

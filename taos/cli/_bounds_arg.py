@@ -8,6 +8,7 @@ from taos.errors import InputError
 def _parse_bounds(items, table=None) -> dict:
     """--bounds 'NAME=LO:HI' (each with a unit) -> {name: (lo_si, hi_si)}; names from ``table``
     (name -> an object with ``kind``; default the planar fit's parameters)."""
+    from taos.friction.bounds import loader_bound
     from taos.identify.surrogate import PARAMETERS as PLANAR
     from taos.units import to_si
 
@@ -27,5 +28,11 @@ def _parse_bounds(items, table=None) -> dict:
                         field=f"--bounds {k}", positive=True) for x in (lo_s, hi_s))
         if not lo < hi:
             raise InputError("command line", f"--bounds {k}", "LOW below HIGH", got=repr(v))
+        key = getattr(p, "key", None) or f"{p.section}.{p.toml_key}"
+        limit = loader_bound(key)   # a fit never returns a value the model loader refuses (issue 40)
+        if limit is not None and not limit[0] <= lo < hi <= limit[1]:
+            raise InputError("command line", f"--bounds {k}", f"a range within the model file's bound of {key}, "
+                             f"{limit[0]:.4g} to {limit[1]:.4g} SI (docs/reference/bounds.md)",
+                             got=f"{lo:.4g} to {hi:.4g} SI")
         out[k] = (lo, hi)
     return out

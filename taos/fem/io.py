@@ -2,8 +2,10 @@
 
 Validation rules for a stiffness matrix K (SI blocks N/m, N/rad, N m/m, N m/rad):
 
+* real numbers: a complex array (its imaginary part would be dropped), text, booleans or
+  objects are refused, never cast;
 * shape (6, 6) for a half with its bolted face held, (12, 12) free-free;
-* finite (no NaN or infinity);
+* finite (no NaN or infinity), every entry at most :data:`MAX_ENTRY` (1e15 SI) in magnitude;
 * symmetric: max |K - K^T| <= 1e-6 max |K|;
 * held (6x6): positive definite; free (12x12): positive semi-definite with exactly six
   (rigid-body) zero eigenvalues. Eigenvalues are judged on the diagonally scaled matrix
@@ -27,6 +29,10 @@ import numpy as np
 from ..errors import InputError
 
 SYM_TOL = 1e-6
+#: largest entry of a stiffness matrix [SI]: four orders of magnitude beyond a metre-long steel
+#: bar (E A / L = 2e11 N/m) and the shipped gimbal halves (5.5e10); a larger one is a unit slip
+#: and would overflow the symmetry and eigenvalue checks
+MAX_ENTRY = 1e15
 EIG_TOL = 1e-8
 _SHAPES = {"held": (6, 6), "free": (12, 12)}
 
@@ -38,15 +44,16 @@ def validate_stiffness_matrix(K: object, *, source: str, field: str, kind: str) 
     """
     shape = _SHAPES[kind]
     what = "positive definite" if kind == "held" else "positive semi-definite with 6 rigid-body zero modes"
-    try:
-        A = np.asarray(K, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(source, field, f"a numeric {shape[0]}x{shape[1]} matrix", got=type(K).__name__) from None
+    A = _real_array(K, source, field, f"a real {shape[0]}x{shape[1]} matrix")
     if A.shape != shape:
         raise InputError(source, field, f"a {shape[0]}x{shape[1]} stiffness matrix", got=f"shape {A.shape}")
     if not np.all(np.isfinite(A)):
         raise InputError(source, field, "finite values", got=f"{int(np.sum(~np.isfinite(A)))} NaN/inf entries")
     scale = float(np.max(np.abs(A)))
+    if scale > MAX_ENTRY:
+        raise InputError(source, field, f"entries of at most {MAX_ENTRY:g} in SI (N/m, N/rad, N m/rad: the shipped "
+                         "gimbal halves reach 5.5e10, a metre-long steel bar E A / L = 2e11 N/m)",
+                         got=f"an entry of {scale:.3g}")
     asym = float(np.max(np.abs(A - A.T))) / scale if scale > 0 else 0.0
     if scale == 0.0:
         raise InputError(source, field, f"a {what} stiffness matrix", got="all zeros")
@@ -66,6 +73,22 @@ def validate_stiffness_matrix(K: object, *, source: str, field: str, kind: str) 
     if nzero != want:
         raise InputError(source, field, f"a {what} matrix", got=f"{nzero} zero eigenvalues")
     return 0.5 * (A + A.T)
+
+
+def _real_array(K: object, source: str, field: str, expected: str) -> np.ndarray:
+    """``K`` as a float array, refused (one line) unless it holds real numbers: a complex array
+    (its imaginary part would be dropped silently), text, booleans or objects are no stiffness."""
+    raw = K if isinstance(K, np.ndarray) else None
+    if raw is None:
+        try:
+            raw = np.asarray(K)
+        except (TypeError, ValueError):
+            raise InputError(source, field, expected, got=type(K).__name__) from None
+    if raw.dtype.kind not in "fiu":
+        got = {"c": "complex values", "b": "booleans", "U": "text", "S": "bytes", "O": "objects"}.get(
+            raw.dtype.kind, f"dtype {raw.dtype}")
+        raise InputError(source, field, expected, got=got)
+    return raw.astype(float)
 
 
 @dataclass(frozen=True)
@@ -164,7 +187,7 @@ def load_gimbal_stiffness(path: str | Path) -> GimbalStiffness:
                          if key in data else None)
         refs = None
         if "ref_points_m" in data:
-            refs = np.asarray(data["ref_points_m"], float)
+            refs = _real_array(data["ref_points_m"], src, "ref_points_m", "a finite 3x3 array of points [m]")
             if refs.shape != (3, 3) or not np.all(np.isfinite(refs)):
                 raise InputError(src, "ref_points_m", "a finite 3x3 array of points [m]", got=f"shape {refs.shape}")
         cond = str(data["condition"]) if "condition" in data else ""

@@ -440,8 +440,10 @@ class LuGre(FrictionLaw):
 class ModifiedLuGre(LuGre):
     """Modified LuGre for a vibration environment (this project's documented form).
 
-    The LuGre equations with g(v) = G(v) h(v), where G is the Stribeck curve above (the static
-    level T_s may be set *below* T_c, with a tunable shape exponent delta) and
+    The LuGre equations with g(v) = G(v) h(v), where G is the Stribeck curve above (the
+    bearing's own, with a tunable shape exponent delta; a model file holds T_s >= T_c as for
+    every law, :func:`taos.bounds.check_model_bounds`: the vibration lowers the friction felt at
+    small rates through h, not through a Stribeck curve rising with the rate) and
 
         h(v) = (2/pi) asin(min(1, |v| / V_d))
 
@@ -477,5 +479,10 @@ def friction_from_table(table: dict, source: str, model: str | None = None,
                                 f"{section}.model" if model is None else "--friction")
     from ..errors import check_keys
 
+    from .bounds import check_friction_law, check_friction_values
+
     check_keys(table, set(friction_keys()) | {"model"}, source, section)
-    return params.from_table(table, source, section)
+    check_friction_values(table, source, section)   # issue 40: every key within its physical bound
+    law = params.from_table(table, source, section)
+    check_friction_law(law, source, section)
+    return law

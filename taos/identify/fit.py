@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from taos.errors import InputError
+from taos.friction.bounds import loader_bound
 from taos.identify.estimation import MeasuredResponse
 from taos.identify.globalstage import grid_search
 from taos.identify.surrogate import PARAMETERS, apply_values, build_surrogate, check_free, solve_implicit
@@ -245,6 +246,10 @@ class FitProblem:
         b = self.bounds or {}
         lo = np.array([b[p.name][0] / r if p.name in b else p.lo for p, r in zip(self.params, self.sur.p_ref)])
         hi = np.array([b[p.name][1] / r if p.name in b else p.hi for p, r in zip(self.params, self.sur.p_ref)])
+        for k, (p, r) in enumerate(zip(self.params, self.sur.p_ref)):   # never a value the loader refuses
+            bound = loader_bound(f"{p.section}.{p.toml_key}") if r > 0 else None
+            if bound is not None:
+                lo[k], hi[k] = max(lo[k], bound[0] / r), min(hi[k], bound[1] / r)
         if np.any(lo >= 1.0) or np.any(hi <= 1.0):
             k = int(np.flatnonzero((lo >= 1.0) | (hi <= 1.0))[0])
             name = self.params[k].name

@@ -156,6 +156,7 @@ def variant_values(tm, params, values) -> dict:
 def bounds3d(tm, params, freq_hz, axes) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
     """(lower, upper) [SI] and the rule of each of ``params`` (module docstring), for a record
     with points at ``freq_hz`` [Hz] on ``axes``."""
+    from taos.friction.bounds import loader_bound
     from taos.identify.physbounds import physical_bounds
     from taos.taos3d.model import normal_load_N
 
@@ -180,6 +181,10 @@ def bounds3d(tm, params, freq_hz, axes) -> tuple[np.ndarray, np.ndarray, tuple[s
             lo.append(1e-3 * DEG), hi.append(10.0 * DEG), basis.append("1e-3 to 10 deg/s")
         elif n == "static_torque":
             lo.append(tc), hi.append(3.0 * tc), basis.append("T_c to 3 T_c (Stribeck peak)")
+    for k, p in enumerate(params):   # never a value the model loader refuses (issue 40)
+        b = loader_bound(p.key)
+        if b is not None:
+            lo[k], hi[k] = max(lo[k], b[0]), min(hi[k], b[1])
     return np.array(lo, float), np.array(hi, float), tuple(basis)
 
 

@@ -292,8 +292,8 @@ def key_value(model, key: str) -> float | None:
 def check_free(model, free: Sequence[str] | None) -> tuple[tuple, np.ndarray, np.ndarray, np.ndarray]:
     """(keys, start, lower, upper) [SI] of the free keys: each one of :data:`FREE_KEYS`, a
     parameter of the model's law with a positive value (fitted in log), bounded by its factors
-    and :data:`taos.bounds.MODEL_BOUNDS`. ``None``: :data:`DEFAULT_FREE` keys the law has."""
-    from taos.bounds import MODEL_BOUNDS
+    and the loader's bounds (:func:`taos.friction.bounds.loader_bound`). ``None``: :data:`DEFAULT_FREE` keys the law has."""
+    from taos.friction.bounds import loader_bound
 
     src = "argument"
     if free is None:
@@ -313,8 +313,9 @@ def check_free(model, free: Sequence[str] | None) -> tuple[tuple, np.ndarray, np
             raise InputError(model.source, k, "a positive value in the 3-D model to reduce from", got=f"{v!r}")
         flo, fhi = FREE_KEYS[k]
         a, b = v * flo, v * fhi
-        if k in MODEL_BOUNDS:
-            a, b = max(a, MODEL_BOUNDS[k][0]), min(b, MODEL_BOUNDS[k][1])
+        bound = loader_bound(k)   # the model file's and the friction set's bounds (issue 40)
+        if bound is not None:
+            a, b = max(a, bound[0]), min(b, bound[1])
         start.append(v), lo.append(a), hi.append(b)
     return free, np.array(start), np.array(lo), np.array(hi)
 
