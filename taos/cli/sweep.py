@@ -103,6 +103,8 @@ def cmd_sweep(args) -> int:
         if sens["indices"]:
             print(f"{m}: " + ", ".join(f"{r['parameter']} S1 {r['S1']:.2f} +- {r['S1_conf']:.2f}, ST {r['ST']:.2f} "
                                         f"+- {r['ST_conf']:.2f}" for r in sens["indices"]), file=out)
+            for w in sens.get("warnings", []):
+                print(f"warning: {m}: {w}", file=out)
         else:
             print(f"{m}: no Sobol' indices ({sens['error']})", file=out)
     for u in d["unstable"][:5]:

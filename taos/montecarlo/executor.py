@@ -197,5 +197,6 @@ def _sensitivity(c: Campaign, method: str, ds) -> dict:
     if bad:
         return base | {"indices": None, "error": f"{bad} runs failed or diverged: the estimators need every run"}
     prob = sensitivity.problem(c.dispersions)
-    return base | {"indices": sensitivity.indices(method, prob, np.asarray(ds["factor"].values), y,
-                                                  seed=c.seed % 2 ** 32)}
+    rows = sensitivity.indices(method, prob, np.asarray(ds["factor"].values), y, seed=c.seed % 2 ** 32)
+    warn = sensitivity.sobol_warnings(rows, len(y) // (len(rows) + 2)) if method == "sobol" else []
+    return base | {"indices": rows, "warnings": warn}
