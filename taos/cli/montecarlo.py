@@ -129,8 +129,8 @@ def scheduler_address(text: str, flag: str = "--scheduler") -> str:
     try:
         scheme, loc = parse_address(text, strict=False)
         if scheme not in ("tcp", "tls"):
-            raise ValueError(f"the protocol {scheme}:// (inproc:// lives inside one process; tcp:// or tls:// "
-                             "reach a scheduler)")
+            raise ValueError(f"{scheme}:// does not reach a scheduler from another process (inproc:// lives "
+                             "inside one); use tcp:// or tls://")
         host, port = parse_host_port(loc, default_port=8786)
         if not host or re.search(r"[\s/]", host) or not 1 <= int(port) <= 65535:
             raise ValueError("a host and a port 1 to 65535")

@@ -371,8 +371,8 @@ def _on_cluster(client, kind: RunKind, todo: list, batch: int, stored) -> None:
         except WorkerCodeMismatch as e:
             raise CampaignStopped(f"a worker that joined runs other code: {e}") from None
         except KilledWorker as e:
-            raise CampaignStopped(f"the batch at run {s} killed {RETRIES} workers or more (out of memory?): "
-                                  f"{str(e).splitlines()[0][:120]}") from None
+            raise CampaignStopped(f"workers died running the batch at run {s} and Dask gave up on it "
+                                  f"(KilledWorker: out of memory, or killed?): {str(e).splitlines()[0][:120]}") from None
         except (OSError, TimeoutError) as e:   # the scheduler's connection (CommClosedError is an OSError)
             raise CampaignStopped(_lost(client, f"{type(e).__name__}")) from None
         stored(p, s, out)
