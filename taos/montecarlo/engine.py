@@ -63,7 +63,7 @@ CONNECT_TIMEOUT_S = 20.0
 #: no batch stored for this long with a worker paused: the campaign stops [s]
 STALL_S = 120.0
 #: the polling interval of the cluster's health while waiting for batches [s]
-POLL_S = 0.2
+POLL_S = 0.05
 
 
 class CampaignStopped(InputError):
