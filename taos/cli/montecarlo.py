@@ -129,13 +129,12 @@ def scheduler_address(text: str, flag: str = "--scheduler") -> str:
     try:
         scheme, loc = parse_address(text, strict=False)
         if scheme not in ("tcp", "tls"):
-            raise ValueError(f"{scheme}:// does not reach a scheduler from another process (inproc:// lives "
-                             "inside one); use tcp:// or tls://")
+            raise ValueError(f"{scheme}:// does not reach a scheduler in another process: use tcp:// or tls://")
         host, port = parse_host_port(loc, default_port=8786)
         if not host or re.search(r"[\s/]", host) or not 1 <= int(port) <= 65535:
             raise ValueError("a host and a port 1 to 65535")
     except (ValueError, TypeError) as e:
-        raise InputError("command line", flag, want, got=f"{text!r} ({str(e)[:100]})") from None
+        raise InputError("command line", flag, want, got=f"{text!r} ({str(e)[:160]})") from None
     return f"{scheme}://{'[' + host + ']' if ':' in host else host}:{port}"
 
 
