@@ -278,6 +278,25 @@ def check_not_input(path, field: str, inputs=()) -> None:
 
 # -- the exit-status contract of the command lines (taos and masv) --------------------------
 
+_KEPT: ContextVar[Callable[[], str | None] | None] = ContextVar("taos_kept_on_signal", default=None)
+
+
+def on_signal_kept(describe: Callable[[], str | None]) -> None:
+    """For a command that keeps partial output on purpose (a campaign store kept for
+    ``--resume``): ``describe()`` says, after a signal, what is kept and how to continue; it
+    replaces "no partial output written" in the signal's line (None: nothing kept)."""
+    _KEPT.set(describe)
+
+
+def _kept_text() -> str:
+    try:
+        d = _KEPT.get()
+        text = d() if d is not None else None
+    except BaseException:  # a second signal, an unreadable store: say nothing wrong
+        text = None
+    return " ".join(str(text).split()) if text else "no partial output written"
+
+
 class _Signals:
     """SIGINT/SIGTERM handling of one command-line run: the handler records the signal before it
     raises, so a run whose exception was swallowed somewhere (a library's cleanup) still ends
@@ -396,6 +415,7 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
         print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
         return 130
     handler, old = _Signals(), {}
+    kept_token = _KEPT.set(None)
     old_unraisable = sys.unraisablehook
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGINT):
@@ -454,12 +474,13 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
     if handler.received is not None and "taos.montecarlo.store" in sys.modules:
         with contextlib.suppress(BaseException):   # (a second Ctrl-C stops the wait)
             sys.modules["taos.montecarlo.store"].finish_pending_io()
+    kept = _kept_text() if handler.received is not None else ""
+    _KEPT.reset(kept_token)
     if handler.received == signal.SIGINT:
-        print(f"{parser.prog}: interrupted (Ctrl-C); no partial output written", file=sys.stderr)
+        print(f"{parser.prog}: interrupted (Ctrl-C); {kept}", file=sys.stderr)
         return 130
     if handler.received is not None:
-        print(f"{parser.prog}: terminated (signal {handler.received}); no partial output written",
-              file=sys.stderr)
+        print(f"{parser.prog}: terminated (signal {handler.received}); {kept}", file=sys.stderr)
         return 128 + handler.received
     return rc
 

@@ -143,6 +143,7 @@ def _sweep(args, flight, model, amps, freqs) -> int:
         from taos.flight.lco_campaign import FORMAT, run_map_campaign
         from taos.flight.vehicle import load_flight
         from taos.model import load_model
+        from taos.cli.montecarlo import scheduler_address
         from taos.montecarlo.inputs import digest, recording
         with recording() as input_files:   # every file a load of the inputs reads (the map's inputs hash)
             load_flight(args.flight)
@@ -153,7 +154,8 @@ def _sweep(args, flight, model, amps, freqs) -> int:
                             "friction": args.friction, "load_stiffness": args.load_stiffness}, sort_keys=True)
         sha, table = digest(input_files, text)
         m, failed = run_map_campaign(flight, model, axes, settings, args.out, inputs_sha256=sha, input_files=table,
-                                     workers=args.workers or 0, scheduler=args.scheduler, resume=args.resume,
+                                     workers=args.workers or 0, resume=args.resume,
+                                     scheduler=scheduler_address(args.scheduler) if args.scheduler else None,
                                      progress=args.json != "-")
     else:
         for opt in ("resume", "workers", "scheduler"):

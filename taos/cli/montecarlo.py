@@ -118,18 +118,86 @@ def cmd_ascent(args) -> int:
     return 0
 
 
-_SCHEDULER = re.compile(r"^(tcp|tls|inproc)://[^\s:/]+(:\d{1,5})?$")
+def scheduler_address(text: str, flag: str = "--scheduler") -> str:
+    """A Dask scheduler address as Dask accepts it: ``tcp://host:port``, ``tls://host:port``,
+    ``host:port`` (tcp), IPv6 in brackets (``tcp://[::1]:8786``); the port 1 to 65535 (default
+    8786). ``inproc://`` (an address inside one process) and other protocols are refused."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    want = ("a Dask scheduler address like tcp://10.0.0.5:8786, tls://host:8786, host:8786 or tcp://[::1]:8786 "
+            "(port 1 to 65535)")
+    text = text.strip() if isinstance(text, str) else ""
+    try:
+        scheme, loc = parse_address(text, strict=False)
+        if scheme not in ("tcp", "tls"):
+            raise ValueError(f"{scheme}:// does not reach a scheduler in another process: use tcp:// or tls://")
+        host, port = parse_host_port(loc, default_port=8786)
+        if not host or re.search(r"[\s/]", host) or not 1 <= int(port) <= 65535:
+            raise ValueError("a host and a port 1 to 65535")
+    except (ValueError, TypeError) as e:
+        raise InputError("command line", flag, want, got=f"{text!r} ({str(e)[:160]})") from None
+    return f"{scheme}://{'[' + host + ']' if ':' in host else host}:{port}"
+
+
+def scheduler_from_file(path: str) -> str:
+    """The address in a Dask scheduler file (the JSON ``dask scheduler --scheduler-file`` and
+    dask-jobqueue write), checked as :func:`scheduler_address` checks one."""
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise InputError(path, "(file)", "a Dask scheduler file (JSON with an \"address\")",
+                         got=type(e).__name__ if not isinstance(e, OSError) else (e.strerror or "unreadable")) from None
+    addr = doc.get("address") if isinstance(doc, dict) else None
+    if not isinstance(addr, str):
+        raise InputError(path, "address", "the scheduler's address (a string)", got=repr(addr)[:60])
+    return scheduler_address(addr, flag=f"--scheduler-file {path}: address")
+
+
+def resume_command(args) -> str:
+    """The command that continues this campaign (``--resume`` on the same folder)."""
+    import shlex
+    parts = ["taos", "montecarlo", args.campaign, "--runs", str(args.runs)]
+    for flag, v in (("--case", args.case), ("--friction", args.friction), ("--sensitivity", args.sensitivity),
+                    ("--scheduler", args.scheduler), ("--scheduler-file", args.scheduler_file),
+                    ("--workers", args.workers)):
+        if v is not None:
+            parts += [flag, str(v)]
+    return shlex.join(parts + ["--out", args.out, "--resume"])
+
+
+def stored_runs(out: Path) -> tuple[int, int] | None:
+    """(runs stored, runs) of the campaign in ``out`` (dispersed and nominal), None without one."""
+    from taos.montecarlo import store
+    from taos.montecarlo.executor import MANIFEST, STORE
+    if not (out / MANIFEST).is_file():
+        return None
+    sts = [store.status(out / STORE, g) for g in (None, "nominal")]
+    if any(st is None for st in sts):
+        return 0, 0
+    return sum(int((st != store.STATUS["pending"]).sum()) for st in sts), sum(len(st) for st in sts)
+
+
+def _kept(args) -> str | None:
+    n = stored_runs(Path(args.out))
+    if n is None:
+        return None
+    return (f"{n[0]} of {n[1]} runs stored in {Path(args.out) / 'campaign.zarr'} (kept); continue with: "
+            f"{resume_command(args)}")
 
 
 def cmd_montecarlo(args) -> int:
+    from taos.errors import on_signal_kept
     from taos.montecarlo import load_campaign, run_campaign
+    from taos.montecarlo.engine import CampaignStopped
 
-    if args.scheduler and args.workers is not None:
-        raise InputError("command line", "--scheduler", "either --workers or --scheduler, not both")
-    m = _SCHEDULER.match(args.scheduler) if args.scheduler else None
-    if args.scheduler and (not m or (m.group(2) and not 1 <= int(m.group(2)[1:]) <= 65535)):
-        raise InputError("command line", "--scheduler", "an address like tcp://127.0.0.1:8786 (port 1 to 65535)",
-                         got=repr(args.scheduler))
+    given = [f for f, v in (("--workers", args.workers), ("--scheduler", args.scheduler),
+                            ("--scheduler-file", args.scheduler_file)) if v is not None]
+    if len(given) > 1:
+        raise InputError("command line", given[1], "one of --workers, --scheduler, --scheduler-file",
+                         got=" and ".join(given))
+    scheduler = scheduler_address(args.scheduler) if args.scheduler is not None else None
+    if args.scheduler_file is not None:
+        scheduler = scheduler_from_file(args.scheduler_file)
     if args.workers is not None and args.workers < 1:
         raise InputError("command line", "--workers", "1 or more workers", got=str(args.workers))
     if args.resume:   # before any work: a resume with nothing to continue would start afresh silently
@@ -138,10 +206,16 @@ def cmd_montecarlo(args) -> int:
             raise InputError("command line", "--resume", f"a --out folder holding a campaign ({MANIFEST}) to continue",
                              got=f"none in {args.out}")
     c = load_campaign(args.campaign)
-    res = run_campaign(c, args.out, runs=args.runs, case=args.case, friction=args.friction, workers=args.workers,
-                       scheduler=args.scheduler, resume=args.resume, progress=not args.no_progress,
-                       design=args.sensitivity or "montecarlo", batch=args.batch,
-                       connect_timeout_s=args.connect_timeout)
+    on_signal_kept(lambda: _kept(args))   # a signal from here on: the stored runs and the resume line
+    try:
+        res = run_campaign(c, args.out, runs=args.runs, case=args.case, friction=args.friction,
+                           workers=args.workers, scheduler=scheduler, resume=args.resume,
+                           progress=not args.no_progress, design=args.sensitivity or "montecarlo", batch=args.batch,
+                           connect_timeout_s=args.connect_timeout)
+    except CampaignStopped as e:
+        n = stored_runs(Path(args.out)) or (0, 0)
+        raise InputError(e.source, e.field, e.expected, got=f"{e.reason}; {n[0]} of {n[1]} runs stored in "
+                         f"{Path(args.out) / 'campaign.zarr'} (kept); continue with: {resume_command(args)}") from None
     from taos.plotting import save
     from taos.plotting.ascent import plot_campaign
     save(plot_campaign(res), Path(args.out) / "montecarlo.png")
@@ -150,17 +224,14 @@ def cmd_montecarlo(args) -> int:
         write_json(args.json, summary)
         return 0
     s = res.summary
-    f = s["lco_fraction"]
     amp = s["amplitude_deg_lco_runs"]
-    frac = "" if f["value"] is None else (f" ({100 * f['value']:.1f} %, 95 % CI {100 * f['ci_low']:.1f}-"
-                                          f"{100 * f['ci_high']:.1f} %)")
-    print(f"{c.name}, case {s['case']}: limit cycle in {f['lco_runs']} of {s['runs_ok']} completed runs{frac}"
+    print(f"{c.name}, case {s['case']}: {s['headline']}"
           + (f"; command amplitude median {amp['p50']:.3f} deg (5-95 %: {amp['p5']:.3f}-{amp['p95']:.3f})"
              if amp else ""))
     if s["runs_failed"] or s["runs_diverged"]:
-        print(f"of {s['runs']} runs, {s['runs_failed']} failed and {s['runs_diverged']} diverged: the fraction over "
-              f"all runs lies between {100 * f['all_runs_low']:.1f} and {100 * f['all_runs_high']:.1f} % "
-              "(seeds and reasons in summary.json and the store)")
+        print("(seeds and reasons of the runs without a verdict in summary.json and the store)")
+    for w in s["warnings"] + ((summary.get("sensitivity") or {}).get("warnings") or []):
+        print(f"warning: {w}")
     sens = summary.get("sensitivity")
     if sens and sens.get("indices"):
         top = sens["indices"][0]
@@ -214,7 +285,10 @@ def add_parsers(sub) -> None:
     p.add_argument("--case", help="named case of the campaign (default: its default_case)")
     p.add_argument("--friction", help="swap the friction law, keeping the torque levels")
     p.add_argument("--workers", type=_positive_int, help="local Dask workers (default 2)")
-    p.add_argument("--scheduler", help="an existing Dask scheduler, e.g. tcp://127.0.0.1:8786")
+    p.add_argument("--scheduler", help="an existing Dask scheduler: tcp://HOST:PORT, tls://HOST:PORT, HOST:PORT or "
+                   "tcp://[IPv6]:PORT")
+    p.add_argument("--scheduler-file", metavar="PATH", help="the scheduler's address from a Dask scheduler file "
+                   "(dask scheduler --scheduler-file PATH; dask-jobqueue)")
     p.add_argument("--out", required=True, help="campaign folder (runs are stored as they arrive)")
     p.add_argument("--resume", action="store_true", help="continue the campaign stored in --out")
     p.add_argument("--json", metavar="PATH", help="write the summary here ('-' for standard output)")

@@ -74,10 +74,8 @@ def cmd_sweep(args) -> int:
     if args.scheduler and args.workers is not None:
         raise InputError("command line", "--scheduler", "either --workers or --scheduler, not both")
     if args.scheduler:
-        from taos.cli.montecarlo import _SCHEDULER
-        if not _SCHEDULER.match(args.scheduler):
-            raise InputError("command line", "--scheduler", "an address like tcp://127.0.0.1:8786",
-                             got=repr(args.scheduler))
+        from taos.cli.montecarlo import scheduler_address
+        args.scheduler = scheduler_address(args.scheduler)   # the forms Dask accepts, one line if not
     defn = _definition(args)
     if args.plot and len(defn.design.keys) > 2:
         raise InputError("command line", "--plot", "a sweep of one or two keys (a metric over them)",
@@ -103,6 +101,8 @@ def cmd_sweep(args) -> int:
         if sens["indices"]:
             print(f"{m}: " + ", ".join(f"{r['parameter']} S1 {r['S1']:.2f} +- {r['S1_conf']:.2f}, ST {r['ST']:.2f} "
                                         f"+- {r['ST_conf']:.2f}" for r in sens["indices"]), file=out)
+            for w in sens.get("warnings", []):
+                print(f"warning: {m}: {w}", file=out)
         else:
             print(f"{m}: no Sobol' indices ({sens['error']})", file=out)
     for u in d["unstable"][:5]:
@@ -158,7 +158,8 @@ def add_parsers(sub) -> None:
                    "default: a temporary folder")
     p.add_argument("--resume", action="store_true", help="continue the sweep stored in --out")
     p.add_argument("--workers", type=_whole, help="1: in this process (default); K: a local Dask cluster of K workers")
-    p.add_argument("--scheduler", help="an existing Dask scheduler, e.g. tcp://127.0.0.1:8786")
+    p.add_argument("--scheduler", help="an existing Dask scheduler: tcp://HOST:PORT, tls://HOST:PORT, HOST:PORT or "
+                   "tcp://[IPv6]:PORT")
     p.add_argument("--batch", type=_whole, help="points per task (default from the metrics' cost)")
     p.add_argument("--json", metavar="PATH", help="write the grid, every metric per point, the failed and "
                    "unstable points and the provenance here ('-' for standard output)")

@@ -14,6 +14,19 @@
   cancelled all the same is submitted again with the run kind sent anew (``RESUBMITS``). A run
   that fails in itself is stored as failed with its reason. An interrupted campaign resumes by
   running the batches whose status is still "not run".
+* **One code everywhere.** At connect every worker's taos version and code hash
+  (:func:`code_identity`: SHA-256 of the package's Python source, whence the kernels come) are
+  fetched with ``client.run`` and compared with the client's; a worker running other code, or
+  no taos at all, is refused with one line naming both (:class:`~taos.errors.InputError`, exit
+  2) before anything is written. A worker joining later is checked by every batch it runs
+  (:func:`run_task` compares its own identity with the client's and refuses to run).
+* **A cluster that fails is reported, never waited on in silence.** No batch stored for
+  ``STALL_S`` while a worker is paused (Dask pauses a worker at 80 % of its memory limit), a
+  batch that kept killing its workers (``KilledWorker``), a worker with other code, or the
+  scheduler lost: the campaign stops with :class:`CampaignStopped` (an
+  :class:`~taos.errors.InputError`: one line, exit 2) saying what happened; the stored batches
+  stay, and ``--resume`` continues. No worker at all for ``STALL_S`` (a batch queue not started
+  yet) is said once on standard error, and the campaign waits.
 * **Reproducible.** A run is a pure function of its design row and seed, so the stored values are
   bit-identical for any worker count, batch size or scheduler on one CPU type; each run records
   the CPU/compile target its kernels ran with (:func:`cpu_target`).
@@ -25,10 +38,13 @@ the store, for tests and debugging.
 from __future__ import annotations
 
 import contextlib
+import functools
+import hashlib
 import logging
 import math
 import os
 import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol, Sequence
@@ -44,6 +60,20 @@ RESUBMITS = 5
 TASK_S = 10.0
 MIN_BATCH, MAX_BATCH = 50, 1000
 CONNECT_TIMEOUT_S = 20.0
+#: no batch stored for this long with a worker paused: the campaign stops [s]
+STALL_S = 120.0
+#: the polling interval of the cluster's health while waiting for batches [s]
+POLL_S = 0.05
+
+
+class CampaignStopped(InputError):
+    """The cluster failed mid-campaign (``reason``); the batches stored so far stay and the
+    campaign continues with ``resume`` (``--resume``)."""
+
+    def __init__(self, reason: str):
+        self.reason = reason
+        super().__init__("(cluster)", "campaign", "a cluster that runs the campaign to its end",
+                         got=f"{reason}; the runs stored so far are kept (resume to continue)")
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,8 +139,55 @@ def cpu_target() -> str:
     return f"{name};fastmath=off"
 
 
-def run_task(kind: RunKind, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray) -> dict:
-    """One batch as a Dask task (module level, so workers import it)."""
+@functools.cache
+def code_sha256() -> str:
+    """SHA-256 of the taos package's Python source as this process imports it: every ``*.py``
+    file under the package folder, in sorted relative-path order, path and bytes (compiled
+    caches and data left out). Two processes with the same value run the same code."""
+    import taos
+    root = Path(taos.__file__).resolve().parent
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py"), key=lambda q: q.relative_to(root).as_posix()):
+        h.update(f.relative_to(root).as_posix().encode() + b"\0")
+        h.update(f.read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def code_identity() -> dict:
+    """``{"taos": version, "code_sha256": ...}`` of this process (:func:`code_sha256`)."""
+    from taos.results import package_version
+    return {"taos": package_version(), "code_sha256": code_sha256()}
+
+
+def describe_identity(ident) -> str:
+    if not isinstance(ident, dict):
+        return f"no usable taos ({type(ident).__name__}: {str(ident).splitlines()[0][:80] if str(ident) else ''})"
+    return f"taos {ident.get('taos')} (code sha256 {str(ident.get('code_sha256'))[:16]})"
+
+
+class WorkerCodeMismatch(RuntimeError):
+    """A batch landed on a worker whose taos code differs from the client's (raised there)."""
+
+
+def check_workers(client) -> None:
+    """Refuse (one line, :class:`InputError`) a cluster with a worker whose taos version or code
+    hash (:func:`code_identity`, fetched with ``client.run``) is not the client's."""
+    mine = code_identity()
+    theirs = client.run(code_identity, on_error="return")
+    for addr, ident in sorted(theirs.items()):
+        if ident != mine:
+            raise InputError("command line", "--scheduler", f"workers running this client's {describe_identity(mine)}",
+                             got=f"worker {addr} runs {describe_identity(ident)}")
+
+
+def run_task(kind: RunKind, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray,
+             expect: dict | None = None) -> dict:
+    """One batch as a Dask task (module level, so workers import it); ``expect``: the client's
+    :func:`code_identity`, refused (:class:`WorkerCodeMismatch`) by a worker with other code."""
+    if expect is not None and code_identity() != expect:
+        raise WorkerCodeMismatch(f"this worker runs {describe_identity(code_identity())}, the client "
+                                 f"{describe_identity(expect)}")
     out = kind.run_batch(names, factors, seeds)
     out["cpu"] = [cpu_target()] * len(seeds)
     out["inputs_sha256"] = [kind.inputs_sha256] * len(seeds)
@@ -134,7 +211,9 @@ def connect(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIME
     if scheduler is None:
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
                                silence_logs=logging.ERROR)
-        return Client(cluster), cluster
+        client = Client(cluster)
+        _checked(client, cluster)
+        return client, cluster
     box: dict = {}
 
     def go():
@@ -156,7 +235,20 @@ def connect(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIME
             why = "something answered there, but not as a Dask scheduler"
         raise InputError("command line", "--scheduler", f"the address of a running Dask scheduler answering within "
                          f"{timeout_s:g} s", got=f"{scheduler} ({why})")
+    _checked(box["client"], None)
     return box["client"], None
+
+
+def _checked(client, cluster) -> None:
+    """:func:`check_workers`, the client (and cluster) closed when it refuses."""
+    try:
+        check_workers(client)
+    except BaseException:
+        with contextlib.suppress(Exception):
+            client.close()
+            if cluster is not None:
+                cluster.close()
+        raise
 
 
 @contextlib.contextmanager
@@ -171,14 +263,17 @@ def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TI
     call must not change its caller's process."""
     env = dict(os.environ)
     client = cluster = None
+    quiet = _quiet_dask_logs() if client_needed(workers, scheduler) else contextlib.nullcontext()
     try:
-        client, cluster = connect(workers, scheduler, timeout_s)
-        yield client
+        with quiet:
+            client, cluster = connect(workers, scheduler, timeout_s)
+            yield client
     finally:
         try:
             try:
                 if client is not None:
-                    client.close()
+                    with contextlib.suppress(Exception):   # a scheduler already gone: nothing to close
+                        client.close()
             finally:
                 if cluster is not None:
                     cluster.close()
@@ -189,6 +284,28 @@ def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TI
                 for k, v in env.items():
                     if os.environ.get(k) != v:
                         os.environ[k] = v
+
+
+def client_needed(workers: int, scheduler: str | None) -> bool:
+    return scheduler is not None or workers != 0
+
+
+@contextlib.contextmanager
+def _quiet_dask_logs():
+    """Dask's client-side loggers silenced during a campaign: a lost scheduler or worker is
+    reported once, by the campaign (:class:`CampaignStopped`), not by Dask's "Failed to
+    reconnect" and connection-closed lines on standard error. Restored on exit."""
+    names = ("distributed", "distributed.client", "distributed.comm", "distributed.core", "distributed.batched",
+             "tornado", "asyncio")
+    loggers = [logging.getLogger(n) for n in names]
+    levels = [lg.level for lg in loggers]
+    try:
+        for lg in loggers:
+            lg.setLevel(logging.CRITICAL)
+        yield
+    finally:
+        for lg, lv in zip(loggers, levels):
+            lg.setLevel(lv)
 
 
 def pending_batches(path: Path, part: Part, batch: int) -> list[int]:
@@ -219,32 +336,98 @@ def _on_cluster(client, kind: RunKind, todo: list, batch: int, stored) -> None:
 
     import cloudpickle
     from dask.distributed import as_completed
+    from distributed.scheduler import KilledWorker
     blob = cloudpickle.dumps(kind)
+    mine = code_identity()
     gen = [0, client.submit(_unpickled, blob, pure=False, retries=RETRIES)]  # generation, the run kind
 
     def submit(p: Part, s: int, tries: int):
         d = p.design
-        f = client.submit(run_task, gen[1], d.names, d.factors[s:s + batch], d.seeds[s:s + batch],
+        f = client.submit(run_task, gen[1], d.names, d.factors[s:s + batch], d.seeds[s:s + batch], mine,
                           pure=False, retries=RETRIES)
         meta[f.key] = (p, s, tries, gen[0])
         return f
 
     meta: dict = {}
     ac = as_completed([submit(p, s, 0) for p, s in todo])
-    for f in ac:
+    watch = _Watch(client)
+    while not ac.is_empty():
+        if not ac.has_ready():
+            watch.check()
+            time.sleep(POLL_S)
+            continue
+        f = next(ac)
         p, s, tries, g = meta.pop(f.key)
         try:
             out = f.result()
         except CancelledError:
-            if tries >= RESUBMITS:
-                raise
+            if client.status in ("closing", "closed") or tries >= RESUBMITS:
+                raise CampaignStopped(_lost(client, f"batch at run {s} cancelled {tries + 1} times")) from None
             if g == gen[0]:  # the run kind this batch waited on is gone: send it again, once
                 gen[:] = [g + 1, client.submit(_unpickled, blob, pure=False, retries=RETRIES)]
             f.release()
             ac.add(submit(p, s, tries + 1))
             continue
+        except WorkerCodeMismatch as e:
+            raise CampaignStopped(f"a worker that joined runs other code: {e}") from None
+        except KilledWorker as e:
+            raise CampaignStopped(f"workers died running the batch at run {s} and Dask gave up on it "
+                                  f"(KilledWorker: out of memory, or killed?): {str(e).splitlines()[0][:120]}") from None
+        except (OSError, TimeoutError) as e:   # the scheduler's connection (CommClosedError is an OSError)
+            raise CampaignStopped(_lost(client, f"{type(e).__name__}")) from None
         stored(p, s, out)
+        watch.progress()
         f.release()  # the batch's results leave the worker once stored
+
+
+def _lost(client, what: str) -> str:
+    if client.status in ("closing", "closed") or not _scheduler_answers(client):
+        return "the Dask scheduler was lost (no answer within the connect timeout)"
+    return what
+
+
+def _scheduler_answers(client) -> bool:
+    try:
+        client.scheduler_info()
+        return True
+    except Exception:  # noqa: BLE001 - any failure to ask is a scheduler gone
+        return False
+
+
+class _Watch:
+    """The cluster's health while a campaign waits: stop when no batch has been stored for
+    ``STALL_S`` and a worker is paused; say once when no worker is there at all."""
+
+    def __init__(self, client):
+        self.client, self.last, self.said = client, time.monotonic(), False
+
+    def progress(self) -> None:
+        self.last, self.said = time.monotonic(), False
+
+    def check(self) -> None:
+        if time.monotonic() - self.last < STALL_S:
+            return
+        if self.client.status in ("closing", "closed"):
+            raise CampaignStopped("the Dask scheduler was lost (client closed)")
+        try:
+            workers = self.client.scheduler_info(n_workers=-1).get("workers", {})
+        except TypeError:   # (an older distributed: every worker listed anyway)
+            workers = self.client.scheduler_info().get("workers", {})
+        except Exception as e:  # noqa: BLE001 - the scheduler does not answer
+            raise CampaignStopped(f"the Dask scheduler was lost ({type(e).__name__})") from None
+        paused = sorted(a for a, w in workers.items() if str(w.get("status", "")).endswith("paused"))
+        if paused:
+            mem = [workers[a].get("metrics", {}).get("memory") for a in paused]
+            lim = [workers[a].get("memory_limit") for a in paused]
+            detail = ", ".join(f"{a} ({m / 2 ** 30:.2f} of {lim_ / 2 ** 30:.2f} GiB)" if m and lim_ else a
+                               for a, m, lim_ in zip(paused, mem, lim))
+            raise CampaignStopped(f"no batch stored for {STALL_S:g} s while {len(paused)} of {len(workers)} workers "
+                                  f"are paused (memory above Dask's pause fraction): {detail}")
+        if not workers and not self.said:
+            import sys
+            print(f"taos: no Dask worker connected to the scheduler for {STALL_S:g} s; waiting (Ctrl-C stops, "
+                  "the stored runs stay for --resume)", file=sys.stderr)
+            self.said = True
 
 
 def execute(path: Path, kind: RunKind, parts: Sequence[Part], batch: int, client, progress: bool = False) -> int:

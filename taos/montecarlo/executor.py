@@ -176,7 +176,8 @@ def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | Non
         sens = _sensitivity(c, design, ds)
     prov = {"campaign_file": c.source, "campaign_sha256": c.sha256, "inputs_sha256": kind.inputs_sha256,
             "input_files": table, "ascent_sha256": kind.ascent.sha256, **model_provenance(kind.model),
-            "package_version": package_version(), "seed": c.seed, "case": case, "design": design,
+            "package_version": package_version(), "code_sha256": engine.code_sha256(), "seed": c.seed, "case": case,
+            "design": design,
             "friction_model": kind.model.friction.name, "solver": {"method": ASCENT_INTEGRATOR, "dt_s": c.dt_s},
             "segment_s": [c.start_s, c.start_s + c.duration_s],
             "cpu_targets": sorted({str(v) for v in np.unique(ds["cpu"].values)} - {""})}
@@ -197,5 +198,6 @@ def _sensitivity(c: Campaign, method: str, ds) -> dict:
     if bad:
         return base | {"indices": None, "error": f"{bad} runs failed or diverged: the estimators need every run"}
     prob = sensitivity.problem(c.dispersions)
-    return base | {"indices": sensitivity.indices(method, prob, np.asarray(ds["factor"].values), y,
-                                                  seed=c.seed % 2 ** 32)}
+    rows = sensitivity.indices(method, prob, np.asarray(ds["factor"].values), y, seed=c.seed % 2 ** 32)
+    warn = sensitivity.sobol_warnings(rows, len(y) // (len(rows) + 2)) if method == "sobol" else []
+    return base | {"indices": rows, "warnings": warn}

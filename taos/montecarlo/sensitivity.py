@@ -14,6 +14,16 @@
   ch. 1-2), Wald standard errors from the Fisher information, odds ratio per standard deviation
   of each factor and Holm-adjusted p-values.
 
+**When the indices cannot be trusted** (:func:`sobol_warnings`): the true indices satisfy
+``0 <= S1_i <= ST_i`` and ``sum S1_i <= 1``; an estimate breaking one of them by more than
+``SOBOL_SLACK`` (0.05 of the variance) or by more than its bootstrap interval (a negative index,
+``S1_i > ST_i``, ``sum S1 > 1``; the sum's half-width taken as the root sum of squares of the S1
+half-widths), or an interval half-width above ``SOBOL_MAX_CONF`` (0.1: the factors cannot be
+ranked), says that N is too small for this output, and the warning says so. Choosing N: the estimators' error falls as 1/sqrt(N); start at N = 256 to 1024
+and double N until every index's interval is narrower than the differences that matter and no
+warning is left (Saltelli et al. 2010 use N of the order of 1000; SALib's intervals at N = 16 are
+wider than the indices).
+
 The factors' distributions are those of the campaign's dispersions: ``uniform`` as is, ``normal``
 as a normal truncated at [low, high] (mean +- 6 std where unbounded, floored at 0). The design
 rows are run through the same engine as a Monte Carlo campaign.
@@ -28,6 +38,10 @@ from typing import Sequence
 import numpy as np
 
 METHODS = ("sobol", "morris")
+#: a bound of the Sobol' indices broken by more than this is warned about even inside its interval
+SOBOL_SLACK = 0.05
+#: an index's interval half-width beyond this: warned (the indices are fractions of the variance)
+SOBOL_MAX_CONF = 0.1
 MORRIS_LEVELS = 4
 
 
@@ -81,6 +95,34 @@ def indices(method: str, prob: dict, x: np.ndarray, y: np.ndarray, seed: int, co
                  "sigma": float(r["sigma"][i])} for i, nm in enumerate(prob["names"])]
         rows.sort(key=lambda d: -d["mu_star"])
         return rows
+
+
+def sobol_warnings(rows: Sequence[dict], n_base: int) -> list[str]:
+    """Checks of Sobol' estimates ``rows`` (:func:`indices`) against ``0 <= S1 <= ST``,
+    ``sum S1 <= 1`` (module docstring): one line per bound broken by more than ``SOBOL_SLACK``
+    or beyond its interval, and one when an interval is wider than ``SOBOL_MAX_CONF``; each
+    ends with the advice to raise N (``n_base``)."""
+    out = []
+    tail = f" at N = {n_base}: N is too small for this output (double N until no warning is left)"
+
+    def broken(excess: float, conf: float, what: str) -> None:
+        if excess > SOBOL_SLACK or excess > conf:
+            out.append(what + (f" beyond its interval (+-{conf:.2g})" if excess > conf else
+                               f" (within its interval +-{conf:.2g})") + tail)
+    if any(not all(math.isfinite(r[k]) for k in ("S1", "ST", "S1_conf", "ST_conf")) for r in rows):
+        return ["non-finite Sobol' indices or intervals (an output without variance?)" + tail]
+    s1 = sum(r["S1"] for r in rows)
+    broken(s1 - 1, math.sqrt(sum(r["S1_conf"] ** 2 for r in rows)), f"first-order indices sum to {s1:.3g} > 1")
+    for r in rows:
+        broken(r["S1"] - r["ST"], math.hypot(r["S1_conf"], r["ST_conf"]),
+               f"{r['parameter']}: S1 {r['S1']:.3g} > ST {r['ST']:.3g}")
+        for k in ("S1", "ST"):
+            broken(-r[k], r[f"{k}_conf"], f"{r['parameter']}: {k} {r[k]:.3g} < 0")
+    wide = max(max(r["S1_conf"], r["ST_conf"]) for r in rows) if rows else 0.0
+    if wide > SOBOL_MAX_CONF:
+        out.append(f"interval half-widths up to {wide:.2g} (> {SOBOL_MAX_CONF:g}): the factors cannot be ranked"
+                   + tail)
+    return out
 
 
 def holm(pvalues) -> np.ndarray:

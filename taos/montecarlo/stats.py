@@ -13,11 +13,22 @@ envelope is reported apart, with its reason in the store, never dropped).
   n is too small for the confidence asked;
 * envelopes: the 5/50/95 % bands of the FCS command trace over time;
 * the amplitude's Spearman rank correlation with each factor (quick view) with Holm's step-down
-  correction for testing every factor (S. Holm, Scand. J. Statist. 6 (1979) 65-70);
+  correction for testing every factor (S. Holm, Scand. J. Statist. 6 (1979) 65-70); the p-value
+  is exact (all n! orderings) up to ``EXACT_SPEARMAN_MAX`` runs and Student's t approximation
+  above (J. H. Zar, JASA 67 (1972) 578-580: good from about 10 pairs); with 4 runs the smallest
+  two-sided exact p is 2/24 = 0.083, so nothing is "significant" there;
 * the LCO yes/no outcome: logistic regression on the standardised factors
   (:func:`taos.montecarlo.sensitivity.logistic_regression`).
 
 Statistics depend only on the stored runs, in run order, never on the executor or timing.
+
+**Warnings** (``summary["warnings"]``, printed by ``taos montecarlo``): a statistic that cannot
+be trusted as printed says so: the LCO fraction from fewer than ``MIN_RUNS_FRACTION`` completed
+runs (its 95 % interval can then be wider than +-10 points: 1.96 sqrt(0.25/n) = 0.1 at n = 96),
+a percentile without a distribution-free interval (fewer than 59 runs for p5/p95 at 95 %),
+Spearman's rho from fewer than ``MIN_RUNS_SPEARMAN`` runs, and runs that diverged or failed
+(the fraction over the completed runs alone then hides them: the range over all runs is the
+honest figure). The ``headline`` counts every run: limit cycle, none, diverged, failed, not run.
 """
 
 from __future__ import annotations
@@ -34,6 +45,12 @@ __all__ = ["wilson_interval", "quantile_interval", "percentiles", "holm", "spear
            "summarise"]
 
 PERCENTILES = (5, 50, 95)
+#: fewer completed runs than this: the LCO fraction is warned about (module docstring)
+MIN_RUNS_FRACTION = 100
+#: fewer runs than this: Spearman's rho is warned about
+MIN_RUNS_SPEARMAN = 10
+#: exact permutation p-values of Spearman's rho up to this many runs (9! = 362,880 orderings)
+EXACT_SPEARMAN_MAX = 9
 #: runs listed in the summary's ``failures`` (all of them are in the store)
 MAX_LISTED = 1000
 
@@ -74,18 +91,37 @@ def percentiles(values, confidence: float = 0.95) -> dict | None:
     return out
 
 
+def spearman_exact_p(x: np.ndarray, y: np.ndarray) -> float:
+    """Two-sided exact p-value of Spearman's rho of (x, y): the fraction of the n! orderings of
+    y's ranks whose |rho| reaches the observed one (ties: mid-ranks, permuted as they are)."""
+    import itertools
+
+    from scipy.stats import rankdata
+    rx, ry = rankdata(x), rankdata(y)
+    rx, ry = rx - rx.mean(), ry - ry.mean()
+    perms = np.array(list(itertools.permutations(range(len(ry)))), np.int32)
+    den = math.sqrt(float(rx @ rx) * float(ry @ ry))
+    obs = abs(float(rx @ ry)) / den
+    return float(np.mean(np.abs(ry[perms] @ rx) / den >= obs - 1e-12))
+
+
 def spearman(names, factors: np.ndarray, y: np.ndarray, alpha: float = 0.05) -> list[dict]:
-    """Spearman's rho of each factor column with ``y``, strongest first, Holm-adjusted."""
+    """Spearman's rho of each factor column with ``y``, strongest first, Holm-adjusted; the
+    p-value exact up to :data:`EXACT_SPEARMAN_MAX` runs (``p_method``)."""
     from scipy.stats import spearmanr
     rows = []
     if len(y) < 4 or np.ptp(y) == 0:
         return rows
+    exact = len(y) <= EXACT_SPEARMAN_MAX
     for j, name in enumerate(names):
         x = factors[:, j]
         if np.ptp(x) == 0:
             continue
         rho, pval = spearmanr(x, y)
-        rows.append({"parameter": name, "spearman_rho": float(rho), "p_value": float(pval)})
+        if exact:
+            pval = spearman_exact_p(x, y)
+        rows.append({"parameter": name, "spearman_rho": float(rho), "p_value": float(pval),
+                     "p_method": "exact permutation" if exact else "Student t approximation"})
     for r, a in zip(rows, holm([r["p_value"] for r in rows])):
         r["p_holm"] = float(a)
         r["significant"] = bool(a < alpha)
@@ -107,6 +143,48 @@ def envelope(traces, ok: np.ndarray, block_bytes: int = 64 << 20) -> dict:
         for p in PERCENTILES:
             env[f"p{p}_deg"][j:j + step] = np.degrees(np.percentile(blk, p, axis=0))
     return {k: v.tolist() for k, v in env.items()}
+
+
+def headline(n: int, k: int, n_ok: int, n_div: int, n_fail: int, n_pend: int, ci, all_range,
+             confidence: float) -> str:
+    """One line counting every run: limit cycle, none, diverged, failed, not run; the LCO fraction
+    over the completed runs with its interval and, when some runs have no verdict, its range over
+    all runs."""
+    parts = [f"{k} limit cycle", f"{n_ok - k} none"] + [f"{c} {w}" for c, w in ((n_div, "diverged (hard stops)"),
+                                                                                (n_fail, "failed"),
+                                                                                (n_pend, "not run")) if c]
+    text = f"{n} runs: " + ", ".join(parts)
+    if n_ok:
+        text += (f"; LCO in {100 * k / n_ok:.1f} % of the {n_ok} completed runs ({100 * confidence:g} % CI "
+                 f"{100 * ci[0]:.1f}-{100 * ci[1]:.1f} %)")
+    if n_ok < n and n:
+        text += f"; over all {n} runs between {100 * all_range[0]:.1f} and {100 * all_range[1]:.1f} %"
+    return text
+
+
+def warnings_of(s: dict) -> list[str]:
+    """What in summary ``s`` cannot be trusted as printed (module docstring)."""
+    out = []
+    bad = s["runs_diverged"] + s["runs_failed"]
+    if bad:
+        out.append(f"{bad} of {s['runs']} runs diverged or failed and have no verdict: the LCO fraction over the "
+                   f"completed runs leaves them out; over all runs it lies between "
+                   f"{100 * s['lco_fraction']['all_runs_low']:.1f} and {100 * s['lco_fraction']['all_runs_high']:.1f} %")
+    if s["runs_not_run"]:
+        out.append(f"{s['runs_not_run']} of {s['runs']} runs not run yet (resume the campaign)")
+    if s["runs_ok"] < MIN_RUNS_FRACTION:
+        f = s["lco_fraction"]
+        out.append(f"LCO fraction from {s['runs_ok']} completed runs (fewer than {MIN_RUNS_FRACTION}): "
+                   f"{100 * f['confidence']:g} % interval {100 * f['ci_low']:.1f}-{100 * f['ci_high']:.1f} %")
+    for key in ("amplitude_deg_lco_runs", "amplitude_deg_all_runs", "peak_engine_deg"):
+        p = s.get(key)
+        if p and (p["p5_ci"] is None or p["p95_ci"] is None):
+            out.append(f"{key}: p5/p95 from {p['n']} runs have no distribution-free "
+                       f"{100 * s['lco_fraction']['confidence']:g} % interval (too few runs)")
+    n_sp = s["runs_ok"]
+    if s["sensitivity_of_amplitude"] and n_sp < MIN_RUNS_SPEARMAN:
+        out.append(f"Spearman's rho from {n_sp} runs (fewer than {MIN_RUNS_SPEARMAN}): a screen, not evidence")
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -139,7 +217,7 @@ def summarise(campaign_name: str, case: str, ds, nominal, confidence: float = 0.
     st = np.asarray(ds["status"].values, np.int8)
     ok = st == STATUS["ok"]
     n_fail, n_div = int((st == STATUS["failed"]).sum()), int((st == STATUS["diverged"]).sum())
-    lco = np.asarray(ds["lco"].values, bool) & ok
+    lco = (np.asarray(ds["lco"].values, float) == 1) & ok   # (NaN: a run not run yet)
     k, n_ok, n = int(lco.sum()), int(ok.sum()), len(st)
     lo, hi = wilson_interval(k, n_ok, confidence)
     sc = {v: np.asarray(ds[v].values, float) for v in ("amplitude_deg", "frequency_hz", "peak_engine_deg",
@@ -153,13 +231,16 @@ def summarise(campaign_name: str, case: str, ds, nominal, confidence: float = 0.
            ("status", "lco", "amplitude_deg", "engine_amplitude_deg", "frequency_hz", "peak_engine_deg")}
     nom = {kk: (None if isinstance(v, float) and not math.isfinite(v) else v) for kk, v in nom.items()}
     amp = sc["amplitude_deg"]
+    n_pend = int((st == STATUS["pending"]).sum())
+    all_lo, all_hi = (k / n if n else None), ((k + n_fail + n_div + n_pend) / n if n else None)
     summary = {
-        "campaign": campaign_name, "case": case, "runs": n, "runs_ok": n_ok, "runs_failed": n_fail,
-        "runs_diverged": n_div, "runs_not_run": int((st == STATUS["pending"]).sum()),
+        "campaign": campaign_name, "case": case,
+        "headline": headline(n, k, n_ok, n_div, n_fail, n_pend, (lo, hi), (all_lo, all_hi), confidence),
+        "runs": n, "runs_ok": n_ok, "runs_lco": k, "runs_no_lco": n_ok - k, "runs_failed": n_fail,
+        "runs_diverged": n_div, "runs_not_run": n_pend,
         "lco_fraction": {"value": k / n_ok if n_ok else None, "lco_runs": k, "ci_low": lo, "ci_high": hi,
                          "confidence": confidence, "method": "Wilson score, over the completed runs",
-                         "all_runs_low": k / n if n else None,
-                         "all_runs_high": (k + n_fail + n_div) / n if n else None},
+                         "all_runs_low": all_lo, "all_runs_high": all_hi},
         "nominal": nom,
         "amplitude_deg_lco_runs": percentiles(amp[lco], confidence),
         "frequency_hz_lco_runs": percentiles(sc["frequency_hz"][lco], confidence),
@@ -174,6 +255,7 @@ def summarise(campaign_name: str, case: str, ds, nominal, confidence: float = 0.
         "envelope_t_s": np.asarray(ds["time"].values).tolist(),
         "envelope": envelope(ds["trace"], ok),
     }
+    summary["warnings"] = warnings_of(summary)
     return CampaignResult(campaign_name=campaign_name, case=case, status=st, lco=lco, amplitude_deg=amp,
                           trace_t_s=np.asarray(ds["time"].values), traces_rad=ds["trace"],
                           nominal_trace_rad=np.asarray(nominal["trace"].values[0]), summary=summary)

@@ -12,10 +12,19 @@ Layout (``OUT/campaign.zarr``, Zarr format 2, readable with ``xarray.open_zarr``
     cpu        (run)  str          the CPU / compile target the run's kernels ran with
     inputs_sha256 (run) str        the content hash of the inputs the worker flew the run with
     <scalar>   (run)  float        the run kind's scalar outputs (NaN when not ok)
-    <flag>     (run)  bool         the run kind's yes/no outputs
-    trace      (run, time)         the run kind's trace (NaN when not ok): the FCS command [rad] of a flight run
+    <flag>     (run)  0/1          the run kind's yes/no outputs (stored int8, -1 the fill value:
+                                   read back as float, NaN for a run not run yet)
+    trace      (run, time)         the run kind's trace [rad] (NaN when not ok): the FCS command of a flight run
     engine_trace (run, time)       the engine angle [rad] of a flight run at the same times (NaN when not ok or
                                    the run kind has none; absent from stores written before it)
+
+Self-describing (CF conventions 1.10, readable by ``cf_xarray``): every variable has
+``long_name`` and, where it has a unit, ``units`` in UDUNITS spelling (:func:`cf_attributes`:
+from the SI suffix of its name, ``_deg`` degree, ``_hz`` Hz, ``_s`` s, ``_rad`` rad, ...; the
+trace in rad, the scalars in the unit their name says); ``time`` has ``standard_name = "time"``
+and ``axis = "T"``; status has ``flag_values``/``flag_meanings``. A run not run yet reads as NaN
+in every float output and every flag (so ``ds.lco.mean()`` of a half-finished store is the
+fraction over the runs done, never a 0 counted for a run that did not happen).
 
 A second group (``group="nominal"``) holds the nominal run(s) in the same layout. The arrays are
 chunked along ``run`` by the batch size, so a batch is whole chunks: writing it costs the same at
@@ -35,6 +44,39 @@ STATUS = {"pending": 0, "ok": 1, "failed": 2, "diverged": 3}
 #: the (run, time) variables
 TRACES = ("trace", "engine_trace")
 TEXT_WIDTH = 160
+#: flags on disk: int8, this value for a run not run yet (decoded to NaN by xarray)
+FLAG_FILL = -1
+CONVENTIONS = "CF-1.10"
+#: UDUNITS spelling of the unit each name suffix states (longest suffix first)
+SUFFIX_UNITS = (("_deg_s", "degree s-1"), ("_rad_s", "rad s-1"), ("_n_m", "N m"), ("_deg", "degree"),
+                ("_rad", "rad"), ("_hz", "Hz"), ("_db", "dB"), ("_s", "s"), ("_m", "m"), ("_n", "N"))
+#: long names of the store's own variables and of the flight runs' outputs (:mod:`taos.montecarlo.run`)
+LONG_NAMES = {
+    "run": "run index", "parameter": "dispersed factor name", "time": "time from the start of the segment",
+    "factor": "factor on the nominal value (design row)", "seed": "random seed of the run",
+    "status": "run status", "error": "why the run failed or diverged", "cpu": "CPU / compile target of the kernels",
+    "inputs_sha256": "SHA-256 of the inputs the run was flown with",
+    "trace": "FCS engine-angle command", "engine_trace": "engine angle",
+    "amplitude_deg": "limit-cycle amplitude of the FCS command (fundamental)",
+    "engine_amplitude_deg": "limit-cycle amplitude of the engine angle (fundamental)",
+    "frequency_hz": "limit-cycle frequency", "growth": "amplitude growth over the analysis window (ratio)",
+    "peak_engine_deg": "peak engine angle over the segment", "peak_engine_rate_deg_s": "peak engine rate",
+    "peak_attitude_deg": "peak attitude error over the segment", "lco": "sustained limit cycle (1 yes, 0 no)",
+}
+
+
+def cf_attributes(name: str, long_name: str | None = None) -> dict:
+    """CF attributes of variable ``name``: ``long_name`` (given, from :data:`LONG_NAMES`, else the
+    name in words) and ``units`` from its SI suffix (:data:`SUFFIX_UNITS`; the trace: rad; no
+    ``units`` for a dimensionless ratio, a flag, a count or text)."""
+    out = {"long_name": long_name or LONG_NAMES.get(name) or name.replace("_", " ")}
+    unit = "rad" if name in TRACES else "s" if name == "time" else next(
+        (u for sfx, u in SUFFIX_UNITS if name.endswith(sfx)), None)
+    if unit is not None:
+        out["units"] = unit
+    if name == "time":
+        out |= {"standard_name": "time", "axis": "T"}
+    return out
 
 
 def _lazy(shape, dtype, chunks, fill):
@@ -44,8 +86,9 @@ def _lazy(shape, dtype, chunks, fill):
 
 def create(path: Path, *, labels: np.ndarray, names: tuple[str, ...], factors: np.ndarray, seeds: np.ndarray,
            scalars: tuple[str, ...], flags: tuple[str, ...], trace_t_s: np.ndarray, batch: int, attrs: Mapping,
-           group: str | None = None) -> None:
-    """Write the store's metadata and the design (factors, seeds); every output unset."""
+           group: str | None = None, long_names: Mapping[str, str] | None = None) -> None:
+    """Write the store's metadata and the design (factors, seeds); every output unset (NaN).
+    ``long_names``: the run kind's outputs in words (default :data:`LONG_NAMES`)."""
     import xarray as xr
     n, m = len(labels), len(trace_t_s)
     ch = (min(batch, n),)
@@ -53,7 +96,7 @@ def create(path: Path, *, labels: np.ndarray, names: tuple[str, ...], factors: n
         "factor": (("run", "parameter"), np.asarray(factors, float).reshape(n, len(names))),
         "seed": (("run",), np.asarray(seeds, np.int64)),
         "status": (("run",), _lazy((n,), np.int8, ch, 0),
-                   {"flag_values": list(STATUS.values()), "flag_meanings": " ".join(STATUS)}),
+                   {"flag_values": np.asarray(list(STATUS.values()), np.int8), "flag_meanings": " ".join(STATUS)}),
         "error": (("run",), _lazy((n,), f"<U{TEXT_WIDTH}", ch, "")),
         "cpu": (("run",), _lazy((n,), "<U64", ch, "")),
         "inputs_sha256": (("run",), _lazy((n,), "<U64", ch, "")),
@@ -63,10 +106,14 @@ def create(path: Path, *, labels: np.ndarray, names: tuple[str, ...], factors: n
     for s in scalars:
         data[s] = (("run",), _lazy((n,), float, ch, np.nan))
     for f in flags:
-        data[f] = (("run",), _lazy((n,), bool, ch, False))
+        data[f] = (("run",), _lazy((n,), float, ch, np.nan), {"flag_values": np.asarray([0, 1], np.int8),
+                                                               "flag_meanings": "no yes"})
     ds = xr.Dataset(data, coords={"run": np.asarray(labels, np.int64), "parameter": list(names),
-                                  "time": np.asarray(trace_t_s, float)}, attrs=dict(attrs))
-    ds.to_zarr(path, group=group, compute=False, mode="w-" if group is None else "a", zarr_format=2)
+                                  "time": np.asarray(trace_t_s, float)}, attrs={"Conventions": CONVENTIONS, **attrs})
+    for k, v in ds.variables.items():
+        v.attrs.update(cf_attributes(str(k), (long_names or {}).get(str(k))))
+    enc = {f: {"dtype": "int8", "_FillValue": FLAG_FILL} for f in flags}
+    ds.to_zarr(path, group=group, compute=False, mode="w-" if group is None else "a", zarr_format=2, encoding=enc)
 
 
 def write_batch(path: Path, start: int, out: Mapping[str, np.ndarray], group: str | None = None) -> None:
@@ -78,6 +125,9 @@ def write_batch(path: Path, start: int, out: Mapping[str, np.ndarray], group: st
     old = [k for k in TRACES[1:] if k in out and not (Path(path) / (group or "") / k / ".zarray").exists()]
     body = {k: ((("run", "time") if k in TRACES else ("run",)), np.asarray(v)) for k, v in out.items()
             if k != "status" and k not in old}
+    for k, (dims, v) in body.items():
+        if v.dtype == bool:   # a flag: 0/1 (the store's int8 encoding; NaN stays for runs not run)
+            body[k] = (dims, v.astype(float))
     if "error" in body:
         body["error"] = (("run",), np.asarray([e[:TEXT_WIDTH] for e in out["error"]], f"<U{TEXT_WIDTH}"))
     for k in ("cpu", "inputs_sha256"):

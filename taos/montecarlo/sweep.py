@@ -342,5 +342,5 @@ class SweepResult:
                            "the estimators need every point"}
         prob = {"num_vars": len(d.keys), "names": [k.key for k in d.keys],
                 "bounds": [list(k.numbers) for k in d.keys], "dists": ["unif"] * len(d.keys)}
-        return base | {"indices": sensitivity.indices("sobol", prob, d.factors, y, seed=d.seed,
-                                                      confidence=confidence)}
+        rows = sensitivity.indices("sobol", prob, d.factors, y, seed=d.seed, confidence=confidence)
+        return base | {"indices": rows, "warnings": sensitivity.sobol_warnings(rows, d.n // (len(d.keys) + 2))}
