@@ -291,3 +291,88 @@ def test_a_bad_numba_thread_count_is_one_line(value, tmp_path):
     err = p.stderr.decode()
     assert p.returncode == 2 and len(err.strip().splitlines()) == 1 and "NUMBA_NUM_THREADS" in err, err
     assert not (tmp_path / "f.json").exists()
+
+
+# -- the other HDF5 readers: flight records (taos pti) and describing-function maps ---------------
+
+def _flight_record(path: Path) -> Path:
+    import h5py
+    t = np.arange(200) * 0.01
+    with h5py.File(path, "w") as f:
+        f["t_s"] = t
+        f.attrs["axes"] = "pitch"
+        for name, x in (("pti_rad", 1e-3 * np.sin(t)), ("command_rad", 2e-3 * np.sin(t)), ("piston_m", 1e-3 * np.sin(t))):
+            f[f"pitch/{name}"] = x
+    return path
+
+
+@pytest.mark.parametrize("case", ["link loop", "external link to a text file", "string dtype", "complex data",
+                                  "huge piston", "2-D time"])
+def test_a_malformed_flight_record_is_one_line(case, tmp_path):
+    import h5py
+
+    from taos.errors import InputError
+    from taos.flight.pti_record import load_flight_record
+
+    p = _flight_record(tmp_path / "rec.h5")
+    assert load_flight_record(p).axes == ("pitch",)          # the base is a good record
+    with h5py.File(p, "r+") as f:
+        if case == "2-D time":
+            _replace("t_s", lambda v: np.vstack([v, v]))(f, tmp_path)
+        elif case in ("link loop", "external link to a text file"):
+            del f["pitch/piston_m"]
+            if case == "link loop":
+                f["pitch/piston_m"] = h5py.SoftLink("/pitch/x")
+                f["pitch/x"] = h5py.SoftLink("/pitch/piston_m")
+            else:
+                (tmp_path / "notes.txt").write_text("text\n")
+                f["pitch/piston_m"] = h5py.ExternalLink(str(tmp_path / "notes.txt"), "/x")
+        else:
+            fn = {"string dtype": lambda v: np.array([b"x"] * v.size), "complex data": lambda v: v * 1j,
+                  "huge piston": lambda v: v * 1e300}[case]
+            _replace("pitch/piston_m", fn)(f, tmp_path)
+    with pytest.raises(InputError) as e:
+        load_flight_record(p)
+    msg = str(e.value)
+    assert "\n" not in msg and ("/t_s" if case == "2-D time" else "piston_m") in msg, msg
+
+
+def _df_map(path: Path) -> Path:
+    import json
+
+    import h5py
+    with h5py.File(path, "w") as f:
+        f["amplitude_rad"] = np.array([1e-3, 2e-3])
+        f["freq_hz"] = np.array([0.5, 1.0, 2.0])
+        f["engine"] = np.full((2, 3), 0.9 - 0.1j)
+        f["piston"] = np.full((2, 3), 0.95 - 0.05j)
+        f.attrs["friction_model"] = "dahl"
+        f.attrs["axis"] = "pitch"
+        f.attrs["load_stiffness_N_per_m"] = float("nan")
+        f.attrs["provenance"] = json.dumps({"provenance": {}})
+    return path
+
+
+@pytest.mark.parametrize("case, field", [("engine 1-D", "/engine"), ("engine as text", "/engine"),
+                                         ("axis roll", "axis"), ("negative amplitude", "/amplitude_rad"),
+                                         ("provenance not JSON", "load_stiffness_N_per_m"),
+                                         ("infinite stiffness", "load_stiffness_N_per_m")])
+def test_a_malformed_describing_function_map_is_one_line(case, field, tmp_path):
+    import h5py
+
+    from taos.errors import InputError
+    from taos.flight.describing import DescribingFunctionMap
+
+    p = _df_map(tmp_path / "df.h5")
+    assert DescribingFunctionMap.from_hdf5(p).engine.shape == (2, 3)     # the base is a good map
+    with h5py.File(p, "r+") as f:
+        edit = {"engine 1-D": _replace("engine", lambda v: v[0]),
+                "engine as text": _replace("engine", lambda v: np.array([[b"a"] * 3] * 2)),
+                "axis roll": _attr("axis", "roll"),
+                "negative amplitude": _replace("amplitude_rad", lambda v: -v),
+                "provenance not JSON": _attr("provenance", "{not json"),
+                "infinite stiffness": _attr("load_stiffness_N_per_m", float("inf"))}[case]
+        edit(f, tmp_path)
+    with pytest.raises(InputError) as e:
+        DescribingFunctionMap.from_hdf5(p)
+    assert "\n" not in str(e.value) and field in str(e.value), str(e.value)

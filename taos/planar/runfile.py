@@ -81,10 +81,12 @@ def has(h5, key: str, src: str) -> bool:
     return node(h5, key, src) is not None
 
 
-def dataset(h5, key: str, src: str, *, n: int | None = None, ndim: int = 1, rows: int | None = None) -> np.ndarray:
+def dataset(h5, key: str, src: str, *, n: int | None = None, ndim: int = 1, rows: int | None = None,
+            complex_ok: bool = False) -> np.ndarray:
     """The dataset at ``key`` as a float64 array, refused (InputError naming ``/key``) unless it is
     a real numeric dataset of ``ndim`` dimensions (1: ``(n,)``; 2: ``(rows, n)``), at most
-    :data:`MAX_DATA_SAMPLES` samples long, every value finite."""
+    :data:`MAX_DATA_SAMPLES` samples long, every value finite. ``complex_ok``: complex data is
+    read as complex128 (a frequency response), real data too."""
     import h5py
 
     ds = node(h5, key, src)
@@ -94,9 +96,9 @@ def dataset(h5, key: str, src: str, *, n: int | None = None, ndim: int = 1, rows
     if not isinstance(ds, h5py.Dataset):
         raise InputError(src, name, "a dataset of numbers", got="a group")
     kind = ds.dtype.kind
-    if kind == "c":
+    if kind == "c" and not complex_ok:
         raise InputError(src, name, "real numbers", got=f"complex data ({ds.dtype})")
-    if kind not in "fiu":
+    if kind not in ("fiuc" if complex_ok else "fiu"):
         raise InputError(src, name, "numbers (integers or floats)", got=f"data of type {ds.dtype}")
     shape = ds.shape
     want = "(n,)" if ndim == 1 else f"({rows if rows is not None else 'k'}, n)"
@@ -107,7 +109,7 @@ def dataset(h5, key: str, src: str, *, n: int | None = None, ndim: int = 1, rows
     if n is not None and shape[-1] != n:
         raise InputError(src, name, f"{n} samples like the time column", got=str(shape[-1]))
     try:
-        x = np.asarray(ds[()], dtype=np.float64)
+        x = np.asarray(ds[()], dtype=np.complex128 if complex_ok else np.float64)
     except (OSError, ValueError, TypeError, RuntimeError) as e:   # a filter missing, a corrupt chunk
         raise InputError(src, name, "readable numbers", got=" ".join(str(e).split())[:100]) from None
     bad = np.flatnonzero(~np.isfinite(x.ravel()))
