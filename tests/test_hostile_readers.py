@@ -376,3 +376,11 @@ def test_a_malformed_describing_function_map_is_one_line(case, field, tmp_path):
     with pytest.raises(InputError) as e:
         DescribingFunctionMap.from_hdf5(p)
     assert "\n" not in str(e.value) and field in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("option", ["--angle-scale", "--deflection-scale"])
+def test_a_view_scale_that_draws_beyond_reason_is_one_line_not_an_overflow(option, tmp_path):
+    run = base_run(tmp_path / "run.h5")
+    p = run_cli("view", run, "--html", tmp_path / "v.html", option, "1e300", timeout=120)
+    _assert_one_line(p, option)
+    assert not (tmp_path / "v.html").exists()
