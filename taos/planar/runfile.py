@@ -9,7 +9,7 @@ file is refused, whatever that file is), reached without a link loop, of a real 
 :data:`taos.bounds.MAX_DATA_SAMPLES`, and finite. A run's physical signals are held to the same
 magnitudes as a measured record's (:data:`SIGNAL_LIMITS`, the ``data`` group of
 docs/reference/bounds.md), its moment arm to the model bound ``actuator.moment_arm``, its engine
-name to :data:`taos.planar.envelope.ENGINES`. Each refusal is one line,
+name to :data:`ENGINES`. Each refusal is one line,
 ``InputError(file, dataset or attribute, expected, got)``; nothing is written by reading.
 """
 
@@ -37,6 +37,9 @@ RUN_SIGNAL_KINDS = {"command_rad": "angle", "command_avionics_rad": "angle", "en
 #: SI unit of each kind of :data:`SIGNAL_LIMITS`
 KIND_SI = {"angle": "rad", "length": "m", "pressure": "Pa", "velocity": "m/s"}
 AXES = ("pitch", "yaw")
+#: the engine models a run can use: the planar simplex model (:mod:`taos.planar`) and the 3-D
+#: TAOS model (:mod:`taos.taos3d`)
+ENGINES = ("simplex", "taos")
 
 
 def open_hdf5(path, src: str, what: str):
@@ -154,8 +157,6 @@ def read_run(h5, src: str, arrays, optional=()) -> dict:
     :data:`SIGNAL_LIMITS` for its unit kind; ``moment_arm_m`` within the model bound; an
     ``engine`` attribute (when present) naming a known engine, ``taos`` exactly when the file has
     the 3-D ``/taos`` group."""
-    from .envelope import ENGINES
-
     text = text_attr(h5, "axes", src)
     axes = tuple(text.split(","))
     if not (1 <= len(axes) <= 2 and all(a in AXES for a in axes) and len(set(axes)) == len(axes)):
