@@ -384,3 +384,38 @@ def test_a_view_scale_that_draws_beyond_reason_is_one_line_not_an_overflow(optio
     p = run_cli("view", run, "--html", tmp_path / "v.html", option, "1e300", timeout=120)
     _assert_one_line(p, option)
     assert not (tmp_path / "v.html").exists()
+
+
+@pytest.mark.parametrize("case, field", [("2-D column", "/pitch_piston"), ("unit not text", "unit"),
+                                         ("external link", "/pitch_command"), ("complex column", "/time")])
+def test_a_malformed_hdf5_record_of_named_signals_is_one_line(case, field, tmp_path):
+    """The other HDF5 record layout (root datasets named by signal, a unit attribute each)."""
+    import h5py
+
+    from taos.errors import InputError
+    from taos.identify.data import load_test_data
+
+    p = tmp_path / "r.h5"
+    t = np.arange(400) * 0.01
+    with h5py.File(p, "w") as f:
+        for name, x, unit in (("time", t, "s"), ("pitch_command", np.sin(t), "deg"),
+                              ("pitch_piston", 0.1 * np.sin(t), "in")):
+            f[name] = x
+            f[name].attrs["unit"] = unit
+    assert load_test_data(p).axes == ("pitch",)                  # the base is a good record
+    with h5py.File(p, "r+") as f:
+        if case == "2-D column":
+            _replace("pitch_piston", lambda v: v[:, None])(f, tmp_path)
+            f["pitch_piston"].attrs["unit"] = "in"
+        elif case == "unit not text":
+            f["pitch_command"].attrs["unit"] = np.array([1.0, 2.0])
+        elif case == "external link":
+            with h5py.File(tmp_path / "o.h5", "w") as g:
+                g["x"] = np.zeros(400)
+            del f["pitch_command"]
+            f["pitch_command"] = h5py.ExternalLink(str(tmp_path / "o.h5"), "/x")
+        else:
+            _replace("time", lambda v: v + 0j)(f, tmp_path)
+    with pytest.raises(InputError) as e:
+        load_test_data(p)
+    assert "\n" not in str(e.value) and field in str(e.value), str(e.value)
