@@ -419,3 +419,12 @@ def test_a_malformed_hdf5_record_of_named_signals_is_one_line(case, field, tmp_p
     with pytest.raises(InputError) as e:
         load_test_data(p)
     assert "\n" not in str(e.value) and field in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("text", ["time [s],pitch_command [deg],pitch_piston [in]\n", "\0\0\0\0"],
+                         ids=["header only", "NUL bytes"])
+def test_a_record_without_rows_is_one_line_without_a_numpy_warning(text, tmp_path):
+    rec = tmp_path / "empty.csv"
+    rec.write_text(text)
+    p = run_cli("estimate", rec, timeout=120)
+    _assert_one_line(p, str(rec))

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -145,9 +146,13 @@ def _read_csv(p: Path, src: str) -> FlightRecord:
     if len(set(header)) != len(header):
         raise InputError(src, "header", "each column once")
     try:
-        data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2, encoding="utf-8")
+        with warnings.catch_warnings():   # a header without rows: refused by _check's sample count
+            warnings.filterwarnings("ignore", "loadtxt: input contained no data")
+            data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2, encoding="utf-8")
     except (ValueError, UnicodeDecodeError) as e:
         raise InputError(src, "(rows)", "numbers only, one per column", got=str(e).splitlines()[0][:80]) from None
+    if data.size == 0:
+        raise InputError(src, "(rows)", "16 or more rows of numbers after the header", got="none")
     if data.shape[1] != len(header):
         raise InputError(src, "(rows)", f"{len(header)} numbers per row", got=str(data.shape[1]))
     col = {h: data[:, i] for i, h in enumerate(header)}

@@ -45,6 +45,7 @@ from __future__ import annotations
 import datetime as _dt
 import io
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -341,7 +342,9 @@ def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
                                  f"read as its sidecar: it has no {SIDECAR_MARK} = {path.name!r})",
                                  got="no known signal column")
         try:
-            arr = np.loadtxt(f, delimiter=",", dtype=float, ndmin=2, comments=None)
+            with warnings.catch_warnings():   # a header without rows: refused below by its sample count
+                warnings.filterwarnings("ignore", "loadtxt: input contained no data")
+                arr = np.loadtxt(f, delimiter=",", dtype=float, ndmin=2, comments=None)
         except (ValueError, UnicodeDecodeError) as e:
             raise InputError(src, "(rows)", f"{len(header)} comma-separated numbers per row",
                              got=" ".join(str(e).split())[:120]) from None
