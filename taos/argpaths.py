@@ -103,5 +103,5 @@ def check_environment() -> None:
     if v is not None and not (v.strip().isdigit() and int(v) >= 1):
         raise InputError("environment", "NUMBA_NUM_THREADS", "a whole number of threads, 1 or more (or unset: "
                          "one per core)", got=repr(v)[:40])
-    if "MPLBACKEND" in os.environ and "matplotlib" not in __import__("sys").modules:
+    if os.environ.get("MPLBACKEND", "agg").lower() != "agg" and "matplotlib" not in __import__("sys").modules:
         os.environ["MPLBACKEND"] = "agg"
