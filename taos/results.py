@@ -305,9 +305,9 @@ def check_output_file(path: str | Path, field: str = "(output)", suffixes: tuple
         return p
     if suffixes and p.suffix.lower() not in suffixes:
         raise InputError(str(path), field, "a file name ending in " + " or ".join(suffixes), got=repr(p.suffix))
-    if len(str(p)) > 4000 or any(len(part.encode()) > _NAME_MAX - 60 for part in p.parts):
+    if len(str(p)) > 4000 or any(len(os.fsencode(part)) > _NAME_MAX - 60 for part in p.parts):
         raise InputError(str(path)[:80] + "...", field, f"a file name of at most {_NAME_MAX - 60} bytes "
-                         "per folder level", got=f"{max(len(x.encode()) for x in p.parts)} bytes")
+                         "per folder level", got=f"{max(len(os.fsencode(x)) for x in p.parts)} bytes")
     try:
         st = os.lstat(p)
     except (FileNotFoundError, NotADirectoryError):
@@ -484,9 +484,12 @@ def write_json(path: str, payload: dict) -> None:
 
 
 def write_provenance(h5: h5py.File, provenance: dict) -> None:
-    """Store provenance as attributes of the root group (JSON for nested values)."""
+    """Store provenance as attributes of the root group (JSON for nested values). HDF5 text is
+    UTF-8: a file name whose bytes are not (read under ``LANG=C``, held as surrogate escapes)
+    is stored with those bytes written as ``\\xNN``."""
     for k, v in provenance.items():
-        h5.attrs[k] = v if isinstance(v, (str, int, float)) else json.dumps(v, sort_keys=True)
+        v = v if isinstance(v, (str, int, float)) else json.dumps(v, sort_keys=True)
+        h5.attrs[k] = v.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace") if isinstance(v, str) else v
 
 
 def toml_set(doc, section: str, key: str, value, comment: str | None = None) -> None:
@@ -521,13 +524,15 @@ _OUTPUT_FILE_OPTIONS = {"json": (), "html": (".html", ".htm"), "df_out": (), "ou
                         "plot_map": (".png", ".svg")}
 
 
-from taos.argpaths import input_paths as _input_paths, same_place as _same_place  # noqa: E402
+from taos.argpaths import check_environment, input_paths as _input_paths, same_place as _same_place  # noqa: E402
 
 
 def check_arguments(args) -> None:
     """Checks every ``taos`` command shares, before any work (:func:`taos.errors.run_cli`'s
     ``check``): a seed is a 32-bit unsigned whole number; an output option is not empty, is not
-    one of the inputs (nor a link to one) and names a place :func:`check_output_file` accepts."""
+    one of the inputs (nor a link to one) and names a place :func:`check_output_file` accepts;
+    the environment as :func:`taos.argpaths.check_environment` says."""
+    check_environment()
     seed = getattr(args, "seed", None)
     if isinstance(seed, int) and not 0 <= seed < 2 ** 32:
         raise InputError("command line", "--seed", "a whole number from 0 to 4294967295", got=str(seed))

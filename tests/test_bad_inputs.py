@@ -94,7 +94,7 @@ def sidecar_csv(tmp: Path, sidecar: str) -> Path:
     """Plain column names and a sidecar TOML."""
     write(tmp, "s.csv", "t,c,x\n" + "\n".join(f"{i * 0.01},{np.sin(i / 5):.5f},{np.sin(i / 5) * 0.01:.6f}"
                                               for i in range(200)) + "\n")
-    write(tmp, "s.toml", sidecar)
+    write(tmp, "s.toml", 'sidecar_for = "s.csv"\n' + sidecar)   # the mark: this TOML is s.csv's sidecar
     return tmp / "s.csv"
 
 

@@ -52,7 +52,7 @@ def test_sidecar_toml_maps_any_column_names_and_units(tmp_path):
     p = tmp_path / "rig.csv"
     _write_csv(p, t * 1000, {"cmdP": c * DEG, "xp": 5.0 * c, "cmdY": 0 * c, "xy": 0 * c})
     (tmp_path / "rig.toml").write_text(
-        'condition = "ambient"\nengine_angle_reference = "absolute"\n[columns]\n'
+        'sidecar_for = "rig.csv"\ncondition = "ambient"\nengine_angle_reference = "absolute"\n[columns]\n'
         'time = {signal = "time", unit = "ms"}\ncmdP = {signal = "pitch_command", unit = "rad"}\n'
         'xp = {signal = "pitch_piston", unit = "mm"}\ncmdY = {signal = "yaw_command", unit = "rad"}\n'
         'xy = {signal = "yaw_piston", unit = "mm"}\n')

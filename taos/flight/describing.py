@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from taos.bounds import check_instance, check_response_args
+from taos.errors import InputError
 from taos.planar.freqresp import sine_dwell_points
 from taos.linear import StateSpace, gain_db, phase_deg
 from taos.model import Structure, TvcModel
@@ -136,13 +137,33 @@ class DescribingFunctionMap:
 
     @classmethod
     def from_hdf5(cls, path) -> "DescribingFunctionMap":
-        import h5py
+        """Read a map written by :meth:`to_hdf5`, validated by the run-file reader
+        (:mod:`taos.planar.runfile`): positive finite amplitudes and frequencies, finite complex
+        responses of shape (amplitudes, frequencies), the axis pitch or yaw, a finite load
+        stiffness, JSON provenance; InputError (one line) otherwise."""
+        from ..planar.runfile import dataset, open_hdf5, text_attr
 
-        with h5py.File(path, "r") as h5:
-            return cls(amplitude_rad=h5["amplitude_rad"][()], freq_hz=h5["freq_hz"][()], engine=h5["engine"][()],
-                       piston=h5["piston"][()], friction_model=str(h5.attrs["friction_model"]),
-                       axis=str(h5.attrs["axis"]), load_stiffness_N_per_m=float(h5.attrs["load_stiffness_N_per_m"]),
-                       provenance=json.loads(h5.attrs["provenance"]))
+        src = str(path)
+        with open_hdf5(path, src, "an HDF5 describing-function map written by taos") as h5:
+            a, f = dataset(h5, "amplitude_rad", src), dataset(h5, "freq_hz", src)
+            for name, x in (("/amplitude_rad", a), ("/freq_hz", f)):
+                if not (x.size and np.all(x > 0)):
+                    raise InputError(src, name, "positive values", got=f"{x.size} values, smallest "
+                                     f"{x.min() if x.size else 'none'}")
+            resp = {k: dataset(h5, k, src, ndim=2, rows=a.size, n=f.size, complex_ok=True) for k in ("engine", "piston")}
+            axis = text_attr(h5, "axis", src)
+            if axis not in ("pitch", "yaw"):
+                raise InputError(src, "axis", "pitch or yaw", got=repr(axis)[:40])
+            try:
+                k = float(h5.attrs.get("load_stiffness_N_per_m"))
+                prov = json.loads(text_attr(h5, "provenance", src))
+            except (TypeError, ValueError, RecursionError):
+                k, prov = -1.0, None
+            if not ((math.isnan(k) or 0 <= k < math.inf) and isinstance(prov, dict)):   # NaN: not recorded
+                raise InputError(src, "load_stiffness_N_per_m", "a stiffness of at least 0 N/m (NaN: not recorded) "
+                                 "and JSON provenance", got=str(k))
+            return cls(amplitude_rad=a, freq_hz=f, **resp, friction_model=text_attr(h5, "friction_model", src),
+                       axis=axis, load_stiffness_N_per_m=k, provenance=prov)
 
 
 def describing_function_map(model: TvcModel, amplitudes_rad: np.typing.ArrayLike, freq_hz: np.typing.ArrayLike,

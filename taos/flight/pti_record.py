@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -67,44 +68,53 @@ class FlightRecord:
         return cls(np.asarray(h.t_s, float), tuple(h.axes), sig, h.friction_model, source, dict(h.provenance))
 
 
+#: the record's signals held to the record magnitudes (taos.planar.runfile.SIGNAL_LIMITS) -> unit kind
+SIGNAL_KINDS = {"pti_rad": "angle", "command_rad": "angle", "engine_rad": "angle", "piston_m": "length"}
+
+
 def _check(src: str, t: np.ndarray, sig: dict, axes: tuple) -> None:
+    from taos.planar.runfile import check_limits
+
     if t.ndim != 1 or t.size < 16 or t.size > MAX_SAMPLES:
         raise InputError(src, "t_s", f"16 to {MAX_SAMPLES} samples", got=str(t.size))
-    d = np.diff(t)
-    if not np.all(np.isfinite(t)) or not np.all(d > 0) or np.ptp(d) > 1e-6 * max(float(d.mean()), 1e-12) + 1e-9:
+    with np.errstate(over="ignore", invalid="ignore"):   # times beyond reason are refused here, not warned about
+        d = np.diff(t)
+        bad = not np.all(np.isfinite(t)) or not np.all(np.isfinite(d)) or not np.all(d > 0) \
+            or np.ptp(d) > 1e-6 * max(float(d.mean()), 1e-12) + 1e-9
+    if bad:
         raise InputError(src, "t_s", "strictly increasing, uniformly spaced finite times in s")
     for name, a in sig.items():
         if a.shape != (len(axes), t.size):
             raise InputError(src, name, f"{t.size} samples per axis", got=str(a.shape[-1]))
         if not np.all(np.isfinite(a)):
             raise InputError(src, name, "finite numbers", got="NaN or infinite values")
+        if name in SIGNAL_KINDS:
+            check_limits(a, SIGNAL_KINDS[name], src, name)
 
 
 def _read_hdf5(p: Path, src: str) -> FlightRecord:
-    import h5py
+    """Every dataset read through the run-file reader (:mod:`taos.planar.runfile`: stored in the
+    file itself, real, 1-D, finite, as long as ``/t_s``)."""
+    from taos.planar.runfile import dataset, has, open_hdf5
 
-    try:
-        h5 = h5py.File(p, "r")
-    except OSError:
-        raise InputError(src, "(file)", "a readable HDF5 flight record") from None
-    with h5:
-        if "t_s" not in h5:
+    with open_hdf5(p, src, "a readable HDF5 flight record") as h5:
+        if not has(h5, "t_s", src):
             raise InputError(src, "/t_s", "the time base in s (the layout of taos ascent)", got="nothing")
-        t = np.asarray(h5["t_s"][()], float)
-        axes = tuple(a for a in ("pitch", "yaw") if a in h5)
+        t = dataset(h5, "t_s", src)
+        axes = tuple(a for a in ("pitch", "yaw") if has(h5, a, src))
         if not axes:
             raise InputError(src, "/pitch or /yaw", "a group per axis", got="none")
         sig = {}
         for name in REQUIRED + OPTIONAL:
-            have = [name in h5[a] for a in axes]
+            have = [has(h5, f"{a}/{name}", src) for a in axes]
             if name in REQUIRED and not all(have):
                 ax = axes[have.index(False)]
                 raise InputError(src, f"/{ax}/{name}", "this signal (module taos.flight.pti_record)", got="nothing")
             if all(have):
-                sig[name] = np.vstack([np.asarray(h5[a][name][()], float) for a in axes])
+                sig[name] = np.vstack([dataset(h5, f"{a}/{name}", src, n=t.size) for a in axes])
         prov = {}
         for k, v in h5.attrs.items():
-            v = v.decode() if isinstance(v, bytes) else v
+            v = v.decode("utf-8", "replace") if isinstance(v, bytes) else v
             if isinstance(v, str) and v[:1] in "{[":
                 try:
                     v = json.loads(v)
@@ -118,6 +128,9 @@ def _read_hdf5(p: Path, src: str) -> FlightRecord:
 
 
 def _read_csv(p: Path, src: str) -> FlightRecord:
+    from taos.errors import check_input_file
+
+    check_input_file(p, "a readable UTF-8 CSV flight record")
     try:
         with open(p, encoding="utf-8") as fh:
             header = [h.strip() for h in fh.readline().split(",")]
@@ -133,9 +146,13 @@ def _read_csv(p: Path, src: str) -> FlightRecord:
     if len(set(header)) != len(header):
         raise InputError(src, "header", "each column once")
     try:
-        data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2)
-    except ValueError as e:
+        with warnings.catch_warnings():   # a header without rows: refused by _check's sample count
+            warnings.filterwarnings("ignore", "loadtxt: input contained no data")
+            data = np.loadtxt(p, delimiter=",", skiprows=1, ndmin=2, encoding="utf-8")
+    except (ValueError, UnicodeDecodeError) as e:
         raise InputError(src, "(rows)", "numbers only, one per column", got=str(e).splitlines()[0][:80]) from None
+    if data.size == 0:
+        raise InputError(src, "(rows)", "16 or more rows of numbers after the header", got="none")
     if data.shape[1] != len(header):
         raise InputError(src, "(rows)", f"{len(header)} numbers per row", got=str(data.shape[1]))
     col = {h: data[:, i] for i, h in enumerate(header)}

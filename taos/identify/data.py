@@ -17,8 +17,11 @@ CSV layout: optional leading ``#`` lines holding TOML metadata (``# condition = 
 date of the test, a TOML date or ISO-8601 text, which orders a test series in ``taos compare
 --records``), then a header row whose
 columns are ``signal [unit]`` (``pitch_command [deg]``), then numbers. Or any column names
-with a sidecar TOML beside the file (``run.csv`` + ``run.toml``)::
+with a sidecar TOML beside the file (``run.csv`` + ``run.toml``) that says it is the record's
+sidecar by naming it (``sidecar_for``, :data:`SIDECAR_MARK`; a TOML of the same stem without it,
+such as a command profile, is never read as the sidecar)::
 
+    sidecar_for = "run.csv"
     condition = "ambient"
     engine_angle_reference = "relative"     # or "absolute"
     [columns]
@@ -42,6 +45,7 @@ from __future__ import annotations
 import datetime as _dt
 import io
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -49,6 +53,7 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.bounds import MAX_DATA_SAMPLES, MAX_RESAMPLE_FACTOR
+from taos.planar.runfile import SIGNAL_LIMITS  # noqa: F401  (largest magnitude of a signal by unit kind, and why)
 from taos.results import atomic_write
 
 AXES = ("pitch", "yaw")
@@ -74,14 +79,6 @@ IRREGULAR_TOL = 1e-3
 #: sample rate of a record [Hz]: test-stand DAQs record 100 Hz to 100 kHz; a rate outside
 #: 1 Hz .. 1 MHz is a time column in the wrong unit (ms read as s, or the reverse)
 SAMPLE_RATE_HZ = (1.0, 1e6)
-#: largest magnitude of a signal, by unit kind (SI), and why: beyond it the column is in the
-#: wrong unit or corrupt, and any response estimated from it would be absurd
-SIGNAL_LIMITS = {
-    "angle": (math.radians(45.0), "45 deg: no TVC gimbal swings further (RS-25: 10.5 deg)"),
-    "length": (1.0, "1 m: a piston stroke is centimetres (RS-25 actuator: +-5 in)"),
-    "pressure": (1e9, "1 GPa (145000 psi): hydraulic supplies are 3000-5000 psi"),
-    "velocity": (100.0, "100 m/s: servo-actuator piston rates are below 1 m/s"),
-}
 #: longest record [s]: three times the longest documented run (taos.bounds.MAX_DURATION_S)
 MAX_RECORD_S = 3e4
 
@@ -207,11 +204,13 @@ def _split_header(name: str) -> tuple[str, str | None]:
 META_KEYS = {"condition", "synthetic", "engine_angle_reference", "description", "test_date"}
 
 
-def _check_meta(meta: dict, src: str, sidecar: bool) -> None:
+def _check_meta(meta: dict, src: str, sidecar: bool, typos: bool = True) -> None:
+    """The metadata keys the loader reads of the right type; with ``typos``, a key close to one
+    of them refused (an HDF5 run's provenance attributes are not checked for those)."""
     from taos.errors import nearest
 
-    known = META_KEYS | ({"columns"} if sidecar else set())
-    for k in meta:
+    known = META_KEYS | ({"columns", SIDECAR_MARK} if sidecar else set())
+    for k in (meta if typos else ()):
         if k not in known:
             guess = nearest(k, known)
             if guess is not None:
@@ -244,6 +243,30 @@ def record_date(data: "TestData"):
     """The record's ``test_date`` (:class:`datetime.date`/``datetime``) or None."""
     v = data.metadata.get("test_date")
     return None if v is None else _test_date(v, data.source)
+
+
+#: the key by which a TOML beside a record says it is that record's sidecar: its value is the
+#: record's file name (``sidecar_for = "run.csv"``); a TOML of the same stem without it (a
+#: command profile ``run.toml`` beside ``run.csv``) is not read as the sidecar
+SIDECAR_MARK = "sidecar_for"
+
+
+def _sidecar(path: Path, sidecar: Path) -> dict | None:
+    """The sidecar TOML of record ``path`` (``sidecar``, same stem) parsed, when it exists and
+    says it is this record's sidecar (:data:`SIDECAR_MARK` naming ``path``'s file name); None
+    when there is none or it does not say so; InputError when it names another record."""
+    from taos.errors import parse_toml, read_input_bytes
+
+    if not sidecar.exists():
+        return None
+    side = parse_toml(read_input_bytes(sidecar, "a readable sidecar TOML file"), str(sidecar))
+    if SIDECAR_MARK not in side:
+        return None
+    mark = side.pop(SIDECAR_MARK)
+    if mark != path.name:
+        raise InputError(str(sidecar), SIDECAR_MARK, f"the file name of the record it describes, {path.name!r}",
+                         got=repr(mark)[:60])
+    return side
 
 
 def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
@@ -284,10 +307,8 @@ def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
                              f"{header.index('') + 1}")
         sidecar = path.with_suffix(".toml")
         mapping: dict[str, tuple[str, str]] = {}
-        if sidecar.exists():
-            from taos.errors import parse_toml, read_input_bytes
-
-            side = parse_toml(read_input_bytes(sidecar, "a readable sidecar TOML file"), str(sidecar))
+        side = _sidecar(path, sidecar)
+        if side is not None:
             _check_meta(side, str(sidecar), sidecar=True)
             cols = side.pop("columns", {})
             if not isinstance(cols, dict):
@@ -316,8 +337,14 @@ def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
                         raise InputError(src, h, f"a unit in brackets like '{base} [{SIGNALS[base][2][1:-1]}]'",
                                          got="no unit")
                     mapping[h] = (base, unit)
+            if not mapping and sidecar.exists():   # a TOML beside it that does not say it is the sidecar
+                raise InputError(src, "(header)", f"columns named 'signal [unit]' ({sidecar.name} beside it is not "
+                                 f"read as its sidecar: it has no {SIDECAR_MARK} = {path.name!r})",
+                                 got="no known signal column")
         try:
-            arr = np.loadtxt(f, delimiter=",", dtype=float, ndmin=2, comments=None)
+            with warnings.catch_warnings():   # a header without rows: refused below by its sample count
+                warnings.filterwarnings("ignore", "loadtxt: input contained no data")
+                arr = np.loadtxt(f, delimiter=",", dtype=float, ndmin=2, comments=None)
         except (ValueError, UnicodeDecodeError) as e:
             raise InputError(src, "(rows)", f"{len(header)} comma-separated numbers per row",
                              got=" ".join(str(e).split())[:120]) from None
@@ -343,53 +370,43 @@ def _read_csv(path: Path, src: str) -> tuple[dict, dict, dict]:
 
 
 def _read_hdf5(path: Path, src: str) -> tuple[dict, dict, dict]:
-    import h5py
+    """Returns (metadata, {signal: array SI}, {signal: dataset name}). Every dataset read through
+    the run-file reader (:mod:`taos.planar.runfile`: stored in the file, real, 1-D, finite; a
+    ``taos simulate`` run validated whole, as ``taos view`` reads it)."""
+    from taos.planar.runfile import dataset, has, open_hdf5, text_attr
 
-    from taos.errors import check_input_file
-
-    check_input_file(path, "a readable HDF5 file")
-    try:
-        h5 = h5py.File(path, "r")
-    except OSError as e:
-        raise InputError(src, "(file)", "a readable HDF5 file", got=str(e).splitlines()[0]) from None
-    with h5:
-        meta = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
+    with open_hdf5(path, src, "a readable HDF5 file") as h5:
         out, labels = {}, {}
-        if "axes" in h5.attrs and "t_s" in h5:  # a taos simulate TimeHistory
-            axes = str(h5.attrs["axes"]).split(",")
-            out["time"] = np.asarray(h5["t_s"][()], float)
-            labels["time"] = "/t_s"
-            for ax in axes:
-                for sig, name in (("command", "command_rad"), ("piston", "piston_m"), ("engine", "engine_rad")):
-                    key = f"{ax}/{name}"
-                    if key not in h5:
-                        raise InputError(src, "/" + key, "a dataset of the taos simulate layout", got="missing")
-                    out[f"{ax}_{sig}"] = np.asarray(h5[key][()], float)
-                    labels[f"{ax}_{sig}"] = "/" + key
-                for sig, name in (("load_pressure", "load_pressure_Pa"), ("spool", "spool_flow_m_s")):
-                    if f"{ax}/{name}" in h5:
-                        out[f"{ax}_{sig}"] = np.asarray(h5[f"{ax}/{name}"][()], float)
-                        labels[f"{ax}_{sig}"] = f"/{ax}/{name}"
-                if f"{ax}/supply_pressure_Pa" in h5 and "supply_pressure" not in out:
-                    out["supply_pressure"] = np.asarray(h5[f"{ax}/supply_pressure_Pa"][()], float)
+        if "axes" in h5.attrs and has(h5, "t_s", src):  # a taos simulate TimeHistory
+            from taos.planar.runfile import read_run
+            from taos.planar.simulate import TimeHistory
+
+            run = read_run(h5, src, TimeHistory.ARRAYS, TimeHistory.OPTIONAL_ARRAYS)   # the whole run, as taos view reads it
+            out["time"], labels["time"] = run["t_s"], "/t_s"
+            for i, ax in enumerate(run["axes"]):
+                for sig, name in (("command", "command_rad"), ("piston", "piston_m"), ("engine", "engine_rad"),
+                                  ("load_pressure", "load_pressure_Pa"), ("spool", "spool_flow_m_s")):
+                    if name in run:
+                        out[f"{ax}_{sig}"], labels[f"{ax}_{sig}"] = run[name][i], f"/{ax}/{name}"
+                if "supply_pressure_Pa" in run and "supply_pressure" not in out:
+                    out["supply_pressure"] = run["supply_pressure_Pa"][i]
                     labels["supply_pressure"] = f"/{ax}/supply_pressure_Pa"
+            meta = {k: (v.decode("utf-8", "replace") if isinstance(v, bytes) else v) for k, v in run["provenance"].items()}
             meta.setdefault("engine_angle_reference", "absolute")
             meta.setdefault("synthetic", True)
-            meta = {k: v for k, v in meta.items() if k != "axes"}
         else:
+            meta = {k: (v.decode("utf-8", "replace") if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
             for sig in SIGNALS:
-                if sig in h5:
+                if has(h5, sig, src):
+                    x = dataset(h5, sig, src)
                     ds = h5[sig]
-                    unit = ds.attrs.get("unit")
-                    if unit is None:
+                    if "unit" not in ds.attrs:
                         raise InputError(src, "/" + sig, "a 'unit' attribute like " + SIGNALS[sig][2], got="none")
-                    unit = unit.decode() if isinstance(unit, bytes) else str(unit)
-                    out[sig] = np.asarray(ds[()], float).ravel() * unit_factor(unit, sig, src, "/" + sig)
+                    unit = text_attr(ds, "unit", src + ": /" + sig)
+                    out[sig] = x * unit_factor(unit, sig, src, "/" + sig)
                     labels[sig] = "/" + sig
-    for sig, x in out.items():
-        bad = np.flatnonzero(~np.isfinite(x))
-        if bad.size:
-            raise InputError(src, labels[sig], "finite numbers in every sample", got=f"{x[bad[0]]} at sample {bad[0]}")
+    meta = {k: (str(v) if isinstance(v, np.str_) else bool(v) if isinstance(v, np.bool_) else v) for k, v in meta.items()}
+    _check_meta(meta, src, sidecar=False, typos=False)
     return meta, out, labels
 
 
@@ -483,13 +500,14 @@ def _check_record_sanity(src: str, t, sig: dict, labels: dict) -> None:
     """The record's sample rate within :data:`SAMPLE_RATE_HZ`, its length within
     :data:`MAX_RECORD_S`, and every signal within :data:`SIGNAL_LIMITS` (time strictly
     increasing is checked before)."""
-    rate = (t.size - 1) / (t[-1] - t[0])
+    half = float(t[-1]) / 2 - float(t[0]) / 2   # the span halved: finite for any finite times
     lo, hi = SAMPLE_RATE_HZ
+    rate = (t.size - 1) / (2 * half) if half < MAX_RECORD_S else 0.0   # (a span beyond the record bound: refused below)
     if not lo <= rate <= hi:
         raise InputError(src, labels["time"], f"a sample rate from {lo:g} to {hi:g} Hz (a time column in "
-                         "seconds as its unit says)", got=f"{rate:.4g} Hz")
-    if t[-1] - t[0] > MAX_RECORD_S:
-        raise InputError(src, labels["time"], f"a record of at most {MAX_RECORD_S:g} s", got=f"{t[-1] - t[0]:.4g} s")
+                         "seconds as its unit says)", got=f"{(t.size - 1) / 2 / half:.4g} Hz")
+    if 2 * half > MAX_RECORD_S:
+        raise InputError(src, labels["time"], f"a record of at most {MAX_RECORD_S:g} s", got=f"{2 * half:.4g} s")
     for name, x in sig.items():
         kind = SIGNALS[name][0]
         if kind in SIGNAL_LIMITS and x.size:

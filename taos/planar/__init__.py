@@ -9,7 +9,8 @@ Its modules read like those of its 3-D sibling :mod:`taos.taos3d`:
   (valve flow, supply pressure, hard stops);
 * :mod:`.dynamics` (with :mod:`._avionics_kernels`) - the compiled kernels: the fixed-step
   integrator of the Lur'e plant;
-* :mod:`.simulate` - time histories;
+* :mod:`.simulate` - time histories (:mod:`.runfile` reads their files, and every HDF5 record,
+  without trusting them);
 * :mod:`.freqresp` - exact linear and sine-dwell frequency responses;
 * :mod:`.steady` - the periodic steady state by shooting;
 * :mod:`.envelope` - the checks a run needs before it starts (step, sizes, stability) and after

@@ -18,9 +18,7 @@ from ..bounds import (GIMBAL_RANGE_RAD, HARD_STOP_RAD, LOAD_FORCE_FACTOR, MAX_JO
                      MIN_STEPS_PER_CYCLE, RK4_STEP_LIMIT, check_duration)
 
 
-#: the engine models a run can use: the planar simplex model (:mod:`taos.planar`) and the 3-D
-#: TAOS model (:mod:`taos.taos3d`)
-ENGINES = ("simplex", "taos")
+from .runfile import ENGINES  # noqa: E402,F401  (the engine models a run can use)
 
 
 def default_dt_s(engine: str = "simplex", *, source: str = "command line", field: str = "--engine") -> float:

@@ -172,20 +172,21 @@ class TimeHistory:
 
     @classmethod
     def from_hdf5(cls, path) -> "TimeHistory":
-        import h5py
+        """Read a run file written by :meth:`to_hdf5`, validated (:func:`taos.planar.runfile.read_run`:
+        shapes, real finite numbers, sample times, the moment arm, the engine name); InputError
+        (one line naming the dataset or attribute) otherwise."""
+        from .runfile import open_hdf5, read_run
 
-        with h5py.File(path, "r") as h5:
-            axes = tuple(str(h5.attrs["axes"]).split(","))
-            arrays = {n: np.vstack([h5[ax][n][()] for ax in axes]) for n in cls.ARRAYS}
-            arrays.update({n: np.vstack([h5[ax][n][()] for ax in axes]) for n in cls.OPTIONAL_ARRAYS
-                           if all(n in h5[ax] for ax in axes)})
-            prov = {k: v for k, v in h5.attrs.items() if k not in ("axes", "moment_arm_m")}
-            return cls(t_s=h5["t_s"][()], axes=axes, moment_arm_m=float(h5.attrs["moment_arm_m"]),
-                       provenance=prov, **arrays, **cls._read_extra(h5))
+        src = str(path)
+        with open_hdf5(path, src, "an HDF5 run file written by taos simulate") as h5:
+            run = read_run(h5, src, cls.ARRAYS, cls.OPTIONAL_ARRAYS)
+            extra = cls._read_extra(h5, src, run["t_s"].size)
+        return cls(**run, **extra)
 
     @classmethod
-    def _read_extra(cls, h5: h5py.File) -> dict:
-        """Hook for subclasses: extra constructor arguments read from the file."""
+    def _read_extra(cls, h5: h5py.File, src: str, n: int) -> dict:
+        """Hook for subclasses: extra constructor arguments read from the file (``src`` its name
+        for errors, ``n`` the number of samples)."""
         return {}
 
 

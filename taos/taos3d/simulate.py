@@ -21,7 +21,7 @@ import numpy as np
 
 from ..planar.actuator import actuator_state_space
 from ..bounds import check_flag
-from ..errors import SimulationUnstable
+from ..errors import InputError, SimulationUnstable
 from ..planar._parallel import run_each
 from ..planar.freqresp import LINEAR_SOLVER, FrequencyResponse, settle_time_s
 from ..linear import StateSpace
@@ -118,10 +118,29 @@ class TaosTimeHistory(TimeHistory):
         for k, v in self.extra.items():
             g.create_dataset(k, data=v, compression="gzip", track_times=False)
 
+    #: the /taos arrays held to the record magnitudes (taos.planar.runfile.SIGNAL_LIMITS): rows -> unit kind
+    EXTRA_KINDS = {"bearing_slip_rad": ((0, 2), "angle"), "upper_deflection": ((0, 3), "length"),
+                   "lower_deflection": ((0, 3), "length")}
+
     @classmethod
-    def _read_extra(cls, h5) -> dict:
-        g = h5["taos"]
-        return {"extra": {k: g[k][()] for k in g}}
+    def _read_extra(cls, h5, src: str, n: int) -> dict:
+        """The ``/taos`` arrays, each a real finite ``(k, n)`` table (:mod:`taos.planar.runfile`);
+        the slips and the deflections' translations within the record magnitudes, the
+        deflections' rotations within the angle bound."""
+        import h5py
+
+        from ..planar.runfile import check_limits, dataset, node
+
+        g = node(h5, "taos", src)
+        if not isinstance(g, h5py.Group):
+            raise InputError(src, "/taos", "the 3-D run's group of arrays", got="missing" if g is None else "a dataset")
+        extra = {k: dataset(h5, f"taos/{k}", src, n=n, ndim=2) for k in g}
+        for k, ((r0, r1), kind) in cls.EXTRA_KINDS.items():
+            if k in extra:
+                check_limits(extra[k][r0:r1], kind, src, f"/taos/{k}")
+                if k.endswith("deflection"):
+                    check_limits(extra[k][3:], "angle", src, f"/taos/{k}")
+        return {"extra": extra}
 
 
 def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int = 1,

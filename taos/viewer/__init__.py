@@ -32,33 +32,21 @@ __all__ = ["BaseVisualizer", "EngineDrawing", "MeshcatVisualizer", "OfflineWindo
 
 
 def load_run(path: str | Path) -> TimeHistory | TaosTimeHistory:
-    """Read a ``taos simulate`` HDF5 run; InputError (one line) if it is not one."""
+    """Read a ``taos simulate`` HDF5 run, validated by the run-file reader
+    (:mod:`taos.planar.runfile`: layout, real finite arrays of one length, increasing times,
+    magnitudes, moment arm, engine name); InputError (one line) if it is not one."""
+    from ..planar.runfile import has, open_hdf5
     from ..planar.simulate import TimeHistory
 
     p = Path(path)
     if not p.is_file():
         raise InputError(str(path), "file", "an existing HDF5 run written by taos simulate", got="no such file")
-    try:
-        import h5py
-
-        with h5py.File(p, "r") as h5:
-            three_d = "taos" in h5
-        if three_d:
-            from ..taos3d.simulate import TaosTimeHistory
-            th = TaosTimeHistory.from_hdf5(p)
-        else:
-            th = TimeHistory.from_hdf5(p)
-    except (OSError, KeyError, ValueError) as e:
-        raise InputError(str(path), "HDF5 layout", "a run written by taos simulate (t_s, <axis>/engine_rad, ...)",
-                         got=type(e).__name__ + ": " + str(e).splitlines()[0]) from None
-    import numpy as np
-    t = th.t_s
-    if t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-        raise InputError(str(path), "t_s", "finite, increasing sample times", got=f"{t.size} samples")
-    for name in ("engine_rad", "piston_m", "friction_torque_Nm", "load_force_N"):
-        if not np.all(np.isfinite(getattr(th, name))):
-            raise InputError(str(path), name, "finite values", got="NaN or inf")
-    return th
+    with open_hdf5(p, str(path), "an HDF5 run file written by taos simulate") as h5:
+        three_d = has(h5, "taos", str(path))
+    if three_d:
+        from ..taos3d.simulate import TaosTimeHistory
+        return TaosTimeHistory.from_hdf5(p)
+    return TimeHistory.from_hdf5(p)
 
 
 def _title(th) -> str:

@@ -124,6 +124,14 @@ def auto_deflection_scale(peak_deflection_m: float) -> float:
 AUTO_GIMBAL_M = 0.03
 
 
+def _check_drawn(drawn: float, limit: float, field: str, expected: str, unit: str) -> None:
+    """A drawn (exaggerated) peak within ``limit``, else InputError naming the scale: beyond it the
+    drawing means nothing (and a huge scale overflows the geometry)."""
+    if not drawn <= limit:
+        from taos.errors import InputError
+        raise InputError("view", field, expected, got=f"a drawn peak of {drawn:.3g} {unit}")
+
+
 def viewer_frames(th, geometry: EngineDrawing | None = None, *, angle_scale: float = 1.0,
                   deflection_scale: float | None = None, fps: float = 100.0,
                   stick_rate_rad_s: float = 1.75e-3, gimbal_scale: float | None = None) -> ViewerFrames:
@@ -170,6 +178,11 @@ def viewer_frames(th, geometry: EngineDrawing | None = None, *, angle_scale: flo
     delta = xp - R * theta
     if deflection_scale is None:
         deflection_scale = auto_deflection_scale(float(np.max(np.abs(delta))))
+    _check_drawn(angle_scale * float(np.max(np.abs(theta))), math.pi / 2, "angle_scale (--angle-scale)",
+                 "an exaggeration drawing the engine within 90 deg (it would turn over)", "rad")
+    _check_drawn(deflection_scale * float(np.max(np.abs(delta))), g.actuator_length_m,
+                 "deflection_scale (--deflection-scale)", "an exaggeration drawing the load-path deflection "
+                 f"within the actuator's length {g.actuator_length_m:g} m (the drawn rod would turn inside out)", "m")
 
     extra = getattr(th, "extra", None) or {}
     upper = engine_off = None
@@ -179,6 +192,9 @@ def viewer_frames(th, geometry: EngineDrawing | None = None, *, angle_scale: flo
         if gimbal_scale is None:
             peak = float(np.max(np.linalg.norm(uu + ul, axis=0)))
             gimbal_scale = auto_deflection_scale(peak * AUTO_DEFLECTION_M / AUTO_GIMBAL_M)
+        _check_drawn(gimbal_scale * float(np.max(np.abs(uu) + np.abs(ul))), g.actuator_length_m,
+                     "gimbal_scale (--gimbal-scale)", "an exaggeration drawing the gimbal halves' deflection within "
+                     f"the actuator's length {g.actuator_length_m:g} m", "m")
         upper = (gimbal_scale * uu).T
         engine_off = (gimbal_scale * (uu + ul)).T
     rot = engine_rotation(angle_scale * theta[0], angle_scale * theta[1])
