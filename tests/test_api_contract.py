@@ -44,6 +44,9 @@ BAD_OUT = [None, 1.5, True, -1, UNDER_A_FILE, "bad\x00name", np.zeros(3)]
 BAD_OPT_OUT = [v for v in BAD_OUT if v is not None]
 #: a model object or a model file's name (None, numbers, a missing file, an unusable name)
 BAD_MODEL_OR_PATH = [None, 1.5, True, np.eye(3), -1, "", "bad\x00name", "/no/such/file.toml"]
+#: a 6x6 gimbal-half stiffness (as a stiffness file holds: finite, real, symmetric, positive definite)
+BAD_MATRIX = [None, np.eye(3), np.full((6, 6), math.nan), "K", True, 1.5, np.eye(6) * 1j, -np.eye(6),
+              np.triu(np.ones((6, 6)) + 6 * np.eye(6))]
 #: a fraction from 0 to 1 (a coherence threshold)
 BAD_FRACTION = [None, "0.5", True, math.nan, math.inf, -0.1, 1.5, 10 ** 12]
 BAD_FREQS = [None, "1.0", [True], ["1"], math.nan, math.inf, -1.0, 0.0, 10 ** 12, [], np.ones((2, 2)), [1.0, None]]
@@ -67,7 +70,7 @@ HOSTILE = {
     "amp": BAD_AMP, "step": BAD_STEP, "count0": BAD_COUNT0, "count1": BAD_COUNT1, "duration": BAD_DURATION,
     "settle": BAD_SETTLE, "flag": BAD_FLAG, "axis": BAD_AXIS, "choice": BAD_CHOICE, "threads": BAD_THREADS,
     "seed": BAD_SEED, "scale": BAD_SCALE, "optout": BAD_OPT_OUT, "model_or_path": BAD_MODEL_OR_PATH,
-    "fraction": BAD_FRACTION,
+    "fraction": BAD_FRACTION, "matrix": BAD_MATRIX,
 }
 
 
@@ -95,6 +98,8 @@ class Objects:
                                             freq_hz=[2.0, 5.0], settle_cycles=1, measure_cycles=1)
         elif name == "th":
             v = taos.simulate(self.model, self.profile, duration_s=0.05)
+        elif name in ("K_upper", "K_lower"):   # the model's own halves (valid), given as arguments
+            v = getattr(self.tm, name)
         elif name == "models":
             v = [self.model]
         elif name == "data":
@@ -156,7 +161,8 @@ SPECS: dict[str, dict] = {
     "simulate": {"model": (O("model"), "model"), "profile": (O("profile"), "object"), "dt_s": (V(2e-4), "step"),
                  "record_every": (V(10), "count1"), "duration_s": (V(0.05), "duration"),
                  "progress": (V(False), "flag"), "threads": (V(None), "threads"), "integrator": (V("rk4"), "choice")},
-    "taos_model": {"model": (O("model"), "model")},
+    "taos_model": {"model": (O("model"), "model"), "K_upper": (O("K_upper"), "matrix"),
+                   "K_lower": (O("K_lower"), "matrix")},
     "simulate_taos": {"tm": (O("tm"), "model"), "profile": (O("profile"), "object"), "dt_s": (V(4e-4), "step"),
                       "record_every": (V(10), "count1"), "duration_s": (V(0.05), "duration")},
     "taos_freqresp": {"tm": (O("tm"), "model"), "freq_hz": (V([5.0]), "freqs"), "amplitude_rad": (V(None), "amp"),
