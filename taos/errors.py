@@ -151,6 +151,24 @@ def stored(path) -> tuple | None:
     return table.get(os.fspath(path))
 
 
+def check_path_arg(path, field: str, what: str = "a file or folder name") -> "os.PathLike | str":
+    """An API argument naming a file or folder: text or a :class:`os.PathLike`, not empty and
+    without a NUL byte (never None, a number, a boolean or an array, which :class:`pathlib.Path`
+    would refuse with a TypeError or :func:`os.stat` take as a descriptor); InputError naming
+    ``field`` otherwise."""
+    text = os.fspath(path) if isinstance(path, os.PathLike) else path
+    if isinstance(path, bool) or not isinstance(text, str) or not text or "\0" in text:
+        raise InputError(repr(path)[:40], field, what + " (text or a pathlib.Path)", got=repr(path)[:40])
+    return path
+
+
+def as_argument(e: InputError, field: str, flag: str) -> InputError:
+    """The refusal ``e`` of a value that is both an API argument and a command-line flag
+    (``runs`` and ``--runs``), naming the argument ``field`` with the ``flag`` in its expectation."""
+    return InputError("argument" if e.source == "command line" else e.source, field, f"{e.expected} ({flag})",
+                      got=e.got)
+
+
 def check_input_file(path, what: str, max_bytes: int = MAX_DATA_BYTES, field: str = "(file)") -> int:
     """Refuse, without opening it, an input that is not a regular file (a folder, a device such
     as ``/dev/zero``, a FIFO that would block, a socket) or is larger than ``max_bytes``; returns

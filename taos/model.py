@@ -541,6 +541,13 @@ def load_model(path: str | Path, friction: str | None = None, overrides: Mapping
 
     Raises :class:`~taos.errors.InputError` (one line: file, field, expectation) on bad input.
     """
+    if friction is not None:   # the argument named as such, its command-line flag in the message
+        from .errors import as_argument
+        from .friction import registry
+        try:
+            registry.params_of(friction, "argument", "friction")
+        except InputError as e:
+            raise as_argument(e, "friction", "--friction") from None
     if source_bytes is None:
         p = resolve(path, "model")
         raw, doc = read_toml(p, "a readable model file")

@@ -100,11 +100,37 @@ def _wrap_pm(arg_deg) -> np.ndarray:
     return np.where(m > 180.0, m - 360.0, m)
 
 
+def _finite(m) -> bool:
+    """A numeric matrix with every entry finite (not a CasADi expression)."""
+    try:
+        return bool(np.all(np.isfinite(np.asarray(m, float))))
+    except (TypeError, ValueError, RuntimeError, NotImplementedError):
+        return False
+
+
+def check_sampled_loop(freq_hz, L, field: str = "freq_hz") -> tuple[np.ndarray, np.ndarray]:
+    """(f [Hz], L) of a sampled loop, checked as the command line checks its values:
+    ``freq_hz`` (named ``field``) at least two increasing finite frequencies in (0, 1e4] Hz;
+    ``L`` finite numbers (complex or real, never text, booleans or None) of the same shape;
+    :class:`~taos.errors.InputError` naming the argument otherwise."""
+    from taos.bounds import RESPONSE_FREQ_HZ, check_grid
+    from taos.errors import InputError
+
+    f = check_grid(freq_hz, field, "Hz", 0.0, RESPONSE_FREQ_HZ[1])
+    if f.size < 2 or np.any(np.diff(f) <= 0):
+        raise InputError("argument", field, "at least two increasing frequencies in Hz", got=repr(freq_hz)[:60])
+    try:
+        raw = np.asarray(L)
+    except (TypeError, ValueError):
+        raw = np.asarray(None)
+    if raw.dtype.kind not in "iufc" or raw.shape != f.shape or not np.all(np.isfinite(raw)):
+        raise InputError("argument", "L", f"{f.size} finite numbers (the loop sampled at {field})",
+                         got=f"{raw.dtype} of shape {raw.shape}")
+    return f, raw.astype(complex)
+
+
 def _sampled(freq_hz, L) -> LoopMargins:
-    f = np.asarray(freq_hz, float)
-    L = np.asarray(L, complex)
-    if f.ndim != 1 or f.shape != L.shape or f.size < 2 or np.any(np.diff(f) <= 0) or f[0] <= 0:
-        raise ValueError("loop_margins: need L sampled on an increasing positive frequency grid")
+    f, L = check_sampled_loop(freq_hz, L, "loop")
     lf = np.log10(f)
     pc, gm, gc, pm = [], [], [], []
     im = L.imag
@@ -148,10 +174,16 @@ def loop_margins(loop: StateSpace | np.typing.ArrayLike, L: np.typing.ArrayLike 
     :class:`taos.linear.StateSpace` of the loop L(s); crossings exact (python-control).
     ``loop_margins(freq_hz, L)``: L [-] complex, sampled on increasing ``freq_hz`` [Hz];
     crossings interpolated between samples."""
+    from taos.errors import InputError
+
     if isinstance(loop, StateSpace):
         if L is not None:
-            raise TypeError("loop_margins(ss) takes no sampled response")
+            raise InputError("argument", "L", "None with a StateSpace loop (its response is exact)", got=repr(L)[:40])
+        if len(loop.inputs) != 1 or len(loop.outputs) != 1 or not all(_finite(m) for m in (loop.A, loop.B, loop.C, loop.D)):
+            raise InputError("argument", "loop", "a numeric single-input single-output StateSpace with finite matrices",
+                             got=f"{len(loop.outputs)}x{len(loop.inputs)} outputs x inputs")
         return _exact(loop)
     if L is None:
-        raise TypeError("loop_margins needs a StateSpace, or freq_hz and the sampled loop L")
+        raise InputError("argument", "loop", "a StateSpace, or freq_hz and the sampled loop L",
+                         got=f"{type(loop).__name__} {repr(loop)[:30]}")
     return _sampled(loop, L)

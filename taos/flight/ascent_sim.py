@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from taos.flight._args import check_ascent_args, check_fly_args
 from taos.flight.ascent import Ascent, aero_instability, control_acceleration, pti_command, wind_speed
 from taos.flight.friction_env import friction_scale
 from taos.flight.lco import FlightHistory, flown_model, measure_oscillation
@@ -413,6 +414,7 @@ def simulate_ascent(ascent: Ascent, model: TvcModel, *, axes: tuple[str, ...] = 
     docstring; recorded in the provenance). Each axis is
     one call of the compiled kernel through all the segments (:func:`simulate_ascents`' kernel,
     one lane). Raises :class:`~taos.errors.SimulationUnstable` on a non-finite state."""
+    check_ascent_args(**locals())   # every argument (the parameters, nothing else yet), before any work
     grid = _grid(ascent, start_s, end_s, dt_s, record_interval_s)
     _, rec, t, bounds = grid
     it = list(axes)
@@ -578,6 +580,7 @@ def fly_ascent(ascent: Ascent, models: Sequence[TvcModel], *, reference: TvcMode
     ``friction_follows_thrust``: as :func:`simulate_ascent` (the same seed for every run, so the
     runs differ by their TVC only). ``progress``: a bar over the models. Raises
     :class:`~taos.errors.SimulationUnstable` when a run diverges."""
+    check_fly_args(**locals())   # every argument (the parameters, nothing else yet), before any run
     models = [flown_model(m, avionics) for m in models]   # (ValueError for an unknown setting)
     reference = flown_model(reference, avionics)
     axes = tuple(axes)

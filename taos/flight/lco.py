@@ -141,6 +141,10 @@ def predict_lco(flight: FlightModel, df: DescribingFunctionMap, axis: str | None
     """Solve L0(j w) N(A, w) = -1 over the map (see the module docstring)."""
     import scipy.optimize
 
+    from ._args import check_predict_args
+
+    check_predict_args(flight, df, axis, n_grid)
+
     axis = axis or flight.axis
     la = np.linspace(np.log(df.amplitude_rad[0]), np.log(df.amplitude_rad[-1]), n_grid)
     lf = np.linspace(np.log(df.freq_hz[0]), np.log(df.freq_hz[-1]), n_grid)
@@ -550,6 +554,12 @@ def analyse_lco(flight: FlightModel, model: TvcModel, *, axis: str | None = None
     instead of computed: the map depends on the TVC only, so a sweep over the flight loop's gains
     makes it once. ``extend``: at most this many amplitude rows added per edge of the map while
     a cycle may lie beyond it (:func:`extend_to_cover`; 0: none, the prediction then only warns)."""
+    from ._args import check_lco_args
+
+    check_lco_args(flight, model, axis=axis, amplitudes_rad=amplitudes_rad, freq_hz=freq_hz, duration_s=duration_s,
+                   window_s=window_s, attitude0_rad=attitude0_rad, settle_cycles=settle_cycles,
+                   measure_cycles=measure_cycles, avionics=avionics, time_domain=time_domain, steady=steady, df=df,
+                   extend=extend)
     axis = axis or flight.axis
     model = flown_model(model, avionics)
     if df is None:

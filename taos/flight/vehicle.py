@@ -475,7 +475,8 @@ def _margins(lm: LoopMargins) -> Margins:
 def margins(freq_hz: np.typing.ArrayLike, L: np.typing.ArrayLike) -> Margins:
     """Margins of the sampled open loop ``L`` (complex, on an increasing frequency grid [Hz]);
     every crossing located between samples by :func:`taos.stability.loop_margins`."""
-    return _margins(loop_margins(freq_hz, L))
+    from taos.stability import check_sampled_loop
+    return _margins(loop_margins(*check_sampled_loop(freq_hz, L, "freq_hz")))
 
 
 def flight_loop_margins(flight: FlightModel, axis: str | None = None) -> Margins:

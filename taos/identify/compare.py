@@ -116,7 +116,19 @@ def compare_models(model_a: TvcModel, model_b: TvcModel, data_a: Sequence[Measur
                    labels: tuple[str, str] | None = None) -> Comparison:
     """The comparison table of two models (module docstring); ``data_a``/``data_b`` are
     lists of :class:`~taos.identify.estimation.MeasuredResponse` shown on the plots."""
+    from taos.bounds import check_instance
+    from taos.errors import InputError
+    from taos.identify.estimation import MeasuredResponse
     from taos.planar.simplex import load_resonance_from_notch
+
+    for name, m in (("model_a", model_a), ("model_b", model_b)):
+        check_instance(m, name, TvcModel, "a TvcModel (taos.load_model)")
+    for name, d in (("data_a", data_a), ("data_b", data_b)):
+        if not isinstance(d, (list, tuple)) or not all(isinstance(r, MeasuredResponse) for r in d):
+            raise InputError("argument", name, "a list of MeasuredResponse (taos.estimate)", got=repr(d)[:40])
+    if labels is not None and not (isinstance(labels, (list, tuple)) and len(labels) == 2
+                                   and all(isinstance(x, str) for x in labels)):
+        raise InputError("argument", "labels", "None or two texts", got=repr(labels)[:40])
 
     labels = labels or (model_a.name, model_b.name)
     rows: list[Row] = []

@@ -420,6 +420,11 @@ def load_test_data(path: str | Path, *, resample: bool = True) -> TestData:
     resample : bool
         Resample irregular time stamps onto the median interval (else refuse them).
     """
+    from taos.bounds import check_flag
+    from taos.errors import check_input_file
+
+    check_flag(resample, "resample")
+    check_input_file(path, "a readable data file (.csv or .h5)")   # a path, not None or a number
     p = Path(path)
     src = str(path)
     if not p.exists():

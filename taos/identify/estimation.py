@@ -362,13 +362,18 @@ def estimate(data: TestData, method: str = "auto", **kwargs: Any) -> list[Measur
     record (the whole-record classification :func:`classify_record` is then the evidence).
     For a sweep the H1 points carry the sweep's envelope amplitude (the amplitude the
     describing function sees), not the bin's share of the power."""
+    from taos.bounds import check_choice, check_instance
+
+    check_instance(data, "data", TestData, "a TestData record (taos.load_test_data)")
+    check_choice(method, "method", ("auto", "dwell", "h1"))
     extra = {"moment_arm_m": float(data.metadata["moment_arm_m"])} if "moment_arm_m" in data.metadata else {}
     if method == "auto":
         from taos.identify.segments import axis_excitation, segment_record
 
         unknown = set(kwargs) - {"axes", "nperseg"}
         if unknown:
-            raise TypeError(f"estimate(method='auto') takes axes and nperseg, not {', '.join(sorted(unknown))}")
+            raise InputError("argument", ", ".join(sorted(unknown)), "with method='auto' only axes and nperseg",
+                             got="other keyword arguments")
         segs = segment_record(data)
         out = estimate_by_segment(data, kwargs.get("axes"), nperseg=kwargs.get("nperseg"), segments=segs)
         return [replace(r, meta={**r.meta, "excitation": {**axis_excitation(segs[r.axis]),

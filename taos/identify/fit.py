@@ -47,6 +47,7 @@ import numpy as np
 
 from taos.errors import InputError
 from taos.friction.bounds import loader_bound
+from taos.identify._args import check_fit_args
 from taos.identify.estimation import MeasuredResponse
 from taos.identify.globalstage import grid_search
 from taos.identify.surrogate import PARAMETERS, apply_values, build_surrogate, check_free, solve_implicit
@@ -385,6 +386,7 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
         :mod:`taos.identify.physbounds`, else :data:`taos.identify.surrogate.PARAMETERS`' lo/hi
         times the start value). The result reports them and flags any value that ends on one.
     """
+    check_fit_args(**{k: v for k, v in locals().items() if k != "problem"})   # every argument, before any work
     t0 = time.perf_counter()
     data = tuple(data)
     free = tuple(free)

@@ -454,8 +454,10 @@ def reduce_to_planar(source: object, *, freq_hz: Sequence[float] = DEFAULT_FREQ_
     model that is not a 3-D model, a bad grid or free key, a missing record."""
     from taos.results import base_provenance, file_sha256, model_provenance
 
+    from ._args import check_reduce_source
     from .reduce_file import fit_header
 
+    check_reduce_source(source)
     t0 = time.perf_counter()
     axes = _axes(axes)
     f = check_grid(freq_hz, "freq_hz", 1e-3, 50.0, "Hz")

@@ -59,7 +59,9 @@ def to_control_ss(model, name: str | None = None):
     and signal names (continuous time)."""
     ss = model.state_space() if hasattr(model, "state_space") and not isinstance(model, StateSpace) else model
     if not isinstance(ss, StateSpace):
-        raise TypeError(f"to_control_ss: a taos StateSpace is needed, got {type(model).__name__}")
+        from taos.errors import InputError
+        raise InputError("argument", "model", "a taos StateSpace (or a system with state_space())",
+                         got=f"{type(model).__name__} {repr(model)[:30]}")
     ct = _ct()
     mats = [np.asarray(M, float) for M in (ss.A, ss.B, ss.C, ss.D)]
     kw = {"name": _out_name(name)} if name else {}
@@ -71,9 +73,12 @@ def from_control_ss(sys: control.LTI) -> StateSpace:
     """A continuous-time python-control LTI system (state space or transfer function) as a
     :class:`~taos.linear.StateSpace`, keeping its signal names. A transfer function is realised
     by ``control.ss`` first."""
+    from taos.errors import InputError
+
     ct = _ct()
-    if sys.dt not in (0, None):
-        raise ValueError("from_control_ss: only continuous-time systems (dt = 0) map to taos")
+    if not isinstance(sys, ct.LTI) or sys.dt not in (0, None):
+        raise InputError("argument", "sys", "a continuous-time (dt = 0) python-control state space or transfer function",
+                         got=f"{type(sys).__name__} {repr(sys)[:30]}" if not isinstance(sys, ct.LTI) else f"dt = {sys.dt}")
     s = sys if isinstance(sys, ct.StateSpace) else ct.ss(sys)
     return StateSpace(np.array(s.A, float), np.array(s.B, float), np.array(s.C, float), np.array(s.D, float),
                       tuple(_in_name(n) for n in s.state_labels), tuple(_in_name(n) for n in s.input_labels),
@@ -153,4 +158,8 @@ def to_control(obj: object) -> control.StateSpace | control.FrequencyResponseDat
         return measured_to_control(obj)
     if hasattr(obj, "actuators") and hasattr(obj, "piston") and np.ndim(obj.piston) == 3:
         return masv_freqresp_to_control(obj)
+    if not isinstance(obj, StateSpace) and not hasattr(obj, "state_space"):
+        from taos.errors import InputError
+        raise InputError("argument", "obj", "a StateSpace, a system with state_space(), a FrequencyResponse, a "
+                         "MeasuredResponse or a MASV frequency response", got=f"{type(obj).__name__} {repr(obj)[:30]}")
     return to_control_ss(obj)

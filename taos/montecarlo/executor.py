@@ -114,6 +114,34 @@ def _check_out(out: Path, manifest: dict, resume: bool) -> dict | None:
     return old
 
 
+def _check_args(c, out_dir, runs, case, friction, workers, scheduler, resume, progress, batch, connect_timeout_s):
+    """:func:`run_campaign`'s arguments, each refused naming it (with its command-line flag) before
+    any model is loaded: a Campaign, a folder place (never under a regular file), whole numbers
+    of runs, workers and runs per task in range, True or False, a connection timeout of 0.1 to 600 s."""
+    from taos.bounds import check_count, check_flag, check_instance, check_number
+    from taos.errors import as_argument, check_path_arg
+    from taos.results import check_output_file
+
+    check_instance(c, "c", Campaign, "a Campaign (taos.load_campaign)")
+    folder = lambda: check_output_file(Path(check_path_arg(out_dir, "out_dir", "a campaign folder")) / "x", "out_dir")  # noqa: E731
+    checks = [("out_dir", "--out", folder),
+              ("runs", "--runs", lambda: check_count(runs, "runs", 1, MAX_RUNS)),
+              ("workers", "--workers", lambda: workers is None or check_count(workers, "workers", 0, MAX_WORKERS)),
+              ("batch", "--batch", lambda: batch is None or check_count(batch, "batch", 1, engine.MAX_BATCH)),
+              ("connect_timeout_s", "--connect-timeout",
+               lambda: check_number(connect_timeout_s, "connect_timeout_s", 0.1, 600.0, "s"))]
+    for field, flag, check in checks:
+        try:
+            check()
+        except InputError as e:
+            raise as_argument(e, field, flag) from None
+    for field, v in (("case", case), ("friction", friction), ("scheduler", scheduler)):
+        if v is not None and not (isinstance(v, str) and v):
+            raise InputError("argument", field, "None or a name (text)", got=repr(v)[:40])
+    check_flag(resume, "resume")
+    check_flag(progress, "progress")
+
+
 def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | None = None, friction: str | None = None,
                  workers: int | None = None, scheduler: str | None = None, resume: bool = False,
                  progress: bool = False, design: str = "montecarlo", batch: int | None = None,
@@ -123,6 +151,7 @@ def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | Non
     (module docstring); returns the statistics. ``workers``: size of the default LocalCluster (one
     thread each; 0: in this process); ``scheduler``: an existing Dask scheduler instead;
     ``batch``: runs per task (default from the run cost)."""
+    _check_args(c, out_dir, runs, case, friction, workers, scheduler, resume, progress, batch, connect_timeout_s)
     if design not in DESIGNS:
         raise InputError("command line", "--sensitivity", "one of " + ", ".join(sensitivity.METHODS), got=repr(design))
     if not 1 <= runs <= MAX_RUNS:

@@ -430,4 +430,7 @@ def family_to_dict(family: list[FrequencyResponse]) -> dict:
 def sine_dwell_freqresp(model: TvcModel, freq_hz: np.typing.ArrayLike, amplitude_rad: float, axis: str = "pitch",
                         **kwargs: Any) -> FrequencyResponse:
     """Amplitude-dependent response at one command amplitude [rad] (:func:`sine_dwell_family`)."""
+    from taos.bounds import check_number
+
+    check_number(amplitude_rad, "amplitude_rad", 0.0, math.pi / 2, "rad", lo_open=True)
     return sine_dwell_family(model, freq_hz, [amplitude_rad], axis, **kwargs)[0]

@@ -44,6 +44,7 @@ import numpy as np
 from .actuator import actuator_state_space
 from ..linear import StateSpace, finish, is_symbolic, notch_hz, zeros
 from ..model import TvcModel
+from ..bounds import RESPONSE_FREQ_HZ, check_axis, check_flag, check_instance, check_number
 
 #: Outputs of the simplex linear block, in order.
 SIMPLEX_OUTPUTS = ("x_p_m", "theta_rad", "omega_rad_s", "applied_torque_Nm", "load_force_N", "p_load_Pa")
@@ -118,6 +119,8 @@ def simplex_state_space(model: TvcModel, axis: str = "pitch", *, structure_input
     l_e [m], the engine c.g.'s distance from the gimbal perpendicular to the rotation axis
     (m_e is ``model.engine.mass_kg``).
     """
+    _check_model_axis(model, axis)
+    check_flag(structure_inputs, "structure_inputs")
     act = actuator_state_space(model.actuator)
     R = model.actuator.moment_arm_m
     KL = model.structure.stiffness_N_per_m(axis)   # the axis' own K_L ([structure] load_stiffness_yaw)
@@ -236,8 +239,17 @@ def load_resonance_from_notch(model: TvcModel, axis: str = "pitch",
                               f_lo: float = 0.5, f_hi: float = 30.0) -> float:
     """Frequency [Hz] of the minimum of the linear command -> piston gain (the notch) between
     ``f_lo`` and ``f_hi`` [Hz] (:func:`taos.linear.notch_hz`: dense log grid, bounded search)."""
+    _check_model_axis(model, axis)
+    lo = check_number(f_lo, "f_lo", RESPONSE_FREQ_HZ[0], RESPONSE_FREQ_HZ[1], "Hz")
+    check_number(f_hi, "f_hi", lo, RESPONSE_FREQ_HZ[1], "Hz", lo_open=True)
     ss = simplex_state_space(model, axis)
     return notch_hz(lambda f: np.abs(ss.freqresp(f, "command_rad", "x_p_m")), f_lo, f_hi)
+
+
+def _check_model_axis(model, axis) -> None:
+    """The public functions' ``model`` (a TvcModel) and ``axis`` ('pitch' or 'yaw'), as the command line."""
+    check_instance(model, "model", TvcModel, "a TvcModel (taos.load_model)")
+    check_axis(axis)
 
 
 def check_rk4_step(dt_s: float, model, field: str, source: str = "argument") -> None:

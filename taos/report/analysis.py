@@ -300,6 +300,32 @@ def _measured_responses(data) -> dict:
 
 # -- the analysis ------------------------------------------------------------------------------
 
+def _check_args(model, out, allow_unstable, progress, view_angle_scale, view_fps, threads) -> None:
+    """:func:`greenrun`'s arguments, each refused naming it as the command line refuses its flag:
+    a model (or a model file's name), an output folder place (checked before any work), flags
+    True or False, the 3-D view's scales (:func:`taos.viewer.check_view_args`), a thread count."""
+    from taos.bounds import check_flag, check_number
+    from taos.errors import as_argument, check_path_arg
+    from taos.model import TvcModel
+    from taos.planar._parallel import thread_count
+    from taos.results import check_output_folder
+    from taos.viewer import MAX_VIEW_FPS, MAX_VIEW_SCALE
+
+    if not isinstance(model, TvcModel):
+        check_path_arg(model, "model", "a TvcModel, a model file or a shipped model's name")
+    if out is not None:
+        try:
+            check_output_folder(Path(check_path_arg(out, "out", "a report folder")), OUTPUTS)
+        except InputError as e:
+            raise as_argument(e, "out", "--out") from None
+    check_flag(allow_unstable, "allow_unstable")
+    check_flag(progress, "progress")
+    check_number(view_angle_scale, "view_angle_scale", 0.0, MAX_VIEW_SCALE, lo_open=True)
+    check_number(view_fps, "view_fps", 0.0, MAX_VIEW_FPS, "1/s", lo_open=True)
+    if threads is not None:
+        thread_count(threads)
+
+
 def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None = None, *,
              engine: str = "simplex", friction: str | None = None, out: str | Path | None = None,
              dt_s: float | None = None, spec: SpecMask | str | Path | None = DEFAULT_SPEC,
@@ -361,6 +387,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     from taos.results import check_output_folder, input_provenance
 
     # bad input fails here, before any progress output: one line, nothing written
+    _check_args(model, out, allow_unstable, progress, view_angle_scale, view_fps, threads)
     if out is not None:
         check_output_folder(Path(out), OUTPUTS)
     if isinstance(model, TvcModel):

@@ -54,9 +54,17 @@ def model_summary(model: TvcModel, steps: bool = True, threads: int | None = Non
 
     import numpy as np
 
+    from taos.bounds import check_flag, check_instance
+    from taos.model import TvcModel
+    from taos.planar._parallel import thread_count
     from taos.planar.simplex import load_resonance_from_notch, simplex_state_space
 
     from .servo import servo_figures
+
+    check_instance(model, "model", TvcModel, "a TvcModel (taos.load_model)")
+    check_flag(steps, "steps")
+    if threads is not None:
+        thread_count(threads)
 
     poles = simplex_state_space(model, "pitch").poles()
     p = poles[poles.imag >= 0]

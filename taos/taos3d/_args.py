@@ -109,6 +109,9 @@ def _positive(x) -> bool:
 def check_simulate_args(profile, dt_s, record_every, duration_s) -> None:
     """:func:`taos.taos3d.simulate_taos`: a positive step, a whole record interval, a run of at
     most 1e4 s (the profile's, or ``duration_s``) within the job limits."""
+    from ..bounds import check_profile
+
+    check_profile(profile)
     T = getattr(profile, "duration_s", None)
     if duration_s is not None:
         if isinstance(duration_s, bool) or not isinstance(duration_s, (int, float)) or not 0 < duration_s <= MAX_DURATION_S:

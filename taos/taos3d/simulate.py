@@ -165,6 +165,7 @@ def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S
     duration plus 1 s."""
     _args.check_tm(tm)
     _args.check_simulate_args(profile, dt_s, record_every, duration_s)
+    _args.check_rk4_step(float(dt_s), tm.base, "dt_s")   # the explicit step's rule, as --dt
     T = (profile.duration_s + 1.0) if duration_s is None else duration_s
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s

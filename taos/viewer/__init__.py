@@ -31,16 +31,38 @@ __all__ = ["BaseVisualizer", "EngineDrawing", "MeshcatVisualizer", "OfflineWindo
            "load_run", "offline_html", "serve", "viewer_frames", "write_html"]
 
 
+#: the largest exaggeration [-] of a drawn angle or deflection (a 0.01 deg motion drawn at 100 deg)
+MAX_VIEW_SCALE = 1e4
+#: the highest keyframe rate [1/s] (keyframes are never closer than the recorded samples; a 10 us record)
+MAX_VIEW_FPS = 1e5
+
+
+def check_view_args(th, angle_scale=1.0, deflection_scale=None, fps=100.0, gimbal_scale=None, **_) -> None:
+    """The viewer's arguments, checked as the command line's ``taos view`` checks them: ``th`` a
+    run (:func:`taos.simulate`, :func:`taos.simulate_taos`, :func:`load_run`), every scale a
+    finite number in (0, :data:`MAX_VIEW_SCALE`], ``fps`` in (0, :data:`MAX_VIEW_FPS`] 1/s;
+    :class:`InputError` naming the argument otherwise."""
+    from ..bounds import check_instance, check_number
+    from ..planar.simulate import TimeHistory
+
+    check_instance(th, "th", TimeHistory, "a run (taos.simulate, taos.simulate_taos or taos.load_run)")
+    for name, v in (("angle_scale", angle_scale), ("deflection_scale", deflection_scale), ("gimbal_scale", gimbal_scale)):
+        check_number(v, name, 0.0, MAX_VIEW_SCALE, lo_open=True, optional=name != "angle_scale")
+    check_number(fps, "fps", 0.0, MAX_VIEW_FPS, "1/s", lo_open=True)
+
+
 def load_run(path: str | Path) -> TimeHistory | TaosTimeHistory:
     """Read a ``taos simulate`` HDF5 run, validated by the run-file reader
     (:mod:`taos.planar.runfile`: layout, real finite arrays of one length, increasing times,
     magnitudes, moment arm, engine name); InputError (one line) if it is not one."""
+    from ..errors import check_input_file
     from ..planar.runfile import has, open_hdf5
     from ..planar.simulate import TimeHistory
 
+    check_input_file(path, "an existing HDF5 run written by taos simulate")   # a path, not None or a number
     p = Path(path)
     if not p.is_file():
-        raise InputError(str(path), "file", "an existing HDF5 run written by taos simulate", got="no such file")
+        raise InputError(str(path), "(file)", "an existing HDF5 run written by taos simulate", got="no such file")
     with open_hdf5(p, str(path), "an HDF5 run file written by taos simulate") as h5:
         three_d = has(h5, "taos", str(path))
     if three_d:
@@ -75,8 +97,13 @@ def offline_html(th, *, angle_scale: float = 1.0, deflection_scale: float | None
 
 def write_html(th: TimeHistory | TaosTimeHistory, path: str | Path, **kwargs: Any) -> None:
     """Write :func:`offline_html` to ``path`` atomically."""
+    from ..errors import check_path_arg
+    from ..results import check_output_file
+
+    check_view_args(th, **kwargs)
+    check_output_file(check_path_arg(path, "path", "an output file name"), "path")   # before the page is made
     text = offline_html(th, **kwargs)
-    atomic_write(path, lambda p: Path(p).write_text(text, encoding="utf-8"))
+    atomic_write(path, lambda p: Path(p).write_text(text, encoding="utf-8"), "path")
 
 
 def serve(th: TimeHistory | TaosTimeHistory, *, angle_scale: float = 1.0, deflection_scale: float | None = None,
@@ -84,6 +111,7 @@ def serve(th: TimeHistory | TaosTimeHistory, *, angle_scale: float = 1.0, deflec
     """Serve the animated run on 127.0.0.1 until SIGINT/SIGTERM (or ``stop`` is set).
 
     Calls ``on_ready(url)`` once the scene is loaded; returns 0 after shutting the server down."""
+    check_view_args(th, angle_scale, deflection_scale, fps, gimbal_scale)
     fr = viewer_frames(th, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps,
                        gimbal_scale=gimbal_scale)
     vis, proc = live_visualizer(geometry_for_run(th))
