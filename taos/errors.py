@@ -15,7 +15,10 @@ import stat
 import sys
 from contextlib import contextmanager
 from contextvars import ContextVar
-from typing import Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Callable, Iterable, Mapping
+
+if TYPE_CHECKING:
+    import argparse
 
 
 class InputError(ValueError):

@@ -5,7 +5,6 @@ direction (hot fire stiffer than ambient) from the demo datasets."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 

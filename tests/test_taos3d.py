@@ -20,7 +20,7 @@ from taos.profiles import SineDwell, TwoAxis
 from taos.taos3d import (TaosTimeHistory, beam_half_stiffness, engine_pin_model, linear_state_space,
                          simulate_taos, taos_freqresp, taos_model, two_axis_dwell)
 from taos.taos3d import dynamics as dy
-from taos.taos3d.simulate import DEFAULT_DT_S, pack, rest_state, run_samples
+from taos.taos3d.simulate import DEFAULT_DT_S, pack, rest_state
 
 HALF = beam_half_stiffness(2e10, 5e9, 3e8, 2e8, 0.145)  # synthetic gimbal half (N/m, N m/rad)
 

@@ -4,7 +4,6 @@ load resonances of the 115,000 and 205,000 lbf/in fits (paper sec. 4, fig. 11)."
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 import scipy.optimize as so
 

@@ -42,7 +42,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from taos.errors import InputError
 from taos.identify.data import TestData
 
 #: segment kinds, and the estimator each calls for (None: reported only)

@@ -18,7 +18,6 @@ trimesh; otherwise procedural trimesh primitives with the dimensions above are u
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import trimesh

@@ -160,7 +160,7 @@ def make(seed: int = 29):
     return t, c / DEG, piston, engine
 
 
-HEADER = f"""# condition = "independent reference"
+HEADER = """# condition = "independent reference"
 # synthetic = true
 # engine_angle_reference = "relative"
 # description = "INDEPENDENT record made by tests/data/make_independent_record.py (scipy solve_ivp, no taos code)"
