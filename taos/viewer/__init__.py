@@ -46,9 +46,17 @@ def check_view_args(th, angle_scale=1.0, deflection_scale=None, fps=100.0, gimba
     from ..planar.simulate import TimeHistory
 
     check_instance(th, "th", TimeHistory, "a run (taos.simulate, taos.simulate_taos or taos.load_run)")
-    for name, v in (("angle_scale", angle_scale), ("deflection_scale", deflection_scale), ("gimbal_scale", gimbal_scale)):
-        check_number(v, name, 0.0, MAX_VIEW_SCALE, lo_open=True, optional=name != "angle_scale")
-    check_number(fps, "fps", 0.0, MAX_VIEW_FPS, "1/s", lo_open=True)
+    from ..errors import InputError, as_argument
+
+    try:   # (the same values are taos view's --angle-scale, ... : the line names both)
+        name = "angle_scale"
+        for name, v in (("angle_scale", angle_scale), ("deflection_scale", deflection_scale),
+                        ("gimbal_scale", gimbal_scale)):
+            check_number(v, name, 0.0, MAX_VIEW_SCALE, lo_open=True, optional=name != "angle_scale")
+        name = "fps"
+        check_number(fps, "fps", 0.0, MAX_VIEW_FPS, "1/s", lo_open=True)
+    except InputError as e:
+        raise as_argument(e, name, "--" + name.replace("_", "-")) from None
 
 
 def load_run(path: str | Path) -> TimeHistory | TaosTimeHistory:
