@@ -158,7 +158,8 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
     from dataclasses import replace
 
     from taos.planar.simplex import simplex_limits
-    from taos.planar.saturation import embed_limits
+    from taos.planar.saturation import (N_HEAD, ROW_FLOW_IN, ROW_P, ROW_Q, ROW_UV, ROW_UV_IN, embed_limits,
+                                        row_start)
 
     from ._kernel import integrate
 
@@ -175,11 +176,17 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
                          got=", ".join(sorted({m.friction.name for m in models})))
     for m, a in zip(models, cfg.actuators):
         m.friction.check_step(m.engine.inertia(a.axis), dt_s, m.source)
-    M = scipy.sparse.csr_matrix(np.hstack([cm.A, cm.B]))
-    M.eliminate_zeros()
-    rows = np.zeros((3 * na, N))
+    lims = [embed_limits(simplex_limits(m, a.axis), cm.blocks[k].A.shape[0], 0) if limits else np.zeros(0)
+            for k, (m, a) in enumerate(zip(models, cfg.actuators))]
+    # the stage vector v = [x; u; T; e_v; c_q; q''] of masv._kernel: x' = M v, q'' = Q v, aux = R x
+    nv = N + 4 * na + nm
+    Mf, Qf = np.zeros((N, nv)), np.zeros((nm, nv))
+    Mf[:, :N], Mf[:, N:N + 2 * na], Mf[:, N + 4 * na:] = cm.A_direct, cm.B_direct, cm.Gq
+    Qf[:, :N], Qf[:, N:N + 2 * na] = cm.Qx, cm.Qw
+    rows = np.zeros((6 * na, N))
+    H = np.zeros((na, N_HEAD))
     for k in range(na):
-        o = int(cm.offsets[k])
+        o, m = int(cm.offsets[k]), cm.blocks[k].A.shape[0]
         ith, iom = o + cm.blocks[k].states.index("theta_rad"), o + cm.blocks[k].states.index("omega_rad_s")
         rows[k, iom] = 1.0
         if nm:
@@ -187,18 +194,24 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
         rows[na + k] = cm.output_rows(k, "applied_torque_Nm")[0]
         rows[2 * na + k] = -cm.Ux[na + k]
         rows[2 * na + k, ith] += 1.0
-    R = scipy.sparse.csr_matrix(rows)
-    R.eliminate_zeros()
+        lk = lims[k]
+        if lk.size:
+            H[k] = lk[:N_HEAD]
+            blk = lambda i: lk[row_start(i, m):row_start(i + 1, m)]  # noqa: E731
+            rows[3 * na + k, o:o + m] = blk(ROW_UV)
+            rows[4 * na + k, o:o + m] = blk(ROW_Q)
+            rows[5 * na + k, o:o + m] = blk(ROW_P)
+            Mf[o:o + m, N + 2 * na + k] = blk(ROW_UV_IN)
+            Mf[o:o + m, N + 3 * na + k] = blk(ROW_FLOW_IN)
+    M, Q, R = (scipy.sparse.csr_matrix(a) for a in (Mf, Qf, rows))
+    for a in (M, Q, R):
+        a.eliminate_zeros()
     fp = np.ascontiguousarray(np.vstack([m.friction.pack() for m in models]))
     packs = [m.avionics.pack() for m in models]
     avp = np.zeros((na, max(p.size for p in packs)))
     for k, p in enumerate(packs):
         if avionics:
             avp[k, :p.size] = p
-    lims = [embed_limits(simplex_limits(m, a.axis), cm.blocks[k].A.shape[0], 0) if limits else np.zeros(0)
-            for k, (m, a) in enumerate(zip(models, cfg.actuators))]
-    lptr = np.concatenate([[0], np.cumsum([x.size for x in lims])]).astype(np.int64)
-    lim = np.concatenate(lims + [np.zeros(0)])
     T = _duration(commands) if duration_s is None else float(duration_s)
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
@@ -207,10 +220,9 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
     xo, vo, zo = np.empty((nrec, N)), np.empty((nrec, 2 * na)), np.empty((nrec, na))
     i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
     t0 = time.perf_counter()
-    st = integrate(i64(M.indptr), i64(M.indices), M.data.astype(float), i64(R.indptr), i64(R.indices),
-                   R.data.astype(float), models[0].friction.entry.rates, fp, avp, lim, lptr,
-                   i64(cm.offsets[:-1]), np.zeros(N), np.zeros(na), np.ascontiguousarray(r), float(dt_s),
-                   int(record_every), xo, vo, zo)
+    csr = lambda a: (i64(a.indptr), i64(a.indices), a.data.astype(float))  # noqa: E731
+    st = integrate(*csr(M), *csr(Q), *csr(R), H, models[0].friction.entry.rates, fp, avp, np.zeros(N),
+                   np.zeros(na), np.ascontiguousarray(r), float(dt_s), int(record_every), xo, vo, zo)
     wall = time.perf_counter() - t0
     if st >= 0:
         raise SimulationUnstable(st * dt_s, f"masv simulate, dt = {dt_s} s")
@@ -226,7 +238,7 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
                           "limits": bool(limits)},
             "coupling": {"friction_and_stops": "relative to the structure's gimbal rotation, reaction on the "
                          "structure", "residual_flexibility": bool(np.any(system.g_res)),
-                         "n_states": N, "nnz": int(M.nnz)}}
+                         "n_states": N, "nnz": int(M.nnz + Q.nnz)}}
     return MasvTimeHistory(
         t_s=t[::record_every], actuators=cfg.actuator_names, engines=tuple(e.name for e in cfg.engines),
         engine_of=tuple(a.engine for a in cfg.actuators), command_rad=r[::record_every].T.copy(),
