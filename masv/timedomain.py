@@ -31,7 +31,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse
 
 from taos.errors import InputError, SimulationUnstable
 from taos.profiles import is_two_axis
@@ -157,11 +156,12 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
                          got=f"{dt_s}, {record_every}")
     from dataclasses import replace
 
+    from taos.planar._avionics_slots import AV_TABLE
     from taos.planar.simplex import simplex_limits
     from taos.planar.saturation import (N_HEAD, ROW_FLOW_IN, ROW_P, ROW_Q, ROW_UV, ROW_UV_IN, embed_limits,
                                         row_start)
 
-    from ._kernel import integrate
+    from ._kernel import _csr_arrays, integrate, lane_layout, lane_operator
 
     if friction is not None:
         cfg = replace(cfg, engines=tuple(replace(e, model=e.model.with_friction(friction)) for e in cfg.engines))
@@ -203,29 +203,38 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
             rows[5 * na + k, o:o + m] = blk(ROW_P)
             Mf[o:o + m, N + 2 * na + k] = blk(ROW_UV_IN)
             Mf[o:o + m, N + 3 * na + k] = blk(ROW_FLOW_IN)
-    M, Q, R = (scipy.sparse.csr_matrix(a) for a in (Mf, Qf, rows))
-    for a in (M, Q, R):
-        a.eliminate_zeros()
+    lay = lane_layout(cm.offsets, nm)
+    off = cm.offsets
+
+    def remap(a):
+        out = np.zeros((a.shape[0], lay.nw))
+        np.add.at(out, (slice(None), lay.colmap[:a.shape[1]]), a)
+        return out
+
+    blk_rows = [np.vstack([Mf[off[k] + i] if off[k] + i < off[k + 1] else np.zeros(nv) for k in range(na)])
+                for i in range(lay.m)]
+    ml = lane_operator(blk_rows, lay.colmap, na, lay.ws0, lay.nw)
+    rl = lane_operator([rows[i * na:(i + 1) * na] for i in range(6)], lay.colmap, na, lay.ws0, lay.nw)
+    mp, mx, mvv = _csr_arrays(remap(Mf[nb:]))
     fp = np.ascontiguousarray(np.vstack([m.friction.pack() for m in models]))
-    packs = [m.avionics.pack() for m in models]
+    packs = [m.avionics.pack() if avionics else np.zeros(AV_TABLE) for m in models]   # zeros: off
     avp = np.zeros((na, max(p.size for p in packs)))
     for k, p in enumerate(packs):
-        if avionics:
-            avp[k, :p.size] = p
+        avp[k, :p.size] = p
     T = _duration(commands) if duration_s is None else float(duration_s)
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
     r, how = _commands(cfg, commands, t)
     nrec = n // record_every + 1
-    xo, vo, zo = np.empty((nrec, N)), np.empty((nrec, 2 * na)), np.empty((nrec, na))
-    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
+    xo, vo, zo = np.empty((nrec, lay.nx)), np.empty((nrec, 2 * na)), np.empty((nrec, na))
     t0 = time.perf_counter()
-    csr = lambda a: (i64(a.indptr), i64(a.indices), a.data.astype(float))  # noqa: E731
-    st = integrate(*csr(M), *csr(Q), *csr(R), H, models[0].friction.entry.rates, fp, avp, np.zeros(N),
-                   np.zeros(na), np.ascontiguousarray(r), float(dt_s), int(record_every), xo, vo, zo)
+    st = integrate(ml.arrays(), mp, mx, mvv, _csr_arrays(remap(Qf)), rl.arrays(), H, lay.m, lay.nw, lay.ws0,
+                   models[0].friction.entry.rates, fp, avp, np.zeros(lay.nx), np.zeros(na),
+                   np.ascontiguousarray(r), float(dt_s), int(record_every), xo, vo, zo)
     wall = time.perf_counter() - t0
     if st >= 0:
         raise SimulationUnstable(st * dt_s, f"masv simulate, dt = {dt_s} s")
+    xo = xo[:, lay.xmap]
 
     def out(name):
         return np.vstack([xo @ cm.output_rows(k, name)[0] + vo @ cm.output_rows(k, name)[1] for k in range(na)])
@@ -238,7 +247,7 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
                           "limits": bool(limits)},
             "coupling": {"friction_and_stops": "relative to the structure's gimbal rotation, reaction on the "
                          "structure", "residual_flexibility": bool(np.any(system.g_res)),
-                         "n_states": N, "nnz": int(M.nnz + Q.nnz)}}
+                         "n_states": N, "nnz": int(np.count_nonzero(Mf) + np.count_nonzero(Qf))}}
     return MasvTimeHistory(
         t_s=t[::record_every], actuators=cfg.actuator_names, engines=tuple(e.name for e in cfg.engines),
         engine_of=tuple(a.engine for a in cfg.actuators), command_rad=r[::record_every].T.copy(),
