@@ -223,14 +223,16 @@ def _all_finite(x, z):
 
 
 @njit(cache=True, fastmath=_FM, nogil=True)
-def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fid, fp, avp, x0, z0, r, dt, rec_every, x_out, v_out, z_out):
-    """RK4 over the command samples ``r`` (n_steps + 1, n_a) [rad] (linear between samples),
+def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fid, fp, avp, amap, x0, z0, r, dt, rec_every, x_out, v_out, z_out):
+    """RK4 over the command samples ``r`` (n_steps + 1, n_c) [rad] (linear between samples),
     step ``dt`` [s], from ``x0`` (n_x,) (lane layout) and ``z0`` (n_a,) [rad]. ``ml``, ``rl``
     the lane operators of the blocks' rows and of R (:meth:`LaneOperator.arrays`), (``mp``,
-    ``mx``, ``mv``) the modal rows' CSR and ``ql`` q'''s, all over w_s (length ``nw``, S from
+    ``mx``, ``mv``) the modal rows' CSR and ``ql`` the CSR of q'', all over w_s (length ``nw``, S from
     ``ws0``, ``m`` lane states); ``H`` (n_a, N_HEAD) the blocks' limit heads
     (:mod:`taos.planar.saturation`, zeros: off); ``fid`` the friction law's ``rates`` kernel,
-    ``fp`` (n_a, NPARAM) its packs; ``avp`` (n_a, L) the avionics packs. Records every
+    ``fp`` (n_a, NPARAM) its packs; ``avp`` (n_c, L) the avionics packs: actuator k's
+    post-avionics command is that of command column and pack ``amap[k]`` (actuators with the
+    same command and avionics share one evaluation). Records every
     ``rec_every`` steps the state into ``x_out`` (n_rec, n_x), [u; T] into ``v_out``
     (n_rec, 2 n_a) [rad, N m] and the friction states into ``z_out`` (n_rec, n_a) [rad].
     Returns -1, or the step at which the state became non-finite."""
@@ -240,19 +242,27 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fid, fp, avp, x0, z0, r, dt
     x, z = x0.copy(), z0.copy()
     k1, k2, k3, k4, xt = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     d1, d2, d3, d4, zt = np.empty(na), np.empty(na), np.empty(na), np.empty(na), np.empty(na)
+    nc = r.shape[1]
     u0, um, u1 = np.empty(na), np.empty(na), np.empty(na)
+    c0, cm, c1 = np.empty(nc), np.empty(nc), np.empty(nc)
     W = np.zeros(nw)
     aux = np.empty(len(R_ROWS) * na)
     nsteps = r.shape[0] - 1
+    for j in range(nc):
+        c1[j] = _av.apply(r[0, j], avp[j])
     for k in range(na):
-        u1[k] = _av.apply(r[0, k], avp[k])
+        u1[k] = c1[amap[k]]
     rec = 0
     for s in range(nsteps + 1):
         s1 = min(s + 1, nsteps)
+        for j in range(nc):
+            c0[j] = c1[j]   # the avionics of this step's start sample, computed a step ago
+            cm[j] = _av.apply(0.5 * (r[s, j] + r[s1, j]), avp[j])
+            c1[j] = _av.apply(r[s1, j], avp[j])
         for k in range(na):
-            u0[k] = u1[k]   # the avionics of this step's start sample, computed a step ago
-            um[k] = _av.apply(0.5 * (r[s, k] + r[s1, k]), avp[k])
-            u1[k] = _av.apply(r[s1, k], avp[k])
+            u0[k] = c0[amap[k]]
+            um[k] = cm[amap[k]]
+            u1[k] = c1[amap[k]]
         _rates(x, z, u0, ml, mp, mx, mv, ql, rl, H, fid, fp, W, ws0, m, aux, k1, d1)
         if s % rec_every == 0:
             for i in range(n):

@@ -111,13 +111,15 @@ def _commands(cfg: MasvConfig, commands, t: np.ndarray) -> tuple[np.ndarray, dic
         per = {n: commands.get(n) for n in names}
     else:
         per = {n: commands for n in names}
-    how = {}
+    how, done = {}, {}
     for k, a in enumerate(cfg.actuators):
         p = per[a.name]
         if p is None:
             how[a.name] = "none (zero)"
             continue
-        v = np.atleast_2d(p(t))
+        if id(p) not in done:                 # each profile evaluated once
+            done[id(p)] = np.atleast_2d(p(t))
+        v = done[id(p)]
         out[:, k] = v[1] if (is_two_axis(p) and a.axis == "yaw") else v[0]
         how[a.name] = getattr(p, "name", "") or type(p).__name__
     return out, how
@@ -226,18 +228,26 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
     t = np.arange(n + 1) * dt_s
     r, how = _commands(cfg, commands, t)
     nrec = n // record_every + 1
+    reps, amap = [], np.empty(na, dtype=np.int64)     # actuators with one command and one avionics
+    for k in range(na):
+        j = next((i for i, q in enumerate(reps) if np.array_equal(r[:, q], r[:, k]) and
+                  np.array_equal(avp[q], avp[k])), len(reps))
+        if j == len(reps):
+            reps.append(k)
+        amap[k] = j
     xo, vo, zo = np.empty((nrec, lay.nx)), np.empty((nrec, 2 * na)), np.empty((nrec, na))
     t0 = time.perf_counter()
     st = integrate(ml.arrays(), mp, mx, mvv, _csr_arrays(remap(Qf)), rl.arrays(), H, lay.m, lay.nw, lay.ws0,
-                   models[0].friction.entry.rates, fp, avp, np.zeros(lay.nx), np.zeros(na),
-                   np.ascontiguousarray(r), float(dt_s), int(record_every), xo, vo, zo)
+                   models[0].friction.entry.rates, fp, avp[reps], amap, np.zeros(lay.nx), np.zeros(na),
+                   np.ascontiguousarray(r[:, reps]), float(dt_s), int(record_every), xo, vo, zo)
     wall = time.perf_counter() - t0
     if st >= 0:
         raise SimulationUnstable(st * dt_s, f"masv simulate, dt = {dt_s} s")
     xo = xo[:, lay.xmap]
 
     def out(name):
-        return np.vstack([xo @ cm.output_rows(k, name)[0] + vo @ cm.output_rows(k, name)[1] for k in range(na)])
+        c = [cm.output_rows(k, name) for k in range(na)]
+        return np.vstack([a for a, _ in c]) @ xo.T + np.vstack([b for _, b in c]) @ vo.T
 
     uc = xo @ cm.Ux.T + vo @ cm.Uw.T
     prov = {**config_provenance(cfg), "engine": "masv-nonlinear", "commands": how,
