@@ -102,8 +102,8 @@ def lane_operator(rows: list, colmap: np.ndarray, na: int, ws0: int, nw: int) ->
             sv.append(sh[c])
         lp.append(len(lc))
         sp.append(len(sc))
-    i64 = lambda a: np.asarray(a, dtype=np.int64)  # noqa: E731
-    v2 = lambda a: np.ascontiguousarray(np.reshape(a, (-1, na)), dtype=float)  # noqa: E731
+    i64 = lambda a: np.asarray(a, dtype=np.int64)
+    v2 = lambda a: np.ascontiguousarray(np.reshape(a, (-1, na)), dtype=float)
     return LaneOperator(i64(lp), i64(lc), v2(lv), i64(sp), i64(sc), v2(sv), *_csr_arrays(cross))
 
 

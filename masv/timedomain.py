@@ -159,9 +159,17 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
     from dataclasses import replace
 
     from taos.planar._avionics_slots import AV_TABLE
+    from taos.planar.saturation import (
+        N_HEAD,
+        ROW_FLOW_IN,
+        ROW_P,
+        ROW_Q,
+        ROW_UV,
+        ROW_UV_IN,
+        embed_limits,
+        row_start,
+    )
     from taos.planar.simplex import simplex_limits
-    from taos.planar.saturation import (N_HEAD, ROW_FLOW_IN, ROW_P, ROW_Q, ROW_UV, ROW_UV_IN, embed_limits,
-                                        row_start)
 
     from ._kernel import _csr_arrays, integrate, lane_layout, lane_operator
 
@@ -199,12 +207,12 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
         lk = lims[k]
         if lk.size:
             H[k] = lk[:N_HEAD]
-            blk = lambda i: lk[row_start(i, m):row_start(i + 1, m)]  # noqa: E731
-            rows[3 * na + k, o:o + m] = blk(ROW_UV)
-            rows[4 * na + k, o:o + m] = blk(ROW_Q)
-            rows[5 * na + k, o:o + m] = blk(ROW_P)
-            Mf[o:o + m, N + 2 * na + k] = blk(ROW_UV_IN)
-            Mf[o:o + m, N + 3 * na + k] = blk(ROW_FLOW_IN)
+            blk = {i: lk[row_start(i, m):row_start(i + 1, m)] for i in (ROW_UV, ROW_Q, ROW_P, ROW_UV_IN, ROW_FLOW_IN)}
+            rows[3 * na + k, o:o + m] = blk[ROW_UV]
+            rows[4 * na + k, o:o + m] = blk[ROW_Q]
+            rows[5 * na + k, o:o + m] = blk[ROW_P]
+            Mf[o:o + m, N + 2 * na + k] = blk[ROW_UV_IN]
+            Mf[o:o + m, N + 3 * na + k] = blk[ROW_FLOW_IN]
     lay = lane_layout(cm.offsets, nm)
     off = cm.offsets
 
