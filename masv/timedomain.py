@@ -41,10 +41,11 @@ from .provenance import config_provenance
 from .system import build_system
 
 #: default RK4 step [s]. 4e-4 s: on the Green Run two-axis profile (models/masv/core_stage.toml,
-#: modified LuGre, limits and avionics) the engine angles differ from a 1e-4 s run by at most
-#: 2.3e-4 deg of a 0.362 deg peak, as the 2e-4 s run's 1.5e-4 deg (the stick-slip instants, not
-#: the step, set the difference; benchmarks/RESULTS.md), at half the cost; the relief-valve step
-#: rule of the shipped servo (taos.bounds) is 1.6 of the RK4 limit 2.0 at this step
+#: modified LuGre, limits and avionics) the engine angles differ from a 5e-5 s run by at most
+#: 2.3e-4 deg of a 0.362 deg peak (2e-4 s: 1.5e-4 deg, as `taos simulate` at its default 2e-4 s
+#: on rs25_hotfire; the stick-slip instants, not the step, set the difference; benchmarks/RESULTS.md),
+#: at half the cost; the relief-valve step rule of the shipped servo (taos.bounds) is 1.6 of the
+#: RK4 limit 2.0 at this step
 DEFAULT_DT_S = 4e-4
 #: default recording: every 5th step (2 ms at the default step)
 DEFAULT_RECORD_EVERY = 5
