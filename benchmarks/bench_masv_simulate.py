@@ -6,8 +6,8 @@ profile in the same run.
 
 Peers, same machine, same run, best of ``--repeat`` (compiled kernels warmed first):
   * masv.simulate (masv.timedomain) on models/masv/core_stage.toml (8 engine-axis blocks with friction, limits
-    and avionics, 5 modes to 200 Hz; compiled RK4 kernel masv._kernel.integrate): kernel time and
-    the whole call;
+    and avionics, 5 modes to 200 Hz; compiled RK4 lane kernel masv._kernel.integrate; "nnz" the
+    non-zeros of its factored linear part): kernel time and the whole call;
   * taos.planar.simulate on models/rs25_hotfire.toml, two axes one after the other (threads=1):
     the single-engine kernel taos.planar.dynamics.integrate_samples, whole call.
 Real-time factor = simulated seconds / seconds, both by the wall clock and by this process's CPU

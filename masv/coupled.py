@@ -42,7 +42,11 @@ class CoupledModel:
     e in ``ext``, k in actuator order] (n_ext n_act,). ``offsets`` (n_act + 1,) the blocks'
     first states, ``n_modes``; ``Ux``, ``Uw`` the coupling coordinates u_c = Ux x + Uw w
     (2 n_act rows [e; r]); ``Qx``, ``Qw`` the modal accelerations q'' = Qx x + Qw w; ``blocks``
-    the full blocks, ``cg_dirs`` d_k, ``engine_of`` engine index per actuator."""
+    the full blocks, ``cg_dirs`` d_k, ``engine_of`` engine index per actuator. The same
+    equations factored through q'' (the compiled time domain's form, fewer non-zeros):
+    x' = ``A_direct`` x + ``B_direct`` w + ``Gq`` q'', with A = A_direct + Gq Qx and
+    B = B_direct + Gq Qw (``Gq`` (N, n_modes): the gimbal accelerations' input into the
+    blocks, and the identity on the modal-rate rows)."""
 
     A: np.ndarray
     B: np.ndarray
@@ -58,6 +62,9 @@ class CoupledModel:
     cg_dirs: np.ndarray
     engine_of: np.ndarray
     torque_reaction: bool
+    A_direct: np.ndarray
+    B_direct: np.ndarray
+    Gq: np.ndarray
 
     @property
     def n_act(self) -> int:
@@ -143,6 +150,7 @@ def assemble(blocks, phi_c, phi_g, omega, zeta, g_res, engine_of, cg_dirs, added
     A[:nb] += Bc @ Ux
     B[:nb] += Bc @ Uw
     Qx, Qw = np.zeros((nm, N)), np.zeros((nm, ne))
+    A_direct, B_direct, Gq = A.copy(), B.copy(), np.zeros((N, nm))
     if nm:
         iq, iv = slice(nb, nb + nm), slice(nb + nm, N)
         Ft = np.zeros((ng, N))
@@ -155,9 +163,12 @@ def assemble(blocks, phi_c, phi_g, omega, zeta, g_res, engine_of, cg_dirs, added
         S = np.eye(nm) - phi_g.T @ Dtg @ phi_g
         Qx, Qw = np.linalg.solve(S, Qx), np.linalg.solve(S, Qw)
         A[iq, iv] = np.eye(nm)
+        A_direct, B_direct = A.copy(), B.copy()
+        Gq[:nb] = Ba @ phi_g
+        Gq[iv] = np.eye(nm)
         A[iv] += Qx
         B[iv] += Qw
         A[:nb] += Ba @ phi_g @ Qx
         B[:nb] += Ba @ phi_g @ Qw
     return CoupledModel(A, B, tuple(ext), off, nm, Ux, Uw, Qx, Qw, phi_g, tuple(blocks), np.asarray(cg_dirs),
-                        np.asarray(engine_of), torque_reaction)
+                        np.asarray(engine_of), torque_reaction, A_direct, B_direct, Gq)

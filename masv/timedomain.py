@@ -31,7 +31,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse
 
 from taos.errors import InputError, SimulationUnstable
 from taos.profiles import is_two_axis
@@ -42,10 +41,11 @@ from .provenance import config_provenance
 from .system import build_system
 
 #: default RK4 step [s]. 4e-4 s: on the Green Run two-axis profile (models/masv/core_stage.toml,
-#: modified LuGre, limits and avionics) the engine angles differ from a 1e-4 s run by at most
-#: 2.3e-4 deg of a 0.362 deg peak, as the 2e-4 s run's 1.5e-4 deg (the stick-slip instants, not
-#: the step, set the difference; benchmarks/RESULTS.md), at half the cost; the relief-valve step
-#: rule of the shipped servo (taos.bounds) is 1.6 of the RK4 limit 2.0 at this step
+#: modified LuGre, limits and avionics) the engine angles differ from a 5e-5 s run by at most
+#: 2.3e-4 deg of a 0.362 deg peak (2e-4 s: 1.5e-4 deg, as `taos simulate` at its default 2e-4 s
+#: on rs25_hotfire; the stick-slip instants, not the step, set the difference; benchmarks/RESULTS.md),
+#: at half the cost; the relief-valve step rule of the shipped servo (taos.bounds) is 1.6 of the
+#: RK4 limit 2.0 at this step
 DEFAULT_DT_S = 4e-4
 #: default recording: every 5th step (2 ms at the default step)
 DEFAULT_RECORD_EVERY = 5
@@ -112,13 +112,15 @@ def _commands(cfg: MasvConfig, commands, t: np.ndarray) -> tuple[np.ndarray, dic
         per = {n: commands.get(n) for n in names}
     else:
         per = {n: commands for n in names}
-    how = {}
+    how, done = {}, {}
     for k, a in enumerate(cfg.actuators):
         p = per[a.name]
         if p is None:
             how[a.name] = "none (zero)"
             continue
-        v = np.atleast_2d(p(t))
+        if id(p) not in done:                 # each profile evaluated once
+            done[id(p)] = np.atleast_2d(p(t))
+        v = done[id(p)]
         out[:, k] = v[1] if (is_two_axis(p) and a.axis == "yaw") else v[0]
         how[a.name] = getattr(p, "name", "") or type(p).__name__
     return out, how
@@ -157,10 +159,20 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
                          got=f"{dt_s}, {record_every}")
     from dataclasses import replace
 
+    from taos.planar._avionics_slots import AV_TABLE
+    from taos.planar.saturation import (
+        N_HEAD,
+        ROW_FLOW_IN,
+        ROW_P,
+        ROW_Q,
+        ROW_UV,
+        ROW_UV_IN,
+        embed_limits,
+        row_start,
+    )
     from taos.planar.simplex import simplex_limits
-    from taos.planar.saturation import embed_limits
 
-    from ._kernel import integrate
+    from ._kernel import _csr_arrays, integrate, lane_layout, lane_operator
 
     if friction is not None:
         cfg = replace(cfg, engines=tuple(replace(e, model=e.model.with_friction(friction)) for e in cfg.engines))
@@ -175,11 +187,17 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
                          got=", ".join(sorted({m.friction.name for m in models})))
     for m, a in zip(models, cfg.actuators):
         m.friction.check_step(m.engine.inertia(a.axis), dt_s, m.source)
-    M = scipy.sparse.csr_matrix(np.hstack([cm.A, cm.B]))
-    M.eliminate_zeros()
-    rows = np.zeros((3 * na, N))
+    lims = [embed_limits(simplex_limits(m, a.axis), cm.blocks[k].A.shape[0], 0) if limits else np.zeros(0)
+            for k, (m, a) in enumerate(zip(models, cfg.actuators))]
+    # the stage vector v = [x; u; T; e_v; c_q; q''] of masv._kernel: x' = M v, q'' = Q v, aux = R x
+    nv = N + 4 * na + nm
+    Mf, Qf = np.zeros((N, nv)), np.zeros((nm, nv))
+    Mf[:, :N], Mf[:, N:N + 2 * na], Mf[:, N + 4 * na:] = cm.A_direct, cm.B_direct, cm.Gq
+    Qf[:, :N], Qf[:, N:N + 2 * na] = cm.Qx, cm.Qw
+    rows = np.zeros((6 * na, N))
+    H = np.zeros((na, N_HEAD))
     for k in range(na):
-        o = int(cm.offsets[k])
+        o, m = int(cm.offsets[k]), cm.blocks[k].A.shape[0]
         ith, iom = o + cm.blocks[k].states.index("theta_rad"), o + cm.blocks[k].states.index("omega_rad_s")
         rows[k, iom] = 1.0
         if nm:
@@ -187,36 +205,58 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
         rows[na + k] = cm.output_rows(k, "applied_torque_Nm")[0]
         rows[2 * na + k] = -cm.Ux[na + k]
         rows[2 * na + k, ith] += 1.0
-    R = scipy.sparse.csr_matrix(rows)
-    R.eliminate_zeros()
+        lk = lims[k]
+        if lk.size:
+            H[k] = lk[:N_HEAD]
+            blk = {i: lk[row_start(i, m):row_start(i + 1, m)] for i in (ROW_UV, ROW_Q, ROW_P, ROW_UV_IN, ROW_FLOW_IN)}
+            rows[3 * na + k, o:o + m] = blk[ROW_UV]
+            rows[4 * na + k, o:o + m] = blk[ROW_Q]
+            rows[5 * na + k, o:o + m] = blk[ROW_P]
+            Mf[o:o + m, N + 2 * na + k] = blk[ROW_UV_IN]
+            Mf[o:o + m, N + 3 * na + k] = blk[ROW_FLOW_IN]
+    lay = lane_layout(cm.offsets, nm)
+    off = cm.offsets
+
+    def remap(a):
+        out = np.zeros((a.shape[0], lay.nw))
+        np.add.at(out, (slice(None), lay.colmap[:a.shape[1]]), a)
+        return out
+
+    blk_rows = [np.vstack([Mf[off[k] + i] if off[k] + i < off[k + 1] else np.zeros(nv) for k in range(na)])
+                for i in range(lay.m)]
+    ml = lane_operator(blk_rows, lay.colmap, na, lay.ws0, lay.nw)
+    rl = lane_operator([rows[i * na:(i + 1) * na] for i in range(6)], lay.colmap, na, lay.ws0, lay.nw)
+    mp, mx, mvv = _csr_arrays(remap(Mf[nb:]))
     fp = np.ascontiguousarray(np.vstack([m.friction.pack() for m in models]))
-    packs = [m.avionics.pack() for m in models]
+    packs = [m.avionics.pack() if avionics else np.zeros(AV_TABLE) for m in models]   # zeros: off
     avp = np.zeros((na, max(p.size for p in packs)))
     for k, p in enumerate(packs):
-        if avionics:
-            avp[k, :p.size] = p
-    lims = [embed_limits(simplex_limits(m, a.axis), cm.blocks[k].A.shape[0], 0) if limits else np.zeros(0)
-            for k, (m, a) in enumerate(zip(models, cfg.actuators))]
-    lptr = np.concatenate([[0], np.cumsum([x.size for x in lims])]).astype(np.int64)
-    lim = np.concatenate(lims + [np.zeros(0)])
+        avp[k, :p.size] = p
     T = _duration(commands) if duration_s is None else float(duration_s)
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
     r, how = _commands(cfg, commands, t)
     nrec = n // record_every + 1
-    xo, vo, zo = np.empty((nrec, N)), np.empty((nrec, 2 * na)), np.empty((nrec, na))
-    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
+    reps, amap = [], np.empty(na, dtype=np.int64)     # actuators with one command and one avionics
+    for k in range(na):
+        j = next((i for i, q in enumerate(reps) if np.array_equal(r[:, q], r[:, k]) and
+                  np.array_equal(avp[q], avp[k])), len(reps))
+        if j == len(reps):
+            reps.append(k)
+        amap[k] = j
+    xo, vo, zo = np.empty((nrec, lay.nx)), np.empty((nrec, 2 * na)), np.empty((nrec, na))
     t0 = time.perf_counter()
-    st = integrate(i64(M.indptr), i64(M.indices), M.data.astype(float), i64(R.indptr), i64(R.indices),
-                   R.data.astype(float), models[0].friction.entry.rates, fp, avp, lim, lptr,
-                   i64(cm.offsets[:-1]), np.zeros(N), np.zeros(na), np.ascontiguousarray(r), float(dt_s),
-                   int(record_every), xo, vo, zo)
+    st = integrate(ml.arrays(), mp, mx, mvv, _csr_arrays(remap(Qf)), rl.arrays(), H, lay.m, lay.nw, lay.ws0,
+                   models[0].friction.entry.rates, fp, avp[reps], amap, np.zeros(lay.nx), np.zeros(na),
+                   np.ascontiguousarray(r[:, reps]), float(dt_s), int(record_every), xo, vo, zo)
     wall = time.perf_counter() - t0
     if st >= 0:
         raise SimulationUnstable(st * dt_s, f"masv simulate, dt = {dt_s} s")
+    xo = xo[:, lay.xmap]
 
     def out(name):
-        return np.vstack([xo @ cm.output_rows(k, name)[0] + vo @ cm.output_rows(k, name)[1] for k in range(na)])
+        c = [cm.output_rows(k, name) for k in range(na)]
+        return np.vstack([a for a, _ in c]) @ xo.T + np.vstack([b for _, b in c]) @ vo.T
 
     uc = xo @ cm.Ux.T + vo @ cm.Uw.T
     prov = {**config_provenance(cfg), "engine": "masv-nonlinear", "commands": how,
@@ -226,7 +266,7 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
                           "limits": bool(limits)},
             "coupling": {"friction_and_stops": "relative to the structure's gimbal rotation, reaction on the "
                          "structure", "residual_flexibility": bool(np.any(system.g_res)),
-                         "n_states": N, "nnz": int(M.nnz)}}
+                         "n_states": N, "nnz": int(np.count_nonzero(Mf) + np.count_nonzero(Qf))}}
     return MasvTimeHistory(
         t_s=t[::record_every], actuators=cfg.actuator_names, engines=tuple(e.name for e in cfg.engines),
         engine_of=tuple(a.engine for a in cfg.actuators), command_rad=r[::record_every].T.copy(),
