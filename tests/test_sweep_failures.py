@@ -66,7 +66,8 @@ def _same_store(a: Path, b: Path, names) -> None:
 
 
 def _kept_line(err: str, prefix: str, spath: Path, noun: str, total: int) -> str:
-    lines = err.strip().splitlines()
+    # (the map campaign's progress bar, tqdm's "montecarlo: ..." lines, is not a message)
+    lines = [ln for ln in re.split(r"[\r\n]+", err) if ln.strip() and not ln.startswith("montecarlo:")]
     assert len(lines) == 1 and lines[0].startswith(prefix), err
     assert "no partial output" not in lines[0] and "Traceback" not in err
     n = _stored(spath)
