@@ -153,12 +153,29 @@ def test_sweep_scheduler_loss_is_one_line_with_the_points_kept_and_the_resume_li
     _same_store(out / "sweep.zarr", fresh / "sweep.zarr", ("phase_margin_deg", "lab_peaking_db", "load_mode_hz"))
 
 
-def test_without_out_a_sweep_signal_keeps_nothing_and_says_so(tmp_path):
-    """No ``--out``: the store is temporary and removed, so the line says nothing is kept."""
-    from taos.cli.montecarlo import campaign_stopped
-    from taos.montecarlo.engine import CampaignStopped
-    e = campaign_stopped(CampaignStopped("the Dask scheduler was lost"), None)
-    assert "nothing kept (no --out" in str(e) and "resume" not in str(e)
+def test_without_out_a_lost_cluster_says_nothing_is_kept(tmp_path, monkeypatch):
+    """No ``out_dir`` (no ``--out``): the store is temporary and removed, so the line of a
+    cluster that failed says nothing is kept (not "kept, resume to continue"), and no folder
+    stays behind."""
+    import tempfile
+    from taos.errors import InputError
+    from taos.montecarlo import engine
+    from taos.montecarlo.sweep import SweepDefinition, run_sweep
+    from taos.montecarlo.sweep_define import make_design, parse_set
+
+    def lost(*a, **k):
+        raise engine.CampaignStopped("the Dask scheduler was lost (no answer within the connect timeout)")
+    monkeypatch.setattr(engine, "execute", lost)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    defn = SweepDefinition(str(AMBIENT), make_design([parse_set("structure.load_stiffness=80000 lbf/in,150000 lbf/in")], None, 0, None),
+                           ("load_mode_hz",))
+    with pytest.raises(InputError, match="scheduler was lost") as e:
+        run_sweep(defn)
+    assert not isinstance(e.value, engine.CampaignStopped)
+    assert "nothing kept (no out_dir / --out: the store was temporary)" in str(e.value)
+    assert "resume" not in str(e.value) and not list(tmp_path.iterdir())
+    with pytest.raises(engine.CampaignStopped, match="resume to continue"):   # with a folder: kept
+        run_sweep(defn, tmp_path / "kept")
 
 
 def test_a_foreign_campaign_in_out_is_not_reported_as_kept(tmp_path):
@@ -195,6 +212,9 @@ def test_scheduler_file_is_refused_with_workers_or_scheduler(tmp_path):
             assert len(lines) == 1 and "one of --workers, --scheduler, --scheduler-file" in lines[0], r.stderr
     r = run_cli(*LCO[:-4], "--no-time-domain", "--scheduler-file", f)   # no --sweep: no map campaign
     assert r.returncode == 2 and "--scheduler-file" in r.stderr and "--sweep" in r.stderr, r.stderr
+    r = run_cli(*LCO[:-4], "--requirements", MODELS / "specs" / "flight_signoff_notional.toml",
+                "--scheduler-file", f)   # the sign-off runs in this process: the option would be ignored
+    assert r.returncode == 2 and "--scheduler-file" in r.stderr and "--requirements" in r.stderr, r.stderr
     bad = tmp_path / "bad.json"
     bad.write_text('{"address": "inproc://x/1/2"}')
     r = run_cli(*SWEEP, "--scheduler-file", bad, "--out", tmp_path / "s")

@@ -143,7 +143,7 @@ def _sweep(args, flight, model, amps, freqs) -> int:
         from taos.flight.lco_campaign import FORMAT, run_map_campaign
         from taos.flight.vehicle import load_flight
         from taos.model import load_model
-        from taos.cli.montecarlo import KeptStore, campaign_stopped, cluster_address
+        from taos.cli.montecarlo import KeptStore, cluster_address
         from taos.flight.lco_campaign import MANIFEST, STORE
         from taos.montecarlo.engine import CampaignStopped
         from taos.montecarlo.inputs import digest, recording
@@ -163,7 +163,7 @@ def _sweep(args, flight, model, amps, freqs) -> int:
                                          input_files=table, workers=args.workers or 0, resume=args.resume,
                                          scheduler=scheduler, progress=args.json != "-")
         except CampaignStopped as e:
-            raise campaign_stopped(e, kept) from None
+            raise kept.stopped(e) from None
     else:
         for opt in ("resume", "workers", "scheduler", "scheduler_file"):
             if getattr(args, opt):

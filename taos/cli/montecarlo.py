@@ -232,15 +232,6 @@ class KeptStore:
                           got=f"{e.reason}; {self.describe() or f'no {self.noun} stored (nothing kept)'}")
 
 
-def campaign_stopped(e, kept: KeptStore | None) -> InputError:
-    """The line of a cluster failure of a campaign whose store is ``kept`` (None: a temporary
-    store, removed)."""
-    if kept is None:
-        return InputError(e.source, e.field, e.expected,
-                          got=f"{e.reason}; nothing kept (no --out: the store was temporary)")
-    return kept.stopped(e)
-
-
 def cmd_montecarlo(args) -> int:
     from taos.montecarlo import load_campaign, run_campaign
     from taos.montecarlo.engine import CampaignStopped

@@ -71,7 +71,7 @@ def cmd_sweep(args) -> int:
         return 0
     if args.model is None:
         raise InputError("command line", "MODEL", "a model file to sweep, e.g. models/rs25_ambient.toml", got="none")
-    from taos.cli.montecarlo import KeptStore, campaign_stopped, cluster_address
+    from taos.cli.montecarlo import KeptStore, cluster_address
     scheduler = cluster_address(args)   # the forms Dask accepts, one line if not
     defn = _definition(args)
     if args.plot and len(defn.design.keys) > 2:
@@ -87,8 +87,10 @@ def cmd_sweep(args) -> int:
     try:
         res = run_sweep(defn, args.out, workers=workers, scheduler=scheduler, resume=args.resume,
                         progress=not args.no_progress and sys.stderr.isatty(), batch=args.batch)
-    except CampaignStopped as e:
-        raise campaign_stopped(e, kept) from None
+    except CampaignStopped as e:   # (without --out run_sweep says itself that nothing is kept)
+        if kept is None:
+            raise
+        raise kept.stopped(e) from None
     if args.plot:
         from taos.plotting import save
         from taos.plotting.sweep import plot_sweep
