@@ -62,9 +62,9 @@ def cmd_lco(args) -> int:
         raise InputError("command line", "--signoff", "--requirements FILE with it", got="no --requirements")
     if args.sweep:
         return _sweep(args, flight, model, amps, freqs)
-    for opt in ("out", "resume", "workers", "scheduler"):
+    for opt in ("out", "resume", "workers", "scheduler", "scheduler_file"):
         if getattr(args, opt):
-            raise InputError("command line", "--" + opt, "--sweep too (a stored map campaign)",
+            raise InputError("command line", "--" + opt.replace("_", "-"), "--sweep too (a stored map campaign)",
                              got=str(getattr(args, opt)))
     if args.plot_map:
         raise InputError("command line", "--plot-map", "--sweep too (the map is of a sweep)", got=args.plot_map)
@@ -143,8 +143,11 @@ def _sweep(args, flight, model, amps, freqs) -> int:
         from taos.flight.lco_campaign import FORMAT, run_map_campaign
         from taos.flight.vehicle import load_flight
         from taos.model import load_model
-        from taos.cli.montecarlo import scheduler_address
+        from taos.cli.montecarlo import KeptStore, cluster_address
+        from taos.flight.lco_campaign import MANIFEST, STORE
+        from taos.montecarlo.engine import CampaignStopped
         from taos.montecarlo.inputs import digest, recording
+        scheduler = cluster_address(args)
         with recording() as input_files:   # every file a load of the inputs reads (the map's inputs hash)
             load_flight(args.flight)
             load_model(args.model, friction=args.friction)
@@ -153,14 +156,18 @@ def _sweep(args, flight, model, amps, freqs) -> int:
         text = _json.dumps({"format": FORMAT, "settings": dataclasses.asdict(settings), "axis": flight.axis,
                             "friction": args.friction, "load_stiffness": args.load_stiffness}, sort_keys=True)
         sha, table = digest(input_files, text)
-        m, failed = run_map_campaign(flight, model, axes, settings, args.out, inputs_sha256=sha, input_files=table,
-                                     workers=args.workers or 0, resume=args.resume,
-                                     scheduler=scheduler_address(args.scheduler) if args.scheduler else None,
-                                     progress=args.json != "-")
+        kept = KeptStore(args.out, MANIFEST, STORE, "points", resume_command(args), args.resume)
+        kept.watch()   # a signal from here on: the stored points and the resume line
+        try:
+            m, failed = run_map_campaign(flight, model, axes, settings, args.out, inputs_sha256=sha,
+                                         input_files=table, workers=args.workers or 0, resume=args.resume,
+                                         scheduler=scheduler, progress=args.json != "-")
+        except CampaignStopped as e:
+            raise kept.stopped(e) from None
     else:
-        for opt in ("resume", "workers", "scheduler"):
+        for opt in ("resume", "workers", "scheduler", "scheduler_file"):
             if getattr(args, opt):
-                raise InputError("command line", "--" + opt, "--out DIR too (a stored campaign)",
+                raise InputError("command line", "--" + opt.replace("_", "-"), "--out DIR too (a stored campaign)",
                                  got=str(getattr(args, opt)))
         m = lco_map(flight, model, axes, amplitudes_rad=amps, freq_hz=freqs, avionics=args.avionics,
                     time_domain=settings.time_domain, start=settings.start, duration_s=settings.duration_s,
@@ -193,6 +200,19 @@ def _sweep(args, flight, model, amps, freqs) -> int:
     for f in failed:
         print(f"failed: {f['at']}: {f['error']}", file=sys.stderr)
     return 3 if failed else 0
+
+
+def resume_command(args) -> str:
+    """The command that continues this map campaign (the same map, ``--resume`` on ``--out``)."""
+    from taos.cli.montecarlo import command_line
+    return command_line(["taos", "lco", args.model], [
+        ("--flight", args.flight), ("--friction", args.friction), ("--axis", args.axis),
+        ("--load-stiffness", args.load_stiffness), ("--avionics", args.avionics),
+        ("--amplitudes-deg", args.amplitudes_deg), ("--freq-hz", args.freq_hz), ("--duration", args.duration),
+        ("--no-time-domain", args.no_time_domain), ("--steady", args.steady), ("--sweep", args.sweep),
+        ("--td-start", args.td_start), ("--workers", args.workers), ("--scheduler", args.scheduler),
+        ("--scheduler-file", args.scheduler_file), ("--json", args.json), ("--plot-map", args.plot_map),
+        ("--out", args.out)])
 
 
 def add_parsers(sub) -> None:
@@ -230,6 +250,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--workers", type=int, help="with --out: local Dask worker processes (default 0: this process, "
                    "both cores, no Dask start-up)")
     p.add_argument("--scheduler", help="with --out: an existing Dask scheduler, e.g. tcp://127.0.0.1:8786")
+    p.add_argument("--scheduler-file", metavar="PATH", help="with --out: the scheduler's address from a Dask "
+                   "scheduler file (dask scheduler --scheduler-file PATH; dask-jobqueue)")
     p.add_argument("--plot-map", metavar="PNG_OR_SVG", help="with --sweep: the verdict map")
     p.add_argument("--requirements", metavar="TOML", help="flight sign-off: check the stated limits (gain and phase "
                    "margins, LCO amplitude and frequency band) over the nominal case or every --sweep point; "

@@ -153,69 +153,107 @@ def scheduler_from_file(path: str) -> str:
     return scheduler_address(addr, flag=f"--scheduler-file {path}: address")
 
 
-def resume_command(args) -> str:
-    """The command that continues this campaign (``--resume`` on the same folder)."""
-    import shlex
-    parts = ["taos", "montecarlo", args.campaign, "--runs", str(args.runs)]
-    for flag, v in (("--case", args.case), ("--friction", args.friction), ("--sensitivity", args.sensitivity),
-                    ("--scheduler", args.scheduler), ("--scheduler-file", args.scheduler_file),
-                    ("--workers", args.workers)):
-        if v is not None:
-            parts += [flag, str(v)]
-    return shlex.join(parts + ["--out", args.out, "--resume"])
-
-
-def stored_runs(out: Path) -> tuple[int, int] | None:
-    """(runs stored, runs) of the campaign in ``out`` (dispersed and nominal), None without one."""
-    from taos.montecarlo import store
-    from taos.montecarlo.executor import MANIFEST, STORE
-    if not (out / MANIFEST).is_file():
-        return None
-    sts = [store.status(out / STORE, g) for g in (None, "nominal")]
-    if any(st is None for st in sts):
-        return 0, 0
-    return sum(int((st != store.STATUS["pending"]).sum()) for st in sts), sum(len(st) for st in sts)
-
-
-def _kept(args) -> str | None:
-    n = stored_runs(Path(args.out))
-    if n is None:
-        return None
-    return (f"{n[0]} of {n[1]} runs stored in {Path(args.out) / 'campaign.zarr'} (kept); continue with: "
-            f"{resume_command(args)}")
-
-
-def cmd_montecarlo(args) -> int:
-    from taos.errors import on_signal_kept
-    from taos.montecarlo import load_campaign, run_campaign
-    from taos.montecarlo.engine import CampaignStopped
-
+def cluster_address(args) -> str | None:
+    """The scheduler named by ``--scheduler`` or ``--scheduler-file`` (None: local workers or
+    this process), refusing more than one of ``--workers``, ``--scheduler``, ``--scheduler-file``
+    (taos montecarlo, taos sweep, taos lco --sweep --out)."""
     given = [f for f, v in (("--workers", args.workers), ("--scheduler", args.scheduler),
                             ("--scheduler-file", args.scheduler_file)) if v is not None]
     if len(given) > 1:
         raise InputError("command line", given[1], "one of --workers, --scheduler, --scheduler-file",
                          got=" and ".join(given))
-    scheduler = scheduler_address(args.scheduler) if args.scheduler is not None else None
+    if args.scheduler is not None:
+        return scheduler_address(args.scheduler)
     if args.scheduler_file is not None:
-        scheduler = scheduler_from_file(args.scheduler_file)
+        return scheduler_from_file(args.scheduler_file)
+    return None
+
+
+def command_line(words, options) -> str:
+    """``taos WORDS OPTIONS --resume`` as one shell line: ``options`` is (flag, value) pairs; a
+    value None or False is left out, True is the bare flag, a list repeats the flag."""
+    import shlex
+    parts = [str(w) for w in words]
+    for flag, v in options:
+        if v is None or v is False:
+            continue
+        for x in (v if isinstance(v, (list, tuple)) else [v]):
+            parts += [flag] if x is True else [flag, str(x)]
+    return shlex.join(parts + ["--resume"])
+
+
+def resume_command(args) -> str:
+    """The command that continues this campaign (``--resume`` on the same folder)."""
+    return command_line(["taos", "montecarlo", args.campaign],
+                        [("--runs", args.runs), ("--case", args.case), ("--friction", args.friction),
+                         ("--sensitivity", args.sensitivity), ("--scheduler", args.scheduler),
+                         ("--scheduler-file", args.scheduler_file), ("--workers", args.workers), ("--out", args.out)])
+
+
+def stored_runs(spath: Path, groups=(None, "nominal")) -> tuple[int, int] | None:
+    """(runs stored, runs) of the store ``spath`` over ``groups``, None without a readable store."""
+    from taos.montecarlo import store
+    sts = [store.status(spath, g) for g in groups]
+    if any(st is None for st in sts):
+        return None
+    return sum(int((st != store.STATUS["pending"]).sum()) for st in sts), sum(len(st) for st in sts)
+
+
+class KeptStore:
+    """The campaign store a command begins or continues in ``out`` (``manifest`` and ``store``
+    names in it), kept on purpose when the command stops: after a signal or a failed cluster it
+    says how many ``noun`` (runs, points) are stored and the command that continues
+    (``resume``). The same words for every campaign command (taos montecarlo, taos sweep,
+    taos lco --sweep --out)."""
+
+    def __init__(self, out, manifest: str, store: str, noun: str, resume: str, resuming: bool,
+                 groups=(None,)):
+        self.out, self.spath, self.noun, self.resume, self.groups = Path(out), Path(out) / store, noun, resume, groups
+        self.mpath = self.out / manifest
+        # a manifest there before this run belongs to another run unless this one continues it
+        self.ours = resuming or not self.mpath.exists()
+
+    def describe(self) -> str | None:
+        """What is kept and how to continue; None when this run left no campaign in ``out``."""
+        if not (self.ours and self.mpath.is_file()):
+            return None
+        n = stored_runs(self.spath, self.groups)
+        held = f"{n[0]} of {n[1]} {self.noun} stored" if n is not None else f"none of the {self.noun} stored yet"
+        return f"{held} in {self.spath} (kept); continue with: {self.resume}"
+
+    def watch(self) -> None:
+        """From here on a signal's line says what is kept (:func:`taos.errors.on_signal_kept`)."""
+        from taos.errors import on_signal_kept
+        on_signal_kept(self.describe)
+
+    def stopped(self, e) -> InputError:
+        """A :class:`taos.montecarlo.engine.CampaignStopped` as one line with the kept store."""
+        return InputError(e.source, e.field, e.expected,
+                          got=f"{e.reason}; {self.describe() or f'no {self.noun} stored (nothing kept)'}")
+
+
+def cmd_montecarlo(args) -> int:
+    from taos.montecarlo import load_campaign, run_campaign
+    from taos.montecarlo.engine import CampaignStopped
+    from taos.montecarlo.executor import MANIFEST, STORE
+
+    scheduler = cluster_address(args)
     if args.workers is not None and args.workers < 1:
         raise InputError("command line", "--workers", "1 or more workers", got=str(args.workers))
     if args.resume:   # before any work: a resume with nothing to continue would start afresh silently
-        from taos.montecarlo.executor import MANIFEST
         if not (Path(args.out) / MANIFEST).is_file():
             raise InputError("command line", "--resume", f"a --out folder holding a campaign ({MANIFEST}) to continue",
                              got=f"none in {args.out}")
     c = load_campaign(args.campaign)
-    on_signal_kept(lambda: _kept(args))   # a signal from here on: the stored runs and the resume line
+    kept = KeptStore(args.out, MANIFEST, STORE, "runs", resume_command(args), args.resume, groups=(None, "nominal"))
+    kept.watch()   # a signal from here on: the stored runs and the resume line
     try:
         res = run_campaign(c, args.out, runs=args.runs, case=args.case, friction=args.friction,
                            workers=args.workers, scheduler=scheduler, resume=args.resume,
                            progress=not args.no_progress, design=args.sensitivity or "montecarlo", batch=args.batch,
                            connect_timeout_s=args.connect_timeout)
     except CampaignStopped as e:
-        n = stored_runs(Path(args.out)) or (0, 0)
-        raise InputError(e.source, e.field, e.expected, got=f"{e.reason}; {n[0]} of {n[1]} runs stored in "
-                         f"{Path(args.out) / 'campaign.zarr'} (kept); continue with: {resume_command(args)}") from None
+        raise kept.stopped(e) from None
     from taos.plotting import save
     from taos.plotting.ascent import plot_campaign
     save(plot_campaign(res), Path(args.out) / "montecarlo.png")

@@ -26,6 +26,10 @@ def run_signoff(args, flight, model, amps, freqs) -> int:
         if getattr(args, flag, None):
             raise InputError("command line", "--" + flag.replace("_", "-"), "no plot or map file with --requirements "
                              "(the sign-off page, --signoff DIR, has the Nichols chart)", got=str(getattr(args, flag)))
+    for flag in ("out", "resume", "workers", "scheduler", "scheduler_file"):   # a map campaign's options
+        if getattr(args, flag, None):
+            raise InputError("command line", "--" + flag.replace("_", "-"), "not with --requirements (the sign-off "
+                             "runs in this process; its folder is --signoff DIR)", got=str(getattr(args, flag)))
     req = load_requirements(args.requirements)
     axes = [parse_sweep(s) for s in args.sweep or ()]
     if args.signoff:   # every input and output checked before any work

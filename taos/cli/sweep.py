@@ -71,19 +71,26 @@ def cmd_sweep(args) -> int:
         return 0
     if args.model is None:
         raise InputError("command line", "MODEL", "a model file to sweep, e.g. models/rs25_ambient.toml", got="none")
-    if args.scheduler and args.workers is not None:
-        raise InputError("command line", "--scheduler", "either --workers or --scheduler, not both")
-    if args.scheduler:
-        from taos.cli.montecarlo import scheduler_address
-        args.scheduler = scheduler_address(args.scheduler)   # the forms Dask accepts, one line if not
+    from taos.cli.montecarlo import KeptStore, cluster_address
+    scheduler = cluster_address(args)   # the forms Dask accepts, one line if not
     defn = _definition(args)
     if args.plot and len(defn.design.keys) > 2:
         raise InputError("command line", "--plot", "a sweep of one or two keys (a metric over them)",
                          got=f"{len(defn.design.keys)} keys")
-    from taos.montecarlo.sweep import run_sweep
+    from taos.montecarlo.engine import CampaignStopped
+    from taos.montecarlo.sweep import MANIFEST, STORE, run_sweep
+    kept = None if args.out is None else KeptStore(args.out, MANIFEST, STORE, "points", resume_command(args),
+                                                    args.resume)
+    if kept is not None:
+        kept.watch()   # a signal from here on: the stored points and the resume line
     workers = 1 if args.workers is None else args.workers
-    res = run_sweep(defn, args.out, workers=workers, scheduler=args.scheduler, resume=args.resume,
-                    progress=not args.no_progress and sys.stderr.isatty(), batch=args.batch)
+    try:
+        res = run_sweep(defn, args.out, workers=workers, scheduler=scheduler, resume=args.resume,
+                        progress=not args.no_progress and sys.stderr.isatty(), batch=args.batch)
+    except CampaignStopped as e:   # (without --out run_sweep says itself that nothing is kept)
+        if kept is None:
+            raise
+        raise kept.stopped(e) from None
     if args.plot:
         from taos.plotting import save
         from taos.plotting.sweep import plot_sweep
@@ -110,6 +117,18 @@ def cmd_sweep(args) -> int:
     for f in d["failed"][:5]:
         print(f"failed at {_where(f['set'])}: {f['reason']}", file=out)
     return 0
+
+
+def resume_command(args) -> str:
+    """The command that continues this sweep (the same definition, ``--resume`` on ``--out``)."""
+    from taos.cli.montecarlo import command_line
+    return command_line(["taos", "sweep", args.model], [
+        ("--set", args.set), ("--metric", args.metric), ("--samples", args.samples),
+        ("--sensitivity", args.sensitivity), ("--seed", args.seed or None), ("--axis", args.axis),
+        ("--friction", args.friction), ("--flight", args.flight), ("--avionics", args.avionics),
+        ("--amplitudes-deg", args.amplitudes_deg), ("--freq-hz", args.freq_hz), ("--workers", args.workers),
+        ("--scheduler", args.scheduler), ("--scheduler-file", args.scheduler_file), ("--batch", args.batch),
+        ("--json", args.json), ("--plot", args.plot), ("--out", args.out)])
 
 
 def _whole(text: str) -> int:
@@ -160,6 +179,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--workers", type=_whole, help="1: in this process (default); K: a local Dask cluster of K workers")
     p.add_argument("--scheduler", help="an existing Dask scheduler: tcp://HOST:PORT, tls://HOST:PORT, HOST:PORT or "
                    "tcp://[IPv6]:PORT")
+    p.add_argument("--scheduler-file", metavar="PATH", help="the scheduler's address from a Dask scheduler file "
+                   "(dask scheduler --scheduler-file PATH; dask-jobqueue)")
     p.add_argument("--batch", type=_whole, help="points per task (default from the metrics' cost)")
     p.add_argument("--json", metavar="PATH", help="write the grid, every metric per point, the failed and "
                    "unstable points and the provenance here ('-' for standard output)")

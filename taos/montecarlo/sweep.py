@@ -260,7 +260,15 @@ def run_sweep(defn: SweepDefinition, out_dir: str | Path | None = None, *, worke
                              seeds=design.seeds, scalars=kind.scalars, flags=kind.flags, trace_t_s=kind.trace_t_s,
                              batch=manifest["batch"], attrs={"format": FORMAT, "inputs_sha256": kind.inputs_sha256,
                                                             "model_sha256": base["model_sha256"]})
-            executed = engine.execute(spath, kind, [Part(None, design)], manifest["batch"], client, progress=progress)
+            try:
+                executed = engine.execute(spath, kind, [Part(None, design)], manifest["batch"], client,
+                                          progress=progress)
+            except engine.CampaignStopped as e:
+                if tmp is None:
+                    raise   # its line: the points kept in out_dir, resume to continue
+                raise InputError(e.source, e.field, e.expected,   # a temporary store is removed below
+                                 got=f"{e.reason}; nothing kept (no out_dir / --out: the store was temporary)") \
+                    from None
         wall = time.perf_counter() - t0
         ds = store.open_store(spath, dask=False).load()
     finally:
