@@ -81,7 +81,12 @@ def test_standard_errors_are_neither_too_small_nor_too_large():
       sd 1.9; all 80 would mean intervals too wide);
     * the mean normalised squared error ((value - truth) / std_error)^2 is near 1 (a chi^2_1
       mean; over 80 cases its sd is about 0.16): 0.55 to 1.6. Standard errors twice too large
-      give about 0.25, twice too small about 4."""
+      give about 0.25, twice too small about 4.
+
+    Each fit is the local IPOPT fit from 1.2 K_L (global_stage=False): the statistics of the
+    estimate are the point here, not the start-independence of the global grid (that is
+    tests/test_fit_any_start.py's); with the grid the same 80 values and standard errors came out
+    within 2e-11 at five times the CPU."""
     truth = load_model(MODELS / "rs25_ambient.toml", friction="none")
     truth = truth.replace(avionics=truth.avionics.ideal())
     lin = linear_freqresp(truth, F)
@@ -99,7 +104,8 @@ def test_standard_errors_are_neither_too_small_nor_too_large():
         z = lambda: np.exp(noise * (rng.standard_normal(F.size) + 1j * rng.standard_normal(F.size)))  # noqa: E731
         d = MeasuredResponse("pitch", F, np.full(F.size, 0.4 * DEG), hx * z(), he * z(), np.ones(F.size),
                              np.ones(F.size), np.full(F.size, noise), np.full(F.size, noise))
-        r = fit_frequency_response(start, [d], free, starts=1, problem=prob, correct=False)
+        r = fit_frequency_response(start, [d], free, starts=1, problem=prob, correct=False,
+                                   global_stage=False)
         ci = r.confidence_interval(0.95)
         true = np.array([truth.structure.load_stiffness_N_per_m, truth.actuator.loop_gain_per_s])
         hits += (ci[:, 0] <= true) & (true <= ci[:, 1])

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from tests._shared import shared_dir
 from tests.conftest import MODELS, run_cli
 from tests.inprocess import taos_main
 
@@ -30,14 +31,18 @@ CHECK = ("--check-freq-hz", "0.15,0.7,2", "--check-amplitudes-deg", "0.03,0.15,0
 ACCEPT_F, ACCEPT_A = [0.12, 0.35, 1.4], [0.02, 0.07, 0.3]
 
 
+def _reduce(d: Path) -> None:
+    rc = taos_main("reduce", HOTFIRE, "--out", d / "planar.toml", "--records", RECORD, "--json", d / "reduce.json",
+                   *CHECK)
+    assert rc == 0
+
+
 @pytest.fixture(scope="module")
 def reduced(tmp_path_factory):
-    """``taos reduce`` of the shipped hot-fire 3-D model (default grid), in this process."""
-    d = tmp_path_factory.mktemp("reduce")
-    out, js = d / "planar.toml", d / "reduce.json"
-    rc = taos_main("reduce", HOTFIRE, "--out", out, "--records", RECORD, "--json", js, *CHECK)
-    assert rc == 0
-    return out, json.loads(js.read_text())
+    """``taos reduce`` of the shipped hot-fire 3-D model (default grid), in this process, once a
+    session even when xdist splits this module over both workers (:mod:`tests._shared`)."""
+    d = shared_dir(tmp_path_factory, "reduce", _reduce)
+    return d / "planar.toml", json.loads((d / "reduce.json").read_text())
 
 
 def test_reduced_model_meets_the_acceptance_tolerance(reduced):
