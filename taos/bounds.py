@@ -66,6 +66,8 @@ MAX_DATA_SAMPLES = 5 * 10 ** 7
 MAX_RESAMPLE_FACTOR = 4.0
 NPERSEG_MIN = 8
 MAX_STARTS = 64
+MAX_VIEW_SCALE = 1e4   # the largest exaggeration [-] of a drawn angle or deflection (taos.viewer)
+MAX_VIEW_FPS = 1e5     # the highest keyframe rate [1/s] of a view (never closer than a 10 us record)
 
 
 #: the load resonance and the oil-column and valve frequencies of a model lie in this band [Hz];

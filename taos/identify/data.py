@@ -391,7 +391,9 @@ def _read_hdf5(path: Path, src: str) -> tuple[dict, dict, dict]:
                 if "supply_pressure_Pa" in run and "supply_pressure" not in out:
                     out["supply_pressure"] = run["supply_pressure_Pa"][i]
                     labels["supply_pressure"] = f"/{ax}/supply_pressure_Pa"
-            meta = {k: (v.decode("utf-8", "replace") if isinstance(v, bytes) else v) for k, v in run["provenance"].items()}
+            meta = {k: (v.decode("utf-8", "replace") if isinstance(v, bytes) else v)   # the root attributes
+                    for k, v in h5.attrs.items() if k != "moment_arm_m"}
+            meta["moment_arm_m"] = float(run["moment_arm_m"])   # (validated by read_run)
             meta.setdefault("engine_angle_reference", "absolute")
             meta.setdefault("synthetic", True)
         else:

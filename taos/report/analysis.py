@@ -309,7 +309,7 @@ def _check_args(model, out, allow_unstable, progress, view_angle_scale, view_fps
     from taos.model import TvcModel
     from taos.planar._parallel import thread_count
     from taos.results import check_output_folder
-    from taos.viewer import MAX_VIEW_FPS, MAX_VIEW_SCALE
+    from taos.bounds import MAX_VIEW_FPS, MAX_VIEW_SCALE
 
     if not isinstance(model, TvcModel):
         check_path_arg(model, "model", "a TvcModel, a model file or a shipped model's name")

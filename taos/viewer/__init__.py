@@ -16,6 +16,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..bounds import MAX_VIEW_FPS, MAX_VIEW_SCALE   # the view's argument bounds
 from ..errors import InputError
 from ..results import atomic_write
 from .base import BaseVisualizer
@@ -30,11 +31,6 @@ if TYPE_CHECKING:
 __all__ = ["BaseVisualizer", "EngineDrawing", "MeshcatVisualizer", "OfflineWindow", "ViewerFrames",
            "load_run", "offline_html", "serve", "viewer_frames", "write_html"]
 
-
-#: the largest exaggeration [-] of a drawn angle or deflection (a 0.01 deg motion drawn at 100 deg)
-MAX_VIEW_SCALE = 1e4
-#: the highest keyframe rate [1/s] (keyframes are never closer than the recorded samples; a 10 us record)
-MAX_VIEW_FPS = 1e5
 
 
 def check_view_args(th, angle_scale=1.0, deflection_scale=None, fps=100.0, gimbal_scale=None, **_) -> None:
