@@ -22,7 +22,8 @@ What the FMU holds:
   (:mod:`taos.cosim._standalone_params`: the plant of K_L by CasADi's code generation of the
   symbolic state space, the avionics gain, the friction law's explicit-step rule);
 * ``sources/fmi2_glue.c``: the hand-written, model-independent FMI interface (life cycle,
-  variables, communication step, FMU state; :file:`taos/cosim/fmi2_glue.c`), and the FMI 2.0
+  variables, communication step; :file:`taos/cosim/fmi2_glue.c`, with ``fmi2_glue_common.h``, the
+  logging, state checks, FMU state and refused calls it shares with the 3-D FMU), and the FMI 2.0
   headers it includes (FMPy's copies);
 * ``sources/buildDescription.xml`` (the FMI 3.0 build description, also read for FMI 2.0.4
   source FMUs) and ``<SourceFiles>`` in the model description: a user compiles the sources
@@ -62,6 +63,8 @@ from ._standalone_params import VEHICLE_OUTPUTS, parameters, params_source
 from ._standalone_xml import IDENTIFIER, SOURCES, envelope, model_description
 
 GLUE = Path(__file__).with_name("fmi2_glue.c")
+#: the FMI functions both standalone FMUs share, included by each glue (sources/fmi2_glue_common.h)
+GLUE_COMMON = Path(__file__).with_name("fmi2_glue_common.h")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 #: the output rows of y = C x per axis, in the glue's order (its TAOS_NY rows)
 OUTPUT_ROWS = ("theta_rad", "omega_rad_s", "x_p_m", "load_force_N", "p_load_Pa")
@@ -117,13 +120,15 @@ def model_header(model, dt_s: float, guid: str, allow_unstable: bool) -> str:
     return params_header(model, dt_s, guid, allow_unstable, axes, OUTPUT_ROWS, envelope(model))
 
 
-def build_description() -> str:
-    """``sources/buildDescription.xml`` (FMI 3.0 schema; module docstring)."""
+def build_description(identifier: str = IDENTIFIER, sources: tuple[str, ...] = SOURCES,
+                      what: str = "the standalone taos TVC FMU") -> str:
+    """``sources/buildDescription.xml`` (FMI 3.0 schema; module docstring) of the FMU
+    ``identifier`` compiled from ``sources`` (the 3-D FMU's too)."""
     root = Element("fmiBuildDescription", fmiVersion="3.0")
-    bc = SubElement(root, "BuildConfiguration", modelIdentifier=IDENTIFIER,
-                    description="the standalone taos TVC FMU: C99 sources, link with libm")
+    bc = SubElement(root, "BuildConfiguration", modelIdentifier=identifier,
+                    description=f"{what}: C99 sources, link with libm")
     fs = SubElement(bc, "SourceFileSet", language="C99", compilerOptions="-O2")
-    for s in SOURCES:
+    for s in sources:
         SubElement(fs, "SourceFile", name=s)
     SubElement(bc, "Library", name="m", description="the C maths library (sqrt, exp, pow, asin, hypot)")
     indent(root)
@@ -187,7 +192,7 @@ def build_standalone_fmu(model_path, out, *, friction: str | None = None, avioni
     prov = {**base_provenance(), **model_provenance(model), "friction": model.friction.name, "avionics": avionics,
             "dt_s": block.dt_s, "allow_unstable": allow_unstable, "engine": "simplex", "standalone": True}
     digest = hashlib.sha256(json.dumps(prov, sort_keys=True, default=str).encode() + kernels_c.encode()
-                            + GLUE.read_bytes()).hexdigest()
+                            + GLUE.read_bytes() + GLUE_COMMON.read_bytes()).hexdigest()
     guid = "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"taos-standalone-fmu:{digest}")) + "}"
     prov["guid"] = guid
     with tempfile.TemporaryDirectory(prefix="taos_fmu_c_") as tmp:
@@ -199,6 +204,7 @@ def build_standalone_fmu(model_path, out, *, friction: str | None = None, avioni
         (src / "taos_model.h").write_text(model_header(model, block.dt_s, guid, allow_unstable))
         (src / "taos_params.c").write_text(params_source(model))
         shutil.copyfile(GLUE, src / "fmi2_glue.c")
+        shutil.copyfile(GLUE_COMMON, src / GLUE_COMMON.name)
         for h in FMI_HEADERS:
             shutil.copyfile(headers / h, src / h)
         (src / "buildDescription.xml").write_text(build_description())

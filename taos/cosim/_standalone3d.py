@@ -37,7 +37,7 @@ import tempfile
 import uuid
 import zipfile
 from pathlib import Path
-from xml.etree.ElementTree import Element, SubElement, indent, tostring
+from xml.etree.ElementTree import SubElement, indent, tostring
 
 import numpy as np
 
@@ -131,28 +131,18 @@ def model_header_3d(model, pk, dt_s: float, guid: str, label: str) -> str:
 def model_description_3d(model, dt_s: float, guid: str, prov: dict, avionics: str) -> bytes:
     """The 3-D FMU's model description (module docstring): every variable described, outputs
     with no direct feedthrough (empty ``dependencies``)."""
-    from ._standalone_xml import envelope
+    from ._standalone_xml import description_root, envelope
 
     rng, stop, force = envelope(model)
     version = prov.get("package_version", "?")
-    root = Element("fmiModelDescription", {
-        "fmiVersion": "2.0", "modelName": f"taos TVC 3-D {model.name}", "guid": guid,
-        "description": (f"taos nonlinear TVC of one engine, 3-D TAOS model (both axes coupled through the engine body "
-                        f"and the spherical bearing), standalone C (no Python at run time): model {model.name!r}, "
-                        f"model_sha256 {model.sha256}; friction {model.friction.name}, avionics {avionics}; internal "
-                        f"step {dt_s:g} s (communication steps: whole multiples of it); commands within +-{rng:.6g} "
-                        f"rad, envelope +-{stop:.6g} rad, {force:.6g} N; no tunable parameters; taos {version}."),
-        "author": "taos", "version": str(version), "generationTool": f"taos {version} (taos fmu --engine taos)",
-        "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
-    cs = SubElement(root, "CoSimulation", {
-        "modelIdentifier": IDENTIFIER3D, "needsExecutionTool": "false",
-        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
-        "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
-        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "false",
-        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true", "providesDirectionalDerivative": "false"})
-    files = SubElement(cs, "SourceFiles")
-    for s in SOURCES3D:
-        SubElement(files, "File", name=s)
+    root = description_root(
+        f"taos TVC 3-D {model.name}", guid,
+        (f"taos nonlinear TVC of one engine, 3-D TAOS model (both axes coupled through the engine body "
+         f"and the spherical bearing), standalone C (no Python at run time): model {model.name!r}, "
+         f"model_sha256 {model.sha256}; friction {model.friction.name}, avionics {avionics}; internal "
+         f"step {dt_s:g} s (communication steps: whole multiples of it); commands within +-{rng:.6g} "
+         f"rad, envelope +-{stop:.6g} rad, {force:.6g} N; no tunable parameters; taos {version}."),
+        version, f"taos {version} (taos fmu --engine taos)", IDENTIFIER3D, SOURCES3D)
     defs = SubElement(root, "UnitDefinitions")
     for u in sorted(UNIT_BASE):
         SubElement(SubElement(defs, "Unit", name=u), "BaseUnit", {k: str(v) for k, v in UNIT_BASE[u].items()})
@@ -195,18 +185,6 @@ def model_description_3d(model, dt_s: float, guid: str, prov: dict, avionics: st
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="utf-8", xml_declaration=False) + b"\n"
 
 
-def build_description_3d() -> str:
-    root = Element("fmiBuildDescription", fmiVersion="3.0")
-    bc = SubElement(root, "BuildConfiguration", modelIdentifier=IDENTIFIER3D,
-                    description="the standalone taos 3-D TVC FMU: C99 sources, link with libm")
-    fs = SubElement(bc, "SourceFileSet", language="C99", compilerOptions="-O2")
-    for s in SOURCES3D:
-        SubElement(fs, "SourceFile", name=s)
-    SubElement(bc, "Library", name="m", description="the C maths library")
-    indent(root)
-    return '<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="unicode") + "\n"
-
-
 def build_standalone_fmu_3d(model_path, out, *, friction: str | None = None, avionics: str = "model",
                             dt_s: float | None = None, allow_unstable: bool = False) -> FmuBuild:
     """Build the standalone 3-D FMU (module docstring) of ``model_path`` (a model file or a
@@ -214,7 +192,7 @@ def build_standalone_fmu_3d(model_path, out, *, friction: str | None = None, avi
     :class:`~taos.cosim.TvcBlock` (``engine="taos"``). Nothing is written on a refusal."""
     from ..results import atomic_write, base_provenance, model_provenance
     from ._block import TvcBlock
-    from ._standalone import CFLAGS, SOURCE, _c_compiler, fmi_headers, FMI_HEADERS
+    from ._standalone import CFLAGS, FMI_HEADERS, GLUE_COMMON, SOURCE, _c_compiler, build_description, fmi_headers
 
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
         raise InputError(SOURCE, "platform", "Linux x86-64 (the binary built is linux64; the sources build elsewhere)",
@@ -236,7 +214,7 @@ def build_standalone_fmu_3d(model_path, out, *, friction: str | None = None, avi
     prov = {**base_provenance(), **model_provenance(model), "friction": model.friction.name, "avionics": avionics,
             "dt_s": block.dt_s, "allow_unstable": allow_unstable, "engine": "taos", "standalone": True}
     digest = hashlib.sha256(json.dumps(prov, sort_keys=True, default=str).encode() + kernels_c.encode()
-                            + GLUE3D.read_bytes()).hexdigest()
+                            + GLUE3D.read_bytes() + GLUE_COMMON.read_bytes()).hexdigest()
     guid = "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"taos-standalone-fmu-3d:{digest}")) + "}"
     prov["guid"] = guid
     label = f"TAOS 3-D, {model.friction.name} friction"
@@ -248,9 +226,11 @@ def build_standalone_fmu_3d(model_path, out, *, friction: str | None = None, avi
         (src / "taos_kernels.h").write_text(kernels_h)
         (src / "taos_model.h").write_text(model_header_3d(model, pk, block.dt_s, guid, label))
         shutil.copyfile(GLUE3D, src / "fmi2_glue3d.c")
+        shutil.copyfile(GLUE_COMMON, src / GLUE_COMMON.name)
         for h in FMI_HEADERS:
             shutil.copyfile(headers / h, src / h)
-        (src / "buildDescription.xml").write_text(build_description_3d())
+        (src / "buildDescription.xml").write_text(build_description(IDENTIFIER3D, SOURCES3D,
+                                                                     "the standalone taos 3-D TVC FMU"))
         (root / "binaries" / "linux64").mkdir(parents=True)
         so = root / "binaries" / "linux64" / f"{IDENTIFIER3D}.so"
         cmd = [_c_compiler(), *CFLAGS, "-I", str(src), *(str(src / s) for s in SOURCES3D), "-o", str(so), "-lm"]

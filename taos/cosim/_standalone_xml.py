@@ -85,24 +85,14 @@ def model_description(model, dt_s: float, guid: str, prov: dict, avionics: str) 
     )
     rng, stop, force = envelope(model)
     version = prov.get("package_version", "?")
-    root = Element("fmiModelDescription", {
-        "fmiVersion": "2.0", "modelName": f"taos TVC {model.name}", "guid": guid,
-        "description": (f"taos nonlinear TVC of one engine, both axes (planar simplex model), standalone C (no Python "
-                        f"at run time): model {model.name!r}, model_sha256 {model.sha256}; friction "
-                        f"{model.friction.name}, avionics {avionics}; internal step {dt_s:g} s (communication steps: "
-                        f"whole multiples of it); commands within +-{rng:.6g} rad, envelope +-{stop:.6g} rad, "
-                        f"{force:.6g} N; taos {version}."),
-        "author": "taos", "version": str(version), "generationTool": f"taos {version} (taos fmu)",
-        "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
-    cs = SubElement(root, "CoSimulation", {
-        "modelIdentifier": IDENTIFIER, "needsExecutionTool": "false",
-        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
-        "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
-        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "false",
-        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true", "providesDirectionalDerivative": "false"})
-    files = SubElement(cs, "SourceFiles")
-    for s in SOURCES:
-        SubElement(files, "File", name=s)
+    root = description_root(
+        f"taos TVC {model.name}", guid,
+        (f"taos nonlinear TVC of one engine, both axes (planar simplex model), standalone C (no Python "
+         f"at run time): model {model.name!r}, model_sha256 {model.sha256}; friction "
+         f"{model.friction.name}, avionics {avionics}; internal step {dt_s:g} s (communication steps: "
+         f"whole multiples of it); commands within +-{rng:.6g} rad, envelope +-{stop:.6g} rad, "
+         f"{force:.6g} N; taos {version}."),
+        version, f"taos {version} (taos fmu)", IDENTIFIER, SOURCES)
     outputs = BlockOutputs.signal_names()
     pars = parameters(model, dt_s)
     units = sorted({u for u in [fmi_unit(n) for n in outputs] + ["rad", "s", "N", "N.m"] + [p.unit for p in pars]
@@ -182,3 +172,24 @@ def model_description(model, dt_s: float, guid: str, prov: dict, avionics: str) 
                                      **({"dependenciesKind": "dependent"} if dep else {})})
     indent(root)
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + tostring(root, encoding="utf-8", xml_declaration=False) + b"\n"
+
+
+def description_root(name: str, guid: str, description: str, version: str, tool: str, identifier: str,
+                     sources: tuple[str, ...]) -> Element:
+    """The ``fmiModelDescription`` element of a standalone FMU (planar and 3-D) with its
+    ``CoSimulation`` capabilities (the truthful flags: variable steps, FMU state get/set and
+    serialisation; no interpolation, derivatives or asynchronous steps) and source files."""
+    root = Element("fmiModelDescription", {
+        "fmiVersion": "2.0", "modelName": name, "guid": guid, "description": description,
+        "author": "taos", "version": str(version), "generationTool": tool,
+        "variableNamingConvention": "flat", "numberOfEventIndicators": "0"})
+    cs = SubElement(root, "CoSimulation", {
+        "modelIdentifier": identifier, "needsExecutionTool": "false",
+        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
+        "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
+        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "false",
+        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true", "providesDirectionalDerivative": "false"})
+    files = SubElement(cs, "SourceFiles")
+    for s in sources:
+        SubElement(files, "File", name=s)
+    return root
