@@ -264,26 +264,26 @@ def connected(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TI
     env = dict(os.environ)
     client = cluster = None
     quiet = _quiet_dask_logs() if client_needed(workers, scheduler) else contextlib.nullcontext()
-    try:
-        with quiet:
+    with quiet:   # (the close too: a client whose scheduler is gone logs its reconnect failure there)
+        try:
             client, cluster = connect(workers, scheduler, timeout_s)
             yield client
-    finally:
-        try:
-            try:
-                if client is not None:
-                    with contextlib.suppress(Exception):   # a scheduler already gone: nothing to close
-                        client.close()
-            finally:
-                if cluster is not None:
-                    cluster.close()
         finally:
-            if scheduler is None and workers != 0:   # a LocalCluster was started (or begun)
-                for k in set(os.environ) - set(env):
-                    del os.environ[k]
-                for k, v in env.items():
-                    if os.environ.get(k) != v:
-                        os.environ[k] = v
+            try:
+                try:
+                    if client is not None:
+                        with contextlib.suppress(Exception):   # a scheduler already gone: nothing to close
+                            client.close()
+                finally:
+                    if cluster is not None:
+                        cluster.close()
+            finally:
+                if scheduler is None and workers != 0:   # a LocalCluster was started (or begun)
+                    for k in set(os.environ) - set(env):
+                        del os.environ[k]
+                    for k, v in env.items():
+                        if os.environ.get(k) != v:
+                            os.environ[k] = v
 
 
 def client_needed(workers: int, scheduler: str | None) -> bool:
