@@ -163,16 +163,10 @@ def fmi_headers() -> Path:
     return d
 
 
-def build_standalone_fmu(model_path, out, *, friction: str | None = None, avionics: str = "model",
-                         dt_s: float | None = None, allow_unstable: bool = False) -> FmuBuild:
-    """Build the standalone FMU (module docstring) of ``model_path`` (a model file, or a loaded
-    :class:`~taos.model.TvcModel` such as a variant made with ``model.with_values``) into ``out``
-    after every check of the model (:class:`~taos.cosim.TvcBlock`'s construction); options as
-    :func:`taos.cosim.build_fmu` (simplex engine only). Nothing is written on a refusal."""
-    from ..planar.envelope import check_run_step
-    from ..results import atomic_write, base_provenance, model_provenance
-    from ._block import BlockOutputs, TvcBlock
-
+def standalone_target(model_path, out, friction: str | None, avionics: str) -> tuple[Path, TvcModel]:
+    """The checked output path and the model of a standalone FMU build (planar and 3-D): this
+    platform builds the linux64 binary; a loaded model takes no ``friction``/``avionics``
+    override (its variant is made with ``model.with_values``)."""
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
         raise InputError(SOURCE, "platform", "Linux x86-64 (the binary built is linux64; the sources build elsewhere)",
                          got=f"{platform.system()} {platform.machine()}")
@@ -184,6 +178,20 @@ def build_standalone_fmu(model_path, out, *, friction: str | None = None, avioni
         model = model_path
     else:
         model = fmu_model(model_path, friction, avionics)
+    return out, model
+
+
+def build_standalone_fmu(model_path, out, *, friction: str | None = None, avionics: str = "model",
+                         dt_s: float | None = None, allow_unstable: bool = False) -> FmuBuild:
+    """Build the standalone FMU (module docstring) of ``model_path`` (a model file, or a loaded
+    :class:`~taos.model.TvcModel` such as a variant made with ``model.with_values``) into ``out``
+    after every check of the model (:class:`~taos.cosim.TvcBlock`'s construction); options as
+    :func:`taos.cosim.build_fmu` (simplex engine only). Nothing is written on a refusal."""
+    from ..planar.envelope import check_run_step
+    from ..results import atomic_write, base_provenance, model_provenance
+    from ._block import BlockOutputs, TvcBlock
+
+    out, model = standalone_target(model_path, out, friction, avionics)
     if dt_s is not None:
         check_run_step(dt_s, model, field="--dt")
     block = TvcBlock(model, dt_s=dt_s, allow_unstable=allow_unstable)   # every check taos simulate makes

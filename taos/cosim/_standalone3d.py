@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import platform
 import shutil
 import subprocess
 import tempfile
@@ -42,8 +41,7 @@ from xml.etree.ElementTree import SubElement, indent, tostring
 import numpy as np
 
 from ..errors import InputError
-from ..model import TvcModel
-from ._fmu import CONFIG, RESOURCE_DIR, FmuBuild, check_output_path, fmu_model
+from ._fmu import CONFIG, RESOURCE_DIR, FmuBuild
 
 GLUE3D = Path(__file__).with_name("fmi2_glue3d.c")
 IDENTIFIER3D = "TaosTvc3dC"
@@ -192,19 +190,10 @@ def build_standalone_fmu_3d(model_path, out, *, friction: str | None = None, avi
     :class:`~taos.cosim.TvcBlock` (``engine="taos"``). Nothing is written on a refusal."""
     from ..results import atomic_write, base_provenance, model_provenance
     from ._block import TvcBlock
-    from ._standalone import CFLAGS, FMI_HEADERS, GLUE_COMMON, SOURCE, _c_compiler, build_description, fmi_headers
+    from ._standalone import (CFLAGS, FMI_HEADERS, GLUE_COMMON, SOURCE, _c_compiler, build_description, fmi_headers,
+                              standalone_target)
 
-    if platform.system() != "Linux" or platform.machine() not in ("x86_64", "AMD64"):
-        raise InputError(SOURCE, "platform", "Linux x86-64 (the binary built is linux64; the sources build elsewhere)",
-                         got=f"{platform.system()} {platform.machine()}")
-    out = check_output_path(out)
-    if isinstance(model_path, TvcModel):
-        if friction is not None or avionics != "model":
-            raise InputError(SOURCE, "friction, avionics", "none with a loaded model (make the variant with "
-                             "model.with_values)", got=f"{friction!r}, {avionics!r}")
-        model = model_path
-    else:
-        model = fmu_model(model_path, friction, avionics)
+    out, model = standalone_target(model_path, out, friction, avionics)
     if dt_s is not None and not 0 < dt_s <= DT_MAX_S:
         raise InputError(SOURCE, "--dt", f"a 3-D step above 0 and at most {DT_MAX_S:g} s", got=repr(dt_s))
     block = TvcBlock(model, engine="taos", dt_s=dt_s, allow_unstable=allow_unstable)   # taos simulate's checks
