@@ -233,7 +233,17 @@ def _depth(obj, limit: int, level: int = 0) -> int:
 
 def parse_toml(raw: bytes, src: str, max_depth: int = MAX_TOML_DEPTH) -> dict:
     """A TOML document's table; InputError (one line) when it is not UTF-8 TOML or nests
-    tables and arrays deeper than ``max_depth`` (deep nesting would exhaust the stack)."""
+    tables and arrays deeper than ``max_depth`` (deep nesting would exhaust the stack). The
+    same bytes are parsed once (model variants parse their stored files again and again; a
+    fit's global stage makes 64): the caller gets a copy of the remembered table."""
+    import copy
+
+    return copy.deepcopy(_parse_toml_cached(bytes(raw), src, max_depth))
+
+
+@functools.lru_cache(maxsize=64)
+def _parse_toml_cached(raw: bytes, src: str, max_depth: int) -> dict:
+    """:func:`parse_toml` of ``raw`` remembered by its bytes (errors are not remembered)."""
     import tomllib
 
     try:

@@ -107,16 +107,18 @@ def _range_text(lo: float, hi: float, unit: str) -> str:
     return f"from {_shown(lo, unit)} to {_shown(hi, unit)}"
 
 
-def check_friction_value(key: str, value, src: str, section: str = "friction") -> float | None:
+def check_friction_value(key: str, value, src: str, section: str = "friction",
+                         kinds: Mapping[str, str] | None = None) -> float | None:
     """``value`` of ``[section] key`` (text with its unit, or a number for a dimensionless key)
     in SI, refused unless finite and within :data:`FRICTION_BOUNDS` (one line: ``src``, the
-    field, the range and its reason); None for a key without a bound here."""
+    field, the range and its reason); None for a key without a bound here. ``kinds``: the
+    :func:`key_kinds` of the moment (given when checking a whole table)."""
     bound = FRICTION_BOUNDS.get(f"friction.{key}")
     if bound is None:
         return None
     lo, hi, unit, why = bound
     field = f"{section}.{key}"
-    v = to_si(value, key_kinds()[key], source=src, field=field)
+    v = to_si(value, (kinds or key_kinds())[key], source=src, field=field)
     if not (math.isfinite(v) and lo <= v <= hi):
         raise InputError(src, field, f"a value {_range_text(lo, hi, unit)} ({why})", got=_shown(v, unit))
     return v
@@ -132,8 +134,9 @@ def check_friction_values(table: Mapping, src: str, section: str = "friction") -
     for key in ("coulomb_torque", "static_torque"):
         if key in table and f"friction.{key}" in MODEL_BOUNDS:
             check_bound(to_si(table[key], "torque", source=src, field=f"{section}.{key}"), f"friction.{key}", src)
+    kinds = key_kinds()
     for key in sorted(k for k in table if isinstance(k, str)):
-        check_friction_value(key, table[key], src, section)
+        check_friction_value(key, table[key], src, section, kinds)
 
 
 def check_friction_law(law, src: str, section: str = "friction") -> None:
