@@ -386,9 +386,11 @@ def _lost(client, what: str) -> str:
     return what
 
 
-def _scheduler_answers(client) -> bool:
+def _scheduler_answers(client, timeout_s: float = 5.0) -> bool:
+    """The scheduler answers a call within ``timeout_s`` [s] (asked, not the client's cached
+    ``scheduler_info()``, which swallows a connection error and answers from memory)."""
     try:
-        client.scheduler_info()
+        client.sync(client.scheduler.identity, callback_timeout=timeout_s)
         return True
     except Exception:  # noqa: BLE001 - any failure to ask is a scheduler gone
         return False
