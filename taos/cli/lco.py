@@ -161,7 +161,7 @@ def _sweep(args, flight, model, amps, freqs) -> int:
         try:
             m, failed = run_map_campaign(flight, model, axes, settings, args.out, inputs_sha256=sha,
                                          input_files=table, workers=args.workers or 0, resume=args.resume,
-                                         scheduler=scheduler, progress=args.json != "-")
+                                         scheduler=scheduler, progress=args.json != "-" and sys.stderr.isatty())
         except CampaignStopped as e:
             raise kept.stopped(e) from None
     else:
