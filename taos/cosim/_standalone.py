@@ -142,12 +142,24 @@ def _c_compiler() -> str:
     return cc
 
 
-def compile_sources(src: Path, out: Path) -> None:
-    """Compile the FMU's C sources in ``src`` into the shared library ``out``."""
-    cmd = [_c_compiler(), *CFLAGS, "-I", str(src), *(str(src / s) for s in SOURCES), "-o", str(out), "-lm"]
+def compile_sources(src: Path, out: Path, sources: tuple[str, ...] = SOURCES) -> None:
+    """Compile the FMU's C ``sources`` in ``src`` into the shared library ``out``."""
+    cmd = [_c_compiler(), *CFLAGS, "-I", str(src), *(str(src / s) for s in sources), "-o", str(out), "-lm"]
     r = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if r.returncode != 0:
         raise RuntimeError(f"compiling the standalone FMU failed ({' '.join(cmd)}):\n{r.stderr[-4000:]}")
+
+
+def write_fmu(root: Path, out: Path) -> None:
+    """Zip the FMU folder ``root`` into ``out`` (atomically: a refusal or a kill leaves no half FMU)."""
+    from ..results import atomic_write
+
+    def write(p):
+        with zipfile.ZipFile(p, "w", zipfile.ZIP_DEFLATED) as z:
+            for f in sorted(root.rglob("*")):
+                if f.is_file():
+                    z.write(f, f.relative_to(root).as_posix())
+    atomic_write(out, write)
 
 
 def fmi_headers() -> Path:
@@ -188,7 +200,7 @@ def build_standalone_fmu(model_path, out, *, friction: str | None = None, avioni
     after every check of the model (:class:`~taos.cosim.TvcBlock`'s construction); options as
     :func:`taos.cosim.build_fmu` (simplex engine only). Nothing is written on a refusal."""
     from ..planar.envelope import check_run_step
-    from ..results import atomic_write, base_provenance, model_provenance
+    from ..results import base_provenance, model_provenance
     from ._block import BlockOutputs, TvcBlock
 
     out, model = standalone_target(model_path, out, friction, avionics)
@@ -221,13 +233,7 @@ def build_standalone_fmu(model_path, out, *, friction: str | None = None, avioni
         (root / "resources" / RESOURCE_DIR).mkdir(parents=True)
         (root / "resources" / RESOURCE_DIR / CONFIG).write_text(json.dumps(prov, indent=1, default=str) + "\n")
         (root / "modelDescription.xml").write_bytes(model_description(model, block.dt_s, guid, prov, avionics))
-
-        def write(p):
-            with zipfile.ZipFile(p, "w", zipfile.ZIP_DEFLATED) as z:
-                for f in sorted(root.rglob("*")):
-                    if f.is_file():
-                        z.write(f, f.relative_to(root).as_posix())
-        atomic_write(out, write)
+        write_fmu(root, out)
     return FmuBuild(path=out, model_sha256=model.sha256, engine="simplex", dt_s=block.dt_s, n_inputs=3,
                     n_outputs=len(BlockOutputs.signal_names()) + len(VEHICLE_OUTPUTS),
                     n_parameters=len(parameters(model, block.dt_s)) + 1)

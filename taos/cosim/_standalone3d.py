@@ -31,10 +31,8 @@ from __future__ import annotations
 import hashlib
 import json
 import shutil
-import subprocess
 import tempfile
 import uuid
-import zipfile
 from pathlib import Path
 from xml.etree.ElementTree import SubElement, indent, tostring
 
@@ -188,10 +186,10 @@ def build_standalone_fmu_3d(model_path, out, *, friction: str | None = None, avi
     """Build the standalone 3-D FMU (module docstring) of ``model_path`` (a model file or a
     loaded :class:`~taos.model.TvcModel`) into ``out`` after the checks of
     :class:`~taos.cosim.TvcBlock` (``engine="taos"``). Nothing is written on a refusal."""
-    from ..results import atomic_write, base_provenance, model_provenance
+    from ..results import base_provenance, model_provenance
     from ._block import TvcBlock
-    from ._standalone import (CFLAGS, FMI_HEADERS, GLUE_COMMON, SOURCE, _c_compiler, build_description, fmi_headers,
-                              standalone_target)
+    from ._standalone import (FMI_HEADERS, GLUE_COMMON, SOURCE, build_description, compile_sources, fmi_headers,
+                              standalone_target, write_fmu)
 
     out, model = standalone_target(model_path, out, friction, avionics)
     if dt_s is not None and not 0 < dt_s <= DT_MAX_S:
@@ -222,19 +220,10 @@ def build_standalone_fmu_3d(model_path, out, *, friction: str | None = None, avi
                                                                      "the standalone taos 3-D TVC FMU"))
         (root / "binaries" / "linux64").mkdir(parents=True)
         so = root / "binaries" / "linux64" / f"{IDENTIFIER3D}.so"
-        cmd = [_c_compiler(), *CFLAGS, "-I", str(src), *(str(src / s) for s in SOURCES3D), "-o", str(so), "-lm"]
-        r = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        if r.returncode != 0:
-            raise RuntimeError(f"compiling the standalone 3-D FMU failed ({' '.join(cmd)}):\n{r.stderr[-4000:]}")
+        compile_sources(src, so, SOURCES3D)
         (root / "resources" / RESOURCE_DIR).mkdir(parents=True)
         (root / "resources" / RESOURCE_DIR / CONFIG).write_text(json.dumps(prov, indent=1, default=str) + "\n")
         (root / "modelDescription.xml").write_bytes(model_description_3d(model, block.dt_s, guid, prov, avionics))
-
-        def write(p):
-            with zipfile.ZipFile(p, "w", zipfile.ZIP_DEFLATED) as z:
-                for f in sorted(root.rglob("*")):
-                    if f.is_file():
-                        z.write(f, f.relative_to(root).as_posix())
-        atomic_write(out, write)
+        write_fmu(root, out)
     return FmuBuild(path=out, model_sha256=model.sha256, engine="taos", dt_s=block.dt_s, n_inputs=2,
                     n_outputs=len(OUTPUTS), n_parameters=1)
