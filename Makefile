@@ -4,21 +4,31 @@ PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+TEST_STAMP := $(VENV)/.installed-test
 DEMO_MODEL ?= models/rs25_hotfire.toml
 DEMO_OUT   ?= out/greenrun
 
 .PHONY: demo test check browser bench clean verification docs
 
 # Install with uv (from PyPI into the venv: parallel downloads, several times faster than pip);
-# pip if uv cannot be had. The numba kernels compile on first use and are cached: `make demo`
-# compiles only what the Green Run needs, `make test` warms every kernel first.
+# pip if uv cannot be had. `make demo` installs the package alone; `make test` adds the test
+# extra. No bytecode at install: compiling every module of the venv (scipy, plotly, dask, ...)
+# cost 55 CPU-s of a 76 s install here; `make demo` lets Python write the bytecode of the modules
+# it imports as it imports them, and `make test` compiles taos and the venv once ($(PYC)).
+# The numba kernels compile on first use and are cached: `make demo` compiles only what the
+# Green Run needs, `make test` warms every kernel first.
 $(STAMP): pyproject.toml setup.py
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "Python 3.11+ needed"'
 	$(PYTHON) -m venv $(VENV)
 	( $(BIN)/python -m pip install --quiet uv && \
-	  $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -e '.[test]' ) || \
-	  $(BIN)/python -m pip install --quiet -e '.[test]'
+	  $(BIN)/uv pip install --quiet --python $(BIN)/python -e . ) || \
+	  $(BIN)/python -m pip install --quiet --no-compile -e .
 	touch $(STAMP)
+
+$(TEST_STAMP): $(STAMP)
+	$(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[test]' 2>/dev/null || \
+	  $(BIN)/python -m pip install --quiet --no-compile -e '.[test]'
+	touch $(TEST_STAMP)
 
 # numba's on-disk cache keys each kernel on its own file only: a kernel that inlines code from
 # another file (the friction laws' bearing steps, the 3-D step) or reads its constants keeps its
@@ -36,19 +46,19 @@ WARM := $(VENV)/.warm
 # The Python bytecode (.pyc) of taos and the venv's packages, after any change under taos/:
 # where PYTHONDONTWRITEBYTECODE is set nothing writes it otherwise, and every `taos` process then
 # compiles ~600 modules from source (about 1 s of start-up a process; benchmarks/RESULTS.md).
-$(PYC): $(STAMP) $(TAOS_SOURCES)
+$(PYC): $(TEST_STAMP) $(TAOS_SOURCES)
 	$(BIN)/python -m compileall -q -j 2 taos >/dev/null
 	-$(BIN)/python -m compileall -q -j 2 $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])') >/dev/null
 	touch $(PYC)
 
-$(WARM): $(STAMP) $(KERNEL_SOURCES) taos/cli/warmup.py | $(PYC)
+$(WARM): $(TEST_STAMP) $(KERNEL_SOURCES) taos/cli/warmup.py | $(PYC)
 	find taos -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
 	$(BIN)/python -m taos.cli.warmup --part 1/2 & one=$$!; \
 	  $(BIN)/python -m taos.cli.warmup --part 2/2; two=$$?; wait $$one && exit $$two
 	touch $(WARM)
 
 demo: $(STAMP)
-	$(BIN)/taos greenrun $(DEMO_MODEL) --engine taos --out $(DEMO_OUT)
+	PYTHONDONTWRITEBYTECODE= $(BIN)/taos greenrun $(DEMO_MODEL) --engine taos --out $(DEMO_OUT)
 	@echo "Green Run report: $(DEMO_OUT)/index.html"
 
 # The browser tests need Debian's chromium; install it when missing (root, as in CI).
@@ -61,7 +71,7 @@ browser:
 # The documentation site (Sphinx, warnings are errors): runs the user guide's commands on the
 # shipped models for its pictures, so it takes a few minutes. Output: docs/_build/html.
 DOCS_STAMP := $(VENV)/.docs-installed
-$(DOCS_STAMP): $(STAMP)
+$(DOCS_STAMP): $(TEST_STAMP)
 	$(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[docs]' 2>/dev/null || \
 	  $(BIN)/python -m pip install --quiet -e '.[docs]'
 	touch $(DOCS_STAMP)
@@ -110,7 +120,7 @@ check: $(PYC) $(WARM) browser
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
 
 # the verification suite (tests/verification) and its table docs/verification.md
-verification: $(STAMP)
+verification: $(TEST_STAMP)
 	$(BIN)/python scripts/verification_report.py
 
 bench: $(STAMP)
