@@ -11,7 +11,8 @@ DEMO_OUT   ?= out/greenrun
 .PHONY: demo test check browser bench clean verification docs
 
 # Install with uv (from PyPI into the venv: parallel downloads, several times faster than pip);
-# pip if uv cannot be had. `make demo` installs the package alone; `make test` adds the test
+# pip if uv cannot be had. The venv is made without pip (ensurepip: about 10 s here); the
+# interpreter's own pip installs uv into it. `make demo` installs the package alone; `make test` adds the test
 # extra. No bytecode at install: compiling every module of the venv (scipy, plotly, dask, ...)
 # cost 55 CPU-s of a 76 s install here; `make demo` lets Python write the bytecode of the modules
 # it imports as it imports them, and `make test` compiles taos and the venv once ($(PYC)).
@@ -19,15 +20,18 @@ DEMO_OUT   ?= out/greenrun
 # Green Run needs, `make test` warms every kernel first.
 $(STAMP): pyproject.toml setup.py
 	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "Python 3.11+ needed"'
-	$(PYTHON) -m venv $(VENV)
-	( $(BIN)/python -m pip install --quiet uv && \
+	$(PYTHON) -m venv --without-pip $(VENV)
+	( ( $(PYTHON) -m pip --python $(BIN)/python install --quiet uv 2>/dev/null || \
+	    ( $(BIN)/python -m ensurepip >/dev/null && $(BIN)/python -m pip install --quiet uv ) ) && \
 	  $(BIN)/uv pip install --quiet --python $(BIN)/python -e . ) || \
-	  $(BIN)/python -m pip install --quiet --no-compile -e .
+	  ( $(BIN)/python -m ensurepip >/dev/null; $(BIN)/python -m pip install --quiet --no-compile -e . )
 	touch $(STAMP)
 
+# The bench extra: the MuJoCo peer of benchmarks/bench_taos3d.py; pip: tests/test_install.py
+# and tests/test_plugins.py build and install wheels with it.
 $(TEST_STAMP): $(STAMP)
-	$(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[test]' 2>/dev/null || \
-	  $(BIN)/python -m pip install --quiet --no-compile -e '.[test]'
+	$(BIN)/uv pip install --quiet --python $(BIN)/python -e '.[test,bench]' pip 2>/dev/null || \
+	  $(BIN)/python -m pip install --quiet --no-compile -e '.[test,bench]'
 	touch $(TEST_STAMP)
 
 # numba's on-disk cache keys each kernel on its own file only: a kernel that inlines code from
