@@ -297,7 +297,7 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
     aux = np.empty((nrec, _dy.N_AUX, nl))
     status = np.empty(nl, np.int64)
     m0 = lanes[0].model
-    _dy.integrate_segments_lanes(ip, ix, mx, heads, m0.friction.entry.rates,
+    _dy.integrate_segments_lanes(ip, ix, mx, heads, m0.friction.entry.rates_lanes,
                                  np.ascontiguousarray(np.stack([ln.fpack for ln in lanes], axis=1)),
                                  np.stack([ln.model.avionics.pack() for ln in lanes]),
                                  np.asarray(bounds, np.int64), jdst, jsrc, jcoef, kick, x0, np.zeros(nl), r, dt_s,
