@@ -152,3 +152,62 @@ def test_registry_generates_the_lane_form_for_a_law_without_one():
         _assert_same(e, v, np.full(v.size, 0.3), np.linspace(-3.0, 3.0, v.size), np.tile(p, (v.size, 1)))
     finally:
         friction.unregister("lanes-stick-visc")
+
+
+# -- the lockstep kernels: the lane form gives the results of the per-lane calls it replaced ------
+def _per_lane_calls(rates):
+    """The lockstep kernels' friction before the lane form: the scalar C callback called once
+    per lane (through its pointer, not inlined)."""
+    def rates_lanes(v, z, t_app, P, dz, tf):
+        for q in range(v.shape[0]):
+            dz[q], tf[q] = rates(v[q], z[q], t_app[q], P[q])
+    return cfunc(signatures()["LANES_SIG"])(rates_lanes)
+
+
+@pytest.fixture
+def per_lane_law():
+    """Swap a built-in law's lane form for the per-lane calls while the test runs."""
+    from dataclasses import replace
+
+    from taos.friction import registry
+    saved = {}
+
+    def swap(law_id):
+        e = friction.get(law_id)
+        saved[law_id] = e
+        registry._REGISTRY[law_id] = replace(e, rates_lanes=_per_lane_calls(e.rates))
+    yield swap
+    registry._REGISTRY.update(saved)
+
+
+def test_monte_carlo_batch_bit_identical_with_per_lane_calls(per_lane_law):
+    """A soft Monte Carlo batch (Dahl, 200 s, lockstep lanes) gives the same bits either way."""
+    from taos.montecarlo import load_campaign
+    from taos.montecarlo.executor import flight_runs, montecarlo_design
+
+    kind, _ = flight_runs(load_campaign("post_separation"), "soft", None)
+    d = montecarlo_design(load_campaign("post_separation"), 3)
+    new = kind.run_batch(d.names, d.factors, d.seeds)
+    per_lane_law(kind.model.friction.name)
+    old = kind.run_batch(d.names, d.factors, d.seeds)
+    arrays = [k for k in new if isinstance(new[k], np.ndarray)]
+    assert "trace" in arrays and np.ptp(new["trace"]) > 0
+    for k in arrays:
+        assert np.array_equal(new[k], old[k], equal_nan=True), k
+
+
+@pytest.mark.parametrize("law_id", ["modified-lugre", "coulomb-switching"])
+def test_masv_simulate_bit_identical_with_per_lane_calls(per_lane_law, law_id):
+    """masv simulate (4 engines, 8 actuators as lanes), 3 s of the Green Run: the same bits."""
+    from masv.config import load_config
+    from masv.timedomain import ACTUATOR_ARRAYS, simulate
+    from taos.profiles import load_profile
+
+    cfg = load_config(MODELS / "masv" / "core_stage.toml")
+    prof = load_profile(MODELS / "profiles" / "greenrun_two_axis.toml")
+    new = simulate(cfg, prof, duration_s=3.0, friction=law_id)
+    per_lane_law(law_id)
+    old = simulate(cfg, prof, duration_s=3.0, friction=law_id)
+    assert np.ptp(new.gimbal_torque_Nm) > 0
+    for k in ACTUATOR_ARRAYS + ("modal_q", "modal_qdot"):
+        assert np.array_equal(getattr(new, k), getattr(old, k)), k
