@@ -15,7 +15,7 @@ An entry (:class:`FrictionLawEntry`) holds everything about a law:
   ``dz``, ``tf`` (n,) out: lane q gets exactly ``rates(v[q], z[q], t_app[q], P[q])``, the
   scalar law inlined into a loop and compiled with the scalar kernel's floating-point flags
   (bit-identical, ``tests/test_friction_lanes.py``). Never a second copy of the law: a
-  built-in law's module declares it as that loop over its scalar kernel (:func:`each_lane` in
+  built-in law's module declares it as that loop over its scalar kernel (:func:`inlined` in
   :mod:`._builtin`, cached), and an entry without one (a law registered at run time, a
   plug-in) gets it generated here from its ``rates`` (:func:`lanes_of`);
 * ``zdot3``, ``torque3``, ``bearing_step``: the vector spherical-bearing form (3-D model),
