@@ -9,8 +9,11 @@ One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run
    seconds per run), the share of it spent in the compiled kernel
    (taos.planar.dynamics.integrate_segments_lanes, timed), and the same runs through the
    previous per-run path (one dense RK4 call per 5 s segment with the plant rebuilt each time,
-   ``--legacy-runs``; the tests' reference) for the ratio in the same run. Run from the project
-   root with ``PYTHONPATH=.`` (it imports the reference from tests/).
+   ``--legacy-runs``; the tests' reference) for the ratio in the same run. Beside it, the same
+   batch with the friction law called lane by lane (an indirect call of the scalar C callback per
+   run and stage, the lockstep kernel's friction before the laws' lane form, issue 44 point 4):
+   its CPU seconds per run, kernel share, and whether its results equal the lane form's bit for
+   bit. Run from the project root with ``PYTHONPATH=.`` (it imports the reference from tests/).
 2. The soft campaign, ``--runs`` runs on a LocalCluster of 2 workers, end to end (cluster start-up
    included), as ``taos montecarlo post_separation --runs N --case soft`` runs it; its LCO
    fraction.
@@ -76,6 +79,32 @@ def legacy_run(kind, names, factors, seed) -> float:
     return float(per_segment_reference(asc, model, c.axis, c.start_s, c.start_s + c.duration_s, c.dt_s, seed)[-1])
 
 
+def per_lane_calls(rates):
+    """The previous path's friction: a lane form (registry ``LANES_SIG``) that calls the scalar C
+    callback ``rates`` once per lane (the callback not inlined: what the lockstep kernel did
+    before the laws' lane form)."""
+    from numba import cfunc
+
+    from taos.friction.registry import signatures
+
+    def rates_lanes(v, z, t_app, P, dz, tf):
+        for q in range(v.shape[0]):
+            dz[q], tf[q] = rates(v[q], z[q], t_app[q], P[q])
+
+    return cfunc(signatures()["LANES_SIG"])(rates_lanes)
+
+
+def _batch(kind, d, spent: list, dyn) -> tuple:
+    """Run the batch of design rows 1.. timed: (result, wall s, CPU s)."""
+    undo = _timed(dyn, "integrate_segments_lanes", spent)
+    try:
+        t0, c0 = time.perf_counter(), time.process_time()
+        out = kind.run_batch(d.names, d.factors[1:], d.seeds[1:])
+        return out, time.perf_counter() - t0, time.process_time() - c0
+    finally:
+        undo()
+
+
 def peer(n: int, n_legacy: int) -> dict:
     """One-run cost of n soft runs as one batch in this process, the kernel's share, and the
     previous per-run path on the first ``n_legacy`` of them."""
@@ -83,17 +112,26 @@ def peer(n: int, n_legacy: int) -> dict:
     c = load_campaign("post_separation")
     kind, _ = flight_runs(c, "soft", None)
     d = montecarlo_design(c, n + 1)
+    from dataclasses import replace
+
+    from taos.friction import registry
     kind.run_batch(d.names, d.factors[:2], d.seeds[:2])  # load the compiled kernels
     spent = [0.0, 0.0]
-    undo = _timed(dyn, "integrate_segments_lanes", spent)
-    try:
-        t0, c0 = time.perf_counter(), time.process_time()
-        kind.run_batch(d.names, d.factors[1:], d.seeds[1:])
-        el, cpu = time.perf_counter() - t0, time.process_time() - c0
-    finally:
-        undo()
+    got, el, cpu = _batch(kind, d, spent, dyn)
     res = {"runs": n, "s_per_run": el / n, "cpu_s_per_run": cpu / n, "kernel_share": spent[0] / el,
            "kernel_cpu_s_per_run": spent[1] / n}
+    law = registry.get(kind.model.friction.name)   # the law the batch flies
+    registry._REGISTRY[law.id] = replace(law, rates_lanes=per_lane_calls(law.rates))
+    try:
+        kind.run_batch(d.names, d.factors[:2], d.seeds[:2])   # compile the per-lane-call form
+        spent = [0.0, 0.0]
+        prev, el_p, cpu_p = _batch(kind, d, spent, dyn)
+    finally:
+        registry._REGISTRY[law.id] = law
+    same = all(np.array_equal(np.asarray(got[k]), np.asarray(prev[k]), equal_nan=True)
+               for k in got if isinstance(got[k], np.ndarray))
+    res.update(law=law.id, per_lane_s_per_run=el_p / n, per_lane_cpu_s_per_run=cpu_p / n,
+               per_lane_kernel_cpu_s_per_run=spent[1] / n, per_lane_bit_identical=bool(same))
     if n_legacy:
         legacy_run(kind, d.names, d.factors[0], int(d.seeds[0]))
         t0, c0 = time.perf_counter(), time.process_time()
@@ -204,7 +242,8 @@ def main() -> None:
     if "peer" not in skip:
         res["peer"] = p = peer(a.peer_runs, a.legacy_runs)
         print(f"peer: {p['s_per_run']:.4f} s per run ({p['cpu_s_per_run']:.4f} s CPU), kernel "
-              f"{100 * p['kernel_share']:.0f} %", flush=True)
+              f"{100 * p['kernel_share']:.0f} %; friction per lane: {p['per_lane_cpu_s_per_run']:.4f} s CPU, "
+              f"bit-identical {p['per_lane_bit_identical']}", flush=True)
     if "soft" not in skip:
         out = root / "soft"
         shutil.rmtree(out, ignore_errors=True)
@@ -229,6 +268,11 @@ def main() -> None:
         print(f"| one soft run in-process, one batch (peer) | {p['runs']} | 1 | {p['s_per_run']:.4f} s/run "
               f"({p['cpu_s_per_run']:.4f} s CPU) | kernel {100 * p['kernel_share']:.0f} % of the wall, "
               f"{p['kernel_cpu_s_per_run']:.4f} s CPU per run |")
+        print(f"| same batch, friction law called lane by lane (previous lockstep path) | {p['runs']} | 1 | "
+              f"{p['per_lane_s_per_run']:.4f} s/run ({p['per_lane_cpu_s_per_run']:.4f} s CPU) | kernel "
+              f"{p['per_lane_kernel_cpu_s_per_run']:.4f} s CPU per run against {p['kernel_cpu_s_per_run']:.4f} "
+              f"(x{p['per_lane_kernel_cpu_s_per_run'] / p['kernel_cpu_s_per_run']:.2f}); results bit-identical: "
+              f"{p['per_lane_bit_identical']} |")
         if "legacy_runs" in p:
             print(f"| same, previous per-run path (dense RK4 per segment, plant rebuilt) | {p['legacy_runs']} | 1 | "
                   f"{p['legacy_s_per_run']:.4f} s/run ({p['legacy_cpu_s_per_run']:.4f} s CPU) | x"

@@ -11,7 +11,8 @@ dynamics)::
                  (a function of the command only: evaluated once per sample and mid-step)
     [w; T_a; th; u_v; q; P_L]_k                      rows of R over the state (w = omega_k - r_k',
                  th = theta_k - r_k, the block's valve command, valve flow, load pressure)
-    (z_k', T_f,k) = fid(w_k, z_k, T_a,k, fp_k)       the friction law's registry kernel
+    (z_k', T_f,k) = fid(w_k, z_k, T_a,k, fp_k)       the friction law's registry kernel (its lane
+                 form rates_lanes: every actuator in one call, the scalar law's bits)
     T_k        = T_f,k - stop_torque(th_k, w_k, ...) taos.planar.saturation.stop_torque
     e_v,k      = valve_excess(u_v,k + K_v R u_k)     taos.planar.saturation.valve_excess
     c_q,k      = pressure_flow_correction(q_k, P_L,k) taos.planar.saturation (square-root law,
@@ -180,7 +181,7 @@ def _lanes(lp, lc, lv, sp, sc, sv, xp, xc, xv, W, ws0, out):
 
 
 @njit(cache=True, fastmath=_FM, inline="always")
-def _rates(x, z, u, ml, mp, mx, mv, ql, rl, H, fid, fp, W, ws0, m, aux, dx, dz):
+def _rates(x, z, u, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, dx, dz):
     """dx/dt into ``dx`` (n_x,), dz/dt into ``dz`` (n_a,), for the state ``x`` [x] (lane
     layout), friction states ``z`` (n_a,) [rad], post-avionics commands ``u`` (n_a,) [rad];
     ``ml`` the blocks' lane rows, (``mp``, ``mx``, ``mv``) the modal state rows' CSR over w_s,
@@ -194,14 +195,12 @@ def _rates(x, z, u, ml, mp, mx, mv, ql, rl, H, fid, fp, W, ws0, m, aux, dx, dz):
     for j in range(nm2):
         W[ws0 + j] = x[nl + j]
     _lanes(rl[0], rl[1], rl[2], rl[3], rl[4], rl[5], rl[6], rl[7], rl[8], W, ws0, aux)
+    fidl(aux[:na], z, aux[na:2 * na], fp, dz, W[nl + na:nl + 2 * na])   # T_f into T's lanes
     for k in range(na):
         w = aux[k]
         h = H[k]
-        dzk, tf = fid(w, z[k], aux[na + k], fp[k])
-        dz[k] = dzk
         W[nl + k] = u[k]
-        W[nl + na + k] = tf - _lim.stop_torque(aux[2 * na + k], w, h[_lim.LIM_THMAX], h[_lim.LIM_KS],
-                                               h[_lim.LIM_CS])
+        W[nl + na + k] -= _lim.stop_torque(aux[2 * na + k], w, h[_lim.LIM_THMAX], h[_lim.LIM_KS], h[_lim.LIM_CS])
         W[nl + 2 * na + k] = _lim.valve_excess(h, aux[3 * na + k] + h[_lim.LIM_KVR] * u[k])
         W[nl + 3 * na + k] = _lim.pressure_flow_correction(h, aux[4 * na + k], aux[5 * na + k])
     _csr(ql[0], ql[1], ql[2], W, W, ws0 + nm2)
@@ -223,14 +222,14 @@ def _all_finite(x, z):
 
 
 @njit(cache=True, fastmath=_FM, nogil=True)
-def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fid, fp, avp, amap, x0, z0, r, dt, rec_every, x_out, v_out, z_out):
+def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0, r, dt, rec_every, x_out, v_out, z_out):
     """RK4 over the command samples ``r`` (n_steps + 1, n_c) [rad] (linear between samples),
     step ``dt`` [s], from ``x0`` (n_x,) (lane layout) and ``z0`` (n_a,) [rad]. ``ml``, ``rl``
     the lane operators of the blocks' rows and of R (:meth:`LaneOperator.arrays`), (``mp``,
     ``mx``, ``mv``) the modal rows' CSR and ``ql`` the CSR of q'', all over w_s (length ``nw``, S from
     ``ws0``, ``m`` lane states); ``H`` (n_a, N_HEAD) the blocks' limit heads
-    (:mod:`taos.planar.saturation`, zeros: off); ``fid`` the friction law's ``rates`` kernel,
-    ``fp`` (n_a, NPARAM) its packs; ``avp`` (n_c, L) the avionics packs: actuator k's
+    (:mod:`taos.planar.saturation`, zeros: off); ``fidl`` the friction law's lane form
+    ``rates_lanes`` (the actuators as lanes, one call a stage), ``fp`` (n_a, NPARAM) its packs; ``avp`` (n_c, L) the avionics packs: actuator k's
     post-avionics command is that of command column and pack ``amap[k]`` (actuators with the
     same command and avionics share one evaluation). Records every
     ``rec_every`` steps the state into ``x_out`` (n_rec, n_x), [u; T] into ``v_out``
@@ -263,7 +262,7 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fid, fp, avp, amap, x0, z0,
             u0[k] = c0[amap[k]]
             um[k] = cm[amap[k]]
             u1[k] = c1[amap[k]]
-        _rates(x, z, u0, ml, mp, mx, mv, ql, rl, H, fid, fp, W, ws0, m, aux, k1, d1)
+        _rates(x, z, u0, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k1, d1)
         if s % rec_every == 0:
             for i in range(n):
                 x_out[rec, i] = x[i]
@@ -279,17 +278,17 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fid, fp, avp, amap, x0, z0,
             xt[i] = x[i] + h * k1[i]
         for k in range(na):
             zt[k] = z[k] + h * d1[k]
-        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fid, fp, W, ws0, m, aux, k2, d2)
+        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k2, d2)
         for i in range(n):
             xt[i] = x[i] + h * k2[i]
         for k in range(na):
             zt[k] = z[k] + h * d2[k]
-        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fid, fp, W, ws0, m, aux, k3, d3)
+        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k3, d3)
         for i in range(n):
             xt[i] = x[i] + dt * k3[i]
         for k in range(na):
             zt[k] = z[k] + dt * d3[k]
-        _rates(xt, zt, u1, ml, mp, mx, mv, ql, rl, H, fid, fp, W, ws0, m, aux, k4, d4)
+        _rates(xt, zt, u1, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k4, d4)
         for i in range(n):
             x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
         for k in range(na):

@@ -247,7 +247,7 @@ def simulate(cfg: MasvConfig, commands, *, dt_s: float = DEFAULT_DT_S, record_ev
     xo, vo, zo = np.empty((nrec, lay.nx)), np.empty((nrec, 2 * na)), np.empty((nrec, na))
     t0 = time.perf_counter()
     st = integrate(ml.arrays(), mp, mx, mvv, _csr_arrays(remap(Qf)), rl.arrays(), H, lay.m, lay.nw, lay.ws0,
-                   models[0].friction.entry.rates, fp, avp[reps], amap, np.zeros(lay.nx), np.zeros(na),
+                   models[0].friction.entry.rates_lanes, fp, avp[reps], amap, np.zeros(lay.nx), np.zeros(na),
                    np.ascontiguousarray(r[:, reps]), float(dt_s), int(record_every), xo, vo, zo)
     wall = time.perf_counter() - t0
     if st >= 0:

@@ -19,7 +19,7 @@ that callee too, so the steps sharing such callees form one group and a group is
   ``saturation.apply``) and ``planar._expstep``;
 * ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` (with its pieces ``taos3d._rhs``,
   ``taos3d._commands``, ``taos3d._so3``) and ``taos3d._bearing``;
-* ``friction``: every built-in law's C callbacks (``friction.registry.load_all``).
+* ``friction``: every built-in law's C callbacks, the lane forms included (``friction.registry.load_all``).
 
 Between groups the only shared callees are ``planar._avionics_kernels.apply`` and the model's
 friction law's C callbacks, which every group calls with the same signature (float64 and

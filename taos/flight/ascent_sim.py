@@ -297,7 +297,7 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
     aux = np.empty((nrec, _dy.N_AUX, nl))
     status = np.empty(nl, np.int64)
     m0 = lanes[0].model
-    _dy.integrate_segments_lanes(ip, ix, mx, heads, m0.friction.entry.rates,
+    _dy.integrate_segments_lanes(ip, ix, mx, heads, m0.friction.entry.rates_lanes,
                                  np.ascontiguousarray(np.stack([ln.fpack for ln in lanes], axis=1)),
                                  np.stack([ln.model.avionics.pack() for ln in lanes]),
                                  np.asarray(bounds, np.int64), jdst, jsrc, jcoef, kick, x0, np.zeros(nl), r, dt_s,
@@ -350,7 +350,7 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
     how many there are."""
     from taos.errors import InputError, SimulationUnstable
     res: list = [None] * len(runs)
-    groups: dict = {}
+    groups, version = {}, package_version()   # read once a call (importlib.metadata: ms a read)
     grids = {}
     for i, (asc, model, seed) in enumerate(runs):
         try:
@@ -373,12 +373,12 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
                     continue
                 asc, model, seed = runs[i]
                 res[i] = _history(asc, model, (axis,), [flown], grids[i], dt_s, seed, start_s, attitude0_rad,
-                                  friction_follows_thrust)
+                                  friction_follows_thrust, version=version)
     return res
 
 
 def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tuple, dt_s: float, seed: int,
-             start_s: float, attitude0_rad: float, follow: bool = False) -> AscentHistory:
+             start_s: float, attitude0_rad: float, follow: bool = False, version: str | None = None) -> AscentHistory:
     end, rec, t, _ = grid
     out = {k: [] for k in SIGNALS}
     for Y, Rr in flown:
@@ -390,7 +390,7 @@ def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tu
             out[k].append(Y[:, 8 + j])
     prov = {**model_provenance(model), "ascent_file": ascent.source,
             "ascent_sha256": ascent.sha256, "flight_file": ascent.flight.source,
-            "flight_sha256": ascent.flight.sha256, "package_version": package_version(),
+            "flight_sha256": ascent.flight.sha256, "package_version": version or package_version(),
             "solver": {"method": INTEGRATOR, "dt_s": dt_s, "record_every": rec},
             "seed": int(seed), "start_s": start_s, "end_s": end, "attitude0_rad": attitude0_rad,
             "friction_model": model.friction.name} | ({"friction_follows_thrust": True} if follow else {})

@@ -72,12 +72,33 @@ _FM = {"reassoc", "contract", "arcp", "nsz"}
 
 def kernel(sig_name: str):
     """The decorator declaring a built-in kernel: a numba C callback with the registry's
-    signature ``sig_name`` (:data:`taos.friction.registry.KERNELS`), cached on disk."""
+    signature ``sig_name`` (:data:`taos.friction.registry.KERNELS`, ``LANE_KERNELS``), cached
+    on disk."""
     from numba import cfunc
 
     from .registry import signatures
 
-    return cfunc(signatures()[sig_name], cache=True, fastmath=_FM if sig_name == "RATES_SIG" else False)
+    return cfunc(signatures()[sig_name], cache=True,
+                 fastmath=_FM if sig_name in ("RATES_SIG", "LANES_SIG") else False)
+
+
+def inlined(rates):
+    """The Python function of the scalar C callback ``rates`` as a numba function inlined where
+    it is called, with the scalar kernel's floating-point flags: a law module's lane form
+    (``rates_lanes``, :data:`taos.friction.registry.LANES_SIG`) is the loop over the lanes::
+
+        _law = inlined(my_rates)
+
+        @kernel("LANES_SIG")
+        def my_rates_lanes(v, z, t_app, P, dz, tf):
+            for q in range(v.shape[0]):
+                dz[q], tf[q] = _law(v[q], z[q], t_app[q], P[q])
+
+    (a module-level function, so that numba caches it; a law without one gets the same loop
+    generated, uncached, by :func:`taos.friction.registry.lanes_of`)."""
+    from numba import njit
+
+    return njit(inline="always", fastmath=_FM)(rates._pyfunc)
 
 
 def load(law_id: str) -> tuple:

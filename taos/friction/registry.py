@@ -9,6 +9,15 @@ An entry (:class:`FrictionLawEntry`) holds everything about a law:
 * ``rates``: the scalar kernel (planar model), a compiled C callback with the signature
   :data:`RATES_SIG` giving the bristle-state rate and the torque together (the torque of the
   bristle laws needs the rate; one call per integrator stage);
+* ``rates_lanes``: the same law over n lanes in one call (the lockstep kernels: Monte Carlo
+  batches, the MASV actuators), signature :data:`LANES_SIG`, ``rates_lanes(v, z, t_app, P,
+  dz, tf)`` with ``v``, ``z``, ``t_app`` (n,) and ``P`` (n, NPARAM) (a pack per lane) in,
+  ``dz``, ``tf`` (n,) out: lane q gets exactly ``rates(v[q], z[q], t_app[q], P[q])``, the
+  scalar law inlined into a loop and compiled with the scalar kernel's floating-point flags
+  (bit-identical, ``tests/test_friction_lanes.py``). Never a second copy of the law: a
+  built-in law's module declares it as that loop over its scalar kernel (:func:`inlined` in
+  :mod:`._builtin`, cached), and an entry without one (a law registered at run time, a
+  plug-in) gets it generated here from its ``rates`` (:func:`lanes_of`);
 * ``zdot3``, ``torque3``, ``bearing_step``: the vector spherical-bearing form (3-D model),
   signatures :data:`ZDOT3_SIG`, :data:`TORQUE3_SIG`, :data:`BEARING_SIG`;
 * ``fit_describing_function`` (and ``fit_relay_level``, ``fit_check``): the describing
@@ -63,6 +72,8 @@ from ..errors import InputError
 #: torque3: (T0, T1) [N m] = torque3(w0, w1, z0, z1, dz0, dz1, t0, t1, p);
 #: bearing_step: (w0, w1, z0, z1, T0, T1) = bearing_step(p, Kc, d0, d1, z0, z1, dt, s0)
 KERNELS = {"rates": "RATES_SIG", "zdot3": "ZDOT3_SIG", "torque3": "TORQUE3_SIG", "bearing_step": "BEARING_SIG"}
+#: the lane form of ``rates``: rates_lanes(v, z, t_app, P, dz, tf) -> None (``dz``, ``tf`` written)
+LANE_KERNELS = {"rates_lanes": "LANES_SIG"}
 
 
 @functools.cache
@@ -80,12 +91,14 @@ def signatures() -> dict:
     return {"RATES_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, p),
             "ZDOT3_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, f8, p),
             "TORQUE3_SIG": nt.UniTuple(f8, 2)(f8, f8, f8, f8, f8, f8, f8, f8, p),
-            "BEARING_SIG": nt.UniTuple(f8, 6)(p, nt.float64[:, ::1], f8, f8, f8, f8, f8, f8)}
+            "BEARING_SIG": nt.UniTuple(f8, 6)(p, nt.float64[:, ::1], f8, f8, f8, f8, f8, f8),
+            "LANES_SIG": nt.void(p, p, p, nt.float64[:, ::1], p, p)}
 
 
 def __getattr__(name: str):
-    """``RATES_SIG``, ``ZDOT3_SIG``, ``TORQUE3_SIG``, ``BEARING_SIG``: the kernel signatures."""
-    if name in KERNELS.values():
+    """``RATES_SIG``, ``ZDOT3_SIG``, ``TORQUE3_SIG``, ``BEARING_SIG``, ``LANES_SIG``: the kernel
+    signatures."""
+    if name in KERNELS.values() or name in LANE_KERNELS.values():
         return signatures()[name]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
@@ -102,7 +115,8 @@ class FrictionLawEntry:
     the loop in closed form, including the held engine. ``fit_check(law, source)`` raises
     :class:`InputError` for parameter values the fit's describing function does not cover.
     ``fit_parameters``: the ``[friction]`` keys a fit may free (names of
-    :data:`taos.identify.surrogate.PARAMETERS`).
+    :data:`taos.identify.surrogate.PARAMETERS`). ``rates_lanes``: the lane form of ``rates``
+    (module docstring); None: generated from ``rates`` on :func:`register`.
     """
 
     id: str
@@ -116,6 +130,7 @@ class FrictionLawEntry:
     fit_check: Callable | None = None
     fit_parameters: tuple[str, ...] = ()
     builtin: bool = False
+    rates_lanes: object = None
 
 
 _REGISTRY: dict[str, FrictionLawEntry] = {}
@@ -237,6 +252,24 @@ def _compiled(fn, sig, law_id: str, name: str):
     return cfunc(sig)(py)
 
 
+def lanes_of(rates):
+    """The lane form (:data:`LANES_SIG`, module docstring) of the scalar C callback ``rates``
+    (:data:`RATES_SIG`): its Python function inlined into a loop over the lanes, compiled with
+    the same floating-point flags, so lane q's numbers are those of ``rates`` at lane q's
+    arguments. Not cached on disk (a closure: a law registered at run time or a plug-in, whose
+    scalar kernel is compiled at run time too; the built-in laws declare theirs, cached)."""
+    from numba import cfunc, njit
+
+    flags = {k: v for k, v in rates._compiler.targetoptions.items() if k != "cache"}
+    law = njit(inline="always", **flags)(rates._pyfunc)
+
+    def rates_lanes(v, z, t_app, P, dz, tf):
+        for q in range(v.shape[0]):
+            dz[q], tf[q] = law(v[q], z[q], t_app[q], P[q])
+
+    return cfunc(signatures()["LANES_SIG"], **flags)(rates_lanes)
+
+
 def register(entry: FrictionLawEntry, *, replace_existing: bool = False, builtin: bool = False) -> FrictionLawEntry:
     """Add ``entry`` under ``entry.id`` (kernels compiled to C callbacks here); returns the
     stored entry. Its parameter class must name the same id (``params.name``)."""
@@ -249,6 +282,9 @@ def register(entry: FrictionLawEntry, *, replace_existing: bool = False, builtin
         raise InputError("friction registry", f"{entry.id}.params", f"a parameter class with name = {entry.id!r}",
                          got=repr(getattr(entry.params, "name", None)))
     compiled = {k: _compiled(getattr(entry, k), signatures()[s], entry.id, k) for k, s in KERNELS.items()}
+    lanes = entry.rates_lanes
+    compiled["rates_lanes"] = (lanes_of(compiled["rates"]) if lanes is None else
+                               _compiled(lanes, signatures()["LANES_SIG"], entry.id, "rates_lanes"))
     stored = replace(entry, builtin=builtin, **compiled)
     _REGISTRY[entry.id] = stored
     return stored

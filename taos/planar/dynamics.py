@@ -343,7 +343,7 @@ def _rows(ip, ix, mx, V, h0, h1, OUT, o0):
 
 
 @njit(cache=True, inline="always")
-def _rates_lanes(Z, ip, ix, mx, H, fid, fp, AVP, V, C, S, U, TF, DZ, DX):
+def _rates_lanes(Z, ip, ix, mx, H, fidl, fp, AVP, V, C, S, U, TF, DZ, DX):
     """The state equations of the module docstring for R independent plants ("lanes") at once,
     every linear part as one sparse matrix with a pattern common to all lanes.
 
@@ -356,7 +356,7 @@ def _rates_lanes(Z, ip, ix, mx, H, fid, fp, AVP, V, C, S, U, TF, DZ, DX):
     :mod:`taos.planar.saturation` over (x, u): valve command u_v, valve flow q, load pressure
     P_L, engine angle and rate. Per lane: u = avionics(c) (``_avionics_kernels.apply_lanes``
     with ``AVP`` (AV_TABLE + 2 m, R), the lanes' packs by slot), (dz/dt, T_f) = friction(w, z,
-    T_a) (``fid`` the law's kernel, ``fp`` (R, NPARAM) each lane's pack), the valve excess e_v,
+    T_a) (``fidl`` the law's lane form ``rates_lanes``, ``fp`` (R, NPARAM) each lane's pack), the valve excess e_v,
     the flow correction c_q and the stop torque T_stop from the lane variants of the laws of
     :mod:`taos.planar.saturation` with ``H`` (N_HEAD, R) the lanes' packed heads by slot (all
     off: zeros). Writes dx/dt into ``DX`` (n, R), u [rad] into ``U``, T_f [N m] into ``TF``,
@@ -366,14 +366,15 @@ def _rates_lanes(Z, ip, ix, mx, H, fid, fp, AVP, V, C, S, U, TF, DZ, DX):
     The loops over lanes are element-wise (no sum across lanes), so a lane's result does not
     depend on R or on its position: compiled without fast-math, vector and scalar code give the
     same bits. The avionics and the limit laws are vector loops across the lanes (branches as
-    selects); the friction law, a compiled callback, is called lane by lane."""
+    selects); the friction law is its lane form (one callback for all the lanes, the scalar law
+    inlined in its loop: lane q's bits are those of ``rates`` at lane q,
+    :data:`taos.friction.registry.LANES_SIG`)."""
     n = DX.shape[0]
     iu = V.shape[0] - 5
     nl = V.shape[1]
     _rows(ip, ix, mx, V, n, n + 3, C, 0)
     _av.apply_lanes(C[0], AVP, S, U)
-    for q in range(nl):
-        DZ[q], TF[q] = fid(C[1, q], Z[q], C[2, q], fp[q])
+    fidl(C[1], Z, C[2], fp, DZ, TF)
     for q in range(nl):
         V[iu, q] = U[q]
         V[iu + 1, q] = TF[q]
@@ -385,7 +386,7 @@ def _rates_lanes(Z, ip, ix, mx, H, fid, fp, AVP, V, C, S, U, TF, DZ, DX):
 
 
 @njit(cache=True, error_model="numpy")  # x / 0 -> inf or NaN (the selects discard them), no exception
-def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc, jcoef, kick, x0, z0, r, dt,
+def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc, jcoef, kick, x0, z0, r, dt,
                              rec_every, x_out, aux_out, status):
     """RK4 (as :func:`integrate_samples`) of R independent runs in lockstep ("lanes"), each
     through a sequence of plants held over segments of steps, all in one sparse pattern.
@@ -400,8 +401,9 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
         the limit rows and columns of :mod:`taos.planar.saturation`).
     head : (n_seg, R, N_HEAD) float64
         The packed limits' head (slots ``LIM_*``; zeros: no limits).
-    fid : friction law kernel; fp : (n_seg, R, NPARAM) float64; avp : (R, .) float64
-        The law's ``rates`` kernel (module docstring), each segment's and lane's packed friction
+    fidl : friction law lane kernel; fp : (n_seg, R, NPARAM) float64; avp : (R, .) float64
+        The law's lane form ``rates_lanes`` (registry ``LANES_SIG``: ``rates`` of the module
+        docstring over all the lanes in one call), each segment's and lane's packed friction
         parameters (a level following the thrust: :mod:`taos.flight.friction_env`) and packed
         avionics.
     bounds : (n_seg + 1,) int64
@@ -482,7 +484,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
             for q in range(nl):
                 V[i, q] = X[i, q]
         # the derivative at the step start (K1), with T_f and u there for the record
-        _rates_lanes(Z, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D1, K1)
+        _rates_lanes(Z, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D1, K1)
         if k % rec_every == 0:
             for i in range(n):
                 for q in range(nl):
@@ -502,13 +504,13 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
                 V[i, q] = X[i, q] + h2 * K1[i, q]
         for q in range(nl):
             ZT[q] = Z[q] + h2 * D1[q]
-        _rates_lanes(ZT, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D2, K2)
+        _rates_lanes(ZT, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D2, K2)
         for i in range(n):
             for q in range(nl):
                 V[i, q] = X[i, q] + h2 * K2[i, q]
         for q in range(nl):
             ZT[q] = Z[q] + h2 * D2[q]
-        _rates_lanes(ZT, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D3, K3)
+        _rates_lanes(ZT, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D3, K3)
         for j in range(nr):
             for q in range(nl):
                 V[n + j, q] = R1[j, q]
@@ -517,7 +519,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fid, fp, avp, bounds, jdst, jsrc,
                 V[i, q] = X[i, q] + dt * K3[i, q]
         for q in range(nl):
             ZT[q] = Z[q] + dt * D3[q]
-        _rates_lanes(ZT, ip, ix, M, L, fid, F, AVP, V, C, S, U, TF, D4, K4)
+        _rates_lanes(ZT, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D4, K4)
         for i in range(n):
             for q in range(nl):
                 X[i, q] += dt * (K1[i, q] + 2.0 * K2[i, q] + 2.0 * K3[i, q] + K4[i, q]) / 6.0
