@@ -234,7 +234,8 @@ def test_killing_a_worker_loses_no_run(isolated, reference, tmp_path):
             ["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--batch", "2", "--out", str(out),
              "--no-progress"])))
         th.start()
-        with Client(addr, timeout="10s") as c:
+        # (not this process's default client: the campaign's own client, in the thread, is)
+        with Client(addr, timeout="10s", set_as_default=False) as c:
             deadline = time.time() + 180
             while _stored(out) < 4 and time.time() < deadline:
                 time.sleep(0.05)
