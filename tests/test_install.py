@@ -6,9 +6,14 @@ running interpreter's environment), and the shipped commands are run from anothe
 directory with only that folder on ``PYTHONPATH``: ``taos info rs25_hotfire`` (a shipped model
 named without a path) and ``python -m taos greenrun rs25_hotfire --out DIR`` (the report).
 
-Building the wheel fetches setuptools and wheel into pip's isolated build environment (network);
-the fresh install compiles its numba kernels on first use (about a minute of CPU). The whole
-module is marked slow (``make check`` skips it; ``make test`` runs it).
+Building the wheel fetches setuptools and wheel into pip's isolated build environment (network).
+The installed copy is given the source tree's numba kernel cache (:func:`_copy_kernel_cache`):
+numba keys each cached kernel on the SHA-256 of its source file, the function's bytecode and
+this machine's CPU, so it loads only what it would have compiled from the same text here, and
+compiles the rest; a cold compile for the installed copy cost about 35 CPU-s of `make test` and
+proved nothing the suite's kernel warm-up does not (benchmarks/RESULTS.md, "make test cost,
+2026-12-02 (session 3)"). The whole module is marked slow (``make check`` skips it; ``make
+test`` runs it).
 """
 
 from __future__ import annotations
@@ -32,6 +37,28 @@ ROOT = Path(__file__).resolve().parents[1]
 def _run(args, cwd, env=None, timeout=1800):
     return subprocess.run([str(a) for a in args], cwd=cwd, env=env, capture_output=True, text=True,
                           timeout=timeout)
+
+
+def _copy_kernel_cache(site: Path) -> int:
+    """Copy the source tree's numba cache files (``__pycache__/*.nbi``, ``*.nbc``) of ``taos``
+    and ``masv`` to the same places in ``site``; returns how many source files they belong to.
+    Each one's source file in ``site`` must be byte-identical to the tree's (the wheel ships the
+    tree's kernels); numba checks that again itself (its index holds the source's SHA-256). A
+    kernel that reads code of another file keeps the code it was compiled with, in the tree's
+    cache as here (the Makefile drops and rebuilds the whole cache when a kernel file changes)."""
+    sources = set()
+    for pkg in ("taos", "masv"):
+        for nb in sorted((ROOT / pkg).rglob("__pycache__/*.nb[ic]")):
+            rel = nb.relative_to(ROOT)
+            py = rel.parent.parent / (nb.name.split(".", 1)[0] + ".py")
+            if not (ROOT / py).is_file():
+                continue   # left by a module the tree no longer has
+            assert (site / py).is_file() and (site / py).read_bytes() == (ROOT / py).read_bytes(), \
+                f"the wheel's {py} is not the tree's"
+            (site / rel.parent).mkdir(exist_ok=True)
+            shutil.copyfile(nb, site / rel)
+            sources.add(py)
+    return len(sources)
 
 
 @pytest.fixture(scope="module")
@@ -58,6 +85,7 @@ def installed(tmp_path_factory):
     # environment's PYTHONDONTWRITEBYTECODE, each command below compiled every taos module again)
     r = _run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", site, wheels[0]], cwd=tmp)
     assert r.returncode == 0, r.stderr[-2000:]
+    _copy_kernel_cache(site)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     env["PYTHONPATH"] = str(site)
     work = tmp / "elsewhere"

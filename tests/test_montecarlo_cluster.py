@@ -56,34 +56,44 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def start_cluster(tmp: Path, deny: list[Path], n: int = 2):
-    """A scheduler and ``n`` one-thread workers as separate processes on loopback; the workers
-    run in ``tmp/cwd`` and cannot open anything under ``deny``."""
-    port = _free_port()
-    addr = f"tcp://127.0.0.1:{port}"
+def start_worker(tmp: Path, addr: str, deny: list[Path], name: str | None = None) -> subprocess.Popen:
+    """A one-thread worker process (no nanny) of the scheduler at ``addr``, run in ``tmp/cwd``,
+    that cannot open anything under ``deny``."""
     cwd = tmp / "cwd"
     cwd.mkdir(exist_ok=True)
     (tmp / "deny_preload.py").write_text(DENY)
     env = dict(os.environ, TAOS_TEST_DENY=os.pathsep.join(str(d.resolve()) for d in deny))
-    sched = subprocess.Popen([str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port),
-                              "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    workers = [subprocess.Popen([str(BIN / "dask"), "worker", addr, "--nthreads", "1", "--nworkers", "1",
-                                 "--no-dashboard", "--no-nanny", "--host", "127.0.0.1",
-                                 "--preload", str(tmp / "deny_preload.py")],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=cwd)
-               for _ in range(n)]
+    return subprocess.Popen([str(BIN / "dask"), "worker", addr, "--nthreads", "1", "--nworkers", "1",
+                             "--no-dashboard", "--no-nanny", "--host", "127.0.0.1",
+                             "--preload", str(tmp / "deny_preload.py"), *(["--name", name] if name else [])],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=cwd)
+
+
+def wait_for_workers(addr: str, n: int, procs) -> None:
+    """Until the scheduler at ``addr`` has ``n`` workers (``procs`` stopped if it never does)."""
     from dask.distributed import Client
     deadline = time.time() + 90
     while True:
         try:
             with Client(addr, timeout="5s") as c:
                 c.wait_for_workers(n, timeout=30)
-            break
+            return
         except Exception:
             if time.time() > deadline:
-                stop_cluster([sched, *workers])
+                stop_cluster(procs)
                 raise
             time.sleep(0.5)
+
+
+def start_cluster(tmp: Path, deny: list[Path], n: int = 2):
+    """A scheduler and ``n`` one-thread workers as separate processes on loopback; the workers
+    run in ``tmp/cwd`` and cannot open anything under ``deny``."""
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    sched = subprocess.Popen([str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port),
+                              "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    workers = [start_worker(tmp, addr, deny) for _ in range(n)]
+    wait_for_workers(addr, n, [sched, *workers])
     return addr, sched, workers
 
 
@@ -115,11 +125,15 @@ def reference(tmp_path_factory):
 @pytest.fixture(scope="module")
 def isolated(tmp_path_factory):
     """A loopback cluster whose workers cannot open the project's model, flight, FEM or test
-    data files, nor anything under ``proj`` (where the tests copy inputs)."""
+    data files, nor anything under ``proj`` (where the tests copy inputs): (address, proj, the
+    folders denied). The module's one cluster of separate processes: every test on it leaves
+    its two workers running (a test that kills a worker adds one of its own to kill), and a
+    worker started once loads the kernels once (about 3 CPU-s a worker process)."""
     tmp = tmp_path_factory.mktemp("iso")
     proj = tmp / "proj"
     proj.mkdir()
-    addr, sched, workers = start_cluster(tmp, [ROOT / "models", ROOT / "fem_data", ROOT / "tests" / "data", proj])
+    deny = [ROOT / "models", ROOT / "fem_data", ROOT / "tests" / "data", proj]
+    addr, sched, workers = start_cluster(tmp, deny)
     from dask.distributed import Client
 
     def _try_open(path: str) -> str:  # nested: sent by value to the workers (they cannot import tests)
@@ -132,7 +146,7 @@ def isolated(tmp_path_factory):
         with Client(addr, timeout="10s") as c:
             seen = c.run(_try_open, str(ROOT / "models" / "rs25_flight.toml"))
             assert set(seen.values()) == {"denied"}, seen
-        yield addr, proj
+        yield addr, proj, deny
     finally:
         stop_cluster([*workers, sched])
 
@@ -165,7 +179,7 @@ def test_local_cluster_store_is_bit_identical_to_in_process(reference, tmp_path)
 def test_workers_that_cannot_see_the_files_give_identical_results(isolated, reference, tmp_path):
     """Workers in another folder that may not open a single project file: the campaign (3 runs
     per batch) stores exactly what the in-process run stores, and Ishigami runs there too."""
-    addr, _ = isolated
+    addr, _, _ = isolated
     out = tmp_path / "iso"
     assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--batch", "3", "--out", str(out),
                  "--no-progress"]) == 0
@@ -182,7 +196,7 @@ def test_persistent_cluster_flies_the_edited_input(isolated, tmp_path):
     """The same cluster after the ascent file is edited (a stronger separation kick): the new
     campaign has a new inputs hash and stores what the in-process engine stores for the edited
     input, not the old one."""
-    addr, proj = isolated
+    addr, proj, _ = isolated
     camp = copy_inputs(proj / "edit")
     before = tmp_path / "before"
     assert main(["montecarlo", str(camp), "--runs", "4", "--scheduler", addr, "--batch", "2", "--out", str(before),
@@ -204,10 +218,15 @@ def _stored(out: Path) -> int:
     return 0 if st is None else int((st > 0).sum())
 
 
-def test_killing_a_worker_loses_no_run(reference, tmp_path):
-    """A worker killed mid-campaign: Dask re-runs its batches on the other one; the campaign
-    ends with every run and the same store."""
-    addr, sched, workers = start_cluster(tmp_path, [])
+def test_killing_a_worker_loses_no_run(isolated, reference, tmp_path):
+    """A worker killed mid-campaign while it runs a batch: Dask re-runs its batches on the
+    others; the campaign ends with every run and the same store. (The worker killed is a third
+    one added to the module's cluster for this test, named so that the scheduler shows what it
+    was running when it was killed.)"""
+    from dask.distributed import Client
+    addr, _, deny = isolated
+    victim = start_worker(tmp_path, addr, deny, name="victim")
+    wait_for_workers(addr, 3, [victim])
     out = tmp_path / "kill"
     rc = {}
     try:
@@ -215,42 +234,45 @@ def test_killing_a_worker_loses_no_run(reference, tmp_path):
             ["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--batch", "2", "--out", str(out),
              "--no-progress"])))
         th.start()
-        deadline = time.time() + 180
-        while _stored(out) < 4 and time.time() < deadline:
-            time.sleep(0.05)
-        workers[0].kill()
+        # (not this process's default client: the campaign's own client, in the thread, is)
+        with Client(addr, timeout="10s", set_as_default=False) as c:
+            deadline = time.time() + 180
+            while _stored(out) < 4 and time.time() < deadline:
+                time.sleep(0.05)
+            who = {w: i["name"] for w, i in c.scheduler_info(n_workers=-1)["workers"].items()}
+            running = [t for w, ts in c.processing().items() if who.get(w) == "victim" for t in ts]
+            victim.kill()
         th.join(timeout=300)
     finally:
-        stop_cluster([*workers, sched])
+        stop_cluster([victim])
+    assert running, "the killed worker was running no batch"
     assert rc.get("rc") == 0
     same_store(out, reference)
     assert stats(out) == stats(reference)
 
 
-def test_killed_client_resumes_to_the_same_store(reference, tmp_path):
+def test_killed_client_resumes_to_the_same_store(isolated, reference, tmp_path):
     """The client (the taos process) killed with SIGKILL mid-campaign: --resume on the same
-    folder runs only what is missing and ends with the same store and statistics. (On a cluster
-    of its own: the killed client's tasks keep the workers busy until the scheduler drops them,
-    which held a shared cluster's teardown for 40 s.)"""
-    addr, sched, workers = start_cluster(tmp_path, [])
+    folder runs only what is missing and ends with the same store and statistics. (On the
+    module's cluster: the killed client's tasks end on the workers when the scheduler drops
+    them, a batch of two runs at most; a cluster stopped with them still running is killed 5 s
+    after SIGTERM, :func:`stop_cluster`.)"""
+    addr, _, _ = isolated
     out = tmp_path / "resume"
-    try:
-        p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
-                              "--batch", "2", "--out", str(out), "--no-progress"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        deadline = time.time() + 180
-        while _stored(out) < 5 and time.time() < deadline and p.poll() is None:
-            time.sleep(0.05)
-        p.kill()
-        p.wait()
-        done = _stored(out)
-        assert 0 < done < RUNS + 1
-        assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
-                     "--no-progress"]) == 2  # without --resume: refused
-        assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
-                     "--resume", "--no-progress"]) == 0
-    finally:
-        stop_cluster([*workers, sched])
+    p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
+                          "--batch", "2", "--out", str(out), "--no-progress"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 180
+    while _stored(out) < 5 and time.time() < deadline and p.poll() is None:
+        time.sleep(0.05)
+    p.kill()
+    p.wait()
+    done = _stored(out)
+    assert 0 < done < RUNS + 1
+    assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
+                 "--no-progress"]) == 2  # without --resume: refused
+    assert main(["montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr, "--out", str(out),
+                 "--resume", "--no-progress"]) == 0
     same_store(out, reference)
     assert stats(out) == stats(reference)
     executed = json.loads((out / "summary.json").read_text())["timing"]["runs_executed"]

@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import re
 import select
+import shutil
 import signal
 import subprocess
 import sys
@@ -145,21 +146,35 @@ def _snapshot(folder: Path) -> dict:
     return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
 
 
+@pytest.fixture(scope="module")
+def previous_report(tmp_path_factory) -> Path:
+    """A short Green Run's report folder, made in this process (the previous result the killed
+    greenrun runs below must leave whole: the setup, not the process under test; made once and
+    copied, mark included, into each test's folder)."""
+    tmp = tmp_path_factory.mktemp("previous")
+    prof = tmp / "short.toml"
+    prof.write_text(SHORT_TWO_AXIS)
+    assert _in_process(["greenrun", AMBIENT, "--profile", prof, "--out", tmp / "report", "--quiet"], tmp) == 0
+    return tmp / "report"
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("command", ["simulate", "greenrun"])
-def test_killed_during_write_keeps_previous_result_and_leaves_no_temporary(command, tmp_path):
+def test_killed_during_write_keeps_previous_result_and_leaves_no_temporary(command, tmp_path, request):
     prof = tmp_path / "short.toml"
     prof.write_text(SHORT_TWO_AXIS)
+    # the previous result: made in this process (it is the setup, not the process under test)
     if command == "simulate":
         folder = tmp_path / "runs"
         folder.mkdir()
         args = ["simulate", AMBIENT, "--profile", prof, "--out", folder / "run.h5"]
+        assert _in_process(args, tmp_path) == 0
     else:
         folder = tmp_path / "report"
         args = ["greenrun", AMBIENT, "--profile", prof, "--out", folder, "--quiet"]
-    # the previous result: made in this process (it is the setup, not the process under test)
-    assert _in_process(args, tmp_path) == 0
+        shutil.copytree(request.getfixturevalue("previous_report"), folder)
     before = _snapshot(folder)
+    assert before and not temporaries(folder)
 
     # SIGTERM: one line, exit 143, the temporary file removed at once
     proc = _start_slow(args, tmp_path)
