@@ -41,12 +41,12 @@ INTEGRATOR = "rk4, trapezoidal bearing torque + BDF2 bearing substeps"
 
 @dataclass(frozen=True, eq=False)
 class Packed:
-    """Arrays the compiled kernels take (see :func:`pack`): the model ``P``
-    (:class:`taos.taos3d.dynamics.TaosParams`), the friction law's kernels
+    """Arrays the compiled kernels take (see :func:`pack`): the model ``P`` (a record with the
+    fields of :class:`taos.taos3d.dynamics.TaosParams`, :func:`taos.taos3d._layout.as_record`), the friction law's kernels
     ``fid`` = (``bearing_step``, ``zdot3``, ``torque3``) (its registry entry's) and packed parameters ``fp`` (scaled by the normal load), the
     packed avionics ``avp``, the state length and the actuator's state length."""
 
-    P: _dy.TaosParams
+    P: np.record
     fid: object
     fp: np.ndarray
     avp: np.ndarray
@@ -75,7 +75,7 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     act = actuator_state_space(tm.base.actuator)
     geo = tm.geometry
     R = tm.base.actuator.moment_arm_m
-    P = _dy.TaosParams(
+    P = _dy.TaosParams(   # the named tuple names every field; the kernels take it as a record
         spatial_inertia=f64(Y), spatial_inertia_inv=f64(np.linalg.inv(Y)), chain_stiffness=f64(Ks),
         slip_gain=f64(G), bearing_compliance=f64(Kc), bearing_selection=f64(S),
         structure_attach_m=f64(geo.structure_attach_m), engine_attach_m=f64(geo.engine_attach_m),
@@ -94,7 +94,7 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     fp = law.pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
     na = act.A.shape[0]
-    return Packed(P, (law.entry.bearing_step, law.entry.zdot3, law.entry.torque3), fp, av.pack(), _dy.N_BODY + 2 * na, na)
+    return Packed(_dy.as_record(P), (law.entry.bearing_step, law.entry.zdot3, law.entry.torque3), fp, av.pack(), _dy.N_BODY + 2 * na, na)
 
 
 def rest_state(pk: Packed) -> np.ndarray:
