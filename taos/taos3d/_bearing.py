@@ -88,7 +88,7 @@ def tolerance(dt):
     return TOL_RAD * r * r * r
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def fast_time(zdot3, torque3, fp, Kc, w0, w1, z0, z1, t0, t1):
     """Time constant [s] of the bearing's fast mode where it is unstable, else +inf: with the
     slip rate w = s u and the bristle state z frozen, the law's torque along u,

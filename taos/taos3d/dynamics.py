@@ -299,19 +299,22 @@ def _steps(P, fid, fp, avp, x, bs, r, dt, rec_every, out, ks, aux, cs, kc):
     return -1
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy")
-def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
-    """Two sines (pitch amp[0] sin(2 pi freq[0] t), yaw amp[1] sin(2 pi freq[1] t)) from rest;
-    Fourier coefficients at ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw)
-    (:data:`_DWELL_COLS`) over ``nmeas`` steps after ``nset``: out[o] = (2/N sum y sin,
-    2/N sum y cos, 1/N sum y) [m or rad].
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out, ks, aux, rec, cs, kc):
+    """Two sines (pitch amp[0] sin(2 pi freq[0] t), yaw amp[1] sin(2 pi freq[1] t)) from the
+    state ``x`` and bearing state ``bs`` (both advanced in place); Fourier coefficients at
+    ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw) (:data:`_DWELL_COLS`) over ``nmeas``
+    steps after ``nset``: out[o] = (2/N sum y sin, 2/N sum y cos, 1/N sum y) [m or rad].
+    Compiled without reference counting; each step a call of :func:`step` (as :func:`_steps`).
 
     Parameters
     ----------
     P, fid, fp, avp
         As :func:`integrate`.
-    x0 : (N_BODY + 2 n_a,) float64
-        The rest state (``X_*``); not modified.
+    x : (N_BODY + 2 n_a,) float64
+        The start state (``X_*``; the rest state for a dwell).
+    bs : (N_BEARING,) float64
+        The start bearing state (``BS_*``; zeros at rest).
     amp : (2,) float64
         Command amplitudes, pitch and yaw [rad].
     freq : (2,) float64
@@ -324,18 +327,10 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
         Settling and measured steps.
     out : (4, 3) float64
         Receives the Fourier coefficients.
+    ks, aux, rec, cs, kc
+        Scratch: (5, n), (N_AUX,), (len(REC),), (4, 2), (2, 2).
 
     Returns -1, or the first step whose state became non-finite."""
-    return _dwell_steps(P, fid, fp, avp, x0.copy(), np.zeros(N_BEARING), amp, freq, fmeas, dt, nset, nmeas, out,
-                        np.empty((5, x0.shape[0])), np.empty(N_AUX), np.empty(len(REC)), np.empty((4, 2)),
-                        np.empty((2, 2)))
-
-
-@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out, ks, aux, rec, cs, kc):
-    """:func:`_dwell_one`'s loop from the state ``x``, bearing state ``bs`` (scratch ``ks``
-    (5, n), ``aux``, ``rec``, ``cs`` (4, 2), ``kc`` (2, 2)), compiled without reference
-    counting; each step a call of :func:`step` (as :func:`_steps`)."""
     k1 = ks[0]
     _compliance(P, kc)
     c0 = cs[0]
@@ -375,11 +370,24 @@ def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out,
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
 def dwell_batch(P, fid, fp, avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out, status, b0, b1):
     """Independent two-axis dwells b0 <= b < b1, one after the other without the GIL (the caller
-    runs slices on threads: :func:`taos.planar._parallel.run_each`): :func:`_dwell_one` for row b of ``amps``
-    (n, 2) [rad] and ``freqs`` (n, 2) [Hz], with ``fmeas`` (n,) [Hz], ``dts`` (n,) [s],
-    ``nset``, ``nmeas`` (n,) int, into ``out[b]`` (n, 4, 3) and ``status[b]`` (n,) int
-    (-1 or the failing step); ``P``, ``fid``, ``fp``, ``avp``, ``x0`` as :func:`_dwell_one`."""
+    runs slices on threads: :func:`taos.planar._parallel.run_each`): :func:`_dwell_steps` from
+    the rest state ``x0`` (not modified) for row b of ``amps`` (n, 2) [rad] and ``freqs`` (n, 2)
+    [Hz], with ``fmeas`` (n,) [Hz], ``dts`` (n,) [s], ``nset``, ``nmeas`` (n,) int, into
+    ``out[b]`` (n, 4, 3) and ``status[b]`` (n,) int (-1 or the failing step); ``P``, ``fid``,
+    ``fp``, ``avp`` as :func:`integrate`."""
+    n = x0.shape[0]
+    x = np.empty(n)
+    bs = np.empty(N_BEARING)
+    ks = np.empty((5, n))
+    aux = np.empty(N_AUX)
+    rec = np.empty(len(REC))
+    cs = np.empty((4, 2))
+    kc = np.empty((2, 2))
     for b in range(b0, b1):
-        status[b] = _dwell_one(P, fid, fp, avp, x0, amps[b], freqs[b], fmeas[b], dts[b], nset[b],
-                               nmeas[b], out[b])
+        for i in range(n):
+            x[i] = x0[i]
+        for i in range(N_BEARING):
+            bs[i] = 0.0
+        status[b] = _dwell_steps(P, fid, fp, avp, x, bs, amps[b], freqs[b], fmeas[b], dts[b], nset[b], nmeas[b],
+                                 out[b], ks, aux, rec, cs, kc)
 

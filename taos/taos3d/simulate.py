@@ -151,8 +151,9 @@ def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int =
     pk = pack(tm) if pk is None else pk
     nrec = (cmd.shape[0] - 1) // record_every + 1
     out = np.empty((nrec, len(_dy.REC)))
-    status = _dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(_dy.N_BEARING), cmd, dt_s,
-                           record_every, out)
+    n = pk.n_state   # integrate's loop, called with its scratch (one compiled kernel less to load)
+    status = _dy._steps(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(_dy.N_BEARING), cmd, dt_s,
+                        record_every, out, np.empty((5, n)), np.empty(_dy.N_AUX), np.empty((4, 2)), np.empty((2, 2)))
     if status >= 0:
         raise SimulationUnstable(status * dt_s, f"TAOS, {tm.base.friction.name} friction, dt = {dt_s} s")
     return out
