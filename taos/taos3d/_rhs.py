@@ -14,7 +14,10 @@ psi = G e, and the velocity kick of a change of the bearing torque.
 Each is one compiled kernel, called by the step (:func:`taos.taos3d.dynamics.step`) and the
 records; the packed model ``P`` is a record (:func:`taos.taos3d._layout.as_record`), passed as
 one pointer, whose arrays have compile-time shapes (the actuator's state size is a constant of
-the compiled code: fixed-size loops). Scalar locals and tuples only: no heap arrays.
+the compiled code: fixed-size loops). The small helpers (:mod:`taos.taos3d._so3`,
+:func:`_act_linear`, the limits, :func:`_psi`, :func:`_torque_kick`) are compiled inline into
+their callers. Scalar locals and tuples only: no heap
+arrays.
 """
 
 from __future__ import annotations
@@ -41,8 +44,8 @@ def _act_linear(Aa, bxc, bf, ux, F, x, off, dx, m):
         dx[off + k] = s
 
 
-#: the actuator rate/pressure limits (taos.planar.saturation), the same source compiled here with
-#: the 3-D kernels' flags (not cached: its code is part of the cached right-hand side's)
+#: the actuator rate/pressure limits (taos.planar.saturation), the same source compiled inline into
+#: the right-hand side with the 3-D kernels' flags
 _valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.valve_pressure_rows.py_func)
 
 
@@ -180,7 +183,7 @@ def rhs(x, T0, T1, u0, u1, P, dx, aux):
     aux[AUX_THETA + 1] = ty
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _torque_kick(x, r0, r1, r2, th, d0, d1, h, P):
     """x[7:13] += h a, a [m/s^2, rad/s^2] the engine's body-frame acceleration that a change
     (d0, d1) [N m] of the bearing torque adds at the state x (its rotation vector (r0, r1, r2)
@@ -212,7 +215,7 @@ def pose_psi(x, P):
     return _psi(x, r0, r1, r2, P)
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
 def _psi(x, r0, r1, r2, P):
     """:func:`pose_psi` given the rotation vector (r0, r1, r2) [rad] of the state's quaternion."""
     G = P.slip_gain

@@ -59,16 +59,21 @@ constant in time: every stage takes its mean over the step (:func:`stage_inputs`
 stage points. Quaternions are renormalised after each step. With friction off (T = 0) the
 scheme is plain RK4.
 
-The right-hand side :func:`_rhs` uses scalar locals and tuples only (no heap arrays), and the
+The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays), and the
 step's kernels allocate nothing and are compiled without reference counting (``_nrt=False``);
-the recorded step reuses its derivative as the first RK4 stage. A numba call passes the
-packed model ``P`` as about 150 machine words on the stack, so the run's loops
-(:func:`_steps`, :func:`_dwell_steps`) inline the step (:func:`_step`), which runs its four
-stages through one inlined right-hand side; :func:`rhs` and :func:`step` are the callable
-(non-inlined) forms. The actuator block and its limits run with the second-order valve's state
-size (6) as a literal (unrolled loops; other sizes the runtime-size loops), and the log map
-needs no library call (:func:`_logq4`): issue 28, 1.29 -> 0.92 us a step at 4e-4 s, the
-arithmetic unchanged to rounding (benchmarks/RESULTS.md).
+the recorded step reuses its derivative as the first RK4 stage. The packed model ``P`` is a
+numpy record (:func:`~taos.taos3d._layout.as_record`): numba passes it as one pointer (a
+named tuple of arrays would be flattened into about 150 machine words a call) and its arrays
+have compile-time shapes at fixed offsets, so the actuator block and its limits run
+fixed-size, unrolled loops for whatever state size the model has. Each kernel is therefore
+compiled once and called: the run's loops (:func:`_steps`, :func:`_dwell_steps`) call
+:func:`step`, which calls :func:`rhs` for its four stages and
+:func:`taos.taos3d._bearing.advance` for the bearing; only the small SO(3) and actuator
+helpers are compiled inline. (Until issue 44 the loops inlined the step and the step the
+right-hand side, through numba's ``inline="always"``, which re-types and copies the callee
+into every caller: the 3-D Green Run compiled the right-hand side three times, about 75 of its
+116 CPU-s from a cold cache; the warm step is as fast as then, benchmarks/RESULTS.md.) The log
+map needs no library call (:func:`_logq4`).
 
 The kernels live in small modules, one concept each, and are re-exported here (import them
 from this module): :mod:`taos.taos3d._so3` the SO(3) maps (``_logq4``, ``_rotation``,
@@ -81,8 +86,9 @@ Packed data (every index below is a module constant of :mod:`taos.taos3d._layout
 here, used by the packer :func:`taos.taos3d.simulate.pack` and the kernels alike;
 ``tests/test_kernel_packs.py`` checks the tables tile their arrays):
 
-* ``P``: the model, a :class:`~taos.taos3d._layout.TaosParams` named tuple (fields, shapes and
-  units in its docstring);
+* ``P``: the model, a record with the fields of the :class:`~taos.taos3d._layout.TaosParams`
+  named tuple (fields, shapes and units in its docstring; :func:`~taos.taos3d._layout.as_record`,
+  :func:`~taos.taos3d._layout.as_params`);
 * ``x`` (:data:`N_BODY` + 2 n_a): engine position ``X_P`` (3) [m], orientation quaternion
   ``X_Q`` (4, xyzw) [-], body twist: linear ``X_V`` (3) [m/s] and angular ``X_W`` (3)
   [rad/s]; then the pitch and the yaw actuator's states (n_a each,
