@@ -48,7 +48,7 @@ class TaosParams(NamedTuple):
                                            damping [N s/m]
     act_vp_index                int        index of the piston rate v_p in the actuator state
     limits                      (k,)       actuator/gimbal limits over one actuator's state
-                                           (:mod:`taos.planar.saturation`; empty: none)
+                                           (:mod:`taos.planar.saturation`; all zero: none)
     torque_wrench               (6, 2)     K_s S Kc: the chain wrench per unit bearing torque
                                            [N/(N m), N m/(N m)] (:func:`taos.taos3d.dynamics._torque_kick`)
     act_pl_index                int        index of the load pressure P_L [Pa] in the actuator

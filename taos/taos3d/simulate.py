@@ -57,10 +57,15 @@ class Packed:
 def actuator_limits(tm: TaosModel) -> np.ndarray:
     """The actuator and gimbal limits (:mod:`taos.planar.saturation`) packed over one actuator's state:
     valve flow saturation, supply-pressure limit (square-root law, relief valve) per actuator, hard stops per axis (the
-    stop damping from the pitch inertia; the 3-D engine is axisymmetric about its axis)."""
-    from ..planar.saturation import limit_rows_for_actuator, pack_model_limits
+    stop damping from the pitch inertia; the 3-D engine is axisymmetric about its axis). With every limit off, the
+    same layout all zeros (the kernels act on a limit only where its head slot is positive, so this is the same as no
+    limits), so that every model of one actuator size is one record type: one compiled kernel family."""
+    from ..planar.saturation import N_HEAD, N_ROWS, limit_rows_for_actuator, pack_model_limits
     rows, _ = limit_rows_for_actuator(tm.base.actuator)
-    return pack_model_limits(tm.base.actuator, tm.base.engine, "pitch", rows)
+    lim = pack_model_limits(tm.base.actuator, tm.base.engine, "pitch", rows)
+    if lim.size == 0:
+        lim = np.zeros(N_HEAD + N_ROWS * len(next(iter(rows.values()))))
+    return lim
 
 
 def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
