@@ -43,6 +43,9 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5] [--o
    at the engine; kv = kp / K_v, the actuator loop's first-order lag 1/K_v), implicitfast
    integrator, at 1 ms and 0.1 ms, driven by the same Green Run commands. The peer has no
    hydraulics, compliant gimbal or bearing slip: it is the cheaper model of the two.
+6. Head to head (``--only-speed`` and the full run): TAOS at its default step and the peer at
+   1 ms in alternating rounds of the same process (``--repeat`` rounds), so that both see the
+   same load; the best CPU time of each, their ratio, and the median of the rounds' ratios.
 """
 
 from __future__ import annotations
@@ -231,6 +234,44 @@ def energy_balance():
         r = run_in_tree(ENERGY_CODE % (tests, MODEL, ENERGY_LAWS, dts), tree)
         for law in ENERGY_LAWS:
             print(f"    {name:14s} {law:18s} " + "  ".join(f"{r[f'{law} {dt:g}']:+.2e}" for dt in dts))
+
+
+def head_to_head(tm, prof, repeat):
+    """Point 6 of the module docstring: TAOS at the default step against the MuJoCo peer at
+    1 ms, alternating within each of ``repeat`` rounds (CPU time, ``time.process_time``)."""
+    try:
+        import mujoco
+        from mujoco import rollout
+    except ImportError:
+        print("[head-to-head] skipped: mujoco is not installed (pip install -e .[bench])")
+        return
+    dt_t, dt_m = DEFAULT_DT_S, 1e-3
+    _, cmd_t = commands(prof, T_RUN, dt_t)
+    pk = pack(tm)
+    every = int(round(REC_S / dt_t))
+    m = mujoco.MjModel.from_xml_string(mujoco_xml(tm, dt_m))
+    d = mujoco.MjData(m)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    s0 = np.empty(mujoco.mj_stateSize(m, spec))
+    mujoco.mj_getState(m, d, s0, spec)
+    _, cmd_m = commands(prof, T_RUN, dt_m)
+    ctrl = np.ascontiguousarray(cmd_m[1:][None, :, :])
+    run_t = lambda: run_samples(tm, cmd_t, dt_t, every, pk)  # noqa: E731
+    run_m = lambda: rollout.rollout(m, d, s0[None], ctrl)  # noqa: E731
+    run_samples(tm, cmd_t[:11], dt_t, every, pk)  # compile / load the cache
+    rollout.rollout(m, d, s0[None], ctrl[:, :10])
+    ct, cm = [], []
+    for _ in range(repeat):
+        for f, acc in ((run_t, ct), (run_m, cm)):
+            c0 = time.process_time()
+            f()
+            acc.append(time.process_time() - c0)
+    ratios = [b / a for a, b in zip(ct, cm)]
+    print(f"[head-to-head] {repeat} alternating rounds, CPU time of the 60 s run: TAOS dt {dt_t:g} s best "
+          f"{min(ct):.4f} s = {T_RUN / min(ct):.1f}x real time ({1e6 * min(ct) / (len(cmd_t) - 1):.3f} us/step); "
+          f"MuJoCo {mujoco.__version__} rollout dt {dt_m:g} s best {min(cm):.4f} s = {T_RUN / min(cm):.1f}x; "
+          f"TAOS / MuJoCo speed {min(cm) / min(ct):.2f} (best against best), median of the rounds "
+          f"{statistics.median(ratios):.2f}")
 
 
 def mujoco_xml(tm, dt):
@@ -422,6 +463,8 @@ def main():
     ap.add_argument("--no-conv60", action="store_true", help="skip the 60 s modified-LuGre convergence part")
     ap.add_argument("--only-conv60", action="store_true", help="run the 60 s convergence part alone")
     ap.add_argument("--only-speed", action="store_true", help="run the speed part and the MuJoCo peer alone")
+    ap.add_argument("--only-head-to-head", action="store_true",
+                    help="run the alternating TAOS / MuJoCo rounds alone (point 6)")
     ap.add_argument("--decay-impact", action="store_true",
                     help="run only the planar impact of the rational decay against the former exponential")
     args = ap.parse_args()
@@ -437,9 +480,14 @@ def main():
     if args.only_conv60:
         convergence60(prof)
         return
+    if args.only_head_to_head:
+        head_to_head(tm, prof, args.repeat)
+        print(f"machine load (uptime): {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
+        return
     rec = taos_speed(tm, prof, DEFAULT_DT_S, args.repeat)
     taos_speed(tm, prof, ALT_DT, args.repeat)
     mujoco_peer(tm, prof, args.repeat, rec)
+    head_to_head(tm, prof, max(args.repeat, 5))
     if args.only_speed:
         print(f"machine load (uptime): {subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip()}")
         return

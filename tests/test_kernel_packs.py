@@ -129,13 +129,16 @@ def packed():
 
 
 def test_taos3d_pack_fills_every_field(packed):
-    """The packer builds the named tuple by field name, every field with its documented shape."""
+    """The packer builds the named tuple by field name, every field with its documented shape,
+    and hands the kernels its record (the same fields, the same values)."""
     from taos.planar.actuator import actuator_state_space
     from taos.taos3d import dynamics as dy
 
     tm, pk = packed
     P = pk.P
-    assert isinstance(P, dy.TaosParams) and len(P) == len(dy.TaosParams._fields)
+    assert isinstance(P, np.record) and P.dtype.names == dy.TaosParams._fields
+    for name, v in zip(dy.TaosParams._fields, dy.as_params(P)):
+        assert np.array_equal(v, P[name]), name
     na = pk.n_act
     assert pk.n_state == dy.N_BODY + 2 * na
     shapes = {"spatial_inertia": (6, 6), "spatial_inertia_inv": (6, 6), "chain_stiffness": (6, 6),

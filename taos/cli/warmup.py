@@ -106,9 +106,16 @@ def _taos_model() -> None:
 
 
 def _simulate_taos() -> None:
+    import numpy as np
+
     from taos.profiles import SineDwell
-    from taos.taos3d import simulate_taos, taos_model
-    simulate_taos(taos_model(_model()), SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
+    from taos.taos3d import dynamics as dy, simulate_taos, taos_model
+    from taos.taos3d.simulate import pack, rest_state
+    tm = taos_model(_model())
+    simulate_taos(tm, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01)
+    pk = pack(tm)   # integrate, the co-simulation core's entry (simulate_taos calls its loop directly)
+    dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(dy.N_BEARING), np.zeros((2, 2)), 4e-4, 1,
+                 np.empty((2, len(dy.REC))))
 
 
 def _taos_freqresp() -> None:

@@ -59,7 +59,7 @@ typedef struct {
     fmi2CallbackFreeMemory dealloc;
     fmi2ComponentEnvironment env;
     taos_nt_TaosParams P;
-    double ks[5][TAOS_NX], aux[TAOS_NAUX], cs[4][2], rec[2][TAOS_NREC];
+    double ks[5][TAOS_NX], aux[TAOS_NAUX], cs[4][2], kc[2][2], rec[2][TAOS_NREC];
     double *r;                /* command samples (n + 1, 2), grown with the host's memory */
     long r_rows;
 } Inst;
@@ -74,7 +74,7 @@ typedef struct {
 static long run(Inst *s, long n) {
     return taos3d_steps(&s->P, (double *)taos_fp, TAOS_NFP, (double *)taos_avp, TAOS_NAVP, s->d.x, TAOS_NX,
                         s->d.bs, TAOS_NBS, s->r, n + 1, 2, s->d.dt, n > 0 ? n : 1, &s->rec[0][0], n > 0 ? 2 : 1,
-                        TAOS_NREC, &s->ks[0][0], 5, TAOS_NX, s->aux, TAOS_NAUX, &s->cs[0][0], 4, 2);
+                        TAOS_NREC, &s->ks[0][0], 5, TAOS_NX, s->aux, TAOS_NAUX, &s->cs[0][0], 4, 2, &s->kc[0][0], 2, 2);
 }
 
 static int grow(Inst *s, long n) {

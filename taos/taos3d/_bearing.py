@@ -88,7 +88,7 @@ def tolerance(dt):
     return TOL_RAD * r * r * r
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def fast_time(zdot3, torque3, fp, Kc, w0, w1, z0, z1, t0, t1):
     """Time constant [s] of the bearing's fast mode where it is unstable, else +inf: with the
     slip rate w = s u and the bristle state z frozen, the law's torque along u,
@@ -174,8 +174,8 @@ def _commit(bs, hb, p0, p1, z0, z1, w0, w1, t0, t1):
 def advance(bs, fk, fp, Kc, dt, qa0, qa1, qb0, qb1, tol, max_split, fast_steps):
     """Advance the bearing state ``bs`` (``BS_*``) over a body step ``dt`` [s] in which the
     pose-demanded bearing angle moves linearly from (qa0, qa1) to (qb0, qb1) [rad] (module
-    docstring); ``fid``/``fp`` the law's bearing step and packed parameters, ``Kc`` (2, 2) the
-    chain compliance [rad/(N m)], ``tol`` the local error tolerance [rad], ``max_split`` the
+    docstring); ``fk`` the law's (bearing_step, zdot3, torque3) and ``fp`` its packed
+    parameters, ``Kc`` (2, 2) the chain compliance [rad/(N m)] (a C array), ``tol`` the local error tolerance [rad], ``max_split`` the
     body step over the shortest substep. Returns the bearing torque's mean over the step (2)
     [N m] and the number of substeps taken."""
     fid, zdot3, torque3 = fk

@@ -42,7 +42,7 @@ def command_mean(c0, c1, p):
     return s / (hi - lo)
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+@njit(cache=True, fastmath=_FM, error_model="numpy")
 def stage_inputs(c0, cm, c1, avp):
     """Post-avionics commands [rad] for the RK4 stages (start, middle, end; pitch and yaw) of a
     step with pre-avionics commands c0/cm/c1 (2,) at its start, middle and end. A quantised

@@ -48,7 +48,7 @@ class TaosParams(NamedTuple):
                                            damping [N s/m]
     act_vp_index                int        index of the piston rate v_p in the actuator state
     limits                      (k,)       actuator/gimbal limits over one actuator's state
-                                           (:mod:`taos.planar.saturation`; empty: none)
+                                           (:mod:`taos.planar.saturation`; all zero: none)
     torque_wrench               (6, 2)     K_s S Kc: the chain wrench per unit bearing torque
                                            [N/(N m), N m/(N m)] (:func:`taos.taos3d.dynamics._torque_kick`)
     act_pl_index                int        index of the load pressure P_L [Pa] in the actuator
@@ -82,6 +82,53 @@ class TaosParams(NamedTuple):
     torque_wrench: np.ndarray
     act_pl_index: int
     act_q_index: int
+
+
+def params_dtype(p: TaosParams) -> np.dtype:
+    """The structured dtype of the packed model ``p``: one field per :class:`TaosParams` field,
+    in its order, each array with its own shape (float64), the scalars float64 and the indices
+    int64 (:func:`as_record`)."""
+    fields = []
+    for name in TaosParams._fields:
+        v = getattr(p, name)
+        if isinstance(v, np.ndarray):
+            fields.append((name, np.float64, v.shape))
+        elif isinstance(v, (int, np.integer)) and not isinstance(v, bool):
+            fields.append((name, np.int64))
+        else:
+            fields.append((name, np.float64))
+    return np.dtype(fields, align=True)
+
+
+def as_record(p: TaosParams) -> np.record:
+    """The packed model as a numpy record (:func:`params_dtype`), the form the kernels take.
+
+    numba passes a named tuple of arrays to a compiled call flattened (each array's data
+    pointer, shape and strides: about 150 machine words a call) and reads every array through
+    its run-time strides; a record is passed as one pointer, and its fields are arrays of
+    compile-time shape at fixed offsets. So the kernels call each other (the right-hand side
+    four times a step, the step once) without inlining one into another, and each kernel is
+    compiled once. The record reads as the named tuple does (``P.act_A``, ``P.moment_arm_m``);
+    :func:`as_params` gives the named tuple back."""
+    rec = np.zeros(1, dtype=params_dtype(p)).view(np.recarray)[0]
+    for name in TaosParams._fields:
+        rec[name] = getattr(p, name)
+    return rec
+
+
+def as_params(rec) -> TaosParams:
+    """The named tuple of a packed-model record (:func:`as_record`): arrays as views of the
+    record, scalars as Python numbers."""
+    out = []
+    for name in TaosParams._fields:
+        v = rec[name]
+        if isinstance(v, np.ndarray):
+            out.append(v)
+        elif isinstance(v, np.integer):
+            out.append(int(v))
+        else:
+            out.append(float(v))
+    return TaosParams(*out)
 
 
 #: the engine's body state in ``x``: position [m], quaternion (xyzw), linear [m/s] and angular

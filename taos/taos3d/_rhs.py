@@ -2,17 +2,22 @@
 torque (the formulation is in :mod:`taos.taos3d.dynamics`), the bearing's pose-demanded angle
 psi = G e, and the velocity kick of a change of the bearing torque.
 
-* :func:`rhs` / :func:`_rhs`: dx/dt of the packed state ``x`` (``X_*``, then the pitch and yaw
-  actuators) and the reports ``aux`` (``AUX_*``: chain wrench [N, N m], load forces [N], bearing
-  slip [rad], engine angles [rad]) given the bearing torque (T0, T1) [N m] and the post-avionics
-  commands (u0, u1) [rad];
+* :func:`rhs`: dx/dt of the packed state ``x`` (``X_*``, then the pitch and yaw actuators) and
+  the reports ``aux`` (``AUX_*``: chain wrench [N, N m], load forces [N], bearing slip [rad],
+  engine angles [rad]) given the bearing torque (T0, T1) [N m] and the post-avionics commands
+  (u0, u1) [rad];
 * :func:`pose_psi` / :func:`_psi`: psi = G e [rad], the bearing angles that carry no torque at
   the pose of ``x``;
 * :func:`_torque_kick`: x[7:13] += h a, the body acceleration a change of the bearing torque adds
   (the step's trapezoidal torque kick).
 
-The ``_`` forms are compiled inline into the step (:func:`taos.taos3d.dynamics._step`); the
-others are their callable (non-inlined) forms. Scalar locals and tuples only: no heap arrays.
+Each is one compiled kernel, called by the step (:func:`taos.taos3d.dynamics.step`) and the
+records; the packed model ``P`` is a record (:func:`taos.taos3d._layout.as_record`), passed as
+one pointer, whose arrays have compile-time shapes (the actuator's state size is a constant of
+the compiled code: fixed-size loops). The small helpers (:mod:`taos.taos3d._so3`,
+:func:`_act_linear`, the limits, :func:`_psi`, :func:`_torque_kick`) are compiled inline into
+their callers. Scalar locals and tuples only: no heap
+arrays.
 """
 
 from __future__ import annotations
@@ -30,7 +35,8 @@ from ._so3 import _FM, _cross3, _logq4, _mv6, _rotation, _row6, _rtv, _rv, _worl
 def _act_linear(Aa, bxc, bf, ux, F, x, off, dx, m):
     """dx[off:off+m] = A x[off:off+m] + b_xc ux + b_fl F: the linear actuator (m states,
     :func:`taos.planar.actuator.actuator_state_space`) at the command ``ux`` = R u [m] and the load
-    force ``F`` [N]; inlined, so a literal ``m`` lets LLVM unroll the fixed-size products."""
+    force ``F`` [N] (``m`` the size of the packed model's arrays: a compile-time constant, so
+    LLVM unrolls the fixed-size products)."""
     for k in range(m):
         s = bxc[k] * ux + bf[k] * F
         for j in range(m):
@@ -38,20 +44,13 @@ def _act_linear(Aa, bxc, bf, ux, F, x, off, dx, m):
         dx[off + k] = s
 
 
-#: the actuator rate/pressure limits (taos.planar.saturation), the same source compiled inline here
+#: the actuator rate/pressure limits (taos.planar.saturation), the same source compiled inline into
+#: the right-hand side with the 3-D kernels' flags
 _valve_pressure = njit(fastmath=_FM, error_model="numpy", inline="always")(_lim.valve_pressure_rows.py_func)
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def rhs(x, T0, T1, u0, u1, P, dx, aux):
-    """State derivative of the TAOS engine + actuators (module docstring); arguments as
-    :func:`_rhs`, whose compiled body this calls (the step inlines that body instead: a call
-    passes the packed model's ~150 machine words on the stack)."""
-    _rhs(x, T0, T1, u0, u1, P, dx, aux)
-
-
-@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
-def _rhs(x, T0, T1, u0, u1, P, dx, aux):
     """State derivative of the TAOS engine + actuators (module docstring).
 
     Parameters
@@ -62,8 +61,9 @@ def _rhs(x, T0, T1, u0, u1, P, dx, aux):
         Bearing friction torque, pitch and yaw [N m].
     u0, u1 : float
         Post-avionics commands, pitch and yaw [rad].
-    P : TaosParams
-        The packed model.
+    P : record
+        The packed model (:class:`~taos.taos3d._layout.TaosParams` fields,
+        :func:`~taos.taos3d._layout.as_record`).
     dx : (N_BODY + 2 n_a,) float64
         Receives dx/dt [SI per second].
     aux : (N_AUX,) float64
@@ -146,14 +146,9 @@ def _rhs(x, T0, T1, u0, u1, P, dx, aux):
         Tw2 += m2
         u = u0 if a == 0 else u1
         # the linear actuator, then the rate and pressure limits (none if lim is empty); the
-        # second-order valve's size (6 states) as a literal: fixed-size loops
-        if na == 6:
-            _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, 6)
-        else:
-            _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, na)
-        if mlim == 6:
-            _valve_pressure(lim, x, off, u, dx, 6)
-        elif mlim > 0:
+        # sizes are the record's array shapes, constants of the compiled code: fixed-size loops
+        _act_linear(Aa, bxc, bf, Rarm * u, F, x, off, dx, na)
+        if mlim > 0:
             _valve_pressure(lim, x, off, u, dx, mlim)
         aux[AUX_FL + a] = F
     # rigid body (body frame, linear first): a = Yinv (f - v x* (Y v))
@@ -195,7 +190,7 @@ def _torque_kick(x, r0, r1, r2, th, d0, d1, h, P):
     and angle th [rad], :func:`_logq4` of its quaternion): the chain wrench changes by
     dW = Ks S Kc dT (phi = G e - Kc T in :func:`rhs`), acting on the engine as
     (-dW[:3], Jl^-T (-dW[3:])) in the world, Y^-1 of that in the body frame. ``h`` [s];
-    ``P`` the packed model (:class:`TaosParams`)."""
+    ``P`` the packed model (record, :func:`taos.taos3d._layout.as_record`)."""
     Yinv, BT = P.spatial_inertia_inv, P.torque_wrench
     dF0 = -(BT[0, 0] * d0 + BT[0, 1] * d1)
     dF1 = -(BT[1, 0] * d0 + BT[1, 1] * d1)
@@ -215,7 +210,7 @@ def _torque_kick(x, r0, r1, r2, th, d0, d1, h, P):
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
 def pose_psi(x, P):
     """psi = G e: the bearing angles (pitch, yaw) that carry no torque at the pose of the state
-    ``x`` (``X_*``) [rad]; ``P`` the packed model (:class:`TaosParams`)."""
+    ``x`` (``X_*``) [rad]; ``P`` the packed model (record, :func:`taos.taos3d._layout.as_record`)."""
     r0, r1, r2, _ = _logq4(x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3])
     return _psi(x, r0, r1, r2, P)
 

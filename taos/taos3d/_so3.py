@@ -1,7 +1,9 @@
 """The 3-D kernels' small geometry: SO(3) maps on scalar locals and tuples (no heap arrays).
 
-Every function here is compiled inline into the right-hand side and the step of
-:mod:`taos.taos3d.dynamics` (``inline="always"``, the same fast-math flags ``_FM``):
+Every function here is small and compiled inline (``inline="always"``, the same fast-math
+flags ``_FM``) into the few kernels that use it, each of which is compiled once: the
+right-hand side, the torque kick and the step of :mod:`taos.taos3d.dynamics` (numba's inlining
+re-types the callee inside each caller, cheap for these; the big kernels call each other):
 
 * :func:`_logq4` / :func:`_logq`: the rotation vector r = log3(R) [rad] of a unit quaternion (xyzw),
   with a Taylor series of atan(t) / t below 17 deg (no ``atan2`` call);

@@ -59,16 +59,21 @@ constant in time: every stage takes its mean over the step (:func:`stage_inputs`
 stage points. Quaternions are renormalised after each step. With friction off (T = 0) the
 scheme is plain RK4.
 
-The right-hand side :func:`_rhs` uses scalar locals and tuples only (no heap arrays), and the
+The right-hand side :func:`rhs` uses scalar locals and tuples only (no heap arrays), and the
 step's kernels allocate nothing and are compiled without reference counting (``_nrt=False``);
-the recorded step reuses its derivative as the first RK4 stage. A numba call passes the
-packed model ``P`` as about 150 machine words on the stack, so the run's loops
-(:func:`_steps`, :func:`_dwell_steps`) inline the step (:func:`_step`), which runs its four
-stages through one inlined right-hand side; :func:`rhs` and :func:`step` are the callable
-(non-inlined) forms. The actuator block and its limits run with the second-order valve's state
-size (6) as a literal (unrolled loops; other sizes the runtime-size loops), and the log map
-needs no library call (:func:`_logq4`): issue 28, 1.29 -> 0.92 us a step at 4e-4 s, the
-arithmetic unchanged to rounding (benchmarks/RESULTS.md).
+the recorded step reuses its derivative as the first RK4 stage. The packed model ``P`` is a
+numpy record (:func:`~taos.taos3d._layout.as_record`): numba passes it as one pointer (a
+named tuple of arrays would be flattened into about 150 machine words a call) and its arrays
+have compile-time shapes at fixed offsets, so the actuator block and its limits run
+fixed-size, unrolled loops for whatever state size the model has. Each kernel is therefore
+compiled once and called: the run's loops (:func:`_steps`, :func:`_dwell_steps`) call
+:func:`step`, which calls :func:`rhs` for its four stages and
+:func:`taos.taos3d._bearing.advance` for the bearing; only the small SO(3) and actuator
+helpers are compiled inline. (Until issue 44 the loops inlined the step and the step the
+right-hand side, through numba's ``inline="always"``, which re-types and copies the callee
+into every caller: the 3-D Green Run compiled the right-hand side three times, about 75 of its
+116 CPU-s from a cold cache; the warm step is as fast as then, benchmarks/RESULTS.md.) The log
+map needs no library call (:func:`_logq4`).
 
 The kernels live in small modules, one concept each, and are re-exported here (import them
 from this module): :mod:`taos.taos3d._so3` the SO(3) maps (``_logq4``, ``_rotation``,
@@ -81,8 +86,9 @@ Packed data (every index below is a module constant of :mod:`taos.taos3d._layout
 here, used by the packer :func:`taos.taos3d.simulate.pack` and the kernels alike;
 ``tests/test_kernel_packs.py`` checks the tables tile their arrays):
 
-* ``P``: the model, a :class:`~taos.taos3d._layout.TaosParams` named tuple (fields, shapes and
-  units in its docstring);
+* ``P``: the model, a record with the fields of the :class:`~taos.taos3d._layout.TaosParams`
+  named tuple (fields, shapes and units in its docstring; :func:`~taos.taos3d._layout.as_record`,
+  :func:`~taos.taos3d._layout.as_params`);
 * ``x`` (:data:`N_BODY` + 2 n_a): engine position ``X_P`` (3) [m], orientation quaternion
   ``X_Q`` (4, xyzw) [-], body twist: linear ``X_V`` (3) [m/s] and angular ``X_W`` (3)
   [rad/s]; then the pitch and the yaw actuator's states (n_a each,
@@ -109,23 +115,17 @@ from ._commands import command_mean, stage_inputs  # noqa: F401
 from ._layout import (  # noqa: F401
     AUX_FL, AUX_PHI, AUX_THETA, AUX_W, BS_H, BS_PHI, BS_PHI_PREV, BS_SLIP, BS_T, BS_W, BS_Z, BS_Z_PREV, N_AUX,
     N_BEARING, N_BODY, REC, REC_FL, REC_P, REC_PHI, REC_PL, REC_Q, REC_TF, REC_THETA, REC_U, REC_W, REC_XP, REC_Z,
-    U_END, U_MID, U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams)
-from ._rhs import _act_linear, _psi, _rhs, _torque_kick, _valve_pressure, pose_psi, rhs  # noqa: F401
+    U_END, U_MID, U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams, as_params, as_record)
+from ._rhs import _act_linear, _psi, _torque_kick, _valve_pressure, pose_psi, rhs  # noqa: F401
 from ._so3 import (  # noqa: F401
     _FM, _cross3, _logq, _logq4, _mv6, _rotation, _row6, _rtv, _rv, _world_torque)
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi):
-    """One step (:func:`_step`, whose compiled body this calls; the run's loop
-    :func:`_steps` inlines that body instead); arguments and return as :func:`_step`."""
-    return _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi)
-
-
-@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
-def _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi):
+def step(x, bs, u, dt, P, fid, fp, ks, kc, aux, k1_ready, psi):
     """One step (module docstring): RK4 on (q, v, actuators) with the bearing torque T held at
-    its step-start value, the BDF2 bearing update, the trapezoidal torque kick.
+    its step-start value, the BDF2 bearing update, the trapezoidal torque kick. One compiled
+    kernel, called by every run's loop (:func:`_steps`, :func:`_dwell_steps`).
 
     Parameters
     ----------
@@ -138,55 +138,47 @@ def _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi)
         start (``U_START``), middle (``U_MID``) and end (``U_END``).
     dt : float
         Step [s].
-    P : TaosParams
-        The packed model.
+    P : record
+        The packed model (:class:`TaosParams` fields, :func:`~taos.taos3d._layout.as_record`).
     fid : tuple of first-class functions
         The friction law's ``bearing_step``, ``zdot3``, ``torque3``
         (:data:`taos.friction.registry.BEARING_SIG`, ``ZDOT3_SIG``, ``TORQUE3_SIG``).
     fp : (NPARAM,) float64
         The law's packed (normal-load scaled) parameters (:mod:`taos.friction._slots`).
-    avp : float64 array
-        Packed avionics (``AV_*``; unused here, the stage commands already passed through it).
-    k1, k2, k3, k4, xt : (N_BODY + 2 n_a,) float64
-        Scratch: the RK4 stages and the trial state.
+    ks : (5, N_BODY + 2 n_a) float64
+        Scratch: the RK4 stages k1..k4 and the trial state (rows).
+    kc : (2, 2) float64
+        The bearing compliance ``P.bearing_compliance`` [rad/(N m)] as a C array (the friction
+        law's bearing step takes an array, not a record's field: :func:`_steps` copies it).
     aux : (N_AUX,) float64
         Scratch for :func:`rhs`.
     k1_ready : bool
-        k1 already holds the derivative at the step start (from the record, same inputs).
+        ks[0] already holds the derivative at the step start (from the record, same inputs).
     psi : (2,) float64
         The pose-demanded bearing angle :func:`pose_psi` at the step start [rad]; receives
         its value at the step end (the torque kick moves no pose: the next step's start).
 
     Returns True while the state stays finite."""
     n = x.shape[0]
+    k1 = ks[0]
+    k2 = ks[1]
+    k3 = ks[2]
+    k4 = ks[3]
+    xt = ks[4]
     T0, T1 = bs[BS_T], bs[BS_T + 1]
     qa0, qa1 = psi[0], psi[1]  # the pose-demanded bearing angle at the step start
     h = 0.5 * dt
-    # the four stages through one inlined right-hand side (one copy of its code, no call)
-    for st in range(4):
-        if st == 0:
-            if k1_ready:
-                continue
-            for i in range(n):
-                xt[i] = x[i]
-            ko = k1
-            ua, ub = u[U_START], u[U_START + 1]
-        elif st == 1:
-            for i in range(n):
-                xt[i] = x[i] + h * k1[i]
-            ko = k2
-            ua, ub = u[U_MID], u[U_MID + 1]
-        elif st == 2:
-            for i in range(n):
-                xt[i] = x[i] + h * k2[i]
-            ko = k3
-            ua, ub = u[U_MID], u[U_MID + 1]
-        else:
-            for i in range(n):
-                xt[i] = x[i] + dt * k3[i]
-            ko = k4
-            ua, ub = u[U_END], u[U_END + 1]
-        _rhs(xt, T0, T1, ua, ub, P, ko, aux)
+    if not k1_ready:
+        rhs(x, T0, T1, u[U_START], u[U_START + 1], P, k1, aux)
+    for i in range(n):
+        xt[i] = x[i] + h * k1[i]
+    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k2, aux)
+    for i in range(n):
+        xt[i] = x[i] + h * k2[i]
+    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k3, aux)
+    for i in range(n):
+        xt[i] = x[i] + dt * k3[i]
+    rhs(xt, T0, T1, u[U_END], u[U_END + 1], P, k4, aux)
     h6 = dt / 6.0
     for i in range(n):
         x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -199,8 +191,7 @@ def _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k1_ready, psi)
     psi[1] = ps1
     # the bearing by variable-step BDF2 under its own error control (taos.taos3d._bearing),
     # psi linear over the step; the engine gets the mean torque over the step
-    m0, m1, _ = _bg.advance(bs, fid, fp, P.bearing_compliance, dt, qa0, qa1, ps0, ps1, _bg.tolerance(dt), _bg.MAX_SPLIT,
-                            _bg.FAST_STEPS)
+    m0, m1, _ = _bg.advance(bs, fid, fp, kc, dt, qa0, qa1, ps0, ps1, _bg.tolerance(dt), _bg.MAX_SPLIT, _bg.FAST_STEPS)
     _torque_kick(x, r0, r1, r2, th, m0 - T0, m1 - T1, dt, P)  # the mean of T over the step (second order)
     t0, t1, z0, z1 = bs[BS_T], bs[BS_T + 1], bs[BS_Z], bs[BS_Z + 1]
     s = t0 + t1 + z0 + z1  # a NaN or an infinity anywhere makes the sum non-finite
@@ -243,8 +234,8 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
 
     Parameters
     ----------
-    P : TaosParams
-        The packed model (:func:`taos.taos3d.simulate.pack`).
+    P : record
+        The packed model (:func:`taos.taos3d.simulate.pack`; :class:`TaosParams` fields).
     fid : tuple of first-class functions
         The friction law's ``bearing_step``, ``zdot3``, ``torque3``
         (:data:`taos.friction.registry.BEARING_SIG`, ``ZDOT3_SIG``, ``TORQUE3_SIG``).
@@ -268,19 +259,26 @@ def integrate(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out):
     Returns -1, or the first step whose state became non-finite."""
     n = x0.shape[0]
     return _steps(P, fid, fp, avp, x0, bs0, r, dt, rec_every, out, np.empty((5, n)), np.empty(N_AUX),
-                  np.empty((4, 2)))
+                  np.empty((4, 2)), np.empty((2, 2)))
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def _steps(P, fid, fp, avp, x, bs, r, dt, rec_every, out, ks, aux, cs):
+def _compliance(P, kc):
+    """kc (2, 2) = the bearing compliance ``P.bearing_compliance`` [rad/(N m)], as a C array
+    (the friction law's bearing step takes an array)."""
+    Kc = P.bearing_compliance
+    for i in range(2):
+        for j in range(2):
+            kc[i, j] = Kc[i, j]
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _steps(P, fid, fp, avp, x, bs, r, dt, rec_every, out, ks, aux, cs, kc):
     """:func:`integrate`'s loop (arguments as there; ``ks`` (5, n), ``aux`` (N_AUX,), ``cs``
-    (4, 2) scratch), compiled without reference counting, with the step inlined (a call
-    passes the packed model's ~150 machine words on the stack)."""
+    (4, 2), ``kc`` (2, 2) scratch), compiled without reference counting; each step a call of
+    :func:`step`."""
     k1 = ks[0]
-    k2 = ks[1]
-    k3 = ks[2]
-    k4 = ks[3]
-    xt = ks[4]
+    _compliance(P, kc)
     c0 = cs[0]
     cm = cs[1]
     c1 = cs[2]
@@ -302,24 +300,27 @@ def _steps(P, fid, fp, avp, x, bs, r, dt, rec_every, out, ks, aux, cs):
             rec += 1
         if k == nsteps:
             break
-        if not _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, ready, psi):
+        if not step(x, bs, u, dt, P, fid, fp, ks, kc, aux, ready, psi):
             return k + 1
     return -1
 
 
-@njit(cache=True, fastmath=_FM, error_model="numpy")
-def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
-    """Two sines (pitch amp[0] sin(2 pi freq[0] t), yaw amp[1] sin(2 pi freq[1] t)) from rest;
-    Fourier coefficients at ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw)
-    (:data:`_DWELL_COLS`) over ``nmeas`` steps after ``nset``: out[o] = (2/N sum y sin,
-    2/N sum y cos, 1/N sum y) [m or rad].
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out, ks, aux, rec, cs, kc):
+    """Two sines (pitch amp[0] sin(2 pi freq[0] t), yaw amp[1] sin(2 pi freq[1] t)) from the
+    state ``x`` and bearing state ``bs`` (both advanced in place); Fourier coefficients at
+    ``fmeas`` of (xp_pitch, xp_yaw, theta_pitch, theta_yaw) (:data:`_DWELL_COLS`) over ``nmeas``
+    steps after ``nset``: out[o] = (2/N sum y sin, 2/N sum y cos, 1/N sum y) [m or rad].
+    Compiled without reference counting; each step a call of :func:`step` (as :func:`_steps`).
 
     Parameters
     ----------
     P, fid, fp, avp
         As :func:`integrate`.
-    x0 : (N_BODY + 2 n_a,) float64
-        The rest state (``X_*``); not modified.
+    x : (N_BODY + 2 n_a,) float64
+        The start state (``X_*``; the rest state for a dwell).
+    bs : (N_BEARING,) float64
+        The start bearing state (``BS_*``; zeros at rest).
     amp : (2,) float64
         Command amplitudes, pitch and yaw [rad].
     freq : (2,) float64
@@ -332,22 +333,12 @@ def _dwell_one(P, fid, fp, avp, x0, amp, freq, fmeas, dt, nset, nmeas, out):
         Settling and measured steps.
     out : (4, 3) float64
         Receives the Fourier coefficients.
+    ks, aux, rec, cs, kc
+        Scratch: (5, n), (N_AUX,), (len(REC),), (4, 2), (2, 2).
 
     Returns -1, or the first step whose state became non-finite."""
-    return _dwell_steps(P, fid, fp, avp, x0.copy(), np.zeros(N_BEARING), amp, freq, fmeas, dt, nset, nmeas, out,
-                        np.empty((5, x0.shape[0])), np.empty(N_AUX), np.empty(len(REC)), np.empty((4, 2)))
-
-
-@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
-def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out, ks, aux, rec, cs):
-    """:func:`_dwell_one`'s loop from the state ``x``, bearing state ``bs`` (scratch ``ks``
-    (5, n), ``aux``, ``rec``, ``cs`` (4, 2)), compiled without reference counting, with the
-    step inlined (as :func:`_steps`)."""
     k1 = ks[0]
-    k2 = ks[1]
-    k3 = ks[2]
-    k4 = ks[3]
-    xt = ks[4]
+    _compliance(P, kc)
     c0 = cs[0]
     cm = cs[1]
     c1 = cs[2]
@@ -373,7 +364,7 @@ def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out,
                 out[o, 0] += y * s
                 out[o, 1] += y * c
                 out[o, 2] += y
-        if not _step(x, bs, u, dt, P, fid, fp, avp, k1, k2, k3, k4, xt, aux, k >= nset, psi):
+        if not step(x, bs, u, dt, P, fid, fp, ks, kc, aux, k >= nset, psi):
             return k + 1
     for o in range(4):
         out[o, 0] *= 2.0 / nmeas
@@ -385,11 +376,24 @@ def _dwell_steps(P, fid, fp, avp, x, bs, amp, freq, fmeas, dt, nset, nmeas, out,
 @njit(cache=True, nogil=True, fastmath=_FM, error_model="numpy")
 def dwell_batch(P, fid, fp, avp, x0, amps, freqs, fmeas, dts, nset, nmeas, out, status, b0, b1):
     """Independent two-axis dwells b0 <= b < b1, one after the other without the GIL (the caller
-    runs slices on threads: :func:`taos.planar._parallel.run_each`): :func:`_dwell_one` for row b of ``amps``
-    (n, 2) [rad] and ``freqs`` (n, 2) [Hz], with ``fmeas`` (n,) [Hz], ``dts`` (n,) [s],
-    ``nset``, ``nmeas`` (n,) int, into ``out[b]`` (n, 4, 3) and ``status[b]`` (n,) int
-    (-1 or the failing step); ``P``, ``fid``, ``fp``, ``avp``, ``x0`` as :func:`_dwell_one`."""
+    runs slices on threads: :func:`taos.planar._parallel.run_each`): :func:`_dwell_steps` from
+    the rest state ``x0`` (not modified) for row b of ``amps`` (n, 2) [rad] and ``freqs`` (n, 2)
+    [Hz], with ``fmeas`` (n,) [Hz], ``dts`` (n,) [s], ``nset``, ``nmeas`` (n,) int, into
+    ``out[b]`` (n, 4, 3) and ``status[b]`` (n,) int (-1 or the failing step); ``P``, ``fid``,
+    ``fp``, ``avp`` as :func:`integrate`."""
+    n = x0.shape[0]
+    x = np.empty(n)
+    bs = np.empty(N_BEARING)
+    ks = np.empty((5, n))
+    aux = np.empty(N_AUX)
+    rec = np.empty(len(REC))
+    cs = np.empty((4, 2))
+    kc = np.empty((2, 2))
     for b in range(b0, b1):
-        status[b] = _dwell_one(P, fid, fp, avp, x0, amps[b], freqs[b], fmeas[b], dts[b], nset[b],
-                               nmeas[b], out[b])
+        for i in range(n):
+            x[i] = x0[i]
+        for i in range(N_BEARING):
+            bs[i] = 0.0
+        status[b] = _dwell_steps(P, fid, fp, avp, x, bs, amps[b], freqs[b], fmeas[b], dts[b], nset[b], nmeas[b],
+                                 out[b], ks, aux, rec, cs, kc)
 

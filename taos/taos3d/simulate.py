@@ -41,12 +41,12 @@ INTEGRATOR = "rk4, trapezoidal bearing torque + BDF2 bearing substeps"
 
 @dataclass(frozen=True, eq=False)
 class Packed:
-    """Arrays the compiled kernels take (see :func:`pack`): the model ``P``
-    (:class:`taos.taos3d.dynamics.TaosParams`), the friction law's kernels
+    """Arrays the compiled kernels take (see :func:`pack`): the model ``P`` (a record with the
+    fields of :class:`taos.taos3d.dynamics.TaosParams`, :func:`taos.taos3d._layout.as_record`), the friction law's kernels
     ``fid`` = (``bearing_step``, ``zdot3``, ``torque3``) (its registry entry's) and packed parameters ``fp`` (scaled by the normal load), the
     packed avionics ``avp``, the state length and the actuator's state length."""
 
-    P: _dy.TaosParams
+    P: np.record
     fid: object
     fp: np.ndarray
     avp: np.ndarray
@@ -57,10 +57,15 @@ class Packed:
 def actuator_limits(tm: TaosModel) -> np.ndarray:
     """The actuator and gimbal limits (:mod:`taos.planar.saturation`) packed over one actuator's state:
     valve flow saturation, supply-pressure limit (square-root law, relief valve) per actuator, hard stops per axis (the
-    stop damping from the pitch inertia; the 3-D engine is axisymmetric about its axis)."""
-    from ..planar.saturation import limit_rows_for_actuator, pack_model_limits
+    stop damping from the pitch inertia; the 3-D engine is axisymmetric about its axis). With every limit off, the
+    same layout all zeros (the kernels act on a limit only where its head slot is positive, so this is the same as no
+    limits), so that every model of one actuator size is one record type: one compiled kernel family."""
+    from ..planar.saturation import N_HEAD, N_ROWS, limit_rows_for_actuator, pack_model_limits
     rows, _ = limit_rows_for_actuator(tm.base.actuator)
-    return pack_model_limits(tm.base.actuator, tm.base.engine, "pitch", rows)
+    lim = pack_model_limits(tm.base.actuator, tm.base.engine, "pitch", rows)
+    if lim.size == 0:
+        lim = np.zeros(N_HEAD + N_ROWS * len(next(iter(rows.values()))))
+    return lim
 
 
 def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
@@ -75,7 +80,7 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     act = actuator_state_space(tm.base.actuator)
     geo = tm.geometry
     R = tm.base.actuator.moment_arm_m
-    P = _dy.TaosParams(
+    P = _dy.TaosParams(   # the named tuple names every field; the kernels take it as a record
         spatial_inertia=f64(Y), spatial_inertia_inv=f64(np.linalg.inv(Y)), chain_stiffness=f64(Ks),
         slip_gain=f64(G), bearing_compliance=f64(Kc), bearing_selection=f64(S),
         structure_attach_m=f64(geo.structure_attach_m), engine_attach_m=f64(geo.engine_attach_m),
@@ -94,7 +99,7 @@ def pack(tm: TaosModel, ideal_avionics: bool = False) -> Packed:
     fp = law.pack()
     av = tm.base.avionics.ideal() if ideal_avionics else tm.base.avionics
     na = act.A.shape[0]
-    return Packed(P, (law.entry.bearing_step, law.entry.zdot3, law.entry.torque3), fp, av.pack(), _dy.N_BODY + 2 * na, na)
+    return Packed(_dy.as_record(P), (law.entry.bearing_step, law.entry.zdot3, law.entry.torque3), fp, av.pack(), _dy.N_BODY + 2 * na, na)
 
 
 def rest_state(pk: Packed) -> np.ndarray:
@@ -151,8 +156,9 @@ def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int =
     pk = pack(tm) if pk is None else pk
     nrec = (cmd.shape[0] - 1) // record_every + 1
     out = np.empty((nrec, len(_dy.REC)))
-    status = _dy.integrate(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(_dy.N_BEARING), cmd, dt_s,
-                           record_every, out)
+    n = pk.n_state   # integrate's loop, called with its scratch (one compiled kernel less to load)
+    status = _dy._steps(pk.P, pk.fid, pk.fp, pk.avp, rest_state(pk), np.zeros(_dy.N_BEARING), cmd, dt_s,
+                        record_every, out, np.empty((5, n)), np.empty(_dy.N_AUX), np.empty((4, 2)), np.empty((2, 2)))
     if status >= 0:
         raise SimulationUnstable(status * dt_s, f"TAOS, {tm.base.friction.name} friction, dt = {dt_s} s")
     return out
