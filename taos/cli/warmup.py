@@ -15,8 +15,9 @@ signature's data file. A step that calls a non-inlined cached kernel of another 
 that callee too, so the steps sharing such callees form one group and a group is never split:
 
 * ``planar``: the planar simulation, the dwells (ETDRK4 and RK4), the shooting kernels and the
-  verdict map's confirmation share ``planar.dynamics`` (``integrate_samples``, ``sine_steps``,
-  ``saturation.apply``) and ``planar._expstep``;
+  verdict map's confirmation share ``planar.dynamics`` (``integrate_samples``, which the
+  confirmation runs itself, ``_rk4_step``, ``sine_steps``, ``saturation.apply``) and
+  ``planar._expstep`` (``etdrk4_step``, ``_nonlin``, ``sine_steps_exp``);
 * ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` (with its pieces ``taos3d._rhs``,
   ``taos3d._commands``, ``taos3d._so3``) and ``taos3d._bearing``;
 * ``friction``: every built-in law's C callbacks, the lane forms included (``friction.registry.load_all``).

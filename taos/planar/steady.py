@@ -68,7 +68,7 @@ def _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, am
     if use_exp:
         E, E2, P2, F1, F2, F3, G, D, tab_m = ex
         return _ex.sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D,
-                                  tab_m, amp, n_per_cycle, dt, x, z, 0, nsteps, meas, out)
+                                  tab_m, amp, n_per_cycle, dt, x, z, int(0), nsteps, meas, out)
     return _ig.sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z, nsteps,
                           meas, out, k1, k2, k3, k4, xt, r0, rm, r1)
 
@@ -91,7 +91,7 @@ def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, a
     corr[:, :] = 0.0
     z0 = src[n] if nz else 0.0
     z, st, zmax = _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, x,
-                         z0, n_per_cycle, True, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+                         z0, n_per_cycle, bool(True), corr, k1, k2, k3, k4, xt, r0, rm, r1)
     if set_zscale and nz:
         s[n] = max(zmax, 1e-300)
     d = 0.0
@@ -102,6 +102,14 @@ def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, a
         dst[n] = z
         d = max(d, abs(z - src[n]) / s[n])
     return st, d
+
+
+@njit(cache=True, inline="always")
+def _copy(src, dst, m):
+    """dst[:m] = src[:m] as an element loop (an array-to-array slice assignment's shape check
+    compiles an exception message: seconds of compile for nothing)."""
+    for i in range(m):
+        dst[i] = src[i]
 
 
 @njit(cache=True, fastmath=_FM)
@@ -128,7 +136,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
     s = scale.copy()
     kk = k_rre + 2
     Y = np.zeros((kk, n + 1))  # iterates of one extrapolation cycle (unscaled; entry n unused if nz = 0)
-    Y[0, :] = y0
+    _copy(y0, Y[0], n + 1)
     ystar = Y[0].copy()       # the start the response is measured from (corr holds its period)
     res = np.inf
     periods = 0
@@ -145,7 +153,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
                 return st + (periods - 1) * n_per_cycle
             if d <= tol:
                 res = d
-                ystar[:] = Y[i - 1]
+                _copy(Y[i - 1], ystar, n + 1)
                 converged = True
                 used = i + 1
                 break
@@ -177,9 +185,9 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
                 nxt[i] = acc / sg
                 ok = ok and math.isfinite(nxt[i])
         if not ok:
-            Y[0] = Y[kk - 1]
+            _copy(Y[kk - 1], Y[0], n + 1)
             break
-        Y[0, :m] = nxt[:m]
+        _copy(nxt, Y[0], m)
     if not converged:
         # fallback: integrate on from the last point until the settled dwell's budget is spent
         cur = Y[0].copy()
@@ -189,22 +197,23 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
             periods += 1
             if st >= 0:
                 return st + (periods - 1) * n_per_cycle
-            ystar[:] = cur
+            _copy(cur, ystar, n + 1)
             res = d
-            cur[:] = nxt
+            _copy(nxt, cur, n + 1)
             if d <= tol:
                 converged = True
                 break
     # measure from the periodic start: one measured period is the one already integrated from it
     # (the same steps from the same state); more periods are integrated again from it
     if n_meas == n_per_cycle:
-        out[:, :] = corr
+        for o in range(out.shape[0]):
+            _copy(corr[o], out[o], 3)
     else:
         out[:, :] = 0.0
-        x[:] = ystar[:n]
+        _copy(ystar, x, n)
         z0 = ystar[n] if nz else 0.0
         _, st, _ = _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, x,
-                          z0, n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
+                          z0, n_meas, bool(True), out, k1, k2, k3, k4, xt, r0, rm, r1)
         if st >= 0:
             return st + periods * n_per_cycle
     _ig.normalise_sums(out, n_meas)
