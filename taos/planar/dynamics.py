@@ -188,22 +188,25 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
             r0[j] = r[k, j]
             r1[j] = r[k1n, j]
             rm[j] = 0.5 * (r0[j] + r1[j])
-        if k % rec_every == 0:
-            # outputs at the step start; T_f and u from a rate evaluation there
-            dz, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k1)
+        record = k % rec_every == 0
+        if record:  # outputs at the step start
             for o in range(Cy.shape[0]):
                 s = 0.0
                 for i in range(n):
                     s += Cy[o, i] * x[i]
                 y_out[rec, o] = s
-            aux_out[rec, AUX_TF] = tf
             aux_out[rec, AUX_Z] = z
+        # T_f and u at the step start come from the step's first rate evaluation; after the last
+        # sample a step of zero length gives them (x and z are left as they are)
+        zn, tf, u = _rk4_step(x, z, r0, rm, r1, dt if k < nsteps else 0.0, A, Br, bc, bf, cc, dc, cw, ca, lim,
+                              fid, fp, avp, k1, k2, k3, k4, xt)
+        if record:
+            aux_out[rec, AUX_TF] = tf
             aux_out[rec, AUX_U] = u
             rec += 1
         if k == nsteps:
             break
-        z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
-                            k1, k2, k3, k4, xt)
+        z = zn
         if not _finite(x, z):
             return k + 1
     return -1

@@ -45,9 +45,20 @@ import math
 
 import numpy as np
 from numba import njit
+from numba.core import types as _nbtypes
 
 from . import _expstep as _ex
 from . import dynamics as _ig
+
+#: numba's LAPACK driver of ``np.linalg.lstsq`` (``numba_ez_gelsd`` in numba's helper library,
+#: the signature of ``numba.np.linalg._LAPACK.numba_ez_gelsd`` for float64, Fortran integers
+#: int32): kind, m, n, nrhs, a, lda, b, ldb, s, rcond, rank -> status
+_F_INT = np.int32
+_P = _nbtypes.CPointer
+_GELSD = _nbtypes.ExternalFunction("numba_ez_gelsd", _nbtypes.intc(
+    _nbtypes.char, _nbtypes.intp, _nbtypes.intp, _nbtypes.intp, _P(_nbtypes.float64), _nbtypes.intp,
+    _P(_nbtypes.float64), _nbtypes.intp, _P(_nbtypes.float64), _nbtypes.float64, _P(_nbtypes.int32)))
+_KIND_D = ord("d")
 
 _FM = _ig._FM
 
@@ -102,6 +113,27 @@ def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, a
         dst[n] = z
         d = max(d, abs(z - src[n]) / s[n])
     return st, d
+
+
+@njit(cache=True)
+def _lstsq_ones(M):
+    """np.linalg.lstsq(M, ones)[0] for a square ``M`` (q, q): the minimum-norm least-squares
+    solution by the same LAPACK call as numba's ``np.linalg.lstsq`` (``dgelsd`` through
+    numba's ``numba_ez_gelsd``, rcond -1: singular values below machine precision times the
+    largest dropped), so the same bits, without its wrapper's shape and finiteness checks whose
+    exception messages cost 5-10 s of compile (``M`` is finite here: finite periods). NaNs if
+    the SVD does not converge (the caller then falls back to integrating on)."""
+    q = M.shape[0]
+    a = np.empty(q * q)       # Fortran order
+    for j in range(q):
+        for i in range(q):
+            a[i + q * j] = M[i, j]
+    b = np.ones(q)
+    s = np.empty(q)
+    rank = np.empty(1, _F_INT)
+    if _GELSD(_KIND_D, q, q, 1, a.ctypes, q, b.ctypes, q, s.ctypes, -1.0, rank.ctypes) != 0:
+        b[:] = np.nan
+    return b
 
 
 @njit(cache=True, inline="always")
@@ -173,7 +205,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
             tr += M[a, a]
         for a in range(q):
             M[a, a] += 1e-15 * tr
-        gam = np.linalg.lstsq(M, np.ones(q))[0]
+        gam = _lstsq_ones(M)
         sg = gam.sum()
         ok = math.isfinite(sg) and sg != 0.0
         cycles += 1
