@@ -15,8 +15,9 @@ signature's data file. A step that calls a non-inlined cached kernel of another 
 that callee too, so the steps sharing such callees form one group and a group is never split:
 
 * ``planar``: the planar simulation, the dwells (ETDRK4 and RK4), the shooting kernels and the
-  verdict map's confirmation share ``planar.dynamics`` (``integrate_samples``, ``sine_steps``,
-  ``saturation.apply``) and ``planar._expstep``;
+  verdict map's confirmation share ``planar.dynamics`` (``integrate_samples``, which the
+  confirmation runs itself, ``_rk4_step``, ``sine_steps``, ``saturation.apply``) and
+  ``planar._expstep`` (``etdrk4_step``, ``_nonlin``, ``sine_steps_exp``);
 * ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` (with its pieces ``taos3d._rhs``,
   ``taos3d._commands``, ``taos3d._so3``) and ``taos3d._bearing``;
 * ``friction``: every built-in law's C callbacks, the lane forms included (``friction.registry.load_all``).
@@ -136,12 +137,14 @@ class Step:
 
 
 STEPS: tuple[Step, ...] = (
+    # the planar steps' costs: the previous quiet-machine figures times each step's measured
+    # after/before ratio (issue 44 point 1, benchmarks/RESULTS.md "planar kernels' cold compile")
     Step("simulate", "planar", _simulate, 7.6),
-    Step("simulate exponential", "planar", _simulate_exp, 12.2),
-    Step("dwell exponential", "planar", _dwell, 8.3),
-    Step("dwell rk4", "planar", lambda: _dwell(integrator="rk4"), 12.1),
-    Step("shoot", "planar", _shoot, 22.7),
-    Step("lco confirmation", "planar", _lco_confirm, 1.6),
+    Step("simulate exponential", "planar", _simulate_exp, 7.0),
+    Step("dwell exponential", "planar", _dwell, 6.6),
+    Step("dwell rk4", "planar", lambda: _dwell(integrator="rk4"), 4.7),
+    Step("shoot", "planar", _shoot, 14.4),
+    Step("lco confirmation", "planar", _lco_confirm, 0.1),
     Step("friction laws", "friction", _friction, 4.7),
     Step("ascent lanes", "lanes", _ascent_lanes, 16.3),
     Step("3-D model", "3d", _taos_model, 10.5),

@@ -57,7 +57,6 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from taos.harmonics import harmonic_amplitudes
 from taos.planar import dynamics as _dyn
@@ -79,15 +78,6 @@ PREROLL_CYCLES, PREROLL_STEPS = 3, 4000
 #: recorded every this many integration steps
 RECORD_EVERY = 25
 OUTCOMES = ("sustained", "decays", "grows", "undecided")
-
-
-@njit(cache=True, nogil=True)
-def _integrate_nogil(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, z0, r, dt, rec_every, y_out,
-                     aux_out):
-    """:func:`taos.planar.dynamics.integrate_samples` without the GIL (same arguments, same
-    arithmetic), so independent runs proceed on several threads."""
-    return _dyn.integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, z0, r, dt, rec_every,
-                                  y_out, aux_out)
 
 
 @dataclass(frozen=True)
@@ -244,7 +234,8 @@ def confirm(plant, model, start: CycleStart, *, duration_s: float = 300.0, windo
         nrec = k // RECORD_EVERY + 1
         y = np.empty((nrec, Cy.shape[0]))
         aux = np.empty((nrec, _dyn.N_AUX))
-        st = _integrate_nogil(*args, Cy, *kern, x, z, np.zeros((k + 1, 1)), dt_s, RECORD_EVERY, y, aux)
+        # integrate_samples runs without the GIL: the confirmations proceed on several threads
+        st = _dyn.integrate_samples(*args, Cy, *kern, x, z, np.zeros((k + 1, 1)), dt_s, RECORD_EVERY, y, aux)
         if st >= 0:
             raise SimulationUnstable((done + st) * dt_s, f"{model.friction.name} friction, confirmation run")
         x, z = np.ascontiguousarray(y[-1, 2:]), float(aux[-1, _dyn.AUX_Z])
@@ -298,12 +289,13 @@ def confirm_many(jobs, threads: int | None = None, **kw) -> list[Confirmation]:
 
 
 def compile_kernel(model) -> None:
-    """Compile (or load from the cache) the confirmation's kernel with ``model``'s plant types:
+    """Compile (or load from the cache) the confirmation's kernel (the simulation's own
+    :func:`taos.planar.dynamics.integrate_samples`, the same specialisation) with ``model``'s plant types:
     a run of no step on its simplex plant (``python -m taos.cli.warmup`` calls it)."""
     from taos.planar.simplex import simplex_plant
 
     plant = simplex_plant(model, "pitch")
     n = plant.ss.A.shape[0]
     y, aux = np.empty((1, n)), np.empty((1, _dyn.N_AUX))
-    _integrate_nogil(*kernel_args(plant, model), np.eye(n), model.friction.entry.rates, model.friction.pack(),
+    _dyn.integrate_samples(*kernel_args(plant, model), np.eye(n), model.friction.entry.rates, model.friction.pack(),
                      model.avionics.pack(), np.zeros(n), 0.0, np.zeros((1, plant.n_ext)), 1e-4, 1, y, aux)

@@ -106,9 +106,9 @@ def _friction_rate(fid, fp, w, ta, z, cwbf, cabf):
         dw = max(1e-7, 1e-5 * abs(w[k]))
         dz = max(1e-12, 1e-5 * abs(z[k]))
         da = max(1e-3, 1e-5 * abs(ta[k]))
-        Tw, gw = _quotients(fid, fp, w[k], z[k], ta[k], 0, dw)
-        Tz, gz = _quotients(fid, fp, w[k], z[k], ta[k], 1, dz)
-        Ta, ga = _quotients(fid, fp, w[k], z[k], ta[k], 2, da)
+        Tw, gw = _quotients(fid, fp, w[k], z[k], ta[k], int(0), dw)
+        Tz, gz = _quotients(fid, fp, w[k], z[k], ta[k], int(1), dz)
+        Ta, ga = _quotients(fid, fp, w[k], z[k], ta[k], int(2), da)
         m11 = Tw * cwbf + Ta * cabf
         m21 = gw * cwbf + ga * cabf
         tr = m11 + gz

@@ -169,9 +169,10 @@ def etd_coefficients(A: np.ndarray, h: float):
             c(h * (4 * p3 - p2)))
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM)
 def _matvec_add(M, v, out, scale):
-    """out += scale * M v."""
+    """out += scale * M v. (Not inlined, as :func:`_nonlin`: compiled once per process and cache;
+    LLVM still inlines it into its callers when it links them, so the warm step is unchanged.)"""
     n = out.shape[0]
     for i in range(n):
         s = 0.0
@@ -247,11 +248,12 @@ def _stair(G, D, H, M, cmax, w, ph0, ph1, avp, out):
     return u
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM)
 def _nonlin(x, z, r, u, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, N):
     """N(x, z, t) of the module docstring into ``N`` (n,) [x/s]; returns dz/dt [rad/s]. ``r``
     the external input [r], ``u`` the avionics output [rad]; with ``stair`` false the command
-    term b_c u is carried here (no quantiser)."""
+    term b_c u is carried here (no quantiser). Not inlined: :func:`etdrk4_step`'s four calls
+    share one compile (LLVM inlines it at link time)."""
     n = x.shape[0]
     w = 0.0
     ta = 0.0
@@ -388,11 +390,11 @@ def _dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, 
     dt = 1.0 / (freq * n_per_cycle)
     out[:, :] = 0.0
     z, st, _ = sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D,
-                              tab_m, amp, n_per_cycle, dt, x, 0.0, 0, n_settle, False, out)
+                              tab_m, amp, n_per_cycle, dt, x, 0.0, int(0), n_settle, bool(False), out)
     if st >= 0:
         return st
     _, st, _ = sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D,
-                              tab_m, amp, n_per_cycle, dt, x, z, n_settle, n_meas, True, out)
+                              tab_m, amp, n_per_cycle, dt, x, z, n_settle, n_meas, bool(True), out)
     if st >= 0:
         return st + n_settle
     _dy.normalise_sums(out, n_meas)

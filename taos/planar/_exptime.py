@@ -247,19 +247,24 @@ def linear_orbit(E, P1, P2, cs, every, xs):
     (n_samples,) linear between samples (first-order hold: x+ = E x + h phi_1 b c_k + h phi_2
     b (c_{k+1} - c_k) with ``E`` = e^{hA}, ``P1`` = h phi_1(hA) b, ``P2`` = h phi_2(hA) b), its
     state every ``every`` samples into ``xs`` (n_samples // every + 1, n)."""
+    # element loops, no array-to-array slice assignment (its shape check's exception message
+    # costs 5 s of compile)
     n = E.shape[0]
     x = np.zeros(n)
     xn = np.empty(n)
-    xs[0] = x
+    for i in range(n):
+        xs[0, i] = 0.0
     for k in range(cs.shape[0] - 1):
         for i in range(n):
             s = P1[i] * cs[k] + P2[i] * (cs[k + 1] - cs[k])
             for j in range(n):
                 s += E[i, j] * x[j]
             xn[i] = s
-        x[:] = xn
+        for i in range(n):
+            x[i] = xn[i]
         if (k + 1) % every == 0:
-            xs[(k + 1) // every] = x
+            for i in range(n):
+                xs[(k + 1) // every, i] = x[i]
 
 
 @njit(cache=True)

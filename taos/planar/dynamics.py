@@ -108,7 +108,7 @@ def work_buffers(n, nr):
             np.empty(nr), np.empty(nr), np.empty(nr))
 
 
-@njit(cache=True, fastmath=_FM, inline="always")
+@njit(cache=True, fastmath=_FM)
 def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
               k1, k2, k3, k4, xt):
     """Advance (x, z) by one classical RK4 step in place; return (z_new [rad], T_f [N m], u [rad])
@@ -117,7 +117,13 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
     ``x`` (n,) [x] (in place), ``z`` [rad]; ``r0``, ``rm``, ``r1`` (n_r,) [r] the external input
     at the step's start, middle and end; ``dt`` [s]; plant arrays, ``fid``, ``fp``, ``avp``:
     module docstring; ``k1``..``k4``, ``xt`` (n,) scratch (k1 receives the derivative at the
-    step start)."""
+    step start).
+
+    Compiled once, not inlined: :func:`integrate_samples`, :func:`sine_steps` and the shooting
+    periods (:mod:`taos.planar.steady`) call this one compiled step (inlined, each caller paid
+    for typing and lowering four copies of :func:`_rates` again). :func:`_rates` stays inlined
+    here: called out of line, its ~110 scalar arguments (arrays pass as their fields) cost 30 %
+    of the warm step."""
     n = x.shape[0]
     dz1, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k1)
     for i in range(n):
@@ -182,22 +188,25 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
             r0[j] = r[k, j]
             r1[j] = r[k1n, j]
             rm[j] = 0.5 * (r0[j] + r1[j])
-        if k % rec_every == 0:
-            # outputs at the step start; T_f and u from a rate evaluation there
-            dz, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k1)
+        record = k % rec_every == 0
+        if record:  # outputs at the step start
             for o in range(Cy.shape[0]):
                 s = 0.0
                 for i in range(n):
                     s += Cy[o, i] * x[i]
                 y_out[rec, o] = s
-            aux_out[rec, AUX_TF] = tf
             aux_out[rec, AUX_Z] = z
+        # T_f and u at the step start come from the step's first rate evaluation; after the last
+        # sample a step of zero length gives them (x and z are left as they are)
+        zn, tf, u = _rk4_step(x, z, r0, rm, r1, dt if k < nsteps else 0.0, A, Br, bc, bf, cc, dc, cw, ca, lim,
+                              fid, fp, avp, k1, k2, k3, k4, xt)
+        if record:
+            aux_out[rec, AUX_TF] = tf
             aux_out[rec, AUX_U] = u
             rec += 1
         if k == nsteps:
             break
-        z, _, _ = _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
-                            k1, k2, k3, k4, xt)
+        z = zn
         if not _finite(x, z):
             return k + 1
     return -1
@@ -295,11 +304,11 @@ def _sine_dwell_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, f
     k1, k2, k3, k4, xt, r0, rm, r1 = work_buffers(n, nr)
     out[:, :] = 0.0
     z, st, _ = sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, 0.0,
-                          n_settle, False, out, k1, k2, k3, k4, xt, r0, rm, r1)
+                          n_settle, bool(False), out, k1, k2, k3, k4, xt, r0, rm, r1)
     if st >= 0:
         return st
     _, st, _ = sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z,
-                          n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
+                          n_meas, bool(True), out, k1, k2, k3, k4, xt, r0, rm, r1)
     if st >= 0:
         return st + n_settle
     normalise_sums(out, n_meas)

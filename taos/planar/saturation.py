@@ -270,7 +270,9 @@ def apply(lim, x, u, dx):
     ``dx`` the derivative corrected in place (as :func:`apply_valve_pressure` with off = 0)."""
     if lim.shape[0] == 0:
         return
-    apply_valve_pressure(lim, x, 0, u, dx)
+    # int(0): a run-time zero, not the literal 0 (a literal argument of a jitted call compiles a
+    # specialisation of its own: numba types a constant argument as Literal[int](0))
+    apply_valve_pressure(lim, x, int(0), u, dx)
     if lim[LIM_THMAX] > 0.0:
         m = (lim.shape[0] - N_HEAD) // N_ROWS
         t = stop_torque(_dot(lim, ROW_THETA, m, x, 0), _dot(lim, ROW_OMEGA, m, x, 0), lim[LIM_THMAX],

@@ -45,9 +45,20 @@ import math
 
 import numpy as np
 from numba import njit
+from numba.core import types as _nbtypes
 
 from . import _expstep as _ex
 from . import dynamics as _ig
+
+#: numba's LAPACK driver of ``np.linalg.lstsq`` (``numba_ez_gelsd`` in numba's helper library,
+#: the signature of ``numba.np.linalg._LAPACK.numba_ez_gelsd`` for float64, Fortran integers
+#: int32): kind, m, n, nrhs, a, lda, b, ldb, s, rcond, rank -> status
+_F_INT = np.int32
+_P = _nbtypes.CPointer
+_GELSD = _nbtypes.ExternalFunction("numba_ez_gelsd", _nbtypes.intc(
+    _nbtypes.char, _nbtypes.intp, _nbtypes.intp, _nbtypes.intp, _P(_nbtypes.float64), _nbtypes.intp,
+    _P(_nbtypes.float64), _nbtypes.intp, _P(_nbtypes.float64), _nbtypes.float64, _P(_nbtypes.int32)))
+_KIND_D = ord("d")
 
 _FM = _ig._FM
 
@@ -68,7 +79,7 @@ def _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, am
     if use_exp:
         E, E2, P2, F1, F2, F3, G, D, tab_m = ex
         return _ex.sine_steps_exp(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, E, E2, P2, F1, F2, F3, G, D,
-                                  tab_m, amp, n_per_cycle, dt, x, z, 0, nsteps, meas, out)
+                                  tab_m, amp, n_per_cycle, dt, x, z, int(0), nsteps, meas, out)
     return _ig.sine_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, amp, n_per_cycle, dt, x, z, nsteps,
                           meas, out, k1, k2, k3, k4, xt, r0, rm, r1)
 
@@ -91,7 +102,7 @@ def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, a
     corr[:, :] = 0.0
     z0 = src[n] if nz else 0.0
     z, st, zmax = _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, x,
-                         z0, n_per_cycle, True, corr, k1, k2, k3, k4, xt, r0, rm, r1)
+                         z0, n_per_cycle, bool(True), corr, k1, k2, k3, k4, xt, r0, rm, r1)
     if set_zscale and nz:
         s[n] = max(zmax, 1e-300)
     d = 0.0
@@ -102,6 +113,35 @@ def _period(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, a
         dst[n] = z
         d = max(d, abs(z - src[n]) / s[n])
     return st, d
+
+
+@njit(cache=True)
+def _lstsq_ones(M):
+    """np.linalg.lstsq(M, ones)[0] for a square ``M`` (q, q): the minimum-norm least-squares
+    solution by the same LAPACK call as numba's ``np.linalg.lstsq`` (``dgelsd`` through
+    numba's ``numba_ez_gelsd``, rcond -1: singular values below machine precision times the
+    largest dropped), so the same bits, without its wrapper's shape and finiteness checks whose
+    exception messages cost 5-10 s of compile (``M`` is finite here: finite periods). NaNs if
+    the SVD does not converge (the caller then falls back to integrating on)."""
+    q = M.shape[0]
+    a = np.empty(q * q)       # Fortran order
+    for j in range(q):
+        for i in range(q):
+            a[i + q * j] = M[i, j]
+    b = np.ones(q)
+    s = np.empty(q)
+    rank = np.empty(1, _F_INT)
+    if _GELSD(_KIND_D, q, q, 1, a.ctypes, q, b.ctypes, q, s.ctypes, -1.0, rank.ctypes) != 0:
+        b[:] = np.nan
+    return b
+
+
+@njit(cache=True, inline="always")
+def _copy(src, dst, m):
+    """dst[:m] = src[:m] as an element loop (an array-to-array slice assignment's shape check
+    compiles an exception message: seconds of compile for nothing)."""
+    for i in range(m):
+        dst[i] = src[i]
 
 
 @njit(cache=True, fastmath=_FM)
@@ -128,7 +168,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
     s = scale.copy()
     kk = k_rre + 2
     Y = np.zeros((kk, n + 1))  # iterates of one extrapolation cycle (unscaled; entry n unused if nz = 0)
-    Y[0, :] = y0
+    _copy(y0, Y[0], n + 1)
     ystar = Y[0].copy()       # the start the response is measured from (corr holds its period)
     res = np.inf
     periods = 0
@@ -145,7 +185,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
                 return st + (periods - 1) * n_per_cycle
             if d <= tol:
                 res = d
-                ystar[:] = Y[i - 1]
+                _copy(Y[i - 1], ystar, n + 1)
                 converged = True
                 used = i + 1
                 break
@@ -165,7 +205,7 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
             tr += M[a, a]
         for a in range(q):
             M[a, a] += 1e-15 * tr
-        gam = np.linalg.lstsq(M, np.ones(q))[0]
+        gam = _lstsq_ones(M)
         sg = gam.sum()
         ok = math.isfinite(sg) and sg != 0.0
         cycles += 1
@@ -177,9 +217,9 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
                 nxt[i] = acc / sg
                 ok = ok and math.isfinite(nxt[i])
         if not ok:
-            Y[0] = Y[kk - 1]
+            _copy(Y[kk - 1], Y[0], n + 1)
             break
-        Y[0, :m] = nxt[:m]
+        _copy(nxt, Y[0], m)
     if not converged:
         # fallback: integrate on from the last point until the settled dwell's budget is spent
         cur = Y[0].copy()
@@ -189,22 +229,23 @@ def _shoot_one(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp
             periods += 1
             if st >= 0:
                 return st + (periods - 1) * n_per_cycle
-            ystar[:] = cur
+            _copy(cur, ystar, n + 1)
             res = d
-            cur[:] = nxt
+            _copy(nxt, cur, n + 1)
             if d <= tol:
                 converged = True
                 break
     # measure from the periodic start: one measured period is the one already integrated from it
     # (the same steps from the same state); more periods are integrated again from it
     if n_meas == n_per_cycle:
-        out[:, :] = corr
+        for o in range(out.shape[0]):
+            _copy(corr[o], out[o], 3)
     else:
         out[:, :] = 0.0
-        x[:] = ystar[:n]
+        _copy(ystar, x, n)
         z0 = ystar[n] if nz else 0.0
         _, st, _ = _steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, ex, use_exp, amp, n_per_cycle, dt, x,
-                          z0, n_meas, True, out, k1, k2, k3, k4, xt, r0, rm, r1)
+                          z0, n_meas, bool(True), out, k1, k2, k3, k4, xt, r0, rm, r1)
         if st >= 0:
             return st + periods * n_per_cycle
     _ig.normalise_sums(out, n_meas)
