@@ -1,8 +1,14 @@
 """Compile and cache every numba kernel once (``python -m taos.cli.warmup``; run by ``make test``).
 
 The integrator kernels take tens of seconds to compile on a cold cache and are cached on disk
-after their first use. ``make demo`` does not warm up: the Green Run compiles just the
-kernels it uses. ``make test`` warms every kernel first, so that no test pays a compile.
+after their first use. ``make test`` warms every kernel first, so that no test pays a compile.
+``make demo`` does not warm everything: the Green Run compiles just the kernels it uses, and
+beside it a second process compiles the planar simulation's step (``--only simulate``: the
+figures of merit's runs), which the Green Run would otherwise compile after the 3-D model's
+kernels on the same core (numba compiles one kernel at a time in a process). Both processes may
+compile a shared kernel (the friction law's C callbacks) at once: each kernel has one
+specialisation (``tests/test_kernel_specialisations.py``), so both save the same key, which
+numba's cache allows (below); a warm cache makes the second process a load of about a second.
 
 ``--part K/N`` compiles the K-th of N disjoint shares of the kernels, so that ``make`` runs the
 shares at the same time on several cores (``make`` runs ``--part 1/2`` and ``--part 2/2``).
@@ -295,10 +301,22 @@ def _part(text: str) -> tuple[int, int]:
     return k, n
 
 
+def _names(text: str) -> frozenset[str]:
+    names = frozenset(v.strip() for v in text.split(","))
+    known = {s.name for s in STEPS}
+    if not names <= known:
+        raise argparse.ArgumentTypeError(f"unknown step(s) {sorted(names - known)}; expected some of {sorted(known)}")
+    return names
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m taos.cli.warmup", description=__doc__.splitlines()[0])
     ap.add_argument("--part", type=_part, default=(1, 1), metavar="K/N",
                     help="compile the K-th of N disjoint shares of the kernels (default 1/1: all)")
+    ap.add_argument("--only", type=_names, default=None, metavar="STEP[,STEP]",
+                    help="compile only these steps (`make demo` compiles the planar simulation's kernels "
+                         "this way beside the Green Run's own 3-D compiles); one of: "
+                         + ", ".join(s.name for s in STEPS))
     ap.add_argument("--sources", action="store_true",
                     help="print the source files whose code numba compiles, relative to the working folder")
     args = ap.parse_args(argv)
@@ -307,9 +325,12 @@ def main(argv: list[str] | None = None) -> None:
         for p in kernel_sources():
             print(p.relative_to(cwd) if p.is_relative_to(cwd) else p)
         return
+    if args.only is not None and args.part != (1, 1):
+        ap.error("--only and --part exclude each other")
     k, n = args.part
     t0 = time.perf_counter()
-    for step in shares(n)[k - 1]:
+    todo = shares(n)[k - 1] if args.only is None else [s for s in STEPS if s.name in args.only]
+    for step in todo:
         t1 = time.perf_counter()
         step.run()
         print(f"taos warm-up {k}/{n}: {step.name} {time.perf_counter() - t1:.1f} s", flush=True)
