@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from taos.flight import ascent_lanes
+from taos.flight import ascent_lanes, ascent_sim
 from taos.flight.ascent import load_ascent, wind_speed
 from taos.montecarlo import load_campaign, open_store, run_campaign
 
@@ -54,6 +54,22 @@ def flight_at_scalar(ascent, t_s, axis):
     fcs = dataclasses.replace(fl.fcs, attitude_gain=fl.fcs.attitude_gain * k,
                               integral_gain_per_s=fl.fcs.integral_gain_per_s * k, rate_gain_s=fl.fcs.rate_gain_s * k)
     return dataclasses.replace(fl, vehicle=veh, fcs=fcs), boost
+
+
+def recorded_by_segment(plants, bounds, rec, Xq):
+    """The previous recorded outputs: y = C x term by term, segment by segment."""
+    from taos.flight.ascent_sim import _RECORDED
+    Y = np.empty((Xq.shape[0], 8))
+    for p, k0, k1 in zip(plants, bounds[:-1], bounds[1:]):
+        sl = slice(k0 // rec, k1 // rec + (1 if k1 == bounds[-1] else 0))
+        for j, name in enumerate(_RECORDED):
+            if name is not None:
+                row = p.ss.C[p.ss.output_index(name)]
+                y = np.zeros(sl.stop - sl.start)
+                for i in np.flatnonzero(row):
+                    y += row[i] * Xq[sl, i]
+                Y[sl, j] = y
+    return Y
 
 
 @pytest.fixture(scope="module")
@@ -107,8 +123,8 @@ def test_base_variant_loaded_once_is_the_loaded_one():
 
 def test_small_campaign_store_equals_the_previous_way(tmp_path, monkeypatch):
     """The short campaign (4 runs and the nominal, in process) stored the same, array for array,
-    as with the turbulence loop, the segment flights one at a time and every variant loading
-    its base again."""
+    as with the turbulence loop, the segment flights one at a time, every variant loading its
+    base again and the recorded outputs summed segment by segment."""
     from taos import variants
     c = load_campaign(DATA / "mc_short.toml")
     run_campaign(c, tmp_path / "new", runs=4, workers=0)
@@ -116,6 +132,7 @@ def test_small_campaign_store_equals_the_previous_way(tmp_path, monkeypatch):
     monkeypatch.setattr(ascent_lanes, "flights_at",
                         lambda asc, ts, axis: [flight_at_scalar(asc, float(t), axis) for t in np.atleast_1d(ts)])
     monkeypatch.setattr(variants, "base_variant", lambda model, old, load: load(old))
+    monkeypatch.setattr(ascent_sim, "_recorded", recorded_by_segment)
     run_campaign(c, tmp_path / "old", runs=4, workers=0)
     for group in (None, "nominal"):
         new, old = open_store(tmp_path / "new" / "campaign.zarr", group), open_store(tmp_path / "old" / "campaign.zarr", group)

@@ -112,6 +112,33 @@ _RECORDED = ("attitude_rad", "rate_rad_s", "delta_cmd_rad", "theta_rad", "omega_
              "booster_deflection_rad")
 
 
+def _recorded(plants: list, bounds: tuple, rec: int, Xq: np.ndarray) -> np.ndarray:
+    """(n_rec, 8): the :data:`_RECORDED` outputs y = C x of one lane at its records ``Xq``
+    (n_rec, n), each record with the C of its segment's plant (column 6, the friction torque,
+    left for the caller). y = C x term by term in the order of the state index, over all the
+    records at once: a term whose coefficient is zero in a segment adds 0 x = +-0 there, which
+    changes no bit of a finite sum begun at +0, so every record has the bits of its own
+    segment's sum, whatever the lane's memory layout."""
+    nrec = Xq.shape[0]
+    seg = np.empty(nrec, np.int64)   # the segment of each record
+    for s_, (k0, k1) in enumerate(zip(bounds[:-1], bounds[1:])):
+        seg[k0 // rec:k1 // rec + (1 if k1 == bounds[-1] else 0)] = s_
+    p0 = plants[0].ss
+    if any(p.ss.outputs != p0.outputs or p.ss.states != p0.states for p in plants):
+        raise ValueError("a lane's segment plants differ in their outputs or states")
+    C = np.stack([p.ss.C for p in plants])   # (n_seg, n_y, n)
+    Y = np.empty((nrec, 8))
+    for j, name in enumerate(_RECORDED):
+        if name is not None:
+            rows = C[:, p0.output_index(name)]   # (n_seg, n)
+            coef = rows[seg]
+            y = np.zeros(nrec)
+            for i in np.flatnonzero(np.any(rows != 0.0, axis=0)):
+                y += coef[:, i] * Xq[:, i]
+            Y[:, j] = y
+    return Y
+
+
 def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
     """Fly ``lanes`` (equal keys) in one call of
     :func:`taos.planar.dynamics.integrate_segments_lanes`; per lane (the first 8 :data:`SIGNALS`
@@ -150,17 +177,7 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
             out.append(SimulationUnstable(float(t[status[q]]), f"{ln.model.friction.name} friction, dt = {dt_s} s"))
             continue
         Xq = X[:, :, q]
-        Y = np.empty((nrec, 8))
-        for p, k0, k1 in zip(ln.plants, bounds[:-1], bounds[1:]):
-            sl = slice(k0 // rec, k1 // rec + (1 if k1 == bounds[-1] else 0))
-            o = p.ss.output_index
-            for j, name in enumerate(_RECORDED):
-                if name is not None:  # y = C x term by term: the same bits whatever the lane's memory layout
-                    row = p.ss.C[o(name)]
-                    y = np.zeros(sl.stop - sl.start)
-                    for i in np.flatnonzero(row):
-                        y += row[i] * Xq[sl, i]
-                    Y[sl, j] = y
+        Y = _recorded(ln.plants, bounds, rec, Xq)
         Y[:, 2] += ln.r[::rec, 0]  # the FCS command: the PTI is added to it
         Y[:, 6] = aux[:, _dy.AUX_TF, q]
         Yh = np.column_stack([Xq[:, si(v)] for v in HYDRAULIC.values()])
