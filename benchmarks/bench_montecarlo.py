@@ -19,7 +19,9 @@ One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run
    included), as ``taos montecarlo post_separation --runs N --case soft`` runs it; its LCO
    fraction. With ``--previous TREE`` (a checkout of the previous code, e.g. ``git worktree add
    /tmp/prev <base>``), the same campaign flown again by that code in its own process, end to end
-   from its import of taos, and its store compared with this code's array for array.
+   from its import of taos, and its store compared with this code's array for array. Both
+   report their CPU seconds in all (this process and its ended children: the workers), the
+   measure that a shared machine's load does not inflate as it does the wall time.
 3. Scaling (``--with-big``): ``--big-runs`` runs of models/montecarlo/scaling_short.toml (10 s of
    flight) on a loopback cluster (a scheduler and 2 workers as separate processes), the client
    being the ``taos montecarlo --scheduler`` command in its own process: its wall time and peak
@@ -222,6 +224,13 @@ def big(n: int, root: Path) -> dict:
             "runs_diverged": summary["statistics"]["runs_diverged"], "workers": summary["timing"]["workers"]}
 
 
+def _cpu() -> float:
+    """CPU seconds (user + system) of this process and of its children that ended (the cluster's
+    workers once it is closed, a subprocess and its own children once it is done)."""
+    return sum(getattr(resource.getrusage(w), f) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+               for f in ("ru_utime", "ru_stime"))
+
+
 _PREVIOUS = """
 import json, sys, time
 from pathlib import Path
@@ -246,10 +255,10 @@ def previous_soft(tree: Path, n: int, root: Path) -> dict:
                           capture_output=True, text=True, cwd=str(root))   # its compiled kernels cached first
     if warm.returncode != 0:
         raise RuntimeError(warm.stderr[-2000:])
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), _cpu()
     p = subprocess.run([sys.executable, "-c", _PREVIOUS, str(out), str(n), "2"], env=env, capture_output=True, text=True,
                        cwd=str(root))
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, _cpu() - c0
     if p.returncode != 0:
         raise RuntimeError(p.stderr[-2000:])
     got = json.loads(p.stdout.strip().splitlines()[-1])
@@ -259,7 +268,7 @@ def previous_soft(tree: Path, n: int, root: Path) -> dict:
         for k in a.data_vars:
             x, y = np.asarray(a[k].values), np.asarray(b[k].values)
             same &= bool(np.array_equal(x, y, equal_nan=x.dtype.kind == "f"))
-    return {"runs": n, "wall_s": wall, "run_campaign_wall_s": got["wall_s"], "taos": got["taos"],
+    return {"runs": n, "wall_s": wall, "cpu_s": cpu, "run_campaign_wall_s": got["wall_s"], "taos": got["taos"],
             "store_equal": same}
 
 
@@ -294,11 +303,11 @@ def main() -> None:
     if "soft" not in skip:
         out = root / "soft"
         shutil.rmtree(out, ignore_errors=True)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), _cpu()
         r = run_campaign(load_campaign("post_separation"), out, runs=a.runs, case="soft", workers=2, progress=True)
-        el = time.perf_counter() - t0
+        el, cpu = time.perf_counter() - t0, _cpu() - c0
         s = r.summary
-        res["soft"] = {"runs": a.runs, "wall_s": el, "batch": json.loads((out / "summary.json").read_text())["timing"]
+        res["soft"] = {"runs": a.runs, "wall_s": el, "cpu_s": cpu, "batch": json.loads((out / "summary.json").read_text())["timing"]
                        ["batch"], "lco_fraction": s["lco_fraction"], "runs_ok": s["runs_ok"],
                        "runs_failed": s["runs_failed"], "runs_diverged": s["runs_diverged"]}
         print(f"soft: {a.runs} runs in {el:.1f} s", flush=True)
@@ -331,14 +340,16 @@ def main() -> None:
     if "soft" in res:
         s = res["soft"]
         f = s["lco_fraction"]
-        print(f"| soft campaign, LocalCluster 2 workers, end to end | {s['runs']} | 2 | {s['wall_s']:.1f} s | batch "
+        print(f"| soft campaign, LocalCluster 2 workers, end to end | {s['runs']} | 2 | {s['wall_s']:.1f} s | "
+              f"{s['cpu_s']:.1f} CPU-s in all ({s['cpu_s'] / s['runs']:.4f} a run); batch "
               f"{s['batch']}; LCO {f['lco_runs']} of {s['runs_ok']} ok ({f['value']:.3f}, 95 % {f['ci_low']:.3f}-"
               f"{f['ci_high']:.3f}), {s['runs_failed']} failed, "
               f"{s['runs_diverged']} diverged |")
     if "soft_previous" in res:
         s, q = res["soft"], res["soft_previous"]
         print(f"| same campaign, previous code ({q['taos']}), its own process | {q['runs']} | 2 | {q['wall_s']:.1f} s | "
-              f"x{q['wall_s'] / s['wall_s']:.2f} this code's wall; stores equal array for array: {q['store_equal']} |")
+              f"{q['cpu_s']:.1f} CPU-s in all ({q['cpu_s'] / q['runs']:.4f} a run, x{q['cpu_s'] / s['cpu_s']:.2f} this "
+              f"code's); wall x{q['wall_s'] / s['wall_s']:.2f} this code's; stores equal array for array: {q['store_equal']} |")
     if "big" in res:
         b = res["big"]
         print(f"| scaling_short, loopback cluster 2 workers, client in its own process | {b['runs']} | 2 | "
