@@ -189,6 +189,10 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
 #: memory one call may take for its inputs and records [bytes] (fewer lanes for long runs)
 LANES = 32
 LANE_BYTES = 1 << 30
+#: kernel calls are made of a multiple of this many lanes (but the last): calls of 21-31 lanes
+#: measured 1.2-1.8x the time a lane of a 32-lane call (benchmarks/RESULTS.md, section mcfast: the
+#: compiled vector loops across the lanes leave a scalar rest)
+LANE_VECTOR = 16
 
 
 def _lane_bytes(ln: _Lane, n_t: int, rec: int) -> int:
@@ -224,8 +228,9 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
     for (_, rec, _, bounds), members in groups.items():
         t = grids[members[0][0]][2]
         lanes = max(1, min(LANES, LANE_BYTES // _lane_bytes(members[0][1], len(t), rec)))
-        ng = -(-len(members) // lanes)  # as few kernel calls as allowed, of even sizes
-        for chunk in (members[g * len(members) // ng:(g + 1) * len(members) // ng] for g in range(ng)):
+        lanes -= lanes % LANE_VECTOR if lanes > LANE_VECTOR else 0
+        # as few kernel calls as allowed, all but the last of ``lanes`` runs (LANE_VECTOR)
+        for chunk in (members[g:g + lanes] for g in range(0, len(members), lanes)):
             for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], t, bounds, rec, dt_s)):
                 if isinstance(flown, Exception):
                     res[i] = flown
