@@ -7,7 +7,8 @@
   scheduler's copy if a worker holding it dies); nothing is cached on a worker under any other
   key, so a persistent cluster flies whatever the client loaded.
 * **Batches.** A task is a batch of runs (:func:`batch_size`: about ``TASK_S`` seconds of work,
-  50 to 1000 runs, fewer when the campaign is too small to keep every worker busy). A batch's
+  50 to 1000 runs rounded up to a multiple of :data:`BATCH_MULTIPLE`, fewer when the campaign is
+  too small to keep every worker busy). A batch's
   results are written into the store (:mod:`taos.montecarlo.store`) the moment they arrive and
   released from the workers; the client never holds more than one batch of outputs.
 * **No run lost.** A worker that dies: Dask re-runs its batches elsewhere (``RETRIES``); a batch
