@@ -1,6 +1,7 @@
 """Monte Carlo campaign speed and scaling.
 
     PYTHONPATH=. python benchmarks/bench_montecarlo.py [--runs 2000] [--peer-runs 32] [--big-runs 100000] [--out DIR]
+        [--previous TREE]
 
 One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run scaling part):
 
@@ -16,7 +17,11 @@ One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run
    bit. Run from the project root with ``PYTHONPATH=.`` (it imports the reference from tests/).
 2. The soft campaign, ``--runs`` runs on a LocalCluster of 2 workers, end to end (cluster start-up
    included), as ``taos montecarlo post_separation --runs N --case soft`` runs it; its LCO
-   fraction.
+   fraction. With ``--previous TREE`` (a checkout of the previous code, e.g. ``git worktree add
+   /tmp/prev <base>``), the same campaign flown again by that code in its own process, end to end
+   from its import of taos, and its store compared with this code's array for array. Both
+   report their CPU seconds in all (this process and its ended children: the workers), the
+   measure that a shared machine's load does not inflate as it does the wall time.
 3. Scaling (``--with-big``): ``--big-runs`` runs of models/montecarlo/scaling_short.toml (10 s of
    flight) on a loopback cluster (a scheduler and 2 workers as separate processes), the client
    being the ``taos montecarlo --scheduler`` command in its own process: its wall time and peak
@@ -219,6 +224,54 @@ def big(n: int, root: Path) -> dict:
             "runs_diverged": summary["statistics"]["runs_diverged"], "workers": summary["timing"]["workers"]}
 
 
+def _cpu() -> float:
+    """CPU seconds (user + system) of this process and of its children that ended (the cluster's
+    workers once it is closed, a subprocess and its own children once it is done)."""
+    return sum(getattr(resource.getrusage(w), f) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+               for f in ("ru_utime", "ru_stime"))
+
+
+_PREVIOUS = """
+import json, sys, time
+from pathlib import Path
+t0 = time.perf_counter()
+from taos.montecarlo import load_campaign, run_campaign
+r = run_campaign(load_campaign("post_separation"), Path(sys.argv[1]), runs=int(sys.argv[2]), case="soft",
+                 workers=int(sys.argv[3]))
+print(json.dumps({"wall_s": time.perf_counter() - t0, "taos": __import__("taos").__file__}))
+"""
+
+
+def previous_soft(tree: Path, n: int, root: Path) -> dict:
+    """The soft campaign flown by the code in ``tree`` (its own process, ``PYTHONPATH=tree``,
+    from the import of taos on: what the campaign costs a user of that code), and whether its
+    store holds the same arrays as this code's (``root/soft``)."""
+    out = root / "soft_previous"
+    shutil.rmtree(out, ignore_errors=True)
+    env = dict(os.environ, PYTHONPATH=str(tree.resolve()))
+    import compileall
+    compileall.compile_dir(str(tree / "taos"), quiet=2, workers=2)
+    warm = subprocess.run([sys.executable, "-c", _PREVIOUS, str(root / "warm_previous"), "2", "0"], env=env,
+                          capture_output=True, text=True, cwd=str(root))   # its compiled kernels cached first
+    if warm.returncode != 0:
+        raise RuntimeError(warm.stderr[-2000:])
+    t0, c0 = time.perf_counter(), _cpu()
+    p = subprocess.run([sys.executable, "-c", _PREVIOUS, str(out), str(n), "2"], env=env, capture_output=True, text=True,
+                       cwd=str(root))
+    wall, cpu = time.perf_counter() - t0, _cpu() - c0
+    if p.returncode != 0:
+        raise RuntimeError(p.stderr[-2000:])
+    got = json.loads(p.stdout.strip().splitlines()[-1])
+    same = True
+    for group in (None, "nominal"):
+        a, b = store.open_store(root / "soft" / "campaign.zarr", group), store.open_store(out / "campaign.zarr", group)
+        for k in a.data_vars:
+            x, y = np.asarray(a[k].values), np.asarray(b[k].values)
+            same &= bool(np.array_equal(x, y, equal_nan=x.dtype.kind == "f"))
+    return {"runs": n, "wall_s": wall, "cpu_s": cpu, "run_campaign_wall_s": got["wall_s"], "taos": got["taos"],
+            "store_equal": same}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--runs", type=int, default=2000)
@@ -227,6 +280,9 @@ def main() -> None:
     ap.add_argument("--big-runs", type=int, default=100_000)
     ap.add_argument("--with-big", action="store_true", help="also run the 100,000-run scaling part")
     ap.add_argument("--skip", default="", help="comma-separated parts to skip: peer,soft,big")
+    ap.add_argument("--previous", default=None, help="a checkout of the previous code (e.g. the branch base in a "
+                    "git worktree): the soft campaign flown again by it, end to end in its own process, for the "
+                    "ratio in the same run, and its store compared with this one array for array")
     ap.add_argument("--out", default=None, help="keep the campaigns here (default: a temporary folder)")
     a = ap.parse_args()
     skip = set(a.skip.split(",")) | (set() if a.with_big else {"big"})
@@ -247,14 +303,18 @@ def main() -> None:
     if "soft" not in skip:
         out = root / "soft"
         shutil.rmtree(out, ignore_errors=True)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), _cpu()
         r = run_campaign(load_campaign("post_separation"), out, runs=a.runs, case="soft", workers=2, progress=True)
-        el = time.perf_counter() - t0
+        el, cpu = time.perf_counter() - t0, _cpu() - c0
         s = r.summary
-        res["soft"] = {"runs": a.runs, "wall_s": el, "batch": json.loads((out / "summary.json").read_text())["timing"]
+        res["soft"] = {"runs": a.runs, "wall_s": el, "cpu_s": cpu, "batch": json.loads((out / "summary.json").read_text())["timing"]
                        ["batch"], "lco_fraction": s["lco_fraction"], "runs_ok": s["runs_ok"],
                        "runs_failed": s["runs_failed"], "runs_diverged": s["runs_diverged"]}
         print(f"soft: {a.runs} runs in {el:.1f} s", flush=True)
+    if a.previous and "soft" not in skip:
+        res["soft_previous"] = previous_soft(Path(a.previous), a.runs, root)
+        print(f"soft, previous tree: {a.runs} runs in {res['soft_previous']['wall_s']:.1f} s; stores equal "
+              f"{res['soft_previous']['store_equal']}", flush=True)
     if "big" not in skip:
         res["big"] = big(a.big_runs, root)
         print(f"big: {res['big']}", flush=True)
@@ -280,10 +340,16 @@ def main() -> None:
     if "soft" in res:
         s = res["soft"]
         f = s["lco_fraction"]
-        print(f"| soft campaign, LocalCluster 2 workers, end to end | {s['runs']} | 2 | {s['wall_s']:.1f} s | batch "
+        print(f"| soft campaign, LocalCluster 2 workers, end to end | {s['runs']} | 2 | {s['wall_s']:.1f} s | "
+              f"{s['cpu_s']:.1f} CPU-s in all ({s['cpu_s'] / s['runs']:.4f} a run); batch "
               f"{s['batch']}; LCO {f['lco_runs']} of {s['runs_ok']} ok ({f['value']:.3f}, 95 % {f['ci_low']:.3f}-"
               f"{f['ci_high']:.3f}), {s['runs_failed']} failed, "
               f"{s['runs_diverged']} diverged |")
+    if "soft_previous" in res:
+        s, q = res["soft"], res["soft_previous"]
+        print(f"| same campaign, previous code ({q['taos']}), its own process | {q['runs']} | 2 | {q['wall_s']:.1f} s | "
+              f"{q['cpu_s']:.1f} CPU-s in all ({q['cpu_s'] / q['runs']:.4f} a run, x{q['cpu_s'] / s['cpu_s']:.2f} this "
+              f"code's); wall x{q['wall_s'] / s['wall_s']:.2f} this code's; stores equal array for array: {q['store_equal']} |")
     if "big" in res:
         b = res["big"]
         print(f"| scaling_short, loopback cluster 2 workers, client in its own process | {b['runs']} | 2 | "

@@ -210,8 +210,8 @@ class TvcModel:
         lbf/in", ...}``; a plain number is SI) given other values, through the loader and its
         bounds: the one way to make a variant (:mod:`taos.variants`)."""
         from .errors import stored_inputs
-        from .variants import (check_unchanged, check_variant_source, code_changes, keep_code_changes,
-                               merge_overrides, variant_sha256)
+        from .variants import (base_variant, check_unchanged, check_variant_source, code_changes,
+                               keep_code_changes, merge_overrides, variant_sha256)
 
         check_variant_source(self, values)
         code = code_changes(self)
@@ -229,7 +229,7 @@ class TvcModel:
         if not code:
             return out
         # the changes made in code stay, with the variant's own effect laid over them
-        code = keep_code_changes(code, load(old), out)
+        code = keep_code_changes(code, base_variant(self, old, load), out)
         out = dataclasses.replace(out, **code)
         marks = tuple((f"code.{k}", v) for k, v in code.items())
         return dataclasses.replace(out, overrides=overrides + marks, sha256=variant_sha256(out.base_sha256,

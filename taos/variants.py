@@ -124,6 +124,28 @@ def code_changes(model: Any) -> dict:
     return {k[5:]: v for k, v in model.overrides if k.startswith("code.")}
 
 
+#: (model file, files' combined hash, overrides) -> the file's variant without the code's changes,
+#: as :func:`base_variant` loaded it (a few models a process: most recent last)
+_BASES: dict = {}
+MAX_BASES = 8
+
+
+def base_variant(model: Any, old: tuple, load) -> Any:
+    """``load(old)``: the model's file variant with its earlier file overrides ``old`` and without
+    the changes made in code, the reference :func:`keep_code_changes` compares a new variant to.
+    It is the same for every variant of ``model`` (a pure function of the files' contents, which
+    ``model.base_sha256`` hashes, and of ``old``), so it is loaded once a process and kept: a
+    Monte Carlo batch makes a variant per run of the same model."""
+    key = (model.source, model.base_sha256, repr(old))
+    got = _BASES.pop(key, None)
+    if got is None:
+        got = load(old)
+        while len(_BASES) >= MAX_BASES:
+            _BASES.pop(next(iter(_BASES)))
+    _BASES[key] = got
+    return got
+
+
 def keep_code_changes(code: Mapping[str, Any], before: Any, after: Any) -> dict:
     """The sections changed in code, with the variant's own effect laid over them: each field the
     new keys changed (``after`` against ``before``, the file's variant with and without them, both

@@ -30,7 +30,6 @@ without friction, each run's post-separation windows analysed (:class:`AscentStu
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -38,20 +37,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from taos.flight._args import check_ascent_args, check_fly_args
-from taos.flight.ascent import Ascent, aero_instability, control_acceleration, pti_command, wind_speed
-from taos.flight.friction_env import friction_scale
+from taos.flight.ascent import Ascent
+# the lanes (plant, grid, inputs, packing) live in taos.flight.ascent_lanes; named here as before
+from taos.flight.ascent_lanes import (AXES, MAX_STEPS, _external_inputs, _grid, _lane, _Lane,  # noqa: F401
+                                      ascent_plant, flight_at, flights_at)
 from taos.flight.lco import FlightHistory, flown_model, measure_oscillation
-from taos.flight.vehicle import FlightModel, PlantParts, flight_plant
 from taos.harmonics import fit_sines
-from taos.linear import StateSpace
 from taos.model import TvcModel
 from taos.results import atomic_write, package_version, write_provenance
-from taos.planar import saturation as sat
-from taos.planar.simplex import LurePlant, extend_plant
-from taos.planar.simulate import kernel_args
 from taos.results import model_provenance
 
-AXES = ("pitch", "yaw")
 DEFAULT_DT_S = 5e-4
 #: recorded signals of an ascent run, per axis (SI)
 SIGNALS = ("attitude_rad", "rate_rad_s", "command_rad", "engine_rad", "engine_rate_rad_s", "piston_m",
@@ -61,61 +56,10 @@ SIGNALS = ("attitude_rad", "rate_rad_s", "command_rad", "engine_rad", "engine_ra
 #: piston area; :mod:`taos.planar.actuator`) -> their state names, for the duty cycle
 #: (:mod:`taos.flight.duty`)
 HYDRAULIC = {"piston_rate_m_s": "v_p_m_s", "load_pressure_Pa": "p_load_Pa", "valve_flow_m_s": "q_m_s"}
-MAX_STEPS = 50_000_000
 #: the integrator of every ascent run (the compiled RK4 kernel of :mod:`taos.planar.dynamics`), as
 #: the runs' provenance names it
 INTEGRATOR = "rk4-fixed-step"
 
-
-def flight_at(ascent: Ascent, t_s: float, axis: str) -> tuple[FlightModel, float]:
-    """The flight loop frozen at ``t_s``: vehicle properties from the trajectory, FCS gains
-    scheduled by a_ref / a(t); and the booster control acceleration per radian [1/s^2]."""
-    fl = ascent.flight
-    tr = ascent.trajectory
-    core, boost = (float(v) for v in control_acceleration(ascent, t_s))
-    k = fl.vehicle.control_acceleration_per_s2(axis) / (core + boost)
-    inertia = float(tr.at("inertia_kgm2", t_s))
-    veh = dataclasses.replace(fl.vehicle, mass_kg=float(tr.at("mass_kg", t_s)), pitch_inertia_kgm2=inertia,
-                              yaw_inertia_kgm2=inertia,
-                              thrust_per_engine_N=float(tr.at("core_thrust_per_engine_N", t_s)),
-                              gimbal_arm_m=float(tr.at("gimbal_arm_m", t_s)),
-                              aero_instability_per_s2=float(aero_instability(ascent, t_s)))
-    fcs = dataclasses.replace(fl.fcs, attitude_gain=fl.fcs.attitude_gain * k,
-                              integral_gain_per_s=fl.fcs.integral_gain_per_s * k, rate_gain_s=fl.fcs.rate_gain_s * k)
-    return dataclasses.replace(fl, vehicle=veh, fcs=fcs), boost
-
-
-def ascent_plant(flight: FlightModel, model: TvcModel, axis: str, booster_accel_per_s2: float,
-                 booster_time_constant_s: float, *, parts: PlantParts | None = None) -> LurePlant:
-    """:func:`~taos.flight.vehicle.flight_plant` with the booster TVC state and the disturbance
-    input added (module docstring). External inputs ``pti_rad`` [rad], ``disturbance_rad_s2``
-    [rad/s^2]; the flight plant's limits carried (:func:`~taos.planar.simplex.extend_plant`).
-    Outputs: the flight plant's, ``booster_deflection_rad``, then every state
-    (``state:<name>``) so a run can be continued. ``parts``: as for ``flight_plant``."""
-    base = flight_plant(flight, model, axis, parts=parts)
-    ss = base.ss
-    n = ss.A.shape[0]
-    ixr = ss.state_index("xi_rate_rad_s")
-    tau = booster_time_constant_s
-    A = np.zeros((n + 1, n + 1))
-    A[:n, :n] = ss.A
-    A[ixr, n] = booster_accel_per_s2
-    A[n, :n] = base.cmd_c / tau
-    A[n, n] = -1.0 / tau
-    B = np.zeros((n + 1, 4))
-    B[:n, 0] = ss.B[:, 0]
-    B[n, 0] = 1.0 / tau           # the booster sees the PTI too (it is on the FCS command)
-    B[ixr, 1] = 1.0
-    B[:n, 2:] = ss.B[:, 1:]
-    states = ss.states + ("booster_deflection_rad",)
-    C = np.zeros((ss.C.shape[0] + 1 + n + 1, n + 1))
-    C[: ss.C.shape[0], :n] = ss.C
-    C[ss.C.shape[0], n] = 1.0
-    C[ss.C.shape[0] + 1:] = np.eye(n + 1)
-    outputs = ss.outputs + ("booster_deflection_rad",) + tuple(f"state:{s}" for s in states)
-    full = StateSpace(A, B, C, np.zeros((C.shape[0], 4)), states,
-                      ("pti_rad", "disturbance_rad_s2", "command_rad", "friction_torque_Nm"), outputs)
-    return extend_plant(base, full, n_ext=2, cmd_d=[1.0, 0.0])
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,111 +107,36 @@ class AscentHistory:
         atomic_write(path, write)
 
 
-def _grid(ascent: Ascent, start_s: float, end_s: float | None, dt_s: float, record_interval_s: float):
-    """(end [s], record step in steps, t (n_steps + 1,) [s], segment bounds (step indices)): the
-    segments are the file's update interval, split at the booster separation."""
-    end = ascent.end_time_s if end_s is None else float(end_s)
-    rec = max(1, int(round(record_interval_s / dt_s)))
-    nsteps = int(math.ceil((end - start_s) / dt_s / rec)) * rec
-    if nsteps <= 0 or nsteps > MAX_STEPS:
-        from taos.errors import InputError
-        raise InputError("command line", "duration / dt", f"1 to {MAX_STEPS} steps", got=str(nsteps))
-    t = start_s + np.arange(nsteps + 1) * dt_s
-    seg = max(rec, int(round(ascent.update_interval_s / dt_s / rec)) * rec)
-    bounds = set(range(0, nsteps, seg)) | {nsteps}
-    sep = ascent.boosters.separation_time_s
-    if start_s < sep < end:
-        bounds.add(int(round((sep - start_s) / dt_s / rec)) * rec)
-    return end, rec, t, tuple(sorted(bounds))
-
-
-def _external_inputs(ascent: Ascent, ax: str, t: np.ndarray, seed: int, dt_s: float) -> np.ndarray:
-    """(n_steps + 1, 2): the PTI [rad] and the wind disturbance M_a alpha_w [rad/s^2]; the
-    turbulence of axis k drawn from SeedSequence([seed, k])."""
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed), AXES.index(ax)]))
-    w = wind_speed(ascent, t, rng, dt_s)
-    comp = math.cos(ascent.wind.azimuth_rad) if ax == "pitch" else math.sin(ascent.wind.azimuth_rad)
-    dist = aero_instability(ascent, t) * comp * w / ascent.trajectory.at("velocity_m_s", t)
-    return np.column_stack([pti_command(ascent, ax, t), dist])
-
-
-@dataclass(frozen=True, eq=False)
-class _Lane:
-    """One run of one axis prepared for the lockstep kernel: its segment plants, their matrices
-    (n_seg, n + 8, n + n_r + 5) in the layout of :func:`taos.planar.dynamics._rates_lanes`, the
-    packed limits' heads (n_seg, N_HEAD), the xi re-basing coefficients (n_seg, 2) and kicks
-    (n_seg, n) at the segment starts, the initial state, the external inputs."""
-
-    plants: list
-    mats: np.ndarray
-    heads: np.ndarray
-    jcoef: np.ndarray
-    kick: np.ndarray
-    x0: np.ndarray
-    r: np.ndarray
-    model: TvcModel
-    #: (n_seg, NPARAM) the friction law packed per segment (its level following the thrust or not)
-    fpack: np.ndarray
-
-    @property
-    def key(self) -> tuple:
-        """Lanes with equal keys can share one kernel call."""
-        return (self.mats.shape, self.model.friction.name, self.model.avionics.pack().shape,
-                self.model.friction.pack().shape)
-
-
-def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple, rec: int, dt_s: float,
-          start_s: float, attitude0_rad: float, r: np.ndarray, follow: bool = False) -> _Lane:
-    """Each segment's plant is :func:`ascent_plant` frozen at the segment's middle (the parts
-    that do not change, built once); theta = xi + b delta and theta' are kept continuous across a
-    change of b by re-basing xi; the separation kick lands on xi' at the separation."""
-    sep = ascent.boosters.separation_time_s
-    parts = PlantParts.of(ascent.flight, model, ax)
-    plants, bs = [], []
-    for k0, k1 in zip(bounds[:-1], bounds[1:]):
-        flight, a_b = flight_at(ascent, t[k0] + 0.5 * (t[k1] - t[k0]), ax)
-        plants.append(ascent_plant(flight, model, ax, a_b, ascent.boosters.actuator_time_constant_s, parts=parts))
-        bs.append(flight.vehicle.twd_coefficient(ax))
-    p0 = plants[0]
-    si = p0.ss.state_index
-    n, ne = p0.ss.A.shape[0], p0.n_ext
-    mids = [t[k0] + 0.5 * (t[k1] - t[k0]) for k0, k1 in zip(bounds[:-1], bounds[1:])]
-    scale = (friction_scale(model, ascent.trajectory.at("core_thrust_per_engine_N", np.array(mids)))
-             if follow else np.ones(len(mids)))
-    laws = [model.friction.scaled(float(f)) if follow else model.friction for f in scale]
-    for law in {id(x): x for x in (laws[int(np.argmax(scale))], model.friction)}.values():
-        law.check_step(p0.inertia_kgm2, dt_s, model.source)   # (check_friction_step on the stiffest level)
-    mats = np.zeros((len(plants), n + 3 + 5, n + ne + 5))
-    heads = np.zeros((len(plants), sat.N_HEAD))
-    iu = n + ne
-    for M, H, p in zip(mats, heads, plants):
-        pk = kernel_args(p, model)
-        A, Br, bc, bf, cc, dc, cw, ca, lim = pk.A, pk.Br, pk.bc, pk.bf, pk.cc, pk.dc, pk.cw, pk.ca, pk.lim
-        M[:n, :n], M[:n, n:iu], M[:n, iu], M[:n, iu + 1] = A, Br, bc, bf
-        M[n, :n], M[n, n:iu], M[n + 1, :n], M[n + 2, :n] = cc, dc, cw, ca
-        if lim.size:  # the limit rows over x (u_v also over u) and their columns (taos.planar.saturation)
-            row = lambda i: lim[sat.row_start(i, n):sat.row_start(i + 1, n)]  # noqa: E731
-            for j, i in enumerate((sat.ROW_UV, sat.ROW_Q, sat.ROW_P, sat.ROW_THETA, sat.ROW_OMEGA)):
-                M[n + 3 + j, :n] = row(i)
-            M[n + 3, iu] = lim[sat.LIM_KVR]
-            for j, i in enumerate((sat.ROW_UV_IN, sat.ROW_FLOW_IN, sat.ROW_STOP_IN)):
-                M[:n, iu + 2 + j] = row(i)
-            H[:] = lim[:sat.N_HEAD]
-    jcoef = np.zeros((len(plants), 2))
-    kick = np.zeros((len(plants), n))
-    for s_, k0 in enumerate(bounds[:-1]):
-        if s_:
-            jcoef[s_] = bs[s_ - 1] - bs[s_]
-        if start_s < sep and abs(t[k0] - sep) < 0.5 * dt_s * rec + 1e-12 and ascent.boosters.count:
-            kick[s_, si("xi_rate_rad_s")] = ascent.boosters.separation_rate_kick_rad_s
-    x0 = np.zeros(n)
-    x0[si("xi_rad")] = attitude0_rad
-    return _Lane(plants, mats, heads, jcoef, kick, x0, r, model, np.stack([law.pack() for law in laws]))
-
-
 #: recorded outputs of the ascent plant, in the order of SIGNALS[:8] (friction torque from aux)
 _RECORDED = ("attitude_rad", "rate_rad_s", "delta_cmd_rad", "theta_rad", "omega_rad_s", "x_p_m", None,
              "booster_deflection_rad")
+
+
+def _recorded(plants: list, bounds: tuple, rec: int, Xq: np.ndarray) -> np.ndarray:
+    """(n_rec, 8): the :data:`_RECORDED` outputs y = C x of one lane at its records ``Xq``
+    (n_rec, n), each record with the C of its segment's plant (column 6, the friction torque,
+    left for the caller). y = C x term by term in the order of the state index, over all the
+    records at once: a term whose coefficient is zero in a segment adds 0 x = +-0 there, which
+    changes no bit of a finite sum begun at +0, so every record has the bits of its own
+    segment's sum, whatever the lane's memory layout."""
+    nrec = Xq.shape[0]
+    seg = np.empty(nrec, np.int64)   # the segment of each record
+    for s_, (k0, k1) in enumerate(zip(bounds[:-1], bounds[1:])):
+        seg[k0 // rec:k1 // rec + (1 if k1 == bounds[-1] else 0)] = s_
+    p0 = plants[0].ss
+    if any(p.ss.outputs != p0.outputs or p.ss.states != p0.states for p in plants):
+        raise ValueError("a lane's segment plants differ in their outputs or states")
+    C = np.stack([p.ss.C for p in plants])   # (n_seg, n_y, n)
+    Y = np.empty((nrec, 8))
+    for j, name in enumerate(_RECORDED):
+        if name is not None:
+            rows = C[:, p0.output_index(name)]   # (n_seg, n)
+            coef = rows[seg]
+            y = np.zeros(nrec)
+            for i in np.flatnonzero(np.any(rows != 0.0, axis=0)):
+                y += coef[:, i] * Xq[:, i]
+            Y[:, j] = y
+    return Y
 
 
 def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
@@ -308,17 +177,7 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
             out.append(SimulationUnstable(float(t[status[q]]), f"{ln.model.friction.name} friction, dt = {dt_s} s"))
             continue
         Xq = X[:, :, q]
-        Y = np.empty((nrec, 8))
-        for p, k0, k1 in zip(ln.plants, bounds[:-1], bounds[1:]):
-            sl = slice(k0 // rec, k1 // rec + (1 if k1 == bounds[-1] else 0))
-            o = p.ss.output_index
-            for j, name in enumerate(_RECORDED):
-                if name is not None:  # y = C x term by term: the same bits whatever the lane's memory layout
-                    row = p.ss.C[o(name)]
-                    y = np.zeros(sl.stop - sl.start)
-                    for i in np.flatnonzero(row):
-                        y += row[i] * Xq[sl, i]
-                    Y[sl, j] = y
+        Y = _recorded(ln.plants, bounds, rec, Xq)
         Y[:, 2] += ln.r[::rec, 0]  # the FCS command: the PTI is added to it
         Y[:, 6] = aux[:, _dy.AUX_TF, q]
         Yh = np.column_stack([Xq[:, si(v)] for v in HYDRAULIC.values()])
@@ -330,6 +189,10 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
 #: memory one call may take for its inputs and records [bytes] (fewer lanes for long runs)
 LANES = 32
 LANE_BYTES = 1 << 30
+#: kernel calls are made of a multiple of this many lanes (but the last): calls of 21-31 lanes
+#: measured 1.2-1.8x the time a lane of a 32-lane call (benchmarks/RESULTS.md, section mcfast: the
+#: compiled vector loops across the lanes leave a scalar rest)
+LANE_VECTOR = 16
 
 
 def _lane_bytes(ln: _Lane, n_t: int, rec: int) -> int:
@@ -365,8 +228,9 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
     for (_, rec, _, bounds), members in groups.items():
         t = grids[members[0][0]][2]
         lanes = max(1, min(LANES, LANE_BYTES // _lane_bytes(members[0][1], len(t), rec)))
-        ng = -(-len(members) // lanes)  # as few kernel calls as allowed, of even sizes
-        for chunk in (members[g * len(members) // ng:(g + 1) * len(members) // ng] for g in range(ng)):
+        lanes -= lanes % LANE_VECTOR if lanes > LANE_VECTOR else 0
+        # as few kernel calls as allowed, all but the last of ``lanes`` runs (LANE_VECTOR)
+        for chunk in (members[g:g + lanes] for g in range(0, len(members), lanes)):
             for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], t, bounds, rec, dt_s)):
                 if isinstance(flown, Exception):
                     res[i] = flown

@@ -7,7 +7,8 @@
   scheduler's copy if a worker holding it dies); nothing is cached on a worker under any other
   key, so a persistent cluster flies whatever the client loaded.
 * **Batches.** A task is a batch of runs (:func:`batch_size`: about ``TASK_S`` seconds of work,
-  50 to 1000 runs, fewer when the campaign is too small to keep every worker busy). A batch's
+  50 to 1000 runs rounded up to a multiple of :data:`BATCH_MULTIPLE`, fewer when the campaign is
+  too small to keep every worker busy). A batch's
   results are written into the store (:mod:`taos.montecarlo.store`) the moment they arrive and
   released from the workers; the client never holds more than one batch of outputs.
 * **No run lost.** A worker that dies: Dask re-runs its batches elsewhere (``RETRIES``); a batch
@@ -59,6 +60,10 @@ RETRIES = 3
 RESUBMITS = 5
 TASK_S = 10.0
 MIN_BATCH, MAX_BATCH = 50, 1000
+#: runs per task a multiple of the flight runs' kernel call (:data:`taos.flight.ascent_sim.LANES`,
+#: 32 runs in lockstep): calls of 21-31 runs measured 1.2-1.8x the kernel time a run of a 32-run call
+#: (benchmarks/RESULTS.md, section mcfast; the vector loops across the runs leave a scalar rest)
+BATCH_MULTIPLE = 32
 CONNECT_TIMEOUT_S = 20.0
 #: no batch stored for this long with a worker paused: the campaign stops [s]
 STALL_S = 120.0
@@ -195,9 +200,11 @@ def run_task(kind: RunKind, names: tuple[str, ...], factors: np.ndarray, seeds: 
 
 
 def batch_size(n: int, run_cost_s: float, workers: int) -> int:
-    """Runs per task: about ``TASK_S`` s of work, from 50 to 1000, but at most a quarter of a
-    worker's share so that every worker has work to the end."""
+    """Runs per task: about ``TASK_S`` s of work, from 50 to 1000 rounded up to a multiple of
+    :data:`BATCH_MULTIPLE`, but at most a quarter of a worker's share so that every worker has
+    work to the end."""
     b = int(np.clip(round(TASK_S / max(run_cost_s, 1e-9)), MIN_BATCH, MAX_BATCH))
+    b = -(-b // BATCH_MULTIPLE) * BATCH_MULTIPLE
     return max(1, min(b, math.ceil(n / (4 * max(workers, 1)))))
 
 

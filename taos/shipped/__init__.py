@@ -77,15 +77,21 @@ def resolve(path: str | Path, kind: str = "model") -> Path:
     return cand if cand.is_file() else p
 
 
-def _within_shipped(p: Path) -> bool:
-    """Whether ``p`` lies in the shipped data (the models/ or fem_data/ folder)."""
+@cache
+def _resolved_roots() -> tuple[Path, ...]:
+    """The shipped data folders (models/, fem_data/), resolved once a process (as :func:`_root`)."""
     roots = []
     for name in ("models", "fem_data"):
         try:
             roots.append(_root(name).resolve())
         except FileNotFoundError:
             pass
-    return any(p == r or r in p.parents for r in roots)
+    return tuple(roots)
+
+
+def _within_shipped(p: Path) -> bool:
+    """Whether ``p`` lies in the shipped data (the models/ or fem_data/ folder)."""
+    return any(p == r or r in p.parents for r in _resolved_roots())
 
 
 def reference_places(ref: str, referring_file: str | Path, kind: str = "model") -> tuple[Path, Path | None]:
