@@ -78,12 +78,17 @@ def resolve(path: str | Path, kind: str = "model") -> Path:
 
 
 @cache
+def _resolved(p: Path) -> Path:
+    return p.resolve()
+
+
 def _resolved_roots() -> tuple[Path, ...]:
-    """The shipped data folders (models/, fem_data/), resolved once a process (as :func:`_root`)."""
+    """The shipped data folders (models/, fem_data/), each resolved once a process (the folders
+    come from :func:`_root` at every call: a test may replace it)."""
     roots = []
     for name in ("models", "fem_data"):
         try:
-            roots.append(_root(name).resolve())
+            roots.append(_resolved(_root(name)))
         except FileNotFoundError:
             pass
     return tuple(roots)
