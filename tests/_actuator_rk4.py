@@ -16,7 +16,7 @@ from taos.planar.saturation import apply_valve_pressure
 @njit(cache=False)
 def _derivative(A, bx, bf, lim, x, xc, force_N, R):
     dx = A @ x + bx * xc + bf * force_N
-    apply_valve_pressure(lim, x, 0, xc / R, dx)
+    apply_valve_pressure(lim, x, int(0), xc / R, dx)   # int(0): not a literal (its own specialisation in the library cache)
     return dx
 
 
