@@ -249,13 +249,7 @@ def head_to_head(tm, prof, repeat):
     _, cmd_t = commands(prof, T_RUN, dt_t)
     pk = pack(tm)
     every = int(round(REC_S / dt_t))
-    m = mujoco.MjModel.from_xml_string(mujoco_xml(tm, dt_m))
-    d = mujoco.MjData(m)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    s0 = np.empty(mujoco.mj_stateSize(m, spec))
-    mujoco.mj_getState(m, d, s0, spec)
-    _, cmd_m = commands(prof, T_RUN, dt_m)
-    ctrl = np.ascontiguousarray(cmd_m[1:][None, :, :])
+    m, d, s0, ctrl = _mujoco_run(mujoco, tm, prof, dt_m)
     run_t = lambda: run_samples(tm, cmd_t, dt_t, every, pk)  # noqa: E731
     run_m = lambda: rollout.rollout(m, d, s0[None], ctrl)  # noqa: E731
     run_samples(tm, cmd_t[:11], dt_t, every, pk)  # compile / load the cache
@@ -303,6 +297,18 @@ def mujoco_xml(tm, dt):
 </mujoco>"""
 
 
+def _mujoco_run(mujoco, tm, prof, dt):
+    """The MuJoCo peer's model, data, initial full-physics state and the 60 s command at step
+    ``dt`` [s] (the command at each step's end), ready for ``rollout.rollout(m, d, s0[None], ctrl)``."""
+    m = mujoco.MjModel.from_xml_string(mujoco_xml(tm, dt))
+    d = mujoco.MjData(m)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    s0 = np.empty(mujoco.mj_stateSize(m, spec))
+    mujoco.mj_getState(m, d, s0, spec)
+    _, cmd = commands(prof, T_RUN, dt)
+    return m, d, s0, np.ascontiguousarray(cmd[1:][None, :, :])
+
+
 def mujoco_peer(tm, prof, repeat, taos_rec):
     try:
         import mujoco
@@ -311,13 +317,7 @@ def mujoco_peer(tm, prof, repeat, taos_rec):
         print("[mujoco] peer skipped: mujoco is not installed (pip install -e .[bench])")
         return
     for dt in (1e-3, 1e-4):
-        m = mujoco.MjModel.from_xml_string(mujoco_xml(tm, dt))
-        d = mujoco.MjData(m)
-        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-        s0 = np.empty(mujoco.mj_stateSize(m, spec))
-        mujoco.mj_getState(m, d, s0, spec)
-        _, cmd = commands(prof, T_RUN, dt)
-        ctrl = np.ascontiguousarray(cmd[1:][None, :, :])  # the command at each step's end
+        m, d, s0, ctrl = _mujoco_run(mujoco, tm, prof, dt)
         rollout.rollout(m, d, s0[None], ctrl[:, :10])  # warm up
         (state, _), best, med = timed(lambda: rollout.rollout(m, d, s0[None], ctrl), repeat)
         n = ctrl.shape[1]
@@ -333,7 +333,7 @@ def mujoco_peer(tm, prof, repeat, taos_rec):
             d2 = mujoco.MjData(m)
             t0 = time.perf_counter()
             for i in range(n):
-                d2.ctrl[:] = cmd[i + 1]
+                d2.ctrl[:] = ctrl[0, i]   # the command at step i's end
                 mujoco.mj_step(m, d2)
             w = time.perf_counter() - t0
             print(f"[mujoco {mujoco.__version__}] dt {dt:g} s, mj_step from a Python loop: {T_RUN / w:.1f}x real time, "
