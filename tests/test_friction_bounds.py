@@ -291,7 +291,7 @@ def test_the_theory_page_says_what_the_loader_does():
 
 def test_fit_bounds_beyond_the_loaders_are_refused():
     """``taos fit --bounds`` (planar and 3-D) may not reach past the model file's bounds."""
-    from taos.cli._bounds_arg import _parse_bounds
+    from taos.cli._fit_args import _parse_bounds
     from taos.identify.params3d import PARAMETERS3D
 
     with pytest.raises(InputError, match="--bounds bristle_stiffness"):

@@ -8,7 +8,7 @@ import math
 import sys
 
 from taos.cli import add_friction_option
-from taos.cli._bounds_arg import _parse_bounds  # noqa: F401 (fit, and identify3d through it)
+from taos.cli._fit_args import _free, _outputs, _parse_bounds, _parse_start
 from taos.errors import InputError
 from taos.results import write_json
 
@@ -34,34 +34,6 @@ def _estimate(path, args):
                              f"{data.t_s.size} samples of {path}", got=str(args.nperseg))
         kw["nperseg"] = args.nperseg
     return data, estimate(data, method=args.method, **kw)
-
-
-def _parse_start(items, model) -> dict:
-    from taos.identify.surrogate import PARAMETERS
-    from taos.units import to_si
-
-    out = {}
-    for it in items or []:
-        if "=" not in it:
-            raise InputError("command line", "--start", "NAME=VALUE with a unit, like load_stiffness='150000 lbf/in'",
-                             got=repr(it))
-        k, v = (s.strip() for s in it.split("=", 1))
-        if k not in PARAMETERS:
-            raise InputError("command line", "--start", "a name from " + ", ".join(PARAMETERS), got=repr(k))
-        p = PARAMETERS[k]
-        out[k] = to_si(v if p.kind != "dimensionless" else float(v), p.kind, source="command line",
-                       field=f"--start {k}", positive=True)
-    return out
-
-
-def _outputs(args, *names) -> None:
-    """Refuse output places that cannot be written before any work."""
-    from taos.results import check_output_file
-
-    for n in names:
-        v = getattr(args, n, None)
-        if v not in (None, "-"):
-            check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
 
 
 def cmd_estimate(args) -> int:
@@ -140,11 +112,10 @@ def cmd_fit(args) -> int:
     if not 0.0 <= args.min_coherence <= 1.0:
         raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
     model = load_model(args.model, friction=args.friction)
-    free = [s.strip() for s in args.free.split(",")]
-    if not all(free):
-        raise InputError("command line", "--free", "parameter names separated by single commas, like "
-                         "load_stiffness,coulomb_torque", got=repr(args.free))
-    start = _parse_start(args.start, model)
+    free = _free(args.free)
+    from taos.identify.surrogate import PARAMETERS
+
+    start = _parse_start(args.start, PARAMETERS)
     bounds = _parse_bounds(args.bounds)
     responses, labels = [], []
     for path in args.data:                       # read and validate everything before any output
@@ -287,9 +258,7 @@ def _cmd_compare_series(args) -> int:
         raise InputError("command line", "--starts", f"a number of starts from 1 to {MAX_STARTS}", got=str(args.starts))
     check_output_folder(args.out, SERIES_FILES)
     _outputs(args, "json")
-    free = [x.strip() for x in (args.free or "load_stiffness,coulomb_torque").split(",")]
-    if not all(free):
-        raise InputError("command line", "--free", "parameter names separated by single commas", got=repr(args.free))
+    free = _free(args.free, "load_stiffness,coulomb_torque")
     labels = [x.strip() for x in args.labels.split(",")] if args.labels is not None else None
     model = load_model(args.model)
     from taos.identify.data import load_test_data

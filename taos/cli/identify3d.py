@@ -6,46 +6,11 @@ from __future__ import annotations
 
 import sys
 
+from taos.cli._fit_args import _free, _outputs, _parse_bounds, _parse_start
 from taos.errors import InputError
 from taos.results import write_json
 
 COMPARE3D_FILES = ("table.txt", "comparison.json", "figure11.png")
-
-
-def _outputs(args, *names) -> None:
-    """Refuse output places that cannot be written before any work."""
-    from taos.results import check_output_file
-
-    for n in names:
-        v = getattr(args, n, None)
-        if v not in (None, "-"):
-            check_output_file(v, "--" + n.replace("_", "-"), (".png", ".svg") if n == "plot" else ())
-
-
-def _free(text, default=None) -> list[str]:
-    free = [s.strip() for s in (text or default or "").split(",")]
-    if not all(free):
-        raise InputError("command line", "--free", "parameter names separated by single commas, like "
-                         "load_stiffness,coulomb_torque", got=repr(text))
-    return free
-
-
-def _parse_start3d(items) -> dict:
-    from taos.identify.params3d import PARAMETERS3D
-    from taos.units import to_si
-
-    out = {}
-    for it in items or []:
-        if "=" not in it:
-            raise InputError("command line", "--start", "NAME=VALUE with a unit, like load_stiffness='150000 lbf/in'",
-                             got=repr(it))
-        k, v = (s.strip() for s in it.split("=", 1))
-        if k not in PARAMETERS3D:
-            raise InputError("command line", "--start", "a name from " + ", ".join(PARAMETERS3D), got=repr(k))
-        p = PARAMETERS3D[k]
-        out[k] = to_si(v if p.kind != "dimensionless" else float(v), p.kind, source="command line",
-                       field=f"--start {k}", positive=True)
-    return out
 
 
 def _refuse_planar_only(args) -> None:
@@ -76,12 +41,11 @@ def cmd_fit3d(args) -> int:
     if not 0.0 <= args.min_coherence <= 1.0:
         raise InputError("command line", "--min-coherence", "a coherence from 0 to 1", got=repr(args.min_coherence))
     starts = _starts(args)
-    from taos.cli._bounds_arg import _parse_bounds
     from taos.identify.params3d import PARAMETERS3D
     bounds = _parse_bounds(args.bounds, PARAMETERS3D)
     tm = taos_model(load_model(args.model, friction=args.friction))
     free = _free(args.free)
-    start = _parse_start3d(args.start)
+    start = _parse_start(args.start, PARAMETERS3D)
     datas = [load_test_data(p) for p in args.data]             # every record read and checked first
     axes = None if args.axis in (None, "both") else (args.axis,)
     res = fit_taos(tm, datas, free, start=start, method=args.method, axes=axes, nperseg=args.nperseg,
