@@ -191,16 +191,16 @@ def _etd_rk4(x, T0, T1, u, dt, P, ks, aux, lam0, lam1):
     settles where the flows balance. The supply-pressure limit's flow enters P_L' alone (its
     ``flow_in`` column is zero off P_L, :mod:`taos.planar.saturation`), so its stiff rate is
     that of P_L. Every other state as :func:`_rk4` (arguments as there)."""
+    i0 = N_BODY + P.act_pl_index  # the pitch and yaw load pressures
+    i1 = i0 + P.act_A.shape[0]
+    y0, y1 = x[i0], x[i1]
+    h = 0.5 * dt
     n = x.shape[0]
+    xt = ks[4]  # the trial state, then the four stages' derivatives
     k1 = ks[0]
     k2 = ks[1]
     k3 = ks[2]
     k4 = ks[3]
-    xt = ks[4]
-    h = 0.5 * dt
-    i0 = N_BODY + P.act_pl_index
-    i1 = i0 + P.act_A.shape[0]
-    y0, y1 = x[i0], x[i1]
     e0, e1 = math.exp(-lam0 * dt), math.exp(-lam1 * dt)
     g0, g1 = math.exp(-lam0 * h), math.exp(-lam1 * h)
     q0, _, _ = _phi123(-lam0 * h)
