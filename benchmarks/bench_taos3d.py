@@ -7,16 +7,16 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5] [--o
 
 1. Speed: 60 s two-axis Green Run profile (models/profiles/greenrun_two_axis.toml repeated to
    60 s, as benchmarks/bench_taos.py), hot-fire FEM gimbal, modified-LuGre bearing, at the
-   model's default step (taos.taos3d.simulate.DEFAULT_DT_S, 4e-4 s) and at 2e-4 s (the former
-   default); records every 2 ms. Best and median of ``--repeat`` runs (the machine is
+   model's time-run default step (taos.taos3d.simulate.DEFAULT_DT_S, 8e-4 s since issue 44) and
+   at 4e-4 s (the former default, now the dwells' step DWELL_DT_S); records every 4 ms. Best and median of ``--repeat`` runs (the machine is
    shared: both are printed), and the best CPU time (process time: on a shared machine it
    leaves out the waiting). ``--only-speed``: this part and the peer (5.) alone.
 2. Accuracy of the step: 4 s of the same run (modified LuGre, and Coulomb smooth, whose error
    is not masked by stick-slip timing) against a 2.5e-5 s reference, at the default step and
-   at 2e-4 s (the former kernel's stored records, removed from tests/data (git history),
+   at 4e-4 s (the former kernel's stored records, removed from tests/data (git history),
    predate the servo recalibration and the pressure limit of issue 24: no longer the same
    model, not compared). Then sine dwells (``taos_freqresp_family``, pitch, 0.5-20 Hz, 0.05 and
-   0.4 deg) at the default step and 2e-4 s against 6.25e-6 s, and the 1.25e-5 s run against
+   0.4 deg) at the dwells' step (DWELL_DT_S, 4e-4 s) and 2e-4 s against 6.25e-6 s, and the 1.25e-5 s run against
    6.25e-6 s (how far the reference itself has converged); with TAOS_BEFORE=<checkout of the
    former kernel> the former kernel's dwells at 2e-4 and 1.25e-5 s are run from that source
    tree on this venv and compared with the same reference (``--no-dwells`` skips this part).
@@ -24,7 +24,7 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5] [--o
    tests/test_taos3d.py::test_energy_balance_with_bearing_friction, at four steps; the former
    kernel's too with TAOS_BEFORE).
 4. Modified LuGre over the whole 60 s (issue 24, point 6; ``--no-conv60`` skips it): engine
-   angle at 4e-4, 2e-4 and 1e-4 s against 2.5e-5 and 1.25e-5 s references, the references
+   angle at 8e-4, 4e-4, 2e-4 and 1e-4 s against 2.5e-5 and 1.25e-5 s references, the references
    against each other and against a 2.5e-5 s run whose commands are offset by 1e-10 rad (data
    sensitivity at a fixed step), for the shipped law (rational bristle-damping decay
    sigma_1 v_1 / (v_1 + s)), the same law with constant bristle damping (v_1 = 0) and, as a
@@ -43,8 +43,8 @@ Run:  PYTHONPATH=. .venv/bin/python benchmarks/bench_taos3d.py [--repeat 5] [--o
    at the engine; kv = kp / K_v, the actuator loop's first-order lag 1/K_v), implicitfast
    integrator, at 1 ms and 0.1 ms, driven by the same Green Run commands. The peer has no
    hydraulics, compliant gimbal or bearing slip: it is the cheaper model of the two.
-6. Head to head (``--only-speed`` and the full run): TAOS at its default step and the peer at
-   1 ms in alternating rounds of the same process (``--repeat`` rounds), so that both see the
+6. Head to head (``--only-speed`` and the full run): TAOS at its default step and at the former
+   default (4e-4 s, the same kernel: bit-identical there) and the peer at 1 ms in alternating rounds of the same process (``--repeat`` rounds), so that both see the
    same load; the best CPU time of each, their ratio, and the median of the rounds' ratios.
 """
 
@@ -73,14 +73,14 @@ from taos.friction.registry import BEARING_SIG, TORQUE3_SIG
 from taos.taos3d import load_taos_model
 from taos.taos3d import dynamics as dy
 from taos.taos3d.model import PITCH_AXIS, YAW_AXIS
-from taos.taos3d.simulate import DEFAULT_DT_S, pack, run_samples
+from taos.taos3d.simulate import DEFAULT_DT_S, DWELL_DT_S, pack, run_samples
 
 MODEL = "models/rs25_hotfire.toml"
 FRICTION = "modified-lugre"
 T_RUN = 60.0
-REC_S = 2e-3  # record interval [s]
+REC_S = 4e-3  # record interval [s]: a whole multiple of every step here
 OLD_DT = 2e-4  # the former kernel's step (TAOS_BEFORE dwells)
-ALT_DT = 2e-4  # the former default, half the step: speed and accuracy for comparison
+ALT_DT = 4e-4  # the former default (issue 44: now the dwells' step), half the step: speed and accuracy for comparison
 REF_DT = 2.5e-5
 T_ACC = 4.0
 
@@ -120,7 +120,7 @@ def errors(a, b):
 
 
 def accuracy(prof):
-    print(f"[accuracy] {T_ACC:g} s of the run, records every 10 ms, against dt = {REF_DT:g} s (this kernel): "
+    print(f"[accuracy] {T_ACC:g} s of the run, records every 8 ms, against dt = {REF_DT:g} s (this kernel): "
           f"max |d theta| deg, "
           f"max |d x_p| mm, max |d F_L| N, max |d T_f| N m, rms |d theta| deg")
     for law in (FRICTION, "coulomb-smooth"):
@@ -128,7 +128,7 @@ def accuracy(prof):
 
         def run(dt):
             _, cmd = commands(prof, T_ACC, dt)
-            return run_samples(tm, cmd, dt, int(round(0.01 / dt)))  # every 10 ms, as the stored records
+            return run_samples(tm, cmd, dt, int(round(0.008 / dt)))  # every 8 ms: a multiple of every step
         ref = run(REF_DT)
         rows = [(f"dt {dt:g} s (this kernel)", run(dt)) for dt in (DEFAULT_DT_S, ALT_DT)]
         for name, a in rows:
@@ -173,8 +173,8 @@ def dwell_accuracy():
     n = len(DWELL_F)
     print(f"[dwells] pitch sine dwells {DWELL_F[0]:g}-{DWELL_F[-1]:g} Hz ({n} points), max over the frequencies of "
           f"|d gain| dB / |d phase| deg against this kernel at 6.25e-6 s; engine | piston")
-    new = dwells((DEFAULT_DT_S, ALT_DT, 1.25e-5, 6.25e-6))
-    rows = [(f"this kernel, dt {dt:g} s", new, dt) for dt in (DEFAULT_DT_S, ALT_DT, 1.25e-5)]
+    new = dwells((DWELL_DT_S, 2e-4, 1.25e-5, 6.25e-6))
+    rows = [(f"this kernel, dt {dt:g} s", new, dt) for dt in (DWELL_DT_S, 2e-4, 1.25e-5)]
     before = os.environ.get("TAOS_BEFORE")
     if before:
         old = dwells((OLD_DT, 1.25e-5), before)
@@ -237,35 +237,42 @@ def energy_balance():
 
 
 def head_to_head(tm, prof, repeat):
-    """Point 6 of the module docstring: TAOS at the default step against the MuJoCo peer at
-    1 ms, alternating within each of ``repeat`` rounds (CPU time, ``time.process_time``)."""
+    """Point 6 of the module docstring: TAOS at the default step and at the former default
+    ALT_DT (issue 44) against the MuJoCo peer at 1 ms, alternating within each of ``repeat``
+    rounds (CPU time, ``time.process_time``)."""
     try:
         import mujoco
         from mujoco import rollout
     except ImportError:
         print("[head-to-head] skipped: mujoco is not installed (pip install -e .[bench])")
         return
-    dt_t, dt_m = DEFAULT_DT_S, 1e-3
-    _, cmd_t = commands(prof, T_RUN, dt_t)
+    dt_m = 1e-3
     pk = pack(tm)
-    every = int(round(REC_S / dt_t))
     m, d, s0, ctrl = _mujoco_run(mujoco, tm, prof, dt_m)
-    run_t = lambda: run_samples(tm, cmd_t, dt_t, every, pk)  # noqa: E731
-    run_m = lambda: rollout.rollout(m, d, s0[None], ctrl)  # noqa: E731
-    run_samples(tm, cmd_t[:11], dt_t, every, pk)  # compile / load the cache
+    runs, steps = {}, {}
+    for dt in (DEFAULT_DT_S, ALT_DT):
+        _, cmd = commands(prof, T_RUN, dt)
+        every = int(round(REC_S / dt))
+        run_samples(tm, cmd[:11], dt, every, pk)  # compile / load the cache
+        runs[dt] = lambda cmd=cmd, dt=dt, every=every: run_samples(tm, cmd, dt, every, pk)
+        steps[dt] = len(cmd) - 1
+    runs["mujoco"] = lambda: rollout.rollout(m, d, s0[None], ctrl)
     rollout.rollout(m, d, s0[None], ctrl[:, :10])
-    ct, cm = [], []
+    ct = {k: [] for k in runs}
     for _ in range(repeat):
-        for f, acc in ((run_t, ct), (run_m, cm)):
+        for k, f in runs.items():
             c0 = time.process_time()
             f()
-            acc.append(time.process_time() - c0)
-    ratios = [b / a for a, b in zip(ct, cm)]
-    print(f"[head-to-head] {repeat} alternating rounds, CPU time of the 60 s run: TAOS dt {dt_t:g} s best "
-          f"{min(ct):.4f} s = {T_RUN / min(ct):.1f}x real time ({1e6 * min(ct) / (len(cmd_t) - 1):.3f} us/step); "
-          f"MuJoCo {mujoco.__version__} rollout dt {dt_m:g} s best {min(cm):.4f} s = {T_RUN / min(cm):.1f}x; "
-          f"TAOS / MuJoCo speed {min(cm) / min(ct):.2f} (best against best), median of the rounds "
-          f"{statistics.median(ratios):.2f}")
+            ct[k].append(time.process_time() - c0)
+    cm = ct["mujoco"]
+    print(f"[head-to-head] {repeat} alternating rounds, CPU time of the 60 s run; MuJoCo {mujoco.__version__} rollout "
+          f"dt {dt_m:g} s best {min(cm):.4f} s = {T_RUN / min(cm):.1f}x real time")
+    for dt in (DEFAULT_DT_S, ALT_DT):
+        c = ct[dt]
+        ratios = [b / a for a, b in zip(c, cm)]
+        print(f"    TAOS dt {dt:g} s{' (default)' if dt == DEFAULT_DT_S else ' (former default)'}: best {min(c):.4f} s "
+              f"= {T_RUN / min(c):.1f}x real time ({1e6 * min(c) / steps[dt]:.3f} us/step); TAOS / MuJoCo speed "
+              f"{min(cm) / min(c):.2f} (best against best), median of the rounds {statistics.median(ratios):.2f}")
 
 
 def mujoco_xml(tm, dt):
@@ -430,14 +437,14 @@ def decay_impact():
 
 def convergence60(prof):
     """Point 4 of the module docstring."""
-    refs, dts = (2.5e-5, 1.25e-5), (DEFAULT_DT_S, ALT_DT, 1e-4)
-    print(f"[conv60] modified LuGre, {T_RUN:g} s two-axis Green Run, records every 10 ms: max |d theta| [deg] "
+    refs, dts = (2.5e-5, 1.25e-5), (DEFAULT_DT_S, ALT_DT, 2e-4, 1e-4)
+    print(f"[conv60] modified LuGre, {T_RUN:g} s two-axis Green Run, records every 8 ms: max |d theta| [deg] "
           f"against the {refs[-1]:g} s run; real time at {DEFAULT_DT_S:g} s (under load)")
 
     def run(tm, pk, dt, offset=0.0):
         _, cmd = commands(prof, T_RUN, dt)
         t0 = time.perf_counter()
-        out = run_samples(tm, cmd + offset, dt, int(round(0.01 / dt)), pk)
+        out = run_samples(tm, cmd + offset, dt, int(round(0.008 / dt)), pk)
         return out[:, 0:2], time.perf_counter() - t0
 
     for name, tm, pk in conv60_variants():

@@ -188,8 +188,8 @@ def cmd_simulate(args) -> int:
     model = model_from_args(args)
     tm = taos_from_args(args, model)
     profile = load_command_source(args.profile)
-    dt = run_checks.default_dt_s(args.engine) if args.dt is None else args.dt
-    run_checks.check_run(model, profile, dt)
+    dt = run_checks.default_dt_s(args.engine, time_run=True) if args.dt is None else args.dt
+    run_checks.check_run(model, profile, dt, pressure_limit=args.engine != "taos")
     run_checks.check_linear_stability(model, allow=args.allow_unstable)
     if tm is not None:
         from taos.taos3d import simulate_taos
@@ -252,7 +252,7 @@ def add_parsers(sub) -> None:
     p.add_argument("--engine", choices=ENGINES, default="simplex", help="simplex or taos (3-D)")
     add_friction_option(p, "swap the friction law")
     p.add_argument("--dt", type=float, default=None, help="integration step [s] (default: the engine's own, 2e-4 s "
-                   "simplex, 4e-4 s taos)")
+                   "simplex, 8e-4 s taos)")
     p.add_argument("--integrator", choices=("rk4", "exp"), default="rk4",
                    help="simplex engine: rk4 (fixed step --dt, default) or exp (exponential ETDRK4: the linear block "
                    "and the quantised command exact, the step set by the friction loop and the records, the command "

@@ -127,7 +127,7 @@ class TvcBlock:
         dt = default_dt_s(engine, source=SOURCE, field="engine") if dt_s is None else float(dt_s)
         if hold not in HOLDS:
             raise InputError(SOURCE, "hold", " or ".join(HOLDS), got=repr(hold))
-        check_run_step(dt, model, source=SOURCE, field="dt_s")
+        check_run_step(dt, model, source=SOURCE, field="dt_s", pressure_limit=engine != "taos")
         check_linear_stability(model, allow=allow_unstable)
         if engine == "taos":
             if taos is None:

@@ -221,7 +221,7 @@ def build_fmu(model_path: str | Path, out: str | Path, *, engine: str = "simplex
     out = check_output_path(out)
     model = fmu_model(model_path, friction, avionics)
     if dt_s is not None:
-        check_run_step(dt_s, model, field="--dt")
+        check_run_step(dt_s, model, field="--dt", pressure_limit=engine != "taos")
     block = TvcBlock(model, engine=engine, dt_s=dt_s, allow_unstable=allow_unstable)
     block.outputs   # the rest state through the kernels: a friction law whose kernel fails is refused now, not in the host
     try:

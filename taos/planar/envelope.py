@@ -21,13 +21,18 @@ from ..bounds import (GIMBAL_RANGE_RAD, HARD_STOP_RAD, LOAD_FORCE_FACTOR, MAX_JO
 from .runfile import ENGINES  # noqa: E402,F401  (the engine models a run can use)
 
 
-def default_dt_s(engine: str = "simplex", *, source: str = "command line", field: str = "--engine") -> float:
+def default_dt_s(engine: str = "simplex", *, source: str = "command line", field: str = "--engine",
+                 time_run: bool = False) -> float:
     """The integration step [s] engine model ``engine`` runs at unless told otherwise:
-    :data:`taos.planar.simulate.DEFAULT_DT_S` (2e-4 s) for ``"simplex"``,
-    :data:`taos.taos3d.simulate.DEFAULT_DT_S` (4e-4 s) for ``"taos"`` (imported only then: the 3-D
-    model loads its compiled kernels). Another name is bad input (one line naming ``field``)."""
+    :data:`taos.planar.simulate.DEFAULT_DT_S` (2e-4 s) for ``"simplex"``; for ``"taos"`` (imported
+    only then: the 3-D model loads its compiled kernels) a time run's (``time_run``, ``taos
+    simulate``) :data:`taos.taos3d.simulate.DEFAULT_DT_S` (8e-4 s), else the step of its dwells, the
+    verdict and the co-simulation block :data:`taos.taos3d.simulate.DWELL_DT_S` (4e-4 s). Another name
+    is bad input (one line naming ``field``)."""
     if engine == "taos":
-        from ..taos3d.simulate import DEFAULT_DT_S
+        from ..taos3d.simulate import DEFAULT_DT_S, DWELL_DT_S
+        if not time_run:
+            return DWELL_DT_S
     elif engine == "simplex":
         from .simulate import DEFAULT_DT_S
     else:
@@ -35,24 +40,28 @@ def default_dt_s(engine: str = "simplex", *, source: str = "command line", field
     return DEFAULT_DT_S
 
 
-def fastest_mode_rad_s(model, axes=("pitch", "yaw")) -> float:
+def fastest_mode_rad_s(model, axes=("pitch", "yaw"), *, pressure_limit: bool = True) -> float:
     """|lambda|_max of the linear block over ``axes`` [rad/s], or the supply-pressure limit's
-    fastest rate at stall when larger (:func:`taos.planar.saturation.pressure_limit_rate_per_s`)."""
+    fastest rate at stall when larger (:func:`taos.planar.saturation.pressure_limit_rate_per_s`)
+    and ``pressure_limit`` (False for an engine whose step integrates that rate exactly, the 3-D
+    engine's: :func:`taos.taos3d.dynamics._etd_rk4`)."""
     from .saturation import pressure_limit_rate_per_s
     from .simplex import simplex_state_space
 
     lin = max(float(np.max(np.abs(simplex_state_space(model, ax).poles()))) for ax in axes)
-    return max(lin, pressure_limit_rate_per_s(model.actuator))
+    return max(lin, pressure_limit_rate_per_s(model.actuator)) if pressure_limit else lin
 
 
 def check_run_step(dt_s: float, model=None, *, max_freq_hz: float | None = None, duration_s: float | None = None,
-                   n_axes: int = 1, source: str = "command line", field: str = "--dt") -> None:
-    """The integration step against the fastest linear mode, the command frequencies and the
-    job size (steps and memory, estimated before any array is made)."""
+                   n_axes: int = 1, source: str = "command line", field: str = "--dt",
+                   pressure_limit: bool = True) -> None:
+    """The integration step against the fastest linear mode (and the supply-pressure limit's
+    rate unless ``pressure_limit`` is False: :func:`fastest_mode_rad_s`), the command
+    frequencies and the job size (steps and memory, estimated before any array is made)."""
     if not (math.isfinite(dt_s) and dt_s > 0):
         raise InputError(source, field, "a positive step in seconds", got=repr(dt_s))
     if model is not None:
-        lam = fastest_mode_rad_s(model)
+        lam = fastest_mode_rad_s(model, pressure_limit=pressure_limit)
         if dt_s * lam > RK4_STEP_LIMIT:
             raise InputError(source, field, f"a step at most {RK4_STEP_LIMIT / lam:.3g} s (dt |lambda|max <= "
                              f"{RK4_STEP_LIMIT:g}, fastest mode {lam / (2 * math.pi):.4g} Hz of {model.source})",
@@ -116,11 +125,14 @@ def check_dwell(model, freqs_hz, dt_s: float = 2e-4, axis: str = "pitch", source
                          f"steps (settling {ts:.3g} s, then two cycles, per amplitude)", got=f"{total:.3g} steps")
 
 
-def check_run(model, profile, dt_s: float, *, source: str = "command line", field: str = "--dt") -> None:
-    """Everything about a time run that can be refused before it starts (see the table)."""
+def check_run(model, profile, dt_s: float, *, source: str = "command line", field: str = "--dt",
+              pressure_limit: bool = True) -> None:
+    """Everything about a time run that can be refused before it starts (see the table);
+    ``pressure_limit`` as :func:`check_run_step`."""
     check_duration(profile.duration_s, getattr(profile, "source", "profile"), "(duration)")
     check_run_step(dt_s, model, max_freq_hz=profile_max_frequency_hz(profile) or None,
-               duration_s=profile.duration_s + 1.0, n_axes=2, source=source, field=field)
+               duration_s=profile.duration_s + 1.0, n_axes=2, source=source, field=field,
+               pressure_limit=pressure_limit)
 
 
 def unstable_modes(model, axes=("pitch", "yaw")) -> list[tuple[str, float, float]]:

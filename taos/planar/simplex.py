@@ -252,10 +252,11 @@ def _check_model_axis(model, axis) -> None:
     check_axis(axis)
 
 
-def check_rk4_step(dt_s: float, model, field: str, source: str = "argument") -> None:
+def check_rk4_step(dt_s: float, model, field: str, source: str = "argument", *, pressure_limit: bool = True) -> None:
     """The explicit step's rule of the command line's ``--dt`` (dt |lambda|max <=
-    :data:`taos.bounds.RK4_STEP_LIMIT`, over the linear modes of both axes and the supply-pressure limit's
-    rate: :func:`taos.planar.envelope.fastest_mode_rad_s`)."""
+    :data:`taos.bounds.RK4_STEP_LIMIT`, over the linear modes of both axes and, unless
+    ``pressure_limit`` is False (an engine that integrates that rate exactly, the 3-D one), the
+    supply-pressure limit's rate: :func:`taos.planar.envelope.fastest_mode_rad_s`)."""
     import math
 
     from ..bounds import AXES, RK4_STEP_LIMIT
@@ -263,7 +264,8 @@ def check_rk4_step(dt_s: float, model, field: str, source: str = "argument") -> 
     from .saturation import pressure_limit_rate_per_s
 
     lam = max(float(np.max(np.abs(simplex_state_space(model, ax).poles()))) for ax in AXES)
-    lam = max(lam, pressure_limit_rate_per_s(model.actuator))
+    if pressure_limit:
+        lam = max(lam, pressure_limit_rate_per_s(model.actuator))
     if dt_s * lam > RK4_STEP_LIMIT:
         raise InputError(source, field, f"a step at most {RK4_STEP_LIMIT / lam:.3g} s (dt |lambda|max <= "
                          f"{RK4_STEP_LIMIT:g}, fastest mode {lam / (2 * math.pi):.4g} Hz)", got=f"{dt_s:g} s")

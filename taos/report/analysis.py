@@ -403,7 +403,7 @@ def greenrun(model: TvcModel | str | Path, profile: Profile | str | Path | None 
     prof, profile_file, ppath = _profile_of(profile)
     if dt_s is None:
         dt_s = run_checks.default_dt_s(engine)
-    run_checks.check_run(model, prof, dt_s)
+    run_checks.check_run(model, prof, dt_s, pressure_limit=engine != "taos")
     run_checks.check_linear_stability(model, allow=allow_unstable)
     mask = _spec_mask(spec)
     specs = _spec_results(model, mask)

@@ -224,3 +224,53 @@ def _psi(x, r0, r1, r2, P):
     p1 = G[1, 0] * e0 + G[1, 1] * e1 + G[1, 2] * e2 + G[1, 3] * r0 + G[1, 4] * r1 + G[1, 5] * r2
     return p0, p1
 
+
+
+#: the supply-pressure limit's share of an explicit step: its local rate r is integrated
+#: explicitly up to GUARD_RATE_DT / dt, the excess exactly (:func:`pressure_guard`)
+GUARD_RATE_DT = 1.0
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _limit_rate(lim, x, off, m, ip):
+    """The supply-pressure limit's local decay rate r [1/s] of the load pressure P_L (state
+    ``ip`` of the actuator at ``x[off:off+m]``): the limit adds c_f corr(q, P_L) to P_L' (c_f =
+    4 beta A / V_t, the ``flow_in`` row, which is zero off P_L; :mod:`taos.planar.saturation`,
+    :func:`~taos.planar.saturation.pressure_flow_correction`), whose slope in P_L is -r with
+    r = c_f (|q| g'(d) / P_s + K_r / A [|P_L| > P_r]), g'(d) = 1 / (2 sqrt |d|) for |d| >= eps
+    and 1 / sqrt(eps) within eps of stall (d = (P_s - sgn(q) P_L) / P_s). Its largest value
+    (q = v_max, at stall, relief open) is :func:`taos.planar.saturation.pressure_limit_rate_per_s`.
+    0 with the pressure limit off."""
+    ps = lim[_lim.LIM_PS]
+    if ps <= 0.0:
+        return 0.0
+    q = _lim._dot(lim, _lim.ROW_Q, m, x, off)
+    p = _lim._dot(lim, _lim.ROW_P, m, x, off)
+    sg = 1.0 if q >= 0 else -1.0
+    ad = abs((ps - sg * p) / ps)
+    eps = lim[_lim.LIM_EPS]
+    gp = 1.0 / math.sqrt(eps) if ad < eps else 0.5 / math.sqrt(ad)
+    r = abs(q) * gp / ps
+    if abs(p) - lim[_lim.LIM_PR] > 0.0:
+        r += lim[_lim.LIM_KRA]
+    return r * lim[_lim.N_HEAD + _lim.ROW_FLOW_IN * m + ip]
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def pressure_guard(x, dt, P):
+    """The rates lambda (pitch, yaw) [1/s] that the step integrates exactly on each actuator's
+    load pressure (:func:`taos.taos3d.dynamics.step`): the part of the supply-pressure limit's
+    local rate :func:`_limit_rate` at the state ``x`` above GUARD_RATE_DT / ``dt`` [s], 0 below
+    (the limit's stiffness within eps of stall, up to :func:`taos.planar.saturation.
+    pressure_limit_rate_per_s`, 3,946 1/s on the shipped models, is what would otherwise cap
+    the explicit step at 2 / 3,946 = 5.07e-4 s). ``P`` the packed model (record)."""
+    lim = P.limits
+    na = P.act_A.shape[0]
+    mlim = (lim.shape[0] - _lim.N_HEAD) // _lim.N_ROWS if lim.shape[0] > 0 else 0
+    if mlim == 0:
+        return 0.0, 0.0
+    ip = P.act_pl_index
+    cap = GUARD_RATE_DT / dt
+    l0 = _limit_rate(lim, x, N_BODY, mlim, ip) - cap
+    l1 = _limit_rate(lim, x, N_BODY + na, mlim, ip) - cap
+    return max(l0, 0.0), max(l1, 0.0)

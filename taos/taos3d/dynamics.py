@@ -26,7 +26,8 @@ Formulation (quasi-static condensation of the massless gimbal halves)::
 
 Time stepping (second order in the bearing coupling):
 
-* classical RK4 for (q, v, actuators) with T held at its step-start value T_n, then the
+* classical RK4 for (q, v, actuators) with T held at its step-start value T_n (:func:`_rk4`;
+  :func:`_etd_rk4` near the actuators' stall, below), then the
   bearing update to T_{n+1}, then the velocity kick v += (dt / 2) a_T (T_{n+1} - T_n)
   (:func:`_torque_kick`; the body acceleration is affine in T, so this makes the velocity
   increment the trapezoid of T over the step; the position's share of the ramp is
@@ -49,11 +50,19 @@ at 4e-4 s is 1-3 % of the former first-order scheme's (T held, backward-Euler be
 unstable fast mode (a relaxation oscillation of the slip rate), which a fixed implicit step
 damps away; the bearing substeps resolve it. The shipped LuGre laws' torque rises with the
 slip rate (rational bristle-damping decay), and modified LuGre's 60 s engine angle converges
-at second order: 1.8e-5 deg at 4e-4 s against a 2.5e-5 s run (tests/test_taos3d_step.py,
+at second order: 7.6e-5 / 1.8e-5 deg at 8e-4 / 4e-4 s against a 2.5e-5 s run (tests/test_taos3d_step.py,
 benchmarks/RESULTS.md; :mod:`taos.taos3d._bearing`, docs/theory/taos3d.md). The stiff bearing time constant
 never enters the explicit part, so stability sets no step below 1.1 ms (the oil column and
 the engine's translational modes on the chain, |lambda|max 2463 rad/s on the hot-fire model,
-omega dt < 2.8 for RK4); accuracy sets the default 4e-4 s. A quantised command is piecewise
+omega dt < 2.8 for RK4; the explicit step's rule dt |lambda|max <= 2 allows 8.1e-4 s); accuracy
+sets the time run's default 8e-4 s (:data:`taos.taos3d.simulate.DEFAULT_DT_S`; the dwells keep
+4e-4 s). The one stiffer term is the supply-pressure limit near stall (its rate on the load
+pressure up to 3,946 1/s, :func:`taos.planar.saturation.pressure_limit_rate_per_s`, which capped
+the rule at 5.07e-4 s until issue 44): where its local rate exceeds 1 / dt
+(:func:`pressure_guard`) the step advances the two load pressures by exponential time
+differencing (:func:`_etd_rk4`) at that rate's excess, the other states by the same RK4; below
+it (every shipped Green Run and dwell: its rate stays below 120 1/s there) the step is plain
+RK4, bit for bit. A quantised command is piecewise
 constant in time: every stage takes its mean over the step (:func:`stage_inputs`,
 :func:`command_mean`), which removes the first-order error of sampling its jumps at the
 stage points. Quaternions are renormalised after each step. With friction off (T = 0) the
@@ -116,9 +125,121 @@ from ._layout import (  # noqa: F401
     AUX_FL, AUX_PHI, AUX_THETA, AUX_W, BS_H, BS_PHI, BS_PHI_PREV, BS_SLIP, BS_T, BS_W, BS_Z, BS_Z_PREV, N_AUX,
     N_BEARING, N_BODY, REC, REC_FL, REC_P, REC_PHI, REC_PL, REC_Q, REC_TF, REC_THETA, REC_U, REC_W, REC_XP, REC_Z,
     U_END, U_MID, U_START, X_P, X_Q, X_V, X_W, _DWELL_COLS, TaosParams, as_params, as_record)
-from ._rhs import _act_linear, _psi, _torque_kick, _valve_pressure, pose_psi, rhs  # noqa: F401
+from ._rhs import _act_linear, _psi, _torque_kick, _valve_pressure, pose_psi, pressure_guard, rhs  # noqa: F401
 from ._so3 import (  # noqa: F401
     _FM, _cross3, _logq, _logq4, _mv6, _rotation, _row6, _rtv, _rv, _world_torque)
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _rk4(x, T0, T1, u, dt, P, ks, aux):
+    """Classical RK4 of x (in place) over ``dt`` [s] at the held bearing torque (T0, T1) [N m]
+    and the stage commands ``u`` (:func:`stage_inputs`), ks[0] holding f(x) (arguments as
+    :func:`step`; ks[1:4] the other stages, ks[4] the trial state)."""
+    n = x.shape[0]
+    k1 = ks[0]
+    k2 = ks[1]
+    k3 = ks[2]
+    k4 = ks[3]
+    xt = ks[4]
+    h = 0.5 * dt
+    for i in range(n):
+        xt[i] = x[i] + h * k1[i]
+    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k2, aux)
+    for i in range(n):
+        xt[i] = x[i] + h * k2[i]
+    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k3, aux)
+    for i in range(n):
+        xt[i] = x[i] + dt * k3[i]
+    rhs(xt, T0, T1, u[U_END], u[U_END + 1], P, k4, aux)
+    h6 = dt / 6.0
+    for i in range(n):
+        x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", inline="always")
+def _phi123(z):
+    """phi_1, phi_2, phi_3 of z <= 0 (phi_k(z) = sum_j z^j / (j + k)!; phi_1 = (e^z - 1) / z,
+    phi_{k+1} = (phi_k - 1 / k!) / z): their series below |z| = 1 (to z^17: the next term is
+    below 1e-18), the closed forms above (no cancellation worse than 1e-15 there)."""
+    if z > -1.0:
+        p3 = 0.0
+        f = 1.0 / 2432902008176640000.0  # 1 / 20!, the coefficient of z^17 in phi_3
+        for k in range(18):  # phi_3 = sum_j z^j / (j + 3)!, Horner from j = 17 down
+            p3 = p3 * z + f
+            f *= 20.0 - k  # 1 / (j + 3)! -> 1 / (j + 2)!
+        p2 = 0.5 + z * p3
+        p1 = 1.0 + z * p2
+        return p1, p2, p3
+    p1 = (math.exp(z) - 1.0) / z
+    p2 = (p1 - 1.0) / z
+    p3 = (p2 - 0.5) / z
+    return p1, p2, p3
+
+
+@njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
+def _etd_rk4(x, T0, T1, u, dt, P, ks, aux, lam0, lam1):
+    """:func:`_rk4` with the pitch and yaw actuators' load pressures y (the states P_L) advanced
+    by the exponential time-differencing RK4 of Cox & Matthews (J. Comput. Phys. 176, 2002,
+    eq. 26-29) on y' = -lam y + N(x), N = f + lam y, at the rates ``lam0``, ``lam1`` [1/s]
+    (:func:`pressure_guard`, frozen over the step): with z = -lam dt, E = e^z, E2 = e^(z/2),
+    Q = dt/2 phi_1(z/2) and N1..N4 at the stages,
+    Y2 = E2 y + Q N1, Y3 = E2 y + Q N2, Y4 = E2 Y2 + Q (2 N3 - N1),
+    y+ = E y + f1 N1 + 2 f2 (N2 + N3) + f3 N4, f1 = dt (phi_1 - 3 phi_2 + 4 phi_3),
+    f2 = dt (phi_2 - 2 phi_3), f3 = dt (-phi_2 + 4 phi_3) (:func:`_phi123`). On
+    y' = -(lam + mu) y it is stable for any lam while dt mu stays in an RK4-like region, and it
+    keeps every equilibrium (f1 + 4 f2 + f3 = dt phi_1(z)): the stalled actuator's load pressure
+    settles where the flows balance. The supply-pressure limit's flow enters P_L' alone (its
+    ``flow_in`` column is zero off P_L, :mod:`taos.planar.saturation`), so its stiff rate is
+    that of P_L. Every other state as :func:`_rk4` (arguments as there)."""
+    i0 = N_BODY + P.act_pl_index  # the pitch and yaw load pressures
+    i1 = i0 + P.act_A.shape[0]
+    y0, y1 = x[i0], x[i1]
+    h = 0.5 * dt
+    n = x.shape[0]
+    xt = ks[4]  # the trial state, then the four stages' derivatives
+    k1 = ks[0]
+    k2 = ks[1]
+    k3 = ks[2]
+    k4 = ks[3]
+    e0, e1 = math.exp(-lam0 * dt), math.exp(-lam1 * dt)
+    g0, g1 = math.exp(-lam0 * h), math.exp(-lam1 * h)
+    q0, _, _ = _phi123(-lam0 * h)
+    q1, _, _ = _phi123(-lam1 * h)
+    q0 *= h  # dt/2 phi_1(-lam dt/2)
+    q1 *= h
+    p10, p20, p30 = _phi123(-lam0 * dt)
+    p11, p21, p31 = _phi123(-lam1 * dt)
+    k1[i0] += lam0 * y0  # N1
+    k1[i1] += lam1 * y1
+    for i in range(n):
+        xt[i] = x[i] + h * k1[i]
+    xt[i0] = g0 * y0 + q0 * k1[i0]  # Y2
+    xt[i1] = g1 * y1 + q1 * k1[i1]
+    c0, c1 = xt[i0], xt[i1]
+    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k2, aux)
+    k2[i0] += lam0 * c0  # N2
+    k2[i1] += lam1 * c1
+    for i in range(n):
+        xt[i] = x[i] + h * k2[i]
+    xt[i0] = g0 * y0 + q0 * k2[i0]  # Y3
+    xt[i1] = g1 * y1 + q1 * k2[i1]
+    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k3, aux)
+    k3[i0] += lam0 * xt[i0]  # N3
+    k3[i1] += lam1 * xt[i1]
+    for i in range(n):
+        xt[i] = x[i] + dt * k3[i]
+    xt[i0] = g0 * c0 + q0 * (2.0 * k3[i0] - k1[i0])  # Y4
+    xt[i1] = g1 * c1 + q1 * (2.0 * k3[i1] - k1[i1])
+    rhs(xt, T0, T1, u[U_END], u[U_END + 1], P, k4, aux)
+    k4[i0] += lam0 * xt[i0]  # N4
+    k4[i1] += lam1 * xt[i1]
+    h6 = dt / 6.0
+    for i in range(n):
+        x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    x[i0] = e0 * y0 + dt * ((p10 - 3.0 * p20 + 4.0 * p30) * k1[i0] + 2.0 * (p20 - 2.0 * p30) * (k2[i0] + k3[i0])
+                            + (4.0 * p30 - p20) * k4[i0])
+    x[i1] = e1 * y1 + dt * ((p11 - 3.0 * p21 + 4.0 * p31) * k1[i1] + 2.0 * (p21 - 2.0 * p31) * (k2[i1] + k3[i1])
+                            + (4.0 * p31 - p21) * k4[i1])
 
 
 @njit(cache=True, fastmath=_FM, error_model="numpy", _nrt=False)
@@ -161,27 +282,17 @@ def step(x, bs, u, dt, P, fid, fp, ks, kc, aux, k1_ready, psi):
     Returns True while the state stays finite."""
     n = x.shape[0]
     k1 = ks[0]
-    k2 = ks[1]
-    k3 = ks[2]
-    k4 = ks[3]
-    xt = ks[4]
     T0, T1 = bs[BS_T], bs[BS_T + 1]
     qa0, qa1 = psi[0], psi[1]  # the pose-demanded bearing angle at the step start
-    h = 0.5 * dt
     if not k1_ready:
         rhs(x, T0, T1, u[U_START], u[U_START + 1], P, k1, aux)
-    for i in range(n):
-        xt[i] = x[i] + h * k1[i]
-    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k2, aux)
-    for i in range(n):
-        xt[i] = x[i] + h * k2[i]
-    rhs(xt, T0, T1, u[U_MID], u[U_MID + 1], P, k3, aux)
-    for i in range(n):
-        xt[i] = x[i] + dt * k3[i]
-    rhs(xt, T0, T1, u[U_END], u[U_END + 1], P, k4, aux)
-    h6 = dt / 6.0
-    for i in range(n):
-        x[i] += h6 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    # the load pressures' stiff supply-pressure-limit rates, integrated exactly near stall
+    # (:func:`_etd_rk4`); none (plain RK4, below) elsewhere
+    lam0, lam1 = pressure_guard(x, dt, P)
+    if lam0 > 0.0 or lam1 > 0.0:
+        _etd_rk4(x, T0, T1, u, dt, P, ks, aux, lam0, lam1)
+    else:
+        _rk4(x, T0, T1, u, dt, P, ks, aux)
     qn = math.sqrt(x[X_Q] * x[X_Q] + x[X_Q + 1] * x[X_Q + 1] + x[X_Q + 2] * x[X_Q + 2] + x[X_Q + 3] * x[X_Q + 3])
     for i in range(X_Q, X_Q + 4):
         x[i] /= qn

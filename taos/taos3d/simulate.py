@@ -32,9 +32,16 @@ from . import dynamics as _dy
 from .model import AXES, PITCH_AXIS, YAW_AXIS, TaosModel, spatial_inertia
 from taos.results import model_provenance
 
-#: the 3-D model's step [s]: second-order bearing coupling (taos.taos3d.dynamics) makes it as
-#: accurate as the former first-order scheme at 2e-4 s (tests/test_taos3d_step.py)
-DEFAULT_DT_S = 4e-4
+#: the 3-D time run's default step [s] (:func:`simulate_taos`, ``taos simulate --engine taos``): the
+#: engine angle over the 60 s two-axis Green Run within 1e-4 deg of a 2.5e-5 s run (7.6e-5 deg;
+#: tests/test_taos3d_step.py, benchmarks/RESULTS.md); the explicit step's rule allows it because the
+#: step integrates the supply-pressure limit's stiff rate exactly (:func:`taos.taos3d.dynamics._etd_rk4`).
+#: 4e-4 s until issue 44 (whose bearing coupling is second order: 1.8e-5 deg there)
+DEFAULT_DT_S = 8e-4
+#: the largest step [s] of the 3-D sine dwells (``dt_max_s``), and the verdict's and the
+#: co-simulation block's (the FMU's internal) default step (:func:`taos.planar.envelope.default_dt_s`):
+#: kept by issue 44, so the dwells, the verdict and the FMU's communication-step grid are as before
+DWELL_DT_S = 4e-4
 #: the integrator of every 3-D run and dwell (:func:`taos.taos3d.dynamics.step`), as results name it
 INTEGRATOR = "rk4, trapezoidal bearing torque + BDF2 bearing substeps"
 
@@ -164,14 +171,14 @@ def run_samples(tm: TaosModel, cmd: np.ndarray, dt_s: float, record_every: int =
     return out
 
 
-def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 10,
+def simulate_taos(tm: TaosModel, profile: Profile, *, dt_s: float = DEFAULT_DT_S, record_every: int = 5,
                   duration_s: float | None = None) -> TaosTimeHistory:
     """Run ``profile`` (a single-axis profile drives pitch; two-axis drives both) through the
     TAOS model from rest; ``dt_s`` integration step [s]; ``duration_s`` default the profile's
     duration plus 1 s."""
     _args.check_tm(tm)
     _args.check_simulate_args(profile, dt_s, record_every, duration_s)
-    _args.check_rk4_step(float(dt_s), tm.base, "dt_s")   # the explicit step's rule, as --dt
+    _args.check_rk4_step(float(dt_s), tm.base, "dt_s", pressure_limit=False)   # the explicit step's rule, as --dt
     T = (profile.duration_s + 1.0) if duration_s is None else duration_s
     n = int(math.ceil(T / dt_s))
     t = np.arange(n + 1) * dt_s
@@ -285,7 +292,7 @@ def _linearise(tm: TaosModel) -> StateSpace:
 
 
 def taos_freqresp(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitude_rad: float | None = None, axis: str = "pitch",
-                  cross: bool = False, *, dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2,
+                  cross: bool = False, *, dt_max_s: float = DWELL_DT_S, settle_cycles: int = 2,
                   measure_cycles: int = 2, settle_s: float | None = None,
                   min_steps_per_cycle: int = 64) -> FrequencyResponse:
     """Command -> piston (x_p / (R theta_c)) and command -> engine (theta / theta_c) of the
@@ -315,7 +322,7 @@ def taos_freqresp(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitude_rad: fl
 
 def taos_freqresp_family(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitudes_rad: np.typing.ArrayLike,
                          axis: str = "pitch", cross: bool = False, *,
-                         dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
+                         dt_max_s: float = DWELL_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
                          settle_s: float | None = None, min_steps_per_cycle: int = 64) -> list[FrequencyResponse]:
     """Sine-dwell responses of the TAOS model at every command amplitude [rad] x frequency
     [Hz], all dwells in one parallel call (as :func:`taos_freqresp`, whose single-amplitude
@@ -326,7 +333,7 @@ def taos_freqresp_family(tm: TaosModel, freq_hz: np.typing.ArrayLike, amplitudes
                               min_steps_per_cycle=min_steps_per_cycle)[axis]
 
 
-def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = False, *, dt_max_s: float = DEFAULT_DT_S,
+def taos_freqresp_axes(tm: TaosModel, grids: dict[str, tuple], cross: bool = False, *, dt_max_s: float = DWELL_DT_S,
                        settle_cycles: int = 2, measure_cycles: int = 2, settle_s: float | None = None,
                        min_steps_per_cycle: int = 64) -> dict[str, list[FrequencyResponse]]:
     """:func:`taos_freqresp_family` of several axes, ``grids`` = {axis: (freq_hz [Hz],
@@ -411,7 +418,7 @@ def _dwell(tm, amps, freqs, fmeas, dt_max_s, settle_cycles, measure_cycles, sett
 
 
 def two_axis_dwell(tm: TaosModel, amplitude_rad, freq_hz, *, measure_axis: str = "pitch",
-                   dt_max_s: float = DEFAULT_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
+                   dt_max_s: float = DWELL_DT_S, settle_cycles: int = 2, measure_cycles: int = 2,
                    settle_s: float | None = None, min_steps_per_cycle: int = 64):
     """Pitch and yaw sines at once (rows of ``amplitude_rad``/``freq_hz`` (n, 2) [rad, Hz]);
     returns (piston, engine) complex gains of ``measure_axis`` at its own frequency (n,).
