@@ -38,7 +38,7 @@ def default_dt_s(engine: str = "simplex", *, source: str = "command line", field
 def fastest_mode_rad_s(model, axes=("pitch", "yaw")) -> float:
     """|lambda|_max of the linear block over ``axes`` [rad/s], or the supply-pressure limit's
     fastest rate at stall when larger (:func:`taos.planar.saturation.pressure_limit_rate_per_s`)."""
-    from .saturation import pressure_limit_rate_per_s
+    from ._limits_pack import pressure_limit_rate_per_s
     from .simplex import simplex_state_space
 
     lin = max(float(np.max(np.abs(simplex_state_space(model, ax).poles()))) for ax in axes)
