@@ -26,6 +26,25 @@ N_ORBIT = 1024
 #: jump (:func:`_jumps`); a smooth law's halves agree to ~1e-3 at these stencils
 JUMP_RATIO = 8.0
 
+#: the environment variable that makes a dwell command print, on stderr, the wall-clock time
+#: (``time.time()``, s since the epoch) of its first kernel call and of that call's return (a
+#: dwell's first kernel is the step plan's :func:`taos.friction._kernels.prescribed_rate_fill`):
+#: ``benchmarks/bench_expstep.py --first-kernel`` subtracts the time it started the process
+STAMP_ENV = "TAOS_STARTUP_STAMP"
+_STAMPED: set = set()
+
+
+def stamp(label: str) -> None:
+    """Print ``taos-stamp LABEL TIME`` on stderr once a process when :data:`STAMP_ENV` is set."""
+    import os
+
+    if label not in _STAMPED and os.environ.get(STAMP_ENV):
+        import sys
+        import time
+
+        _STAMPED.add(label)
+        print(f"taos-stamp {label} {time.time():.6f}", file=sys.stderr, flush=True)
+
 
 class KernelSet(Protocol):
     """The compiled kernels a dwell needs (one implementation per engine). ``name``: ``"numba"``
@@ -195,7 +214,9 @@ def dwell_step_s(args, model, amp: float, freq: float, fixed_dt_s: float, ks) ->
     w = xs @ cw
     ta = xs @ ca
     fp, fid = model.friction.pack(), ks.law(model)
+    stamp("first-kernel-call")
     z = ks.rate_response_z(fid, fp, np.ascontiguousarray(w), 1.0 / (freq * N_ORBIT), 0.0)
+    stamp("first-kernel-return")
     sl = np.arange(N_ORBIT, 2 * N_ORBIT, N_ORBIT // 64)
     # and the rate reversals, where a regularised law is stiffest (a smooth Coulomb law's slope
     # T_c / v_eps at w = 0 is a spike far narrower than the 64 samples' spacing)
