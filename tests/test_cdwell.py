@@ -137,6 +137,31 @@ def test_a_foreign_library_is_not_loaded(cache):
     assert man["c_sha256"] == __import__("hashlib").sha256(src.encode()).hexdigest()
 
 
+def test_a_damaged_library_is_rebuilt_and_a_failed_build_remembered(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))   # paths this process has not loaded
+    monkeypatch.setattr(_cdwell, "_LOADED", {})
+    folder = _cdwell.cache_dir()
+    key = _cdwell.cache_key("none", _cdwell.compiler())
+    _cdwell.build("none", folder)
+    (folder / f"{key}.so").write_bytes(b"damaged")
+    assert _cdwell.load("none").name == "c"          # rebuilt
+    assert (folder / f"{key}.so").read_bytes() != b"damaged"
+    _cdwell._LOADED.clear()
+    (folder / f"{key}.json").unlink()
+    calls, real_build = [], _cdwell.build
+
+    def failing(law, folder=None):
+        calls.append(law)
+        raise _cdwell.CUnavailable("the compiler failed")
+    monkeypatch.setattr(_cdwell, "build", failing)
+    for _ in range(2):
+        with pytest.raises(_cdwell.CUnavailable, match="the compiler failed"):
+            _cdwell.load("none")
+    assert calls == ["none"] and (folder / f"{key}.failed").is_file()   # tried once, then remembered
+    monkeypatch.setattr(_cdwell, "build", real_build)
+    assert _cdwell.load("none", retry=True).name == "c" and not (folder / f"{key}.failed").exists()
+
+
 def test_fallbacks_say_why(cache, monkeypatch):
     m = load_model("rs25_flight", friction="dahl")
     monkeypatch.setenv(_cdwell.ENV, "numba")

@@ -91,7 +91,7 @@ def _c_dwells() -> None:
     if _cdwell.compiler() is None:
         return
     for law in modules():
-        _cdwell.load(law)
+        _cdwell.load(law, retry=True)
 
 
 def _simulate() -> None:

@@ -243,9 +243,11 @@ class CKernels:
         self._call("taos_dwell_batch", args)
 
 
-def load(law: str) -> CKernels:
-    """Law ``law``'s C kernel set: the cached library, built first when there is none (module
-    docstring); raises :class:`CUnavailable`."""
+def load(law: str, retry: bool = False) -> CKernels:
+    """Law ``law``'s C kernel set: the cached library, built first when there is none or it is
+    damaged (module docstring); raises :class:`CUnavailable`. A failed build is remembered for
+    its key (``KEY.failed`` beside the libraries, with the reason) and not tried again by each
+    command; ``retry`` (the warm-up) tries again."""
     with _LOCK:
         if law in _LOADED:
             return _LOADED[law]
@@ -254,15 +256,36 @@ def load(law: str) -> CKernels:
             raise CUnavailable("no C compiler ($CC, cc or gcc)")
         folder = cache_dir()
         key = cache_key(law, cc)
-        so, man = folder / f"{key}.so", folder / f"{key}.json"
-        if not man.is_file():
-            so = build(law, folder)
-        try:
-            ks = CKernels(so, json.loads(man.read_text()))
-        except (OSError, ValueError, KeyError, AttributeError) as e:
-            raise CUnavailable(f"loading {so}: {e}") from None
+        so, man, failed = folder / f"{key}.so", folder / f"{key}.json", folder / f"{key}.failed"
+        if failed.is_file() and not retry:   # failed before for this source, compiler and machine
+            raise CUnavailable(f"{failed.read_text().strip()} (remembered in {failed}; `python -m "
+                               "taos.cli.warmup --only 'C dwells'` or removing it tries again)")
+        failed.unlink(missing_ok=True)
+        for attempt in range(2):
+            try:
+                if attempt or not man.is_file():
+                    build(law, folder)
+                ks = CKernels(so, json.loads(man.read_text()))
+                break
+            except CUnavailable as e:
+                _write_failure(failed, str(e))
+                raise
+            except (OSError, ValueError, KeyError, AttributeError) as e:   # a damaged entry: rebuilt once
+                if attempt:
+                    _write_failure(failed, f"loading {so}: {e}")
+                    raise CUnavailable(f"loading {so}: {e}") from None
         _LOADED[law] = ks
         return ks
+
+
+def _write_failure(path: Path, reason: str) -> None:
+    """Remember why the C path failed for this key (its name changes with the sources, the
+    compiler and the machine, so a fix is tried again)."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(reason + "\n")
+    except OSError:
+        pass
 
 
 def dwell_kernels(model):
