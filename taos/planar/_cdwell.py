@@ -58,9 +58,11 @@ ENGINES = ("c", "numba")
 #: the C compiler's flags: IEEE arithmetic (no fast-math, no FMA contraction)
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-math-errno")
 #: the modules (relative to the ``taos`` package) the C is translated from, besides the law's own
+#: (and those that define what the kernels read: the parameter packs, the limits' layout)
 SOURCES = ("planar/_expstep.py", "planar/_expplan.py", "planar/dynamics.py", "planar/saturation.py",
            "planar/_limits_pack.py", "planar/_avionics_kernels.py", "planar/_avionics_slots.py",
-           "friction/_kernels.py", "friction/_slots.py", "cosim/_ccode.py", "cosim/_ccode_func.py",
+           "friction/_kernels.py", "friction/_slots.py", "friction/_vector.py", "friction/_builtin.py",
+           "friction/_laws.py", "cosim/_ccode.py", "cosim/_ccode_func.py",
            "cosim/_ccode_stmt.py", "planar/_cdwell.py")
 ROOT = Path(__file__).resolve().parents[1]
 _LOCK = threading.Lock()
