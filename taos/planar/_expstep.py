@@ -63,6 +63,7 @@ from . import saturation as _lim
 from ._avionics_slots import AV_LSB
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
+#: the command table's node rule and its bound, numba-free in :mod:`taos.planar._expcoef` (re-exported)
 table_nodes = _xc.table_nodes
 TABLE_DTAU_NORM = _xc.TABLE_DTAU_NORM
 
