@@ -62,9 +62,10 @@ $(WARM): $(TEST_STAMP) $(KERNEL_SOURCES) taos/cli/warmup.py | $(PYC)
 	touch $(WARM)
 
 # On a cold kernel cache a second process compiles the planar simulation's kernels beside the
-# Green Run's 3-D ones (taos/cli/warmup.py; a second of loading when the cache is warm).
+# Green Run's 3-D ones (taos/cli/warmup.py; a second of loading when the cache is warm), and the
+# dwells' C libraries (taos/planar/_cdwell.py: about 0.4 CPU-s a law, nothing when cached).
 demo: $(STAMP)
-	@PYTHONDONTWRITEBYTECODE= $(BIN)/python -m taos.cli.warmup --only simulate >/dev/null 2>&1 & w=$$!; \
+	@PYTHONDONTWRITEBYTECODE= $(BIN)/python -m taos.cli.warmup --only "simulate,C dwells" >/dev/null 2>&1 & w=$$!; \
 	  PYTHONDONTWRITEBYTECODE= $(BIN)/taos greenrun $(DEMO_MODEL) --engine taos --out $(DEMO_OUT); \
 	  rc=$$?; wait $$w; exit $$rc
 	@echo "Green Run report: $(DEMO_OUT)/index.html"

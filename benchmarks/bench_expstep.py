@@ -29,7 +29,16 @@ scipy LSODA peer, in the same run.
    ``PYTHONDONTWRITEBYTECODE``); an empty ``python -c pass`` and ``import numba`` as floors; and the
    LSODA peer (Python right-hand side, measured on two 2 s dwells and scaled, plus its start-up).
 
-Run:  .venv/bin/python benchmarks/bench_expstep.py [--quick] [--before-after | --startup]
+7. ``--first-kernel`` (alone; issue 44 point 3): the C dwell kernels (``TAOS_KERNELS=c``,
+   :mod:`taos.planar._cdwell`, the law's library in the cache) against numba's
+   (``TAOS_KERNELS=numba``, numba's cache warm), whole processes through the console script,
+   interleaved: the time from launching the process to its first kernel call and to that
+   call's return (the command prints ``time.time()`` there, ``TAOS_STARTUP_STAMP=1``; the
+   parent subtracts its own ``time.time()`` just before starting the process), median and
+   minimum of ``--repeat`` (default 7) one-dwell calls; then the 3-call job (wall and CPU,
+   median of 3) on each path and the LSODA peer of item 6, in the same run, with ``uptime``.
+
+Run:  .venv/bin/python benchmarks/bench_expstep.py [--quick] [--before-after | --startup | --first-kernel]
 """
 
 from __future__ import annotations
@@ -269,6 +278,59 @@ def startup(quick=False):
           f"settling {ts:.2f} s + 2 + 2 cycles per dwell, scaled by simulated time\n")
 
 
+def _stamped(cmd, env):
+    """(to the first kernel call, to its return, whole process) [s] of one process (item 7)."""
+    t0 = time.time()
+    r = subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env)
+    t_end = time.time() - t0
+    st = {ln.split()[1]: float(ln.split()[2]) - t0 for ln in r.stderr.splitlines() if ln.startswith("taos-stamp ")}
+    return st["first-kernel-call"], st["first-kernel-return"], t_end
+
+
+def first_kernel(repeat=7):
+    """Item 7 of the module docstring."""
+    import statistics
+
+    from taos.model import load_model
+    from taos.planar.freqresp import settle_time_s
+
+    print(f"uptime (start): {os.popen('uptime').read().strip()}\n")
+    base = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONPYCACHEPREFIX")}
+    envs = {e: dict(base, TAOS_KERNELS=e, TAOS_STARTUP_STAMP="1") for e in ("c", "numba")}
+    args = TAOS + ["freqresp", MODEL, "--friction", LAW, "--json", os.devnull]
+    one = args + ["--freq-hz", "1", "--amplitude-deg", "0.1"]
+    for env in envs.values():
+        _stamped(one, env)   # libraries and kernels cached, pages warm
+    st = {e: [] for e in envs}
+    for _ in range(repeat):
+        for e, env in envs.items():
+            st[e].append(_stamped(one, env))
+    print("| kernels | to first kernel call, median / min [s] | to its return, median / min [s] | "
+          "whole 1-dwell process, median [s] |\n|---|---|---|---|")
+    for e, v in st.items():
+        c = [x[0] for x in v]
+        r = [x[1] for x in v]
+        print(f"| {e} | {statistics.median(c):.3f} / {min(c):.3f} | {statistics.median(r):.3f} / {min(r):.3f} | "
+              f"{statistics.median(x[2] for x in v):.3f} |")
+    calls = [args + ["--freq-hz", csv(JOB_FREQ), "--amplitude-deg", f"{a:g}"] for a in JOB_AMPS]
+    job = {e: [] for e in envs}
+    for _ in range(3):
+        for e, env in envs.items():
+            quiet = {k: v for k, v in env.items() if k != "TAOS_STARTUP_STAMP"}
+            job[e].append(np.sum([_cpu_wall(c, quiet) for c in calls], axis=0))
+    m = load_model(MODEL, friction=LAW)
+    per_s = sum(lsoda_dwell(m, a * DEG, f, 2.0) for a, f in ((0.1, 0.5), (0.4, 2.0))) / 4.0
+    t_np = wall([sys.executable, "-c", "import numpy, scipy.integrate"])
+    peer = per_s * simulated_s(settle_time_s(m), JOB_AMPS, JOB_FREQ) + 3 * t_np
+    print(f"\n| 3 calls of {len(JOB_FREQ)} dwells | wall, median [s] | CPU, median [s] | LSODA peer [s] | speed-up |"
+          "\n|---|---|---|---|---|")
+    for e, v in job.items():
+        w = statistics.median(x[0] for x in v)
+        print(f"| {e} kernels | {w:.2f} | {statistics.median(x[1] for x in v):.2f} | {peer:.1f} | {peer / w:.0f}x |")
+    print(f"\nLSODA peer: {per_s:.2f} s per simulated second (Python rhs), start-up {t_np:.2f} s a process")
+    print(f"uptime (end): {os.popen('uptime').read().strip()}")
+
+
 def main(quick=False):
     from taos.linear import gain_db
     from taos.model import load_model
@@ -334,6 +396,9 @@ def main(quick=False):
 
 
 if __name__ == "__main__":
+    if "--first-kernel" in sys.argv:
+        first_kernel(int(sys.argv[sys.argv.index("--repeat") + 1]) if "--repeat" in sys.argv else 7)
+        sys.exit(0)
     if "--before-after" in sys.argv or "--startup" in sys.argv:
         print(f"uptime: {os.popen('uptime').read().strip()}\n")
         (startup if "--startup" in sys.argv else before_after)(quick="--quick" in sys.argv)

@@ -22,8 +22,11 @@ Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.
 
 1. ``units``, ``errors``, ``results``, ``shipped``, ``bounds``, ``harmonics``, ``descfcn`` - units, one-line
    input errors, output files, the documented bounds of every input, sine fits, describing functions;
+   and ``cosim._ccode`` (with ``_ccode_func``, ``_ccode_stmt``), the kernels' Python-to-C
+   translator, which imports nothing of taos (the FMUs and the C dwells of ``planar._cdwell``
+   use it);
 2. ``friction``, ``linear``, ``stability``, ``model`` and the component models
-   ``planar.actuator``, ``planar.avionics``, ``planar.saturation``;
+   ``planar.actuator``, ``planar.avionics``, ``planar.saturation`` (its packing ``planar._limits_pack``);
 3. the engines: ``planar`` (the simplex model, its kernels, simulation, frequency response,
    steady state, run envelope) and ``taos3d`` (3-D), with ``fem``, ``profiles``,
    ``engine_geometry``;

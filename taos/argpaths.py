@@ -92,7 +92,7 @@ def check_environment() -> None:
     """The environment variables a command reads, checked before any work (one line, exit 2;
     docs/reference/cli.md): ``NUMBA_NUM_THREADS`` a whole number of at least 1 (numba fails on
     0 or less when a kernel first asks for its threads, and silently takes its default for text
-    it cannot read). ``MPLBACKEND`` is not refused: a command draws its plots into files with
+    it cannot read); ``TAOS_KERNELS`` ``c`` or ``numba`` (:mod:`taos.planar._cdwell`). ``MPLBACKEND`` is not refused: a command draws its plots into files with
     matplotlib's Agg backend whatever it says, so it is set to Agg here (a name matplotlib does not
     know would stop the import of matplotlib itself). A file name that is not valid in the
     locale's encoding (``LANG=C``, or bytes that are not UTF-8) is handled as the bytes it is
@@ -103,5 +103,9 @@ def check_environment() -> None:
     if v is not None and not (v.strip().isdigit() and int(v) >= 1):
         raise InputError("environment", "NUMBA_NUM_THREADS", "a whole number of threads, 1 or more (or unset: "
                          "one per core)", got=repr(v)[:40])
+    k = os.environ.get("TAOS_KERNELS", "").strip().lower()
+    if k not in ("", "c", "numba"):
+        raise InputError("environment", "TAOS_KERNELS", "c (the dwells' C kernels, default) or numba",
+                         got=repr(os.environ["TAOS_KERNELS"])[:40])
     if os.environ.get("MPLBACKEND", "agg").lower() != "agg" and "matplotlib" not in __import__("sys").modules:
         os.environ["MPLBACKEND"] = "agg"

@@ -155,11 +155,12 @@ def test_nothing_below_the_cli_imports_it():
 LAYERS = {
     "taos.units": 1, "taos.errors": 1, "taos.results": 1, "taos.shipped": 1, "taos.bounds": 1, "taos.argpaths": 1,
     "taos.harmonics": 1, "taos.descfcn": 1,
+    "taos.cosim._ccode": 1, "taos.cosim._ccode_func": 1, "taos.cosim._ccode_stmt": 1,
     "taos.friction": 2, "taos.linear": 2, "taos.stability": 2, "taos.model": 2,
     "taos.model_keys": 2, "taos.variants": 2,
     "taos.planar.actuator": 2, "taos.planar.avionics": 2, "taos.planar._avionics_kernels": 2,
     "taos.planar._avionics_slots": 2,
-    "taos.planar.saturation": 2,
+    "taos.planar.saturation": 2, "taos.planar._limits_pack": 2,
     "taos.planar": 3, "taos.taos3d": 3, "taos.fem": 3, "taos.profiles": 3, "taos.engine_geometry": 3,
     "taos.flight": 4, "taos.identify": 4, "taos.report": 4, "taos.montecarlo": 4,
     "taos.interop": 4, "taos.cosim": 4,

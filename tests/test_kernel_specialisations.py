@@ -31,8 +31,18 @@ def _run_all(model) -> None:
 
     for integ in ("rk4", "exp"):
         simulate(model, SineDwell(math.radians(0.4), 1.0, 1), duration_s=0.01, integrator=integ)
-    for kw in ({}, {"integrator": "rk4"}, {"method": "shoot", "max_cycles": 1}):
-        sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1, **kw)
+    import os
+
+    before = os.environ.get("TAOS_KERNELS")
+    os.environ["TAOS_KERNELS"] = "numba"   # numba's dwell kernels, not their C translation (taos.planar._cdwell)
+    try:
+        for kw in ({}, {"integrator": "rk4"}, {"method": "shoot", "max_cycles": 1}):
+            sine_dwell_grid(model, [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1, **kw)
+    finally:
+        if before is None:
+            os.environ.pop("TAOS_KERNELS")
+        else:
+            os.environ["TAOS_KERNELS"] = before
     compile_kernel(model)
 
 

@@ -42,7 +42,7 @@ def _named_integrator(d: dict) -> str:
 @pytest.fixture
 def ran(monkeypatch):
     """The integrator entry points called, by the name a result should give them."""
-    from taos.planar import _expplan
+    from taos.planar import _expcoef
     from taos.planar import dynamics as planar_dynamics
     from taos.planar.freqresp import INTEGRATOR_NAMES
     from taos.taos3d import dynamics as taos_dynamics
@@ -58,7 +58,7 @@ def ran(monkeypatch):
             return real(*a, **k)
         monkeypatch.setattr(module, attr, wrapped)
 
-    spy(_expplan, "run_dwells", INTEGRATOR_NAMES["exp"])
+    spy(_expcoef, "run_dwells", INTEGRATOR_NAMES["exp"])   # C or numba kernels (taos.planar._cdwell)
     spy(planar_dynamics, "sine_dwell_batch", INTEGRATOR_NAMES["rk4"])
     spy(taos_dynamics, "dwell_batch", INTEGRATOR)
     return calls

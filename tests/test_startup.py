@@ -25,8 +25,8 @@ print(json.dumps({"rc": rc, "loaded": [m for m in %r if m in sys.modules],
 """ % (HEAVY,)
 
 
-def _loaded(tmp_path, *argv):
-    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))   # a fresh unit table
+def _loaded(tmp_path, *argv, **env_more):
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"), **env_more)   # a fresh unit table
     r = subprocess.run([sys.executable, "-c", PROBE, *argv], capture_output=True, text=True, env=env, timeout=300)
     assert r.returncode == 0, r.stderr
     return json.loads(r.stdout.strip().splitlines()[-1])
@@ -45,11 +45,30 @@ def test_info_is_linear_analysis_without_kernels(tmp_path):
 
 
 def test_a_dwell_command_loads_the_kernels_of_its_own_friction_law_only(tmp_path):
-    """``taos freqresp`` on a modified-LuGre model loads (from numba's cache) the LuGre kernel
-    set only, not every built-in law's C callbacks (:mod:`taos.friction._builtin`)."""
+    """``taos freqresp`` on a modified-LuGre model with numba's dwell kernels
+    (``TAOS_KERNELS=numba``) loads (from numba's cache) the LuGre kernel set only, not every
+    built-in law's C callbacks (:mod:`taos.friction._builtin`)."""
     d = _loaded(tmp_path, "freqresp", "rs25_hotfire", "--freq-hz", "1", "--amplitude-deg", "0.1",
-                "--json", str(tmp_path / "fr.json"))
-    assert d["rc"] == 0 and d["laws"] == ["taos.friction._law_lugre"]
+                "--json", str(tmp_path / "fr.json"), TAOS_KERNELS="numba")
+    assert d["rc"] == 0 and d["laws"] == ["taos.friction._law_lugre"] and "numba" in d["loaded"]
+
+
+def test_a_dwell_command_on_the_c_kernels_imports_no_numba(tmp_path):
+    """With its law's C library in the cache (:mod:`taos.planar._cdwell`; the first run builds
+    it, translating the LuGre kernels, so it loads them), ``taos freqresp`` imports none of the
+    heavy packages: no numba, no scipy, no law kernels; the result says it ran the C kernels."""
+    from taos.planar._cdwell import compiler
+
+    if compiler() is None:
+        import pytest
+
+        pytest.skip("no C compiler: the dwells run on numba")
+    argv = ("freqresp", "rs25_hotfire", "--freq-hz", "1,3", "--amplitude-deg", "0.1", "--json", str(tmp_path / "fr.json"))
+    first = _loaded(tmp_path, *argv, TAOS_KERNELS="c")
+    assert first["rc"] == 0 and first["laws"] == ["taos.friction._law_lugre"]
+    again = _loaded(tmp_path, *argv, TAOS_KERNELS="c")
+    assert again == {"rc": 0, "loaded": [], "laws": []}
+    assert json.loads((tmp_path / "fr.json").read_text())["provenance"]["solver"]["kernels"] == "c"
 
 
 def test_info_steps_adds_the_simulated_figures(tmp_path):

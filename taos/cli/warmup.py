@@ -26,7 +26,10 @@ that callee too, so the steps sharing such callees form one group and a group is
   ``planar._expstep`` (``etdrk4_step``, ``_nonlin``, ``sine_steps_exp``);
 * ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` (with its pieces ``taos3d._rhs``,
   ``taos3d._commands``, ``taos3d._so3``) and ``taos3d._bearing``;
-* ``friction``: every built-in law's C callbacks, the lane forms included (``friction.registry.load_all``).
+* ``friction``: every built-in law's C callbacks, the lane forms included (``friction.registry.load_all``);
+* ``cdwell``: not numba's: the dwell kernels translated to C and compiled once per built-in law
+  (:mod:`taos.planar._cdwell`, its own cache), which ``taos freqresp``'s dwells load instead of
+  numba's; building one imports the law's C callbacks (the same key as ``friction``'s).
 
 Between groups the only shared callees are ``planar._avionics_kernels.apply`` and the model's
 friction law's C callbacks, which every group calls with the same signature (float64 and
@@ -63,8 +66,32 @@ def _model():
 
 
 def _dwell(**kw) -> None:
+    """numba's dwell kernels (the reference and the fallback of the C dwells, forced here)."""
+    import os
+
+    from taos.planar._cdwell import ENV
     from taos.planar.freqresp import sine_dwell_grid
-    sine_dwell_grid(_model(), [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1, **kw)
+    before = os.environ.get(ENV)
+    os.environ[ENV] = "numba"
+    try:
+        sine_dwell_grid(_model(), [math.radians(0.4)], [10.0], settle_s=0.0, settle_cycles=1, measure_cycles=1, **kw)
+    finally:
+        if before is None:
+            os.environ.pop(ENV, None)
+        else:
+            os.environ[ENV] = before
+
+
+def _c_dwells() -> None:
+    """The C dwell libraries of the built-in laws (:mod:`taos.planar._cdwell`; none without a C
+    compiler): built where the cache has none, so a dwell command starts without numba."""
+    from taos.friction._builtin import modules
+    from taos.planar import _cdwell
+
+    if _cdwell.compiler() is None:
+        return
+    for law in modules():
+        _cdwell.load(law, retry=True)
 
 
 def _simulate() -> None:
@@ -152,6 +179,7 @@ STEPS: tuple[Step, ...] = (
     Step("shoot", "planar", _shoot, 14.4),
     Step("lco confirmation", "planar", _lco_confirm, 0.1),
     Step("friction laws", "friction", _friction, 4.7),
+    Step("C dwells", "cdwell", _c_dwells, 6.0),
     Step("ascent lanes", "lanes", _ascent_lanes, 16.3),
     Step("3-D model", "3d", _taos_model, 8.9),
     Step("3-D simulate", "3d", _simulate_taos, 7.8),

@@ -10,7 +10,7 @@ import math
 import textwrap
 import types
 
-from ._ccode_stmt import _ARRAY, _BINOP, _SCALAR, Untranslatable, _join, _Statements, is_tup
+from ._ccode_stmt import _ARRAY, _BINOP, _SCALAR, NDIM, Untranslatable, _join, _Statements, is_tup
 
 _MATH = {"sqrt": "sqrt", "exp": "exp", "log": "log", "asin": "asin", "acos": "acos", "atan": "atan",
          "atan2": "atan2", "sin": "sin", "cos": "cos", "tan": "tan", "tanh": "tanh", "floor": "floor",
@@ -42,13 +42,18 @@ def is_kernel(obj) -> bool:
 
 
 def kind_of(value):
-    """The argument kind of a sample value: 'arr1'/'arr2' (float64 array), 'double', 'long',
+    """The argument kind of a sample value: 'arr1'/'arr2'/'arr3' (float64 array), 'iarr1' (a
+    1-D int64 array), 'double', 'long',
     'taos_tupN' (a tuple of N numbers), ('nt', class, field kinds) (a named tuple),
     ('fn', python function) (a kernel passed as an argument) or ('fns', functions) (a tuple of
     kernels)."""
     nd = getattr(value, "ndim", None)
     if nd is not None:
-        if nd not in (1, 2):
+        if value.dtype.kind in "iu":
+            if nd != 1 or value.dtype.itemsize != 8:
+                raise Untranslatable(f"a {nd}-D {value.dtype} array argument")
+            return "iarr1"
+        if nd not in (1, 2, 3):
             raise Untranslatable(f"a {nd}-D array argument")
         return f"arr{nd}"
     if isinstance(value, (bool, int)):
@@ -145,22 +150,25 @@ class _Func(_Statements):
         return None
 
     def arr(self, e):
-        """(ndim, base pointer, shape 0, shape 1) of an array expression (an argument, an array
-        local, a named tuple's array field, a row ``a[i]`` of a 2-D array), else None."""
+        """(ndim, base pointer, shape 0, shape 1, shape 2, kind) of an array expression (an
+        argument, an array local, a named tuple's array field, a row ``a[i]`` of a 2-D array, a
+        matrix ``a[i]`` of a 3-D one), else None."""
         if isinstance(e, ast.Name):
             k = self.kind.get(e.id) or self.locals.get(e.id)
             if k in _ARRAY:
                 n = e.id
-                return int(k[3]), f"{n}_", f"{n}_s0", f"{n}_s1"
+                return NDIM[k], f"{n}_", f"{n}_s0", f"{n}_s1", f"{n}_s2", k
             return None
         f = self.field(e)
         if f is not None:
             c, k = f
-            return (int(k[3]), c, f"{c}_s0", f"{c}_s1") if k in _ARRAY else None
+            return (NDIM[k], c, f"{c}_s0", f"{c}_s1", None, k) if k in ("arr1", "arr2") else None
         if isinstance(e, ast.Subscript) and not isinstance(e.slice, (ast.Tuple, ast.Slice)):
             a = self.arr(e.value)
             if a is not None and a[0] == 2:
-                return 1, f"({a[1]} + ({self.expr(e.slice)}) * {a[3]})", a[3], None
+                return 1, f"({a[1]} + ({self.expr(e.slice)}) * {a[3]})", a[3], None, None, "arr1"
+            if a is not None and a[0] == 3:
+                return 2, f"({a[1]} + ({self.expr(e.slice)}) * {a[3]} * {a[4]})", a[3], a[4], None, "arr2"
         return None
 
     def fn_of(self, e):
@@ -215,9 +223,9 @@ class _Func(_Statements):
             if isinstance(e.value, ast.Attribute) and e.value.attr == "shape":
                 return "long"
             a = self.arr(e.value)
-            if a is not None and a[0] == 2 and not isinstance(e.slice, ast.Tuple):
-                return "arr1"
-            return "double"
+            if a is not None and a[0] >= 2 and not isinstance(e.slice, ast.Tuple):
+                return f"arr{a[0] - 1}"
+            return "long" if a is not None and a[5] == "iarr1" else "double"
         if isinstance(e, ast.Tuple):
             ts = [self.etype(x) for x in e.elts]
             if None in ts:
@@ -240,7 +248,7 @@ class _Func(_Statements):
             a, b = self.etype(e.body), self.etype(e.orelse)
             return None if a is None or b is None else _join(a, b)
         if isinstance(e, ast.Call):
-            return self.call(e)[1]
+            return "arr1" if self.alloc(e) is not None else self.call(e)[1]
         self.fail(e, f"expression {type(e).__name__}")
 
     def infer_locals(self) -> None:
@@ -370,9 +378,9 @@ class _Func(_Statements):
         v = e.value
         if isinstance(v, ast.Attribute) and v.attr == "shape":
             a = self.arr(v.value)
-            if a is None or not isinstance(e.slice, ast.Constant) or e.slice.value not in (0, 1):
+            if a is None or not isinstance(e.slice, ast.Constant) or e.slice.value not in range(a[0]):
                 self.fail(e, "shape of something that is not an array")
-            return a[2] if e.slice.value == 0 else a[3]
+            return a[2 + e.slice.value]
         if is_tup(self.etype(v)):
             if isinstance(e.slice, (ast.Tuple, ast.Slice)):
                 self.fail(e, "a slice or a 2-D index of a tuple")
@@ -380,6 +388,8 @@ class _Func(_Statements):
         a = self.arr(v)
         if a is None:
             self.fail(e, "indexing of something that is not an array or a tuple of numbers")
+        if a[0] == 3:
+            self.fail(e, "an element of a 3-D array (index its matrices: a[i])")
         if a[0] == 1:
             if isinstance(e.slice, (ast.Tuple, ast.Slice)):
                 self.fail(e, "a slice or a 2-D index of a 1-D array")
@@ -415,6 +425,8 @@ class _Func(_Statements):
             return (f"((double)({self.expr(args[0])}))", "double")
         if target is int:
             return (f"((long)({self.expr(args[0])}))", "long")
+        if target is bool:
+            return (f"((long)(({self.expr(args[0])}) != 0))", "long")
         mod = getattr(target, "__module__", None) or ""
         name = getattr(target, "__name__", "")
         if (mod == "math" or mod.startswith("numpy")) and name in _MATH:
@@ -438,8 +450,8 @@ class _Func(_Statements):
                 continue
             ar = self.arr(a)
             if ar is not None:
-                kinds.append(f"arr{ar[0]}")
-                cargs += list(ar[1:1 + ar[0] + 1])
+                kinds.append(ar[5])
+                cargs += list(ar[1:2 + ar[0]])
                 continue
             t = self.etype(a)
             if t is None:
@@ -462,7 +474,8 @@ class _Func(_Statements):
             elif is_tup(t):
                 decls.append(f"    {t} {n}_ = {{{{0}}}};")
             elif t in _ARRAY:
-                decls.append(f"    double *{n}_ = 0; long {n}_s0 = 0;" + (f" long {n}_s1 = 0;" if t == "arr2" else ""))
+                decls.append(f"    {'long' if t == 'iarr1' else 'double'} *{n}_ = 0;"
+                             + "".join(f" long {n}_s{d} = 0;" for d in range(NDIM[t])))
         body = self.body(self.node.body, 1)
         self.ret = ret
         head = f"{'static ' if self.static else ''}{ret} {self.cname}({sig})"
@@ -476,10 +489,8 @@ class _Func(_Statements):
             k = self.kind[n]
             if k in _SCALAR or is_tup(k):
                 out.append(f"{k} {n}_")
-            elif k == "arr1":
-                out += [f"double *{n}_", f"long {n}_s0"]
-            elif k == "arr2":
-                out += [f"double *{n}_", f"long {n}_s0", f"long {n}_s1"]
+            elif k in _ARRAY:
+                out += [f"{'long' if k == 'iarr1' else 'double'} *{n}_"] + [f"long {n}_s{d}" for d in range(NDIM[k])]
             elif k[0] == "nt":
                 out.append(f"{self.tr.struct(k)} *{n}_")
         return out

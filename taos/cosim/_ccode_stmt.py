@@ -7,7 +7,9 @@ import ast
 
 _BINOP = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*"}
 _SCALAR = ("long", "double")
-_ARRAY = ("arr1", "arr2")
+_ARRAY = ("arr1", "arr2", "arr3", "iarr1")
+#: dimensions of each array kind ('iarr1': a 1-D int64 array, ``long *``)
+NDIM = {"arr1": 1, "arr2": 2, "arr3": 3, "iarr1": 1}
 
 
 class Untranslatable(Exception):
@@ -54,6 +56,12 @@ class _Statements:
             if len(s.targets) != 1:
                 self.fail(s, "chained assignment")
             t = s.targets[0]
+            if self.alloc(s.value) is not None:
+                return self.allocate(t, s.value, p, ind)
+            if isinstance(t, ast.Subscript) and all(isinstance(x, ast.Slice) and x.lower is None and x.upper is None
+                                                    and x.step is None for x in
+                                                    (t.slice.elts if isinstance(t.slice, ast.Tuple) else [t.slice])):
+                return self.fill(t, s.value, p)
             if isinstance(t, ast.Tuple):
                 return self.unpack(t, s.value, p)
             if isinstance(t, ast.Name) and t.id == "_":
@@ -79,6 +87,36 @@ class _Statements:
             return self.return_stmt(s, p)
         self.fail(s, f"statement {type(s).__name__}")
 
+    def alloc(self, v):
+        """The size expression of ``np.empty(n)`` / ``np.zeros(n)`` (a 1-D float64 array), else None."""
+        if isinstance(v, ast.Call) and len(v.args) == 1 and not v.keywords and isinstance(v.func, ast.Attribute):
+            g = self.resolve(v.func)
+            if (getattr(g, "__module__", None) or "").startswith("numpy") and getattr(g, "__name__", "") in ("empty", "zeros"):
+                return v.args[0]
+        return None
+
+    def allocate(self, t, v, p, ind) -> list[str]:
+        """``x = np.empty(n)`` / ``np.zeros(n)``: a C99 variable-length array of this call (so at
+        the function's top level only: its storage lives until the function returns)."""
+        if ind != 1 or not isinstance(t, ast.Name) or self.locals.get(t.id) != "arr1":
+            self.fail(v, "an array allocation other than 'name = np.empty(n)' at the function's top level")
+        buf, n = self.tmp(), self.tmp()
+        out = [f"{p}long {n} = {self.expr(self.alloc(v))};", f"{p}double {buf}[{n} > 0 ? {n} : 1];",
+               f"{p}{t.id}_ = {buf}; {t.id}_s0 = {n};"]
+        if self.resolve(v.func).__name__ == "zeros":
+            out.append(f"{p}for (long {n}_i = 0; {n}_i < {n}; {n}_i++) {buf}[{n}_i] = 0.0;")
+        return out
+
+    def fill(self, t, v, p) -> list[str]:
+        """``a[:] = value`` / ``a[:, :] = value`` (every element of an array set to one number)."""
+        a = self.arr(t.value)
+        nd = len(t.slice.elts) if isinstance(t.slice, ast.Tuple) else 1
+        if a is None or a[0] != nd or nd > 2 or self.etype(v) not in _SCALAR:
+            self.fail(t, "a slice assignment other than every element of an array set to a number")
+        i = self.tmp()
+        size = a[2] if nd == 1 else f"{a[2]} * {a[3]}"
+        return [f"{p}for (long {i} = 0; {i} < {size}; {i}++) {a[1]}[{i}] = {self.expr(v)};"]
+
     def assign(self, t, v) -> list[str]:
         """C statements of ``t = v`` for one target (an array local takes the pointer and shape)."""
         if isinstance(t, ast.Name) and t.id in self.fnloc:
@@ -87,7 +125,8 @@ class _Statements:
             a = self.arr(v)
             if a is None:
                 self.fail(v, f"a non-array assigned to the array local {t.id!r}")
-            return [f"{t.id}_ = {a[1]}; {t.id}_s0 = {a[2]};" + (f" {t.id}_s1 = {a[3]};" if a[0] == 2 else "")]
+            return [f"{t.id}_ = {a[1]}; {t.id}_s0 = {a[2]};" + (f" {t.id}_s1 = {a[3]};" if a[0] >= 2 else "")
+                    + (f" {t.id}_s2 = {a[4]};" if a[0] == 3 else "")]
         if not isinstance(t, (ast.Name, ast.Subscript)):
             self.fail(t, "assignment to other than a name or an element")
         return [f"{self.expr(t)} = {self.expr(v)};"]

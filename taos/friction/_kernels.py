@@ -147,13 +147,21 @@ def lugre_torque(v, z, dz, p):
 @njit(cache=True)
 def prescribed_rate_response(rates, p, v, dt, z0):
     """Torque history for a prescribed relative-rate history ``v`` sampled every ``dt``, for
-    the law whose scalar kernel is ``rates`` (its registry entry's).
-
-    The state is advanced by classical RK4 with ``v`` linearly interpolated at the
-    half-step. Returns (torque[n], z[n])."""
+    the law whose scalar kernel is ``rates`` (its registry entry's): (torque[n], z[n]) of
+    :func:`prescribed_rate_fill`."""
     n = v.shape[0]
     tq = np.empty(n)
     zs = np.empty(n)
+    prescribed_rate_fill(rates, p, v, dt, z0, tq, zs)
+    return tq, zs
+
+
+@njit(cache=True)
+def prescribed_rate_fill(rates, p, v, dt, z0, tq, zs):
+    """:func:`prescribed_rate_response` into ``tq`` [N m] and ``zs`` [rad] (n,): the state is
+    advanced by classical RK4 with ``v`` [rad/s] linearly interpolated at the half-step ``dt``
+    [s], from ``z0`` [rad]."""
+    n = v.shape[0]
     z = z0
     for k in range(n):
         zs[k] = z
@@ -164,4 +172,3 @@ def prescribed_rate_response(rates, p, v, dt, z0):
             k3 = rates(vm, z + 0.5 * dt * k2, 0.0, p)[0]
             k4 = rates(v[k + 1], z + dt * k3, 0.0, p)[0]
             z = z + dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
-    return tq, zs

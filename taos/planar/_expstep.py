@@ -57,21 +57,34 @@ import numpy as np
 from numba import njit
 
 from . import _avionics_kernels as _av
+from . import _expcoef as _xc
 from . import dynamics as _dy
 from . import saturation as _lim
 from ._avionics_slots import AV_LSB
 
 _FM = {"reassoc", "contract", "arcp", "nsz"}
-#: cubic-Hermite table of the command response g: nodes so that dtau |A| <= this
-TABLE_DTAU_NORM = 0.1
+#: the command table's node rule and its bound, numba-free in :mod:`taos.planar._expcoef` (re-exported)
+table_nodes = _xc.table_nodes
+TABLE_DTAU_NORM = _xc.TABLE_DTAU_NORM
 
 
 @njit(cache=True)
 def expm_small(W):
-    """exp(W) of a small square matrix by Taylor's series with scaling and squaring (Moler &
-    Van Loan, SIAM Review 45 (2003) 3, method 3): W / 2^s with |W / 2^s|_1 <= 1/4, 14 terms
-    (remainder below (1/4)^15 / 15! ~ 1e-21 relative), then s squarings. Plain loops, no BLAS
-    threads (a threaded BLAS on a busy machine took 20 ms for a 32 x 32 exponential)."""
+    """exp(W) of a small square matrix (:func:`expm_into`)."""
+    n = W.shape[0]
+    R = np.empty((n, n))
+    expm_into(W, np.empty((n, n)), R, np.empty((n, n)), np.empty((n, n)))
+    return R
+
+
+@njit(cache=True)
+def expm_into(W, X, R, T, tmp):
+    """exp(W) into ``R`` (n, n) of a small square matrix ``W`` by Taylor's series with scaling
+    and squaring (Moler & Van Loan, SIAM Review 45 (2003) 3, method 3): W / 2^s with
+    |W / 2^s|_1 <= 1/4, 14 terms (remainder below (1/4)^15 / 15! ~ 1e-21 relative), then s
+    squarings; ``X``, ``T``, ``tmp`` (n, n) scratch. Plain loops, no BLAS threads (a threaded
+    BLAS on a busy machine took 20 ms for a 32 x 32 exponential), no allocation (so that it is
+    translated to C as it is: :mod:`taos.planar._cdwell`)."""
     n = W.shape[0]
     nrm = 0.0
     for j in range(n):
@@ -83,10 +96,12 @@ def expm_small(W):
     while nrm > 0.25:
         nrm *= 0.5
         s += 1
-    X = W * (0.5 ** s)
-    R = np.eye(n)
-    T = np.eye(n)
-    tmp = np.empty((n, n))
+    f = 0.5 ** s
+    for i in range(n):
+        for j in range(n):
+            X[i, j] = W[i, j] * f
+            R[i, j] = 1.0 if i == j else 0.0
+            T[i, j] = R[i, j]
     for k in range(1, 15):
         for i in range(n):
             for j in range(n):
@@ -94,8 +109,10 @@ def expm_small(W):
                 for q in range(n):
                     acc += T[i, q] * X[q, j]
                 tmp[i, j] = acc / k
-        T, tmp = tmp, T   # (swapped, not copied: an array-to-array slice copy costs 3 s of compile)
-        R += T
+        for i in range(n):
+            for j in range(n):
+                T[i, j] = tmp[i, j]
+                R[i, j] += T[i, j]
     for _ in range(s):
         for i in range(n):
             for j in range(n):
@@ -103,70 +120,26 @@ def expm_small(W):
                 for q in range(n):
                     acc += R[i, q] * R[q, j]
                 tmp[i, j] = acc
-        R, tmp = tmp, R
-    return R
-
-
-def _balance(L: np.ndarray) -> np.ndarray:
-    """Diagonal scaling s (powers of 2) with S^-1 L S balanced (LAPACK gebal, no permutation)."""
-    from scipy.linalg import matrix_balance
-
-    return matrix_balance(L, permute=False, separate=True)[1][0]
+        for i in range(n):
+            for j in range(n):
+                R[i, j] = tmp[i, j]
 
 
 def phi_functions(L: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """exp(hL), phi_1(hL), phi_2(hL), phi_3(hL) for a square ``L`` [1/s] and step ``h`` [s], from
-    one exponential of the augmented block matrix (module docstring, part 1)."""
-    n = L.shape[0]
-    # diagonal balancing B = S^-1 L S (states in Pa beside states in m: entries 1e-5 ... 1e10)
-    # keeps the scaling-and-squaring short; f(L) = S f(B) S^-1 for every phi_k
-    sc = _balance(L)
-    B = L * (1.0 / sc)[:, None] * sc[None, :]
-    W = np.zeros((4 * n, 4 * n))
-    W[:n, :n] = h * B
-    for k in range(3):
-        W[k * n:(k + 1) * n, (k + 1) * n:(k + 2) * n] = np.eye(n)
-    X = expm_small(W)
-    back = lambda F: F * sc[:, None] * (1.0 / sc)[None, :]  # noqa: E731
-    return back(X[:n, :n]), back(X[:n, n:2 * n]), back(X[:n, 2 * n:3 * n]), back(X[:n, 3 * n:])
-
-
-def table_nodes(A: np.ndarray, H: float) -> int:
-    """Intervals M of the command table on [0, ``H``] [s] so that (H / M) |lambda(A)|max <=
-    :data:`TABLE_DTAU_NORM` (at least 8)."""
-    lam = float(np.max(np.abs(np.linalg.eigvals(A)))) if A.size else 0.0
-    return max(8, int(math.ceil(H * lam / TABLE_DTAU_NORM)))
+    """exp(hL), phi_1(hL), phi_2(hL), phi_3(hL) (:func:`taos.planar._expcoef.phi_functions`,
+    part 1 of the module docstring) by :func:`expm_small`."""
+    return _xc.phi_functions(L, h, expm_small)
 
 
 def command_table(A: np.ndarray, bc: np.ndarray, H: float, M: int) -> tuple[np.ndarray, np.ndarray]:
-    """Values g(tau_i) and derivatives e^{tau_i A} b_c on tau_i = i H / M, i = 0..M (M:
-    :func:`table_nodes`), g(tau) = int_0^tau e^{sA} b_c ds [x per rad] (module docstring,
-    part 2); ``H`` [s] the half step, ``A`` [1/s], ``bc`` [x/s per rad]."""
-    n = A.shape[0]
-    sc = np.append(_balance(A), 1.0)
-    W = np.zeros((n + 1, n + 1))
-    W[:n, :n] = A * (H / M)
-    W[:n, n] = bc * (H / M)
-    W = W * (1.0 / sc)[:, None] * sc[None, :]
-    step = expm_small(W) * sc[:, None] * (1.0 / sc)[None, :]   # one interval: [[e^{dA}, g(d)], [0, 1]]
-    G = np.zeros((M + 1, n))
-    D = np.zeros((M + 1, n))
-    P = np.eye(n + 1)
-    for i in range(M + 1):
-        G[i] = P[:n, n]
-        D[i] = P[:n, :n] @ bc
-        P = step @ P
-    return G, D
+    """The command table of part 2 (:func:`taos.planar._expcoef.command_table`) by :func:`expm_small`."""
+    return _xc.command_table(A, bc, H, M, expm_small)
 
 
 def etd_coefficients(A: np.ndarray, h: float):
-    """The ETDRK4 matrices (E, E2, P2, F1, F2, F3) of the module docstring for the linear block
-    ``A`` [1/s] and step ``h`` [s]."""
-    E, p1, p2, p3 = phi_functions(A, h)
-    E2, q1, _, _ = phi_functions(A, 0.5 * h)
-    c = lambda a: np.ascontiguousarray(a)  # noqa: E731
-    return (c(E), c(E2), c(0.5 * h * q1), c(h * (p1 - 3 * p2 + 4 * p3)), c(h * (p2 - 2 * p3)),
-            c(h * (4 * p3 - p2)))
+    """The ETDRK4 matrices (E, E2, P2, F1, F2, F3) of part 3 (:func:`taos.planar._expcoef.etd_coefficients`)
+    by :func:`expm_small`."""
+    return _xc.etd_coefficients(A, h, expm_small)
 
 
 @njit(cache=True, fastmath=_FM)

@@ -55,14 +55,33 @@ MAX_THREADS = 256
 def thread_count(threads: int | None = None) -> int:
     """``threads`` (1 to :data:`MAX_THREADS`), or numba's thread count when None."""
     if threads is None:
-        import numba
+        import sys
 
-        return max(1, int(numba.get_num_threads()))
+        if "numba" in sys.modules:
+            import numba
+
+            return max(1, int(numba.get_num_threads()))
+        return _numba_default_threads()
     if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= MAX_THREADS:
         from ..errors import InputError
 
         raise InputError("argument", "threads", f"an integer from 1 to {MAX_THREADS}", got=repr(threads))
     return threads
+
+
+def _numba_default_threads() -> int:
+    """numba's thread count without importing numba (a dwell command on the C path,
+    :mod:`taos.planar._cdwell`): ``NUMBA_NUM_THREADS``, else the cores this process may run on
+    (numba's own default, ``numba.core.config``)."""
+    import os
+
+    env = os.environ.get("NUMBA_NUM_THREADS", "").strip()
+    if env:
+        return max(1, int(env))
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:
+        return max(1, os.cpu_count() or 1)
 
 
 def run_tasks(tasks: Sequence[Callable[[], T]], threads: int | None = None,

@@ -45,7 +45,7 @@ def fastest_mode_rad_s(model, axes=("pitch", "yaw"), *, pressure_limit: bool = T
     fastest rate at stall when larger (:func:`taos.planar.saturation.pressure_limit_rate_per_s`)
     and ``pressure_limit`` (False for an engine whose step integrates that rate exactly, the 3-D
     engine's: :func:`taos.taos3d.dynamics._etd_rk4`)."""
-    from .saturation import pressure_limit_rate_per_s
+    from ._limits_pack import pressure_limit_rate_per_s
     from .simplex import simplex_state_space
 
     lin = max(float(np.max(np.abs(simplex_state_space(model, ax).poles()))) for ax in axes)

@@ -290,25 +290,33 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
     check_friction_step(model, plant.inertia_kgm2, dt_max_s)
     ts = settle_time_s(model, axis) if settle_s is None else settle_s
     args = kernel_args(plant, model)
+    ks = None   # the kernel set of settled exponential dwells: C or numba (taos.planar._cdwell)
     if use_exp:
-        from ._expplan import exp_steps_per_cycle
+        from ._expcoef import exp_steps_per_cycle
 
-        npc = exp_steps_per_cycle(args, model, plant.inertia_kgm2, A, F, dt_max_s, min_steps_per_cycle)
+        if method == "settle":
+            from ._cdwell import dwell_kernels
+
+            ks = dwell_kernels(model)
+        else:
+            from ._expplan import NUMBA as ks_shoot
+        npc = exp_steps_per_cycle(args, model, plant.inertia_kgm2, A, F, dt_max_s, min_steps_per_cycle,
+                                  ks or ks_shoot)
     else:
         npc = np.maximum(np.ceil(1.0 / (F * dt_max_s)), min_steps_per_cycle).astype(np.int64)
     nbud = np.maximum(settle_cycles, np.ceil(ts * F)).astype(np.int64)
     nmeas = (measure_cycles * npc).astype(np.int64)
     o = plant.ss.output_index
     Cy = np.ascontiguousarray(plant.ss.C[[o("x_p_m"), o("theta_rad")]])
-    kern = (model.friction.entry.rates, model.friction.pack(), model.avionics.pack())
+    kern = (model.friction.entry.rates if ks is None else ks.law(model), model.friction.pack(), model.avionics.pack())
     cost = nbud * npc + nmeas   # steps: each dwell is one task, the longest first (run_each)
     out = np.zeros((A.size, 2, 3))
     status = np.full(A.size, -1, np.int64)
     extra = {}
     if use_exp and method == "settle":
-        from ._expplan import run_dwells
+        from ._expcoef import run_dwells
 
-        run_dwells(args, Cy, kern, A, F, npc, nbud * npc, nmeas, out, status)
+        run_dwells(args, Cy, kern, A, F, npc, nbud * npc, nmeas, out, status, ks)
     elif method == "settle":
         from . import dynamics as _ig
 
@@ -352,7 +360,8 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
                        "linear orbit reaches the rate limit or the hard stops" if use_exp else "dt_max_s or less, a "
                        "whole number of steps per cycle"),
               "dt_max_s": float(dt_max_s), "min_steps_per_cycle": int(min_steps_per_cycle),
-              "settle_cycles": int(settle_cycles), "settle_s": float(ts), "measure_cycles": int(measure_cycles)}
+              "settle_cycles": int(settle_cycles), "settle_s": float(ts), "measure_cycles": int(measure_cycles),
+              **(ks.provenance if ks is not None else {"kernels": "numba"})}
     if method == "shoot":
         solver.update({"tol": float(tol), "k_rre": int(k_rre), "max_cycles": int(max_cycles)})
     return DwellPoints(h[:, 0] / R, h[:, 1], method, **extra, solver=solver)

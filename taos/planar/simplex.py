@@ -76,7 +76,7 @@ class LurePlant:
     limits: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def __post_init__(self):
-        from .saturation import n_limit_states
+        from ._limits_pack import n_limit_states
         n = self.ss.A.shape[0]
         if self.limits.size and n_limit_states(self.limits) != n:
             raise ValueError(f"LurePlant: limits packed over {n_limit_states(self.limits)} states, "
@@ -94,7 +94,7 @@ def extend_plant(base: LurePlant, ss: StateSpace, n_ext: int, cmd_d) -> LurePlan
     input's weights on them. The command, rate and applied-torque rows are padded with zeros
     and the actuator/gimbal limits are embedded over the larger state, so a grown plant keeps
     every limit of the one it grew from (the one construction for this)."""
-    from .saturation import embed_limits
+    from ._limits_pack import embed_limits
     n0, n = base.ss.A.shape[0], ss.A.shape[0]
     if n < n0 or ss.states[:n0] != base.ss.states:
         raise ValueError("extend_plant: the new block's first states must be the base plant's")
@@ -221,7 +221,7 @@ def simplex_limits(model: TvcModel, axis: str = "pitch") -> np.ndarray:
     """The model's actuator and gimbal limits packed over the simplex state (:mod:`taos.planar.saturation`):
     valve flow saturation, supply-pressure limit (square-root law and relief valve), hard stops at
     the gimbal range."""
-    from .saturation import limit_rows_for_actuator, pack_model_limits
+    from ._limits_pack import limit_rows_for_actuator, pack_model_limits
     act, eng = model.actuator, model.engine
     rows, _ = limit_rows_for_actuator(act)
     ss = simplex_state_space(model, axis)
@@ -261,7 +261,7 @@ def check_rk4_step(dt_s: float, model, field: str, source: str = "argument", *, 
 
     from ..bounds import AXES, RK4_STEP_LIMIT
     from ..errors import InputError
-    from .saturation import pressure_limit_rate_per_s
+    from ._limits_pack import pressure_limit_rate_per_s
 
     lam = max(float(np.max(np.abs(simplex_state_space(model, ax).poles()))) for ax in AXES)
     if pressure_limit:
