@@ -157,6 +157,51 @@ def test_exact_at_multiples_of_the_internal_step_and_state_restore(fmu3, tm, tmp
     s.freeInstance()
 
 
+def test_full_range_reversals_at_the_pressure_limit_equal_taos_simulate(fmu3, tm, tmp_path):
+    """A 5 Hz full-range square wave on both axes (pitch +-range, yaw opposite): the valves open
+    wide against the engine's inertia and the load pressure passes the supply pressure (relief
+    open), where the supply-pressure limit's rate (up to 3,946 1/s, tests/test_taos3d_stall.py)
+    exceeds 1 / dt at the FMU's 0.4 ms internal step, so the C step takes its exponential branch
+    for the load pressures (taos.taos3d.dynamics._etd_rk4) as the numba kernel does. 2 ms host
+    steps against run_samples of the same samples (numba, fast-math): engine angles within
+    5e-14 deg, load pressures within 2e-13 of the supply pressure (measured 9.1e-15 deg,
+    4.4e-14 P_s: rounding, the C has no fast-math reassociation)."""
+    from taos.taos3d import dynamics as dy
+    from taos.taos3d._rhs import pressure_guard
+    from taos.taos3d.simulate import pack, run_samples
+
+    dt, n, m = 4e-4, 5, 300
+    rng = tm.base.engine.gimbal_range_rad
+    sq = np.where(np.sin(2 * np.pi * 5.0 * n * dt * np.arange(m)) >= 0.0, rng, -rng)
+    cmds = np.stack([sq, -sq], axis=1)
+    samples = np.zeros((n * m + 1, 2))
+    for j in range(m):
+        samples[j * n + 1:(j + 1) * n + 1] = cmds[j]
+    cols = [dy.REC.index("theta_pitch"), dy.REC.index("theta_yaw"), dy.REC_PL, dy.REC_PL + 1]
+    ref = run_samples(tm, samples, dt, n)[:, cols]
+    s, vr = _slave(fmu3, tmp_path, "rev")
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    outs = [vr[k] for k in ("pitch_engine_rad", "yaw_engine_rad", "pitch_load_pressure_Pa", "yaw_load_pressure_Pa")]
+    got = [s.getReal(outs)]
+    for j in range(m):
+        s.setReal([0, 1], list(cmds[j]))
+        s.doStep(j * n * dt, n * dt)
+        got.append(s.getReal(outs))
+    s.terminate()
+    s.freeInstance()
+    got = np.array(got)
+    ps = tm.base.actuator.supply_pressure_Pa
+    pk = pack(tm)
+    x = np.zeros(pk.n_state)   # the guard acts from 1.02 P_s at full valve rate (its rate above 1 / dt)
+    x[dy.N_BODY + pk.P.act_q_index] = tm.base.actuator.max_rate_m_per_s
+    x[dy.N_BODY + pk.P.act_pl_index] = 1.02 * ps
+    assert pressure_guard(x, dt, pk.P)[0] > 0.0
+    assert np.abs(ref[:, 2:]).max() > 1.05 * ps   # measured 1.15 P_s
+    assert np.max(np.abs(got[:, :2] - ref[:, :2])) <= 5e-14 * DEG
+    assert np.max(np.abs(got[:, 2:] - ref[:, 2:])) <= 2e-13 * ps
+
+
 def test_host_mistakes_are_errors_and_change_nothing(fmu3, tm, tmp_path):
     """A wrong communication point, a step not a multiple of the internal step, the internal
     step set after initialisation, a command beyond the gimbal range, an output set: fmi2Error,
