@@ -53,7 +53,7 @@ WARM := $(VENV)/.warm
 # source (about 1 s of start-up a process; benchmarks/RESULTS.md). The venv's packages are not
 # compiled ahead (all 14,000 modules: 24 CPU-s, 15 s before the warm-up could start): every
 # process of `make test` runs with PYTHONDONTWRITEBYTECODE emptied ($(PYW)), so the first one to
-# import a module writes its bytecode (about 3,000 modules, 6 CPU-s; atomic, so two processes
+# import a module writes its bytecode (about 3,400 modules, 7 CPU-s; atomic, so two processes
 # importing it at once are safe).
 PYW := PYTHONDONTWRITEBYTECODE=
 $(PYC): $(TEST_STAMP) $(TAOS_SOURCES)
