@@ -15,7 +15,8 @@ DEMO_OUT   ?= out/greenrun
 # interpreter's own pip installs uv into it. `make demo` installs the package alone; `make test` adds the test
 # extra. No bytecode at install: compiling every module of the venv (scipy, plotly, dask, ...)
 # cost 55 CPU-s of a 76 s install here; `make demo` lets Python write the bytecode of the modules
-# it imports as it imports them, and `make test` compiles taos and the venv once ($(PYC)).
+# it imports as it imports them, and so does `make test` (its warm-up, docs build and pytest
+# processes), after compiling taos once ($(PYC)).
 # The numba kernels compile on first use and are cached: `make demo` compiles only what the
 # Green Run needs, `make test` warms every kernel first.
 $(STAMP): pyproject.toml setup.py
@@ -47,18 +48,22 @@ KERNEL_SOURCES := $(shell $(PYTHON) taos/cli/warmup.py --sources)
 TAOS_SOURCES := $(shell find taos -name '*.py' -not -path '*/__pycache__/*')
 PYC  := $(VENV)/.pyc
 WARM := $(VENV)/.warm
-# The Python bytecode (.pyc) of taos and the venv's packages, after any change under taos/:
-# where PYTHONDONTWRITEBYTECODE is set nothing writes it otherwise, and every `taos` process then
-# compiles ~600 modules from source (about 1 s of start-up a process; benchmarks/RESULTS.md).
+# The Python bytecode (.pyc) of taos, after any change under taos/: where PYTHONDONTWRITEBYTECODE
+# is set nothing writes it otherwise, and every `taos` process then compiles ~600 modules from
+# source (about 1 s of start-up a process; benchmarks/RESULTS.md). The venv's packages are not
+# compiled ahead (all 14,000 modules: 24 CPU-s, 15 s before the warm-up could start): every
+# process of `make test` runs with PYTHONDONTWRITEBYTECODE emptied ($(PYW)), so the first one to
+# import a module writes its bytecode (about 3,400 modules, 7 CPU-s; atomic, so two processes
+# importing it at once are safe).
+PYW := PYTHONDONTWRITEBYTECODE=
 $(PYC): $(TEST_STAMP) $(TAOS_SOURCES)
 	$(BIN)/python -m compileall -q -j 2 taos >/dev/null
-	-$(BIN)/python -m compileall -q -j 2 $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])') >/dev/null
 	touch $(PYC)
 
 $(WARM): $(TEST_STAMP) $(KERNEL_SOURCES) taos/cli/warmup.py | $(PYC)
 	find taos -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
-	$(BIN)/python -m taos.cli.warmup --part 1/2 & one=$$!; \
-	  $(BIN)/python -m taos.cli.warmup --part 2/2; two=$$?; wait $$one && exit $$two
+	$(PYW) $(BIN)/python -m taos.cli.warmup --part 1/2 & one=$$!; \
+	  $(PYW) $(BIN)/python -m taos.cli.warmup --part 2/2; two=$$?; wait $$one && exit $$two
 	touch $(WARM)
 
 # On a cold kernel cache a second process compiles the planar simulation's kernels beside the
@@ -102,8 +107,8 @@ DOCS_STATUS := $(CURDIR)/docs/_build/sphinx.status
 # pytest rewrites every test module's asserts when it imports it, and caches the result in
 # tests/__pycache__ only where bytecode may be written: with PYTHONDONTWRITEBYTECODE set, each
 # pytest process parsed and rewrote ~130 test modules again (8.6 -> 4.1 CPU-s a collection).
-PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -q -p no:cacheprovider
-SPHINX := MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
+PYTEST := $(PYW) $(BIN)/python -m pytest -q -p no:cacheprovider
+SPHINX := $(PYW) MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -W --keep-going -q docs docs/_build/html
 test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 	@rm -rf docs/_build docs/_generated; mkdir -p docs/_build; \
 	  ( $(SPHINX) >docs/_build/sphinx.log 2>&1; echo $$? >$(DOCS_STATUS).tmp; mv $(DOCS_STATUS).tmp $(DOCS_STATUS); \

@@ -137,11 +137,12 @@ def test_lco_map_sigterm_keeps_the_store_and_its_resume_line_finishes_it(tmp_pat
 def test_sweep_scheduler_loss_is_one_line_with_the_points_kept_and_the_resume_line(tmp_path, fresh_sweep):
     """The scheduler killed mid-sweep: exit 2, one line (the scheduler lost, the points kept,
     the resume command; never "internal error"); the resume command, run in this machine's
-    process in place of the lost scheduler, finishes the sweep to an uninterrupted run's store."""
+    process in place of the lost scheduler, finishes the sweep to an uninterrupted run's store.
+    (``--connect-timeout 3``: the lost scheduler is waited for 3 s, not the default 20.)"""
     addr, sched, ws = _scheduler(tmp_path, workers=1)
     out = tmp_path / "s"
     try:
-        p = _start(SWEEP, out, "--scheduler", addr)
+        p = _start(SWEEP, out, "--scheduler", addr, "--connect-timeout", "3")
         _wait_stored(p, out / "sweep.zarr", 3)
         sched.kill()
         _, err = p.communicate(timeout=120)
@@ -181,6 +182,24 @@ def test_without_out_a_lost_cluster_says_nothing_is_kept(tmp_path, monkeypatch):
     assert "resume" not in str(e.value) and not list(tmp_path.iterdir())
     with pytest.raises(engine.CampaignStopped, match="resume to continue"):   # with a folder: kept
         run_sweep(defn, tmp_path / "kept")
+
+
+def test_connect_timeout_out_of_range_is_one_line_before_any_work(tmp_path, capsys):
+    """``--connect-timeout`` (``connect_timeout_s``) 0.1 to 600 s, as taos montecarlo's: outside,
+    one line and exit 2 (InputError in the API), nothing written."""
+    from taos.errors import InputError
+    from taos.montecarlo.sweep import SweepDefinition, run_sweep
+    from taos.montecarlo.sweep_define import make_design, parse_set
+    for bad in ("0", "601", "nan"):
+        assert main([*SWEEP, "--connect-timeout", bad, "--out", str(tmp_path / "s")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "--connect-timeout" in err[0] and "0.1 to 600 s" in err[0], err
+    assert not (tmp_path / "s").exists()
+    defn = SweepDefinition(str(AMBIENT), make_design([parse_set("structure.load_stiffness=80000 lbf/in")], None, 0, None),
+                           ("load_mode_hz",))
+    for bad in (0.0, "20", True):
+        with pytest.raises(InputError, match="connect-timeout"):
+            run_sweep(defn, connect_timeout_s=bad)
 
 
 def test_a_foreign_campaign_in_out_is_not_reported_as_kept(tmp_path):

@@ -86,7 +86,8 @@ def cmd_sweep(args) -> int:
     workers = 1 if args.workers is None else args.workers
     try:
         res = run_sweep(defn, args.out, workers=workers, scheduler=scheduler, resume=args.resume,
-                        progress=not args.no_progress and sys.stderr.isatty(), batch=args.batch)
+                        progress=not args.no_progress and sys.stderr.isatty(), batch=args.batch,
+                        connect_timeout_s=args.connect_timeout)
     except CampaignStopped as e:   # (without --out run_sweep says itself that nothing is kept)
         if kept is None:
             raise
@@ -182,6 +183,8 @@ def add_parsers(sub) -> None:
     p.add_argument("--scheduler-file", metavar="PATH", help="the scheduler's address from a Dask scheduler file "
                    "(dask scheduler --scheduler-file PATH; dask-jobqueue)")
     p.add_argument("--batch", type=_whole, help="points per task (default from the metrics' cost)")
+    p.add_argument("--connect-timeout", type=float, default=20.0,
+                   help="seconds to wait for --scheduler to answer, or for a lost one to come back (default 20)")
     p.add_argument("--json", metavar="PATH", help="write the grid, every metric per point, the failed and "
                    "unstable points and the provenance here ('-' for standard output)")
     p.add_argument("--plot", metavar="PNG_OR_SVG", help="each metric over the one or two swept keys")

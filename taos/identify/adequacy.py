@@ -7,7 +7,8 @@ Robinson, *Data Reduction and Error Analysis*, 3rd ed., sec. 11.1). Reported:
 
 * ``normalised_residual_rms`` = sqrt(sum r^2 / m) (1 when the model explains the data to the
   stated errors);
-* ``chi2``, ``dof``, ``p_value`` = P(chi2_dof >= chi2) (``scipy.stats.chi2.sf``);
+* ``chi2``, ``dof``, ``p_value`` = P(chi2_dof >= chi2) (:func:`chi2_sf`, the value of
+  ``scipy.stats.chi2.sf``);
 * the parameters that end on a bound (their standard errors do not mean anything there);
 * ``verdict``:
 
@@ -83,11 +84,9 @@ def parameters_at_bound(names, values, lower, upper, tol: float = BOUND_TOL) -> 
 def assess(cost: float, n_residuals: int, n_parameters: int, at_bound=(), *, alpha: float = ALPHA,
            rms_limit: float = RMS_LIMIT) -> Adequacy:
     """Verdict from the fit's cost 0.5 sum r^2 over ``n_residuals`` normalised residuals."""
-    import scipy.stats
-
     chi2 = 2.0 * float(cost)
     dof = max(1, int(n_residuals) - int(n_parameters))
-    p = float(scipy.stats.chi2.sf(chi2, dof))
+    p = float(chi2_sf(chi2, dof))
     rms = math.sqrt(chi2 / max(1, n_residuals))
     if at_bound or not np.isfinite(rms) or rms > rms_limit:
         verdict = "inadequate"
@@ -96,3 +95,31 @@ def assess(cost: float, n_residuals: int, n_parameters: int, at_bound=(), *, alp
     else:
         verdict = "marginal"
     return Adequacy(verdict, rms, chi2, dof, p, tuple(at_bound), alpha, rms_limit)
+
+
+# -- the three distribution values the fits report, from scipy.special --------------------------
+# scipy.stats' distributions compute these with the same scipy.special functions (their _ppf and
+# _sf; loc 0 and scale 1 leave the bits as they are), but importing scipy.stats costs about 0.4
+# CPU-s a process (its distributions' docstrings are built at import), paid by every fitting
+# command for three numbers. tests/test_fit_statistics.py checks the values bit for bit.
+
+def chi2_sf(x: float, dof: float):
+    """P(X >= x) for X chi-square with ``dof`` degrees of freedom (``scipy.stats.chi2.sf``:
+    the complemented incomplete gamma function Q(dof / 2, x / 2), ``scipy.special.chdtrc``;
+    1 for x < 0, outside the support)."""
+    import scipy.special
+    return np.float64(1.0) if x < 0 else scipy.special.chdtrc(dof, x)
+
+
+def student_t_quantile(q: float, dof: float):
+    """The q-quantile of Student's t with ``dof`` degrees of freedom (``scipy.stats.t.ppf``:
+    ``scipy.special.stdtrit``; -inf at q = 0, NaN outside [0, 1] or for dof <= 0)."""
+    import scipy.special
+    return np.float64(-np.inf) if q == 0 and dof > 0 else scipy.special.stdtrit(dof, q)
+
+
+def normal_quantile(q: float):
+    """The q-quantile of the standard normal distribution (``scipy.stats.norm.ppf``: the
+    inverse of Phi, ``scipy.special.ndtri``)."""
+    import scipy.special
+    return scipy.special.ndtri(q)

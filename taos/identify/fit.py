@@ -115,9 +115,9 @@ class FitResult:
 
     def confidence_interval(self, level: float = 0.95) -> np.ndarray:
         """(n, 2) two-sided interval [SI] with Student's t on ``dof`` degrees of freedom."""
-        import scipy.stats
-        q = scipy.stats.t.ppf(0.5 + level / 2, self.dof) if not self.absolute_sigma else \
-            scipy.stats.norm.ppf(0.5 + level / 2)
+        from taos.identify.adequacy import normal_quantile, student_t_quantile
+        q = student_t_quantile(0.5 + level / 2, self.dof) if not self.absolute_sigma else \
+            normal_quantile(0.5 + level / 2)
         return np.column_stack([self.values - q * self.std_errors, self.values + q * self.std_errors])
 
     def to_dict(self) -> dict:

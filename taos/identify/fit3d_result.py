@@ -156,8 +156,8 @@ class Fit3dResult:
         from taos.results import model_provenance
         from taos.units import DIMENSIONS
 
-        import scipy.stats
-        q = scipy.stats.norm.ppf(0.975) if self.absolute_sigma else scipy.stats.t.ppf(0.975, self.dof)
+        from taos.identify.adequacy import normal_quantile, student_t_quantile
+        q = normal_quantile(0.975) if self.absolute_sigma else student_t_quantile(0.975, self.dof)
         atb = self.at_bound
         pars = {}
         for i, p in enumerate(self.params):

@@ -223,16 +223,21 @@ def _check_out(out: Path, manifest: dict, resume: bool) -> dict | None:
 
 def run_sweep(defn: SweepDefinition, out_dir: str | Path | None = None, *, workers: int = 1,
               scheduler: str | None = None, resume: bool = False, progress: bool = False,
-              batch: int | None = None) -> "SweepResult":
+              batch: int | None = None, connect_timeout_s: float = engine.CONNECT_TIMEOUT_S) -> "SweepResult":
     """Run the sweep on the engine into ``out_dir`` (None: a temporary folder): ``workers`` 1
     runs in this process, more a LocalCluster of that many one-thread workers; ``scheduler`` an
-    existing Dask scheduler instead. Returns the result read back from the store."""
+    existing Dask scheduler instead, waited for at most ``connect_timeout_s`` [s] (0.1 to 600;
+    also how long a lost scheduler is waited for before the sweep stops). Returns the result
+    read back from the store."""
     from taos.results import atomic_write, package_version
 
     if not 1 <= workers <= MAX_WORKERS:
         raise InputError("command line", "--workers", f"1 to {MAX_WORKERS} workers", got=str(workers))
     if batch is not None and not 1 <= batch <= engine.MAX_BATCH:
         raise InputError("command line", "--batch", f"1 to {engine.MAX_BATCH} points per task", got=str(batch))
+    if isinstance(connect_timeout_s, bool) or not isinstance(connect_timeout_s, (int, float)) \
+            or not 0.1 <= connect_timeout_s <= 600:   # (also NaN)
+        raise InputError("command line", "--connect-timeout", "0.1 to 600 s", got=str(connect_timeout_s))
     if resume and out_dir is None:
         raise InputError("command line", "--resume", "--out FOLDER of the sweep to continue", got="no --out")
     kind, table, base = load_runs(defn)   # every variant checked before anything is written
@@ -246,7 +251,8 @@ def run_sweep(defn: SweepDefinition, out_dir: str | Path | None = None, *, worke
         old = _check_out(out, manifest, resume)
         spath = out / STORE
         t0 = time.perf_counter()
-        with engine.connected(0 if scheduler is None and workers == 1 else workers, scheduler) as client:
+        with engine.connected(0 if scheduler is None and workers == 1 else workers, scheduler,
+                              connect_timeout_s) as client:
             n_workers = len(client.scheduler_info().get("workers", {})) if client is not None else 1
             if old is not None and store.status(spath) is not None:
                 manifest["batch"] = int(old["batch"])
