@@ -61,7 +61,7 @@ $(PYC): $(TEST_STAMP) $(TAOS_SOURCES)
 	touch $(PYC)
 
 $(WARM): $(TEST_STAMP) $(KERNEL_SOURCES) taos/cli/warmup.py | $(PYC)
-	find taos -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
+	find taos masv -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
 	$(PYW) $(BIN)/python -m taos.cli.warmup --part 1/2 & one=$$!; \
 	  $(PYW) $(BIN)/python -m taos.cli.warmup --part 2/2; two=$$?; wait $$one && exit $$two
 	touch $(WARM)

@@ -35,7 +35,9 @@ Layers, bottom to top (none imports a layer above it; ``tests/test_architecture.
    models and responses; the nonlinear TVC as a co-simulation block and FMU);
 5. ``plotting``, ``viewer`` - drawing only; ``report.analysis`` and ``report.html`` - the Green Run
    report, whose folder holds its drawn page;
-6. ``cli`` - the ``taos`` command: argument parsing over the layers below.
+6. ``cli`` - the ``taos`` command: argument parsing over the layers below; ``masv`` sits on all
+   of these, and ``cli.warmup`` (the kernel warm-up of ``make``, imported by nothing) on masv too,
+   since it compiles both packages' kernels.
 
 Names are resolved on first use (PEP 562), so ``import taos`` stays cheap and a command imports
 only what it needs.

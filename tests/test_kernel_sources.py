@@ -19,6 +19,8 @@ from taos.cli import warmup
 
 ROOT = Path(__file__).resolve().parents[1]
 TAOS = ROOT / "taos"
+MASV = ROOT / "masv"
+PKGS = ("taos", "masv")
 NUMBA_IMPORT = re.compile(r"^\s*(import numba(\.\w+)*(\s+as\s+\w+)?\s*(#.*)?$|from numba(\.\w+)* import )", re.M)
 
 
@@ -28,7 +30,7 @@ def sources() -> set[Path]:
 
 
 def _py_files():
-    return [p for p in TAOS.rglob("*.py") if "__pycache__" not in p.parts]
+    return [p for d in (TAOS, MASV) for p in d.rglob("*.py") if "__pycache__" not in p.parts]
 
 
 def test_every_module_importing_numba_is_a_kernel_source(sources):
@@ -66,7 +68,7 @@ def _code_names(code: types.CodeType) -> set[str]:
 
 
 def _loaded_kernels():
-    """Every numba kernel (dispatcher or C callback) in a loaded taos module: (module, py_func)."""
+    """Every numba kernel (dispatcher or C callback) in a loaded taos or masv module: py_func."""
     from numba.core.ccallback import CFunc
     from numba.core.dispatcher import Dispatcher
 
@@ -76,10 +78,11 @@ def _loaded_kernels():
                 "planar._avionics_kernels", "flight.lco_confirm", "taos3d.dynamics", "taos3d._bearing",
                 "friction._kernels", "friction._vector"):
         importlib.import_module(f"taos.{rel}")
+    importlib.import_module("masv._kernel")
     load_all()
     seen = set()
     for name, mod in list(sys.modules.items()):
-        if not name.startswith("taos.") or mod is None:
+        if not name.startswith(("taos.", "masv.")) or mod is None:
             continue
         for obj in vars(mod).values():
             fn = obj.py_func if isinstance(obj, Dispatcher) else obj._pyfunc if isinstance(obj, CFunc) else None
@@ -106,11 +109,11 @@ def _file_of(obj) -> Path | None:
 
 
 def _definers(name: str, value) -> set[Path]:
-    """The loaded taos modules that assign ``name`` at top level to this very ``value``."""
+    """The loaded taos and masv modules that assign ``name`` at top level to this very ``value``."""
     out = set()
     for mname, mod in list(sys.modules.items()):
         f = getattr(mod, "__file__", None)
-        if mname.startswith("taos") and f and getattr(mod, name, object()) is value and name in _top_level_names(
+        if mname.startswith(PKGS) and f and getattr(mod, name, object()) is value and name in _top_level_names(
                 Path(f)):
             out.add(Path(f).resolve())
     return out
@@ -128,13 +131,13 @@ def test_every_loaded_kernel_and_what_it_reads_is_a_kernel_source(sources):
         names = _code_names(fn.__code__)
         values = [(n, g[n]) for n in names if n in g]
         values += [(a, getattr(v, a)) for _, v in values if isinstance(v, types.ModuleType)
-                   and v.__name__.startswith("taos") for a in names if hasattr(v, a)]
+                   and v.__name__.startswith(PKGS) for a in names if hasattr(v, a)]
         for n, v in values:
-            if isinstance(v, types.ModuleType) and not v.__name__.startswith("taos"):
+            if isinstance(v, types.ModuleType) and not v.__name__.startswith(PKGS):
                 continue
             f = _file_of(v)
             if f is not None:
-                if f.is_relative_to(TAOS):
+                if f.is_relative_to(TAOS) or f.is_relative_to(MASV):
                     assert f in sources, (fn.__qualname__, n, f)
             elif isinstance(v, (int, float, tuple, frozenset, set, str)) and n not in _top_level_names(own):
                 found = _definers(n, v)

@@ -30,13 +30,15 @@ that callee too, so the steps sharing such callees form one group and a group is
 * ``cdwell``: not numba's: the dwell kernels translated to C and compiled once per built-in law
   (:mod:`taos.planar._cdwell`, its own cache), which ``taos freqresp``'s dwells load instead of
   numba's; building one imports the law's C callbacks (the same key as ``friction``'s).
+* ``masv``: masv's lane kernel (``masv._kernel.integrate``, one compile for any number of engines
+  and laws), whose inlined limits come from ``planar.saturation``.
 
 Between groups the only shared callees are ``planar._avionics_kernels.apply`` and the model's
 friction law's C callbacks, which every group calls with the same signature (float64 and
 C-contiguous float64 arrays), so a simultaneous save writes the same key with the same code.
 
-``--sources`` prints the source files whose code numba compiles (:func:`kernel_sources`; plain
-Python, imports nothing from taos: the Makefile runs it with any ``python3``) — the files whose
+``--sources`` prints the source files of taos and masv whose code numba compiles
+(:func:`kernel_sources`; plain Python, imports nothing from taos: the Makefile runs it with any ``python3``) — the files whose
 change makes ``make`` drop the kernel cache and warm it again.
 """
 
@@ -157,6 +159,16 @@ def _taos_freqresp() -> None:
     taos_freqresp(taos_model(_model()), [10.0], math.radians(0.4))
 
 
+def _masv_simulate() -> None:
+    # masv's lane kernel (masv._kernel.integrate): one compile for any number of engines and laws
+    from masv.config import load_config
+    from masv.timedomain import simulate
+    from taos.profiles import SineDwell
+    from taos.shipped import models_dir
+    cfg = load_config(models_dir() / "masv" / "core_stage_rigid.toml")
+    simulate(cfg, SineDwell(math.radians(0.1), 1.0, 1), duration_s=0.01)
+
+
 @dataclass(frozen=True)
 class Step:
     """One warm-up step: ``run`` compiles its kernels; ``group`` the steps sharing non-inlined
@@ -184,6 +196,7 @@ STEPS: tuple[Step, ...] = (
     Step("3-D model", "3d", _taos_model, 8.9),
     Step("3-D simulate", "3d", _simulate_taos, 7.8),
     Step("3-D frequency response", "3d", _taos_freqresp, 2.3),
+    Step("masv simulate", "masv", _masv_simulate, 9.9),
 )
 
 
@@ -239,25 +252,27 @@ def _outside_functions(tree: ast.Module):
             stack.extend(ast.iter_child_nodes(node))
 
 
-def _scan(path: Path, root: Path) -> tuple[str, _Module]:
+def _scan(path: Path, root: Path, tops: frozenset[str] = frozenset()) -> tuple[str, _Module]:
+    """The module of ``path`` (under package folder ``root``): its numba use and its imports from
+    ``root``'s package and the packages named in ``tops``."""
     name = _module_name(path, root)
     is_pkg = path.name == "__init__.py"
     tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
     m = _Module(path)
-    top = root.name
+    tops = tops | {root.name}
     module_level = {id(n) for n in _outside_functions(tree)}
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for a in node.names:
                 if a.name.split(".")[0] == "numba":
                     m.imports_numba = True
-                elif a.name.split(".")[0] == top and id(node) in module_level:
+                elif a.name.split(".")[0] in tops and id(node) in module_level:
                     m.modules.add(a.name)
         elif isinstance(node, ast.ImportFrom):
             mod = _resolve(node.module or "", node.level, name, is_pkg)
             if mod.split(".")[0] == "numba":
                 m.imports_numba = True
-            elif mod.split(".")[0] == top and id(node) in module_level:
+            elif mod.split(".")[0] in tops and id(node) in module_level:
                 for a in node.names:
                     m.names[a.asname or a.name] = (mod, a.name)
         elif isinstance(node, ast.Call):
@@ -270,19 +285,25 @@ def _scan(path: Path, root: Path) -> tuple[str, _Module]:
     return name, m
 
 
-def kernel_sources(root: Path = PACKAGE_DIR) -> list[Path]:
-    """The source files under ``root`` (the taos package) whose code numba compiles, sorted.
+#: the packages scanned for kernels: taos, and masv beside it (its lane kernel calls taos's)
+PACKAGES = (PACKAGE_DIR, PACKAGE_DIR.parent / "masv")
+
+
+def kernel_sources(roots: tuple[Path, ...] = PACKAGES) -> list[Path]:
+    """The source files under ``roots`` (the taos and masv packages; one missing is skipped) whose
+    code numba compiles, sorted.
 
     numba's on-disk cache checks only the file of the kernel it compiled; a kernel that inlines
     or calls code from another file, or reads its constants, keeps its old machine code when
     only that other file changes. So the set is: every module that imports numba (anywhere,
     even inside a function), every module that declares kernels with a decorator imported from
     such a module (the friction laws' ``@kernel``), and for each module declaring kernels, every
-    taos module it imports from (a module or a name of it: a callee, a constant, a packed-slot
-    index), each name followed to the module that defines it. Static (``ast``): imports nothing.
+    taos or masv module it imports from (a module or a name of it: a callee, a constant, a
+    packed-slot index), each name followed to the module that defines it. Static (``ast``): imports nothing.
     """
-    root = Path(root)
-    mods = dict(_scan(p, root) for p in sorted(root.rglob("*.py")) if "__pycache__" not in p.parts)
+    roots = [Path(r) for r in roots if Path(r).is_dir()]
+    tops = frozenset(r.name for r in roots)
+    mods = dict(_scan(p, root, tops) for root in roots for p in sorted(root.rglob("*.py")) if "__pycache__" not in p.parts)
     numba_mods = {n for n, m in mods.items() if m.imports_numba}
 
     def declares(n: str) -> bool:
