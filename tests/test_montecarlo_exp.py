@@ -96,3 +96,43 @@ def test_the_campaign_integrator_and_step_are_checked(tmp_path, capsys, lines, f
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f": {field}:" in err[0], err
     assert not out.exists()
+
+
+@pytest.fixture(scope="module")
+def exp_short(tmp_path_factory):
+    """The short test campaign flown by ETDRK4 at 5 ms (its copy beside the original's inputs)."""
+    text = SHORT.read_text().replace('ascent = "../../models/flight/ascent.toml"',
+                                     f'ascent = "{(DATA / "../../models/flight/ascent.toml").resolve()}"')
+    p = tmp_path_factory.mktemp("mcexp") / "exp_short.toml"
+    p.write_text(text.replace('dt = "1 ms"\n', 'dt = "5 ms"\nintegrator = "etdrk4"\n'))
+    return p
+
+
+def test_exp_store_cluster_equals_in_process_and_resume_equals_uninterrupted(exp_short, tmp_path, monkeypatch):
+    """The store's bit-identity with the ETDRK4 lanes: a LocalCluster of 2 workers (the default
+    batch) against the in-process engine with 3 runs a batch, and a campaign stopped after two
+    batches then resumed against the uninterrupted one."""
+    from taos.montecarlo import run_campaign, store
+    from tests.test_montecarlo_cluster import same_store
+    c = load_campaign(exp_short)
+    runs = 10
+    ref = tmp_path / "ref"
+    run_campaign(c, ref, runs=runs, workers=0, batch=3)
+    summary = (ref / "summary.json").read_text()
+    assert '"etdrk4-lanes"' in summary
+    assert main(["montecarlo", str(exp_short), "--runs", str(runs), "--out", str(tmp_path / "local"),
+                 "--no-progress"]) == 0
+    same_store(tmp_path / "local", ref)
+    write, calls = store.write_batch, []
+
+    def stop_after_two(*a, **k):
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        calls.append(1)
+        return write(*a, **k)
+    monkeypatch.setattr(store, "write_batch", stop_after_two)
+    with pytest.raises(KeyboardInterrupt):
+        run_campaign(c, tmp_path / "resumed", runs=runs, workers=0, batch=3)
+    monkeypatch.setattr(store, "write_batch", write)
+    run_campaign(c, tmp_path / "resumed", runs=runs, workers=0, batch=3, resume=True)
+    same_store(tmp_path / "resumed", ref)

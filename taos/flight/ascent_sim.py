@@ -187,11 +187,13 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
     else:
         _dy.integrate_segments_lanes(*common, dt_s, rec, X, aux, status)
     out = []
+    how = f"ETDRK4 step {2.0 * dt_s} s" if exp else f"dt = {dt_s} s"
+    XL = np.ascontiguousarray(X.transpose(2, 0, 1))   # (R, n_rec, n): a lane's records contiguous
     for q, ln in enumerate(lanes):
         if status[q] >= 0:
-            out.append(SimulationUnstable(float(t[status[q]]), f"{ln.model.friction.name} friction, dt = {dt_s} s"))
+            out.append(SimulationUnstable(float(t[status[q]]), f"{ln.model.friction.name} friction, {how}"))
             continue
-        Xq = X[:, :, q]
+        Xq = XL[q]
         Y = _recorded(ln.plants, bounds, rec, Xq)
         Y[:, 2] += ln.r[::rec, 0]  # the FCS command: the PTI is added to it
         Y[:, 6] = aux[:, _dy.AUX_TF, q]

@@ -45,6 +45,18 @@ def _block(M, V, OUT, nb, scale):
                 OUT[i, q] += scale * M[i, j, q] * V[j, q]
 
 
+@njit(cache=True, inline="always")
+def _block_cols(M, V, OUT, nb, cols, scale):
+    """As :func:`_block` over the columns ``cols`` only (the block rows where V, an N, can be
+    nonzero: the others hold exact zeros, whose terms add nothing)."""
+    nl = V.shape[1]
+    for i in range(nb):
+        for jj in range(cols.shape[0]):
+            j = cols[jj]
+            for q in range(nl):
+                OUT[i, q] += scale * M[i, j, q] * V[j, q]
+
+
 @njit(cache=True, error_model="numpy")  # x / 0 -> inf or NaN (the selects discard them), no exception
 def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc, jcoef, kick, x0, z0, r, h, nb,
                                  co, rec_every, x_out, aux_out, status):
@@ -91,6 +103,19 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
             for q in range(nl):
                 H[s, j, q] = head[s, q, j]
     AVP = np.ascontiguousarray(avp.T)
+    # the block rows N reaches (rows of the sparse matrix with entries): the products with N need
+    # only those columns of P2, F1, F2, F3 (in the flight loop 3 of 8: the command and the valve
+    # limit on q', the flow correction on P_L, friction and the stops on the engine rate)
+    cnt = 0
+    for i in range(nb):
+        if ip[i + 1] > ip[i]:
+            cnt += 1
+    cols = np.empty(cnt, np.int64)
+    cnt = 0
+    for i in range(nb):
+        if ip[i + 1] > ip[i]:
+            cols[cnt] = i
+            cnt += 1
     status[:] = -1
     alive = nl
     rec = 0
@@ -143,7 +168,7 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
         for i in range(n):
             for q in range(nl):
                 XA[i, q] = T[i, q] + (h2 * NU[i, q] if i >= nb else 0.0)
-        _block(CO[2], NU, XA, nb, 1.0)
+        _block_cols(CO[2], NU, XA, nb, cols, 1.0)
         for q in range(nl):
             ZA[q] = Z[q] + h2 * D1[q]
         for j in range(nr):
@@ -157,7 +182,7 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
         for i in range(n):
             for q in range(nl):
                 XB[i, q] = T[i, q] + (h2 * NA[i, q] if i >= nb else 0.0)
-        _block(CO[2], NA, XB, nb, 1.0)
+        _block_cols(CO[2], NA, XB, nb, cols, 1.0)
         for q in range(nl):
             ZB[q] = Z[q] + h2 * D2[q]
         for i in range(n):
@@ -170,7 +195,7 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
                 T[i, q] = 2.0 * NB[i, q] - NU[i, q]
                 XC[i, q] = (XA[i, q] + h2 * T[i, q]) if i >= nb else 0.0
         _block(CO[1], XA, XC, nb, 1.0)
-        _block(CO[2], T, XC, nb, 1.0)
+        _block_cols(CO[2], T, XC, nb, cols, 1.0)
         for q in range(nl):
             ZC[q] = ZA[q] + h2 * (2.0 * D3[q] - D1[q])
         for j in range(nr):
@@ -186,9 +211,9 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
                 T[i, q] = NA[i, q] + NB[i, q]
                 XB[i, q] = (X[i, q] + h6 * (NU[i, q] + 2.0 * T[i, q] + NC[i, q])) if i >= nb else 0.0
         _block(CO[0], X, XB, nb, 1.0)
-        _block(CO[3], NU, XB, nb, 1.0)
-        _block(CO[4], T, XB, nb, 2.0)
-        _block(CO[5], NC, XB, nb, 1.0)
+        _block_cols(CO[3], NU, XB, nb, cols, 1.0)
+        _block_cols(CO[4], T, XB, nb, cols, 2.0)
+        _block_cols(CO[5], NC, XB, nb, cols, 1.0)
         for i in range(n):
             for q in range(nl):
                 X[i, q] = XB[i, q]
