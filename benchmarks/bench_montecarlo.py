@@ -6,10 +6,12 @@
 One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run scaling part):
 
 1. The peer: ``--peer-runs`` runs of the soft case (models/montecarlo/post_separation.toml, 200 s
-   of flight, 1 ms RK4) as one batch in this process, no Dask: the one-run cost (wall and CPU
-   seconds per run), the share of it spent in the compiled kernel
-   (taos.planar.dynamics.integrate_segments_lanes, timed), and the same runs through the
-   previous per-run path (one dense RK4 call per 5 s segment with the plant rebuilt each time,
+   of flight, the campaign's integrator: ETDRK4 at 5 ms) as one batch in this process, no Dask:
+   the one-run cost (wall and CPU seconds per run), the share of it spent in the compiled kernel
+   (taos.planar._explanes.integrate_segments_lanes_exp or taos.planar.dynamics.integrate_segments_lanes,
+   timed); the same batch through the RK4 lanes at 1 ms (the previous lockstep path, the campaign
+   file's previous integrator and step); and the same runs through the
+   previous per-run path (one dense RK4 call per 5 s segment at 1 ms with the plant rebuilt each time,
    ``--legacy-runs``; the tests' reference) for the ratio in the same run. Beside it, the same
    batch with the friction law called lane by lane (an indirect call of the scalar C callback per
    run and stage, the lockstep kernel's friction before the laws' lane form, issue 44 point 4):
@@ -19,7 +21,11 @@ One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run
    included), as ``taos montecarlo post_separation --runs N --case soft`` runs it; its LCO
    fraction. With ``--previous TREE`` (a checkout of the previous code, e.g. ``git worktree add
    /tmp/prev <base>``), the same campaign flown again by that code in its own process, end to end
-   from its import of taos, and its store compared with this code's array for array. Both
+   from its import of taos, and its store compared with this code's: array for array, and (the
+   integrators differing) statistic by statistic with their sampling errors (LCO fraction with its
+   Wilson interval and standard error; mean +- standard error, median and 95th percentile of the
+   LCO runs' amplitudes, frequency and peak engine angle) and run by run (the same design rows and
+   seeds: LCO flags changed, the largest difference of every output). Both
    report their CPU seconds in all (this process and its ended children: the workers), the
    measure that a shared machine's load does not inflate as it does the wall time.
 3. Scaling (``--with-big``): ``--big-runs`` runs of models/montecarlo/scaling_short.toml (10 s of

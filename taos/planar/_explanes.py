@@ -97,11 +97,7 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
     C = np.empty((8, nl))
     S = np.empty((2, nl))
     OK = np.empty(nl)
-    H = np.empty((nseg, head.shape[2], nl))
-    for s in range(nseg):
-        for j in range(head.shape[2]):
-            for q in range(nl):
-                H[s, j, q] = head[s, q, j]
+    H = _dy.lanes_by_slot(head)
     AVP = np.ascontiguousarray(avp.T)
     # the block rows N reaches (rows of the sparse matrix with entries): the products with N need
     # only those columns of P2, F1, F2, F3 (in the flight loop 3 of 8: the command and the valve
@@ -128,12 +124,7 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
     h6 = h / 6.0
     for p in range(0, nsamp + 1, 2):
         if seg < nseg and p == bounds[seg]:
-            for j in range(jdst.shape[0]):
-                for q in range(nl):
-                    X[jdst[j], q] += jcoef[seg, j, q] * X[jsrc[j], q]
-            for i in range(n):
-                for q in range(nl):
-                    X[i, q] += kick[seg, i, q]
+            _dy.lanes_jump(X, jdst, jsrc, jcoef, kick, seg)
             M = mx[seg]
             L = H[seg]
             F = fp[seg]
@@ -150,13 +141,7 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
         # N at the step start (with T_f and u there for the record)
         _dy._rates_lanes(Z, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D1, NU)
         if p % rec_every == 0:
-            for i in range(n):
-                for q in range(nl):
-                    x_out[rec, i, q] = X[i, q]
-            for q in range(nl):
-                aux_out[rec, _dy.AUX_TF, q] = TF[q]
-                aux_out[rec, _dy.AUX_Z, q] = Z[q]
-                aux_out[rec, _dy.AUX_U, q] = U[q]
+            _dy.lanes_record(X, Z, TF, U, x_out, aux_out, rec)
             rec += 1
         if p == nsamp:
             break
@@ -219,15 +204,7 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
                 X[i, q] = XB[i, q]
         for q in range(nl):
             Z[q] = Z[q] + h6 * (D1[q] + 2.0 * D2[q] + 2.0 * D3[q] + D4[q])
-        for q in range(nl):
-            OK[q] = Z[q] * 0.0
-        for i in range(n):
-            for q in range(nl):
-                OK[q] += X[i, q] * 0.0
-        for q in range(nl):
-            if status[q] < 0 and not OK[q] == 0.0:
-                status[q] = p1
-                alive -= 1
+        alive -= _dy.lanes_failed(X, Z, OK, status, p1)
         if alive == 0:
             break
     return alive
