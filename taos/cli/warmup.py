@@ -157,7 +157,8 @@ STEPS: tuple[Step, ...] = (
     Step("shoot", "planar", _shoot, 14.4),
     Step("lco confirmation", "planar", _lco_confirm, 0.1),
     Step("friction laws", "friction", _friction, 4.7),
-    Step("ascent lanes", "lanes", _ascent_lanes, 16.3),
+    # (+ 6.5 s: the ETDRK4 lanes, benchmarks/RESULTS.md mcexp)
+    Step("ascent lanes", "lanes", _ascent_lanes, 22.8),
     Step("3-D model", "3d", _taos_model, 8.9),
     Step("3-D simulate", "3d", _simulate_taos, 7.8),
     Step("3-D frequency response", "3d", _taos_freqresp, 2.3),
