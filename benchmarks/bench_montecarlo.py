@@ -6,10 +6,12 @@
 One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run scaling part):
 
 1. The peer: ``--peer-runs`` runs of the soft case (models/montecarlo/post_separation.toml, 200 s
-   of flight, 1 ms RK4) as one batch in this process, no Dask: the one-run cost (wall and CPU
-   seconds per run), the share of it spent in the compiled kernel
-   (taos.planar.dynamics.integrate_segments_lanes, timed), and the same runs through the
-   previous per-run path (one dense RK4 call per 5 s segment with the plant rebuilt each time,
+   of flight, the campaign's integrator: ETDRK4 at 5 ms) as one batch in this process, no Dask:
+   the one-run cost (wall and CPU seconds per run), the share of it spent in the compiled kernel
+   (taos.planar._explanes.integrate_segments_lanes_exp or taos.planar.dynamics.integrate_segments_lanes,
+   timed); the same batch through the RK4 lanes at 1 ms (the previous lockstep path, the campaign
+   file's previous integrator and step); and the same runs through the
+   previous per-run path (one dense RK4 call per 5 s segment at 1 ms with the plant rebuilt each time,
    ``--legacy-runs``; the tests' reference) for the ratio in the same run. Beside it, the same
    batch with the friction law called lane by lane (an indirect call of the scalar C callback per
    run and stage, the lockstep kernel's friction before the laws' lane form, issue 44 point 4):
@@ -19,7 +21,11 @@ One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run
    included), as ``taos montecarlo post_separation --runs N --case soft`` runs it; its LCO
    fraction. With ``--previous TREE`` (a checkout of the previous code, e.g. ``git worktree add
    /tmp/prev <base>``), the same campaign flown again by that code in its own process, end to end
-   from its import of taos, and its store compared with this code's array for array. Both
+   from its import of taos, and its store compared with this code's: array for array, and (the
+   integrators differing) statistic by statistic with their sampling errors (LCO fraction with its
+   Wilson interval and standard error; mean +- standard error, median and 95th percentile of the
+   LCO runs' amplitudes, frequency and peak engine angle) and run by run (the same design rows and
+   seeds: LCO flags changed, the largest difference of every output). Both
    report their CPU seconds in all (this process and its ended children: the workers), the
    measure that a shared machine's load does not inflate as it does the wall time.
 3. Scaling (``--with-big``): ``--big-runs`` runs of models/montecarlo/scaling_short.toml (10 s of
@@ -55,6 +61,8 @@ from taos.montecarlo import store
 from taos.montecarlo.executor import flight_runs, montecarlo_design
 
 BIN = Path(sys.executable).parent
+#: the RK4 step of the previous campaign (``dt = "1 ms"``, ``integrator = "rk4"``): the previous paths' step
+RK4_DT_S = 1e-3
 
 
 def _timed(mod, name: str, spent: list):
@@ -81,7 +89,7 @@ def legacy_run(kind, names, factors, seed) -> float:
     from tests.test_montecarlo import per_segment_reference
     c = kind.campaign
     asc, model, _ = apply_factors(kind.ascent, kind.model, c.cases["soft"], dict(zip(names, map(float, factors))))
-    return float(per_segment_reference(asc, model, c.axis, c.start_s, c.start_s + c.duration_s, c.dt_s, seed)[-1])
+    return float(per_segment_reference(asc, model, c.axis, c.start_s, c.start_s + c.duration_s, RK4_DT_S, seed)[-1])
 
 
 def per_lane_calls(rates):
@@ -100,14 +108,17 @@ def per_lane_calls(rates):
 
 
 def _batch(kind, d, spent: list, dyn) -> tuple:
-    """Run the batch of design rows 1.. timed: (result, wall s, CPU s)."""
-    undo = _timed(dyn, "integrate_segments_lanes", spent)
+    """Run the batch of design rows 1.. timed: (result, wall s, CPU s); the kernel's (RK4 or
+    ETDRK4 lanes) wall and CPU seconds added into ``spent``."""
+    import taos.planar._explanes as xl
+    undo = [_timed(dyn, "integrate_segments_lanes", spent), _timed(xl, "integrate_segments_lanes_exp", spent)]
     try:
         t0, c0 = time.perf_counter(), time.process_time()
         out = kind.run_batch(d.names, d.factors[1:], d.seeds[1:])
         return out, time.perf_counter() - t0, time.process_time() - c0
     finally:
-        undo()
+        for u in undo:
+            u()
 
 
 def peer(n: int, n_legacy: int) -> dict:
@@ -124,7 +135,13 @@ def peer(n: int, n_legacy: int) -> dict:
     spent = [0.0, 0.0]
     got, el, cpu = _batch(kind, d, spent, dyn)
     res = {"runs": n, "s_per_run": el / n, "cpu_s_per_run": cpu / n, "kernel_share": spent[0] / el,
-           "kernel_cpu_s_per_run": spent[1] / n}
+           "kernel_cpu_s_per_run": spent[1] / n, "integrator": c.integrator, "dt_s": c.dt_s}
+    # the previous lockstep path: the same batch by the RK4 lanes at the previous campaign step
+    rk4 = replace(kind, campaign=replace(c, integrator="rk4", dt_s=RK4_DT_S))
+    rk4.run_batch(d.names, d.factors[:2], d.seeds[:2])
+    spent = [0.0, 0.0]
+    _, el_r, cpu_r = _batch(rk4, d, spent, dyn)
+    res.update(rk4_s_per_run=el_r / n, rk4_cpu_s_per_run=cpu_r / n, rk4_kernel_cpu_s_per_run=spent[1] / n)
     law = registry.get(kind.model.friction.name)   # the law the batch flies
     registry._REGISTRY[law.id] = replace(law, rates_lanes=per_lane_calls(law.rates))
     try:
@@ -269,7 +286,40 @@ def previous_soft(tree: Path, n: int, root: Path) -> dict:
             x, y = np.asarray(a[k].values), np.asarray(b[k].values)
             same &= bool(np.array_equal(x, y, equal_nan=x.dtype.kind == "f"))
     return {"runs": n, "wall_s": wall, "cpu_s": cpu, "run_campaign_wall_s": got["wall_s"], "taos": got["taos"],
-            "store_equal": same}
+            "store_equal": same, "statistics": compare_stores(root / "soft" / "campaign.zarr", out / "campaign.zarr")}
+
+
+STAT_KEYS = ("amplitude_deg", "engine_amplitude_deg", "frequency_hz", "peak_engine_deg")
+
+
+def _stats(ds) -> dict:
+    """A store's statistics and their sampling errors: the LCO fraction (Wilson 95 % interval,
+    standard error sqrt(p (1 - p) / n)); per output over the LCO runs, the mean and its standard
+    error s / sqrt(n), the median and the 95th percentile."""
+    from taos.montecarlo import wilson_interval
+    ok = np.asarray(ds["status"].values) == store.STATUS["ok"]
+    lco = np.asarray(ds["lco"].values, bool) & ok
+    n, k = int(ok.sum()), int(lco.sum())
+    p = k / n
+    lo, hi = wilson_interval(k, n)
+    out = {"runs_ok": n, "lco_runs": k, "lco_fraction": p, "lco_ci95": [lo, hi], "lco_se": float(np.sqrt(p * (1 - p) / n))}
+    for key in STAT_KEYS:
+        v = np.asarray(ds[key].values, float)[lco]
+        out[key] = {"mean": float(v.mean()), "se": float(v.std(ddof=1) / np.sqrt(v.size)),
+                    "p50": float(np.median(v)), "p95": float(np.percentile(v, 95))}
+    return out
+
+
+def compare_stores(this: Path, previous: Path) -> dict:
+    """Both stores' statistics (:func:`_stats`) and, run by run (the same design rows and seeds),
+    how many LCO flags differ and the largest difference of each output."""
+    a, b = store.open_store(this), store.open_store(previous)
+    paired = {"lco_flags_differ": int(np.sum(np.asarray(a["lco"].values) != np.asarray(b["lco"].values))),
+              "status_differ": int(np.sum(np.asarray(a["status"].values) != np.asarray(b["status"].values)))}
+    for key in STAT_KEYS + ("peak_engine_rate_deg_s", "peak_attitude_deg", "growth", "trace", "engine_trace"):
+        paired[f"max_abs_diff_{key}"] = float(np.nanmax(np.abs(np.asarray(a[key].values, float)
+                                                                - np.asarray(b[key].values, float))))
+    return {"this": _stats(a), "previous": _stats(b), "paired": paired}
 
 
 def main() -> None:
@@ -325,10 +375,15 @@ def main() -> None:
     print(f"\nload average at start {load0[0]:.1f}, at end {res['load_end'][0]:.1f} on {os.cpu_count()} cores")
     if "peer" in res:
         p = res["peer"]
-        print(f"| one soft run in-process, one batch (peer) | {p['runs']} | 1 | {p['s_per_run']:.4f} s/run "
+        print(f"| one soft run in-process, one batch (peer: {p['integrator']} at {p['dt_s'] * 1e3:g} ms) | {p['runs']} | 1 | "
+              f"{p['s_per_run']:.4f} s/run "
               f"({p['cpu_s_per_run']:.4f} s CPU) | kernel {100 * p['kernel_share']:.0f} % of the wall, "
               f"{p['kernel_cpu_s_per_run']:.4f} s CPU per run |")
-        print(f"| same batch, friction law called lane by lane (previous lockstep path) | {p['runs']} | 1 | "
+        print(f"| same batch, RK4 lanes at {RK4_DT_S * 1e3:g} ms (the previous lockstep path) | {p['runs']} | 1 | "
+              f"{p['rk4_s_per_run']:.4f} s/run ({p['rk4_cpu_s_per_run']:.4f} s CPU) | kernel "
+              f"{p['rk4_kernel_cpu_s_per_run']:.4f} s CPU per run; x{p['rk4_cpu_s_per_run'] / p['cpu_s_per_run']:.2f} "
+              f"CPU against the peer |")
+        print(f"| same batch, friction law called lane by lane | {p['runs']} | 1 | "
               f"{p['per_lane_s_per_run']:.4f} s/run ({p['per_lane_cpu_s_per_run']:.4f} s CPU) | kernel "
               f"{p['per_lane_kernel_cpu_s_per_run']:.4f} s CPU per run against {p['kernel_cpu_s_per_run']:.4f} "
               f"(x{p['per_lane_kernel_cpu_s_per_run'] / p['kernel_cpu_s_per_run']:.2f}); results bit-identical: "
@@ -350,6 +405,18 @@ def main() -> None:
         print(f"| same campaign, previous code ({q['taos']}), its own process | {q['runs']} | 2 | {q['wall_s']:.1f} s | "
               f"{q['cpu_s']:.1f} CPU-s in all ({q['cpu_s'] / q['runs']:.4f} a run, x{q['cpu_s'] / s['cpu_s']:.2f} this "
               f"code's); wall x{q['wall_s'] / s['wall_s']:.2f} this code's; stores equal array for array: {q['store_equal']} |")
+        st = q["statistics"]
+        print("\n| statistic (LCO runs) | this code | previous code | difference / sampling error |\n|---|---|---|---|")
+        a, b = st["this"], st["previous"]
+        print(f"| LCO fraction | {a['lco_fraction']:.4f} ({a['lco_ci95'][0]:.3f}-{a['lco_ci95'][1]:.3f}) | "
+              f"{b['lco_fraction']:.4f} ({b['lco_ci95'][0]:.3f}-{b['lco_ci95'][1]:.3f}) | "
+              f"{(a['lco_fraction'] - b['lco_fraction']) / b['lco_se']:.3f} |")
+        for key in STAT_KEYS:
+            x, y = a[key], b[key]
+            print(f"| {key} mean / median / p95 | {x['mean']:.5f} +- {x['se']:.5f} / {x['p50']:.5f} / {x['p95']:.5f} | "
+                  f"{y['mean']:.5f} +- {y['se']:.5f} / {y['p50']:.5f} / {y['p95']:.5f} | "
+                  f"{(x['mean'] - y['mean']) / y['se']:.2e} |")
+        print(f"paired runs: {st['paired']}")
     if "big" in res:
         b = res["big"]
         print(f"| scaling_short, loopback cluster 2 workers, client in its own process | {b['runs']} | 2 | "

@@ -57,7 +57,7 @@ CAMPAIGN_ROWS = [
     ("duration", "below", _set(("duration",), "5 s"), "analysis_window"),
     ("duration", "above", _set(("duration",), "3000 s"), "duration"),
     ("dt", "below", _set(("dt",), "1 ns"), "dt"),
-    ("dt", "above", _set(("dt",), "10 ms"), "dt"),
+    ("dt", "above", _set(("dt",), "20 ms"), "dt"),
     ("analysis_window", "below", _set(("analysis_window",), "1 s"), "analysis_window"),
     ("analysis_window", "above", _set(("analysis_window",), "300 s"), "analysis_window"),
     ("trace_interval", "below", _set(("trace_interval",), "1 us"), "trace_interval"),

@@ -355,6 +355,10 @@ def per_segment_reference(asc, model, axis: str, start_s: float, end_s: float, d
     return np.concatenate(cmd)
 
 
+#: the RK4 lockstep kernel's step on this campaign (the campaign itself flies ETDRK4 at 5 ms)
+RK4_DT_S = 1e-3
+
+
 @pytest.fixture(scope="module")
 def dispersed_runs():
     """Five dispersed soft-case runs of the post-separation campaign: (ascent, model, seed)."""
@@ -375,7 +379,7 @@ def test_lockstep_runs_are_bit_identical_alone_and_in_any_company(dispersed_runs
     place among them (the store's bit-identity across batch sizes rests on this)."""
     from taos.flight.ascent_sim import simulate_ascents
     c, runs = dispersed_runs
-    kw = dict(axis=c.axis, start_s=c.start_s, end_s=c.start_s + 12.0, dt_s=c.dt_s, record_interval_s=0.02)
+    kw = dict(axis=c.axis, start_s=c.start_s, end_s=c.start_s + 12.0, dt_s=RK4_DT_S, record_interval_s=0.02)
     together = simulate_ascents(runs, **kw)
     for order in ([0], [3], [4, 2], [1, 0, 4, 3, 2]):
         for i, h in zip(order, simulate_ascents([runs[i] for i in order], **kw)):
@@ -390,9 +394,10 @@ def test_lockstep_kernel_matches_the_per_segment_dense_path(dispersed_runs):
     from taos.flight.ascent_sim import simulate_ascents
     c, runs = dispersed_runs
     end = c.start_s + 30.0
-    flown = simulate_ascents(runs[:3], axis=c.axis, start_s=c.start_s, end_s=end, dt_s=c.dt_s, record_interval_s=0.02)
+    flown = simulate_ascents(runs[:3], axis=c.axis, start_s=c.start_s, end_s=end, dt_s=RK4_DT_S,
+                             record_interval_s=0.02)
     for (asc, model, seed), h in zip(runs[:3], flown):
-        ref = per_segment_reference(asc, model, c.axis, c.start_s, end, c.dt_s, seed)
+        ref = per_segment_reference(asc, model, c.axis, c.start_s, end, RK4_DT_S, seed)
         got = h.signal("command_rad", c.axis)
         assert np.max(np.abs(ref)) > 1e-4  # the kick moved it
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))

@@ -33,7 +33,8 @@ that callee too, so the steps sharing such callees form one group and a group is
 * ``masv``: masv's lane kernel (``masv._kernel.integrate``, one compile for any number of engines
   and laws), whose inlined limits come from ``planar.saturation``.
 
-Between groups the only shared callees are ``planar._avionics_kernels.apply`` and the model's
+Between groups the only shared callees are ``planar._avionics_kernels.apply``,
+``planar._expstep.expm_small`` (the exponential lanes' coefficients, ``lanes``) and the model's
 friction law's C callbacks, which every group calls with the same signature (float64 and
 C-contiguous float64 arrays), so a simultaneous save writes the same key with the same code.
 
@@ -114,9 +115,13 @@ def _ascent_lanes() -> None:
     from taos.flight.ascent import load_ascent
     from taos.flight.ascent_sim import simulate_ascent
     from taos.model import load_model
+    from taos.flight.ascent_sim import simulate_ascents
     asc = load_ascent("ascent")
-    simulate_ascent(asc, load_model(asc.tvc_model), axes=("yaw",), start_s=0.0, end_s=0.1, dt_s=1e-3,
-                    record_interval_s=0.01)
+    model = load_model(asc.tvc_model)
+    simulate_ascent(asc, model, axes=("yaw",), start_s=0.0, end_s=0.1, dt_s=1e-3, record_interval_s=0.01)
+    # and their exponential kernel (taos.planar._explanes: Monte Carlo campaigns with integrator = "etdrk4")
+    simulate_ascents([(asc, model, 0)], axis="yaw", start_s=0.0, end_s=0.1, dt_s=5e-3, record_interval_s=0.02,
+                     integrator="etdrk4")
 
 
 def _shoot() -> None:
@@ -192,7 +197,8 @@ STEPS: tuple[Step, ...] = (
     Step("lco confirmation", "planar", _lco_confirm, 0.1),
     Step("friction laws", "friction", _friction, 4.7),
     Step("C dwells", "cdwell", _c_dwells, 6.0),
-    Step("ascent lanes", "lanes", _ascent_lanes, 16.3),
+    # (+ 6.5 s: the ETDRK4 lanes, benchmarks/RESULTS.md mcexp)
+    Step("ascent lanes", "lanes", _ascent_lanes, 22.8),
     Step("3-D model", "3d", _taos_model, 8.9),
     Step("3-D simulate", "3d", _simulate_taos, 7.8),
     Step("3-D frequency response", "3d", _taos_freqresp, 2.3),

@@ -146,10 +146,13 @@ class _Lane:
 
 
 def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple, rec: int, dt_s: float,
-          start_s: float, attitude0_rad: float, r: np.ndarray, follow: bool = False) -> _Lane:
+          start_s: float, attitude0_rad: float, r: np.ndarray, follow: bool = False,
+          step_s: float | None = None) -> _Lane:
     """Each segment's plant is :func:`ascent_plant` frozen at the segment's middle (the parts
     that do not change, built once); theta = xi + b delta and theta' are kept continuous across a
-    change of b by re-basing xi; the separation kick lands on xi' at the separation."""
+    change of b by re-basing xi; the separation kick lands on xi' at the separation. ``dt_s`` [s]
+    the spacing of ``t``; ``step_s`` [s] the integrator's step the friction law's explicit-step
+    rule is checked with (default ``dt_s``)."""
     sep = ascent.boosters.separation_time_s
     parts = PlantParts.of(ascent.flight, model, ax)
     plants, bs = [], []
@@ -164,7 +167,7 @@ def _lane(ascent: Ascent, model: TvcModel, ax: str, t: np.ndarray, bounds: tuple
              if follow else np.ones(len(mids)))
     laws = [model.friction.scaled(float(f)) if follow else model.friction for f in scale]
     for law in {id(x): x for x in (laws[int(np.argmax(scale))], model.friction)}.values():
-        law.check_step(p0.inertia_kgm2, dt_s, model.source)   # (check_friction_step on the stiffest level)
+        law.check_step(p0.inertia_kgm2, dt_s if step_s is None else step_s, model.source)   # (check_friction_step on the stiffest level)
     mats = np.zeros((len(plants), n + 3 + 5, n + ne + 5))
     heads = np.zeros((len(plants), sat.N_HEAD))
     iu = n + ne

@@ -59,6 +59,10 @@ HYDRAULIC = {"piston_rate_m_s": "v_p_m_s", "load_pressure_Pa": "p_load_Pa", "val
 #: the integrator of every ascent run (the compiled RK4 kernel of :mod:`taos.planar.dynamics`), as
 #: the runs' provenance names it
 INTEGRATOR = "rk4-fixed-step"
+#: the exponential integrator of Monte Carlo lanes (:func:`simulate_ascents` ``integrator="etdrk4"``)
+EXP_INTEGRATOR = "etdrk4-lanes"
+#: :func:`simulate_ascents`' integrators
+INTEGRATORS = ("rk4", "etdrk4")
 
 
 
@@ -139,15 +143,22 @@ def _recorded(plants: list, bounds: tuple, rec: int, Xq: np.ndarray) -> np.ndarr
     return Y
 
 
-def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s: float) -> list:
+def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s: float, exp: bool = False) -> list:
     """Fly ``lanes`` (equal keys) in one call of
-    :func:`taos.planar.dynamics.integrate_segments_lanes`; per lane (the first 8 :data:`SIGNALS`
-    then the :data:`HYDRAULIC` ones at the records (n_rec, 11), the external inputs there (n_rec, 2)) or the
-    :class:`~taos.errors.SimulationUnstable` it ended with."""
+    :func:`taos.planar.dynamics.integrate_segments_lanes` (RK4, step ``dt_s`` [s]) or, with
+    ``exp``, of :func:`taos.planar._explanes.integrate_segments_lanes_exp` (ETDRK4, step 2
+    ``dt_s``: ``t``, ``bounds``, ``rec`` and the lanes' inputs are then on the half-step grid);
+    per lane (the first 8 :data:`SIGNALS` then the :data:`HYDRAULIC` ones at the records (n_rec,
+    11), the external inputs there (n_rec, 2)) or the :class:`~taos.errors.SimulationUnstable` it
+    ended with."""
     from taos.errors import SimulationUnstable
     from taos.planar import dynamics as _dy
 
     mats = np.stack([ln.mats for ln in lanes], axis=-1)           # (n_seg, n + 3, n + n_r + 2, R)
+    if exp:   # the TVC block goes to the exact propagation: its entries leave N's matrix
+        nb, co = _exp_block(lanes, mats, 2.0 * dt_s)
+        mats = mats.copy()
+        mats[:, :nb, :nb, :] = 0.0
     mask = np.any(mats != 0.0, axis=(0, 3))
     ip = np.concatenate([[0], np.cumsum(mask.sum(axis=1))]).astype(np.int64)
     ix = np.nonzero(mask)[1].astype(np.int64)
@@ -166,23 +177,51 @@ def _fly_lanes(lanes: list[_Lane], t: np.ndarray, bounds: tuple, rec: int, dt_s:
     aux = np.empty((nrec, _dy.N_AUX, nl))
     status = np.empty(nl, np.int64)
     m0 = lanes[0].model
-    _dy.integrate_segments_lanes(ip, ix, mx, heads, m0.friction.entry.rates_lanes,
-                                 np.ascontiguousarray(np.stack([ln.fpack for ln in lanes], axis=1)),
-                                 np.stack([ln.model.avionics.pack() for ln in lanes]),
-                                 np.asarray(bounds, np.int64), jdst, jsrc, jcoef, kick, x0, np.zeros(nl), r, dt_s,
-                                 rec, X, aux, status)
+    common = (ip, ix, mx, heads, m0.friction.entry.rates_lanes,
+              np.ascontiguousarray(np.stack([ln.fpack for ln in lanes], axis=1)),
+              np.stack([ln.model.avionics.pack() for ln in lanes]), np.asarray(bounds, np.int64), jdst, jsrc, jcoef,
+              kick, x0, np.zeros(nl), r)
+    if exp:
+        from taos.planar._explanes import integrate_segments_lanes_exp
+        integrate_segments_lanes_exp(*common, float(2.0 * dt_s), int(nb), co, int(rec), X, aux, status)
+    else:
+        _dy.integrate_segments_lanes(*common, dt_s, rec, X, aux, status)
     out = []
+    how = f"ETDRK4 step {2.0 * dt_s} s" if exp else f"dt = {dt_s} s"
+    XL = np.ascontiguousarray(X.transpose(2, 0, 1))   # (R, n_rec, n): a lane's records contiguous
     for q, ln in enumerate(lanes):
         if status[q] >= 0:
-            out.append(SimulationUnstable(float(t[status[q]]), f"{ln.model.friction.name} friction, dt = {dt_s} s"))
+            out.append(SimulationUnstable(float(t[status[q]]), f"{ln.model.friction.name} friction, {how}"))
             continue
-        Xq = X[:, :, q]
+        Xq = XL[q]
         Y = _recorded(ln.plants, bounds, rec, Xq)
         Y[:, 2] += ln.r[::rec, 0]  # the FCS command: the PTI is added to it
         Y[:, 6] = aux[:, _dy.AUX_TF, q]
         Yh = np.column_stack([Xq[:, si(v)] for v in HYDRAULIC.values()])
         out.append((np.column_stack([Y, Yh]), ln.r[::rec]))
     return out
+
+
+def _exp_block(lanes: list[_Lane], mats: np.ndarray, h: float) -> tuple[int, np.ndarray]:
+    """(nb, co): the exactly propagated block, the TVC's states (those before the vehicle's
+    ``xi_rad``: valve, oil column, piston, pressure feedback, engine), and its ETDRK4
+    coefficients for the step ``h`` [s] per segment and lane, (n_seg, 6, nb, nb, R)
+    (:func:`taos.planar._expstep.etd_coefficients`; computed once per distinct block: the TVC's
+    block does not change with the vehicle's segments)."""
+    from taos.planar._expstep import etd_coefficients
+
+    nb = lanes[0].plants[0].ss.state_index("xi_rad")
+    nseg, nl = mats.shape[0], mats.shape[-1]
+    co = np.empty((nseg, 6, nb, nb, nl))
+    for q in range(nl):
+        done: dict = {}
+        for s_ in range(nseg):
+            blk = np.ascontiguousarray(mats[s_, :nb, :nb, q])
+            key = blk.tobytes()
+            if key not in done:
+                done[key] = np.stack(etd_coefficients(blk, h))
+            co[s_, :, :, :, q] = done[key]
+    return nb, co
 
 
 #: runs flown in lockstep by one kernel call (the lanes of :func:`simulate_ascents`), and the
@@ -202,24 +241,38 @@ def _lane_bytes(ln: _Lane, n_t: int, rec: int) -> int:
 
 def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, start_s: float = 0.0,
                      end_s: float | None = None, dt_s: float = DEFAULT_DT_S, record_interval_s: float = 0.01,
-                     attitude0_rad: float = 0.0, friction_follows_thrust: bool = False) -> list:
+                     attitude0_rad: float = 0.0, friction_follows_thrust: bool = False,
+                     integrator: str = "rk4") -> list:
     """Fly many ascents on one ``axis``: ``runs`` is a list of (ascent, TVC model, seed); returns,
     per run, its :class:`AscentHistory` (as :func:`simulate_ascent` with ``axes=(axis,)``) or the
     exception it ended with (:class:`~taos.errors.SimulationUnstable`,
     :class:`~taos.errors.InputError`, ValueError, ArithmeticError).
 
+    ``integrator``: ``"rk4"`` (classical RK4, step ``dt_s``, :data:`INTEGRATOR`) or ``"etdrk4"``
+    (:data:`INTEGRATORS`: the TVC's actuator and engine propagated exactly, the rest by ETDRK4's
+    stages, :mod:`taos.planar._explanes`, step ``dt_s``; the inputs sampled every dt_s / 2, and
+    ``record_interval_s`` a whole even number of half steps).
+
     Runs with the same plant structure and segments are integrated :data:`LANES` at a time in
     lockstep (vectorised across the runs); a run's numbers do not depend on the other runs nor on
     how many there are."""
     from taos.errors import InputError, SimulationUnstable
+    if integrator not in INTEGRATORS:
+        raise InputError("argument", "integrator", "one of " + ", ".join(INTEGRATORS), got=repr(integrator))
+    exp = integrator == "etdrk4"
+    gdt = 0.5 * dt_s if exp else dt_s     # the input and record grid's spacing [s]
+    if exp and int(round(record_interval_s / gdt)) % 2:
+        raise InputError("argument", "record_interval_s", f"a whole number of ETDRK4 steps of {dt_s:g} s",
+                         got=repr(record_interval_s))
     res: list = [None] * len(runs)
     groups, version = {}, package_version()   # read once a call (importlib.metadata: ms a read)
     grids = {}
     for i, (asc, model, seed) in enumerate(runs):
         try:
-            end, rec, t, bounds = _grid(asc, start_s, end_s, dt_s, record_interval_s)
-            r = _external_inputs(asc, axis, t, seed, dt_s)
-            ln = _lane(asc, model, axis, t, bounds, rec, dt_s, start_s, attitude0_rad, r, friction_follows_thrust)
+            end, rec, t, bounds = _grid(asc, start_s, end_s, gdt, record_interval_s)
+            r = _external_inputs(asc, axis, t, seed, gdt)
+            ln = _lane(asc, model, axis, t, bounds, rec, gdt, start_s, attitude0_rad, r, friction_follows_thrust,
+                       step_s=dt_s)
         except (SimulationUnstable, InputError, ValueError, ArithmeticError) as e:
             res[i] = e
             continue
@@ -231,19 +284,21 @@ def simulate_ascents(runs: list[tuple[Ascent, TvcModel, int]], *, axis: str, sta
         lanes -= lanes % LANE_VECTOR if lanes > LANE_VECTOR else 0
         # as few kernel calls as allowed, all but the last of ``lanes`` runs (LANE_VECTOR)
         for chunk in (members[g:g + lanes] for g in range(0, len(members), lanes)):
-            for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], t, bounds, rec, dt_s)):
+            for (i, _), flown in zip(chunk, _fly_lanes([ln for _, ln in chunk], t, bounds, rec, gdt, exp)):
                 if isinstance(flown, Exception):
                     res[i] = flown
                     continue
                 asc, model, seed = runs[i]
                 res[i] = _history(asc, model, (axis,), [flown], grids[i], dt_s, seed, start_s, attitude0_rad,
-                                  friction_follows_thrust, version=version)
+                                  friction_follows_thrust, version=version, integrator=integrator)
     return res
 
 
 def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tuple, dt_s: float, seed: int,
-             start_s: float, attitude0_rad: float, follow: bool = False, version: str | None = None) -> AscentHistory:
+             start_s: float, attitude0_rad: float, follow: bool = False, version: str | None = None,
+             integrator: str = "rk4") -> AscentHistory:
     end, rec, t, _ = grid
+    method, rec_steps = (INTEGRATOR, rec) if integrator == "rk4" else (EXP_INTEGRATOR, rec // 2)
     out = {k: [] for k in SIGNALS}
     for Y, Rr in flown:
         for j, k in enumerate(SIGNALS[:8]):
@@ -255,7 +310,7 @@ def _history(ascent: Ascent, model: TvcModel, axes: tuple, flown: list, grid: tu
     prov = {**model_provenance(model), "ascent_file": ascent.source,
             "ascent_sha256": ascent.sha256, "flight_file": ascent.flight.source,
             "flight_sha256": ascent.flight.sha256, "package_version": version or package_version(),
-            "solver": {"method": INTEGRATOR, "dt_s": dt_s, "record_every": rec},
+            "solver": {"method": method, "dt_s": dt_s, "record_every": rec_steps},
             "seed": int(seed), "start_s": start_s, "end_s": end, "attitude0_rad": attitude0_rad,
             "friction_model": model.friction.name} | ({"friction_follows_thrust": True} if follow else {})
     return AscentHistory(t_s=t[::rec], axes=tuple(axes), signals={k: np.vstack(v) for k, v in out.items()},

@@ -11,7 +11,9 @@ of each run as ``taos lco`` does. Format::
     seed = 20221116                         # campaign seed: run i draws from SeedSequence([seed, i])
     start = "130 s"                         # segment flown (flight time)
     duration = "200 s"
-    dt = "1 ms"                             # RK4 step
+    dt = "1 ms"                             # the integrator's step
+    integrator = "rk4"                      # optional: "rk4" (default) or "etdrk4" (the actuator and
+                                            # engine propagated exactly: steps up to 10 ms)
     axis = "yaw"
     analysis_window = "100 s"               # LCO measured over the last window of the segment
     trace_interval = "0.5 s"                # spacing of the stored FCS command trace
@@ -75,7 +77,13 @@ FLIGHT_PARAMETERS = {
 DISTRIBUTIONS = ("normal", "uniform")
 TOP_KEYS = {"name", "description", "ascent", "tvc_model", "friction", "seed", "start", "duration", "dt", "axis",
             "analysis_window", "trace_interval", "default_case", "cases", "dispersions", "update_interval", "ptis", "avionics",
-            "friction_follows_thrust"}
+            "friction_follows_thrust", "integrator"}
+#: the campaign's integrators (:func:`taos.flight.ascent_sim.simulate_ascents`) -> their largest step [s]:
+#: RK4's 2 ms is the oil column's stability bound (benchmarks/RESULTS.md, mcfast); ETDRK4's 10 ms the
+#: largest step that divides the 20 ms records (benchmarks/RESULTS.md, mcexp: its accuracy)
+MAX_DT_S = {"rk4": 2e-3, "etdrk4": 1e-2}
+#: the spacing of a run's records [s] (taos.montecarlo.run.RECORD_INTERVAL_S): an ETDRK4 step divides it
+_RECORDS_S = 0.02
 MAX_SEGMENT_STEPS = 2_000_000
 
 
@@ -122,6 +130,7 @@ class Campaign:
     ptis: bool = True
     avionics: str = "bounding"
     friction_follows_thrust: bool = False
+    integrator: str = "rk4"
 
 
 def _nearest(key: str, allowed) -> str:
@@ -208,8 +217,15 @@ def load_campaign(path: str | Path) -> Campaign:
     t = lambda k, d, **c: to_si(doc.get(k, d), "time", source=src, field=k, **c)  # noqa: E731
     start, dur, dt = t("start", "0 s", nonnegative=True), t("duration", "200 s", positive=True), t("dt", "1 ms", positive=True)
     win, trace = t("analysis_window", "100 s", positive=True), t("trace_interval", "0.5 s", positive=True)
-    if not 1e-5 <= dt <= 2e-3:
+    integrator = doc.get("integrator", "rk4")
+    if integrator not in MAX_DT_S:
+        raise InputError(src, "integrator", "'rk4' or 'etdrk4'", got=repr(integrator))
+    if integrator == "rk4" and not 1e-5 <= dt <= 2e-3:
         raise InputError(src, "dt", "an RK4 step from 0.01 ms to 2 ms (the oil column needs it)", got=repr(doc.get("dt")))
+    if integrator == "etdrk4" and not (1e-5 <= dt <= MAX_DT_S["etdrk4"]
+                                       and abs(_RECORDS_S / dt - round(_RECORDS_S / dt)) < 1e-9):
+        raise InputError(src, "dt", "an ETDRK4 step from 0.01 ms to 10 ms that divides 20 ms (the records)",
+                         got=repr(doc.get("dt")))
     if dur / dt > MAX_SEGMENT_STEPS:
         raise InputError(src, "duration", f"at most {MAX_SEGMENT_STEPS} steps of dt per run", got=f"{dur / dt:.3g}")
     if not 10.0 <= win <= dur:
@@ -253,7 +269,7 @@ def load_campaign(path: str | Path) -> Campaign:
                  friction=fr, seed=seed, start_s=start, duration_s=dur, dt_s=dt, axis=axis,
                  analysis_window_s=win, trace_interval_s=trace, default_case=str(default), cases=cases,
                  dispersions=disp, update_interval_s=upd, ptis=ptis,
-                 avionics=avionics, friction_follows_thrust=follow)
+                 avionics=avionics, friction_follows_thrust=follow, integrator=integrator)
     from taos.bounds import check_campaign_bounds
     check_campaign_bounds(c, {k: f"{q.section}.{q.toml_key}" for k, q in PARAMETERS.items()})   # before any work
     return c

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from taos.errors import InputError
-from taos.flight.ascent_sim import INTEGRATOR as ASCENT_INTEGRATOR
+from taos.flight.ascent_sim import EXP_INTEGRATOR, INTEGRATOR as ASCENT_INTEGRATOR
 from taos.montecarlo import engine, sensitivity, store
 from taos.montecarlo.campaign import Campaign, base_models, check_case, run_factors
 from taos.montecarlo.engine import Design, Part
@@ -207,7 +207,8 @@ def run_campaign(c: Campaign, out_dir: str | Path, *, runs: int, case: str | Non
             "input_files": table, "ascent_sha256": kind.ascent.sha256, **model_provenance(kind.model),
             "package_version": package_version(), "code_sha256": engine.code_sha256(), "seed": c.seed, "case": case,
             "design": design,
-            "friction_model": kind.model.friction.name, "solver": {"method": ASCENT_INTEGRATOR, "dt_s": c.dt_s},
+            "friction_model": kind.model.friction.name, "solver": {"method": EXP_INTEGRATOR if c.integrator == "etdrk4" else ASCENT_INTEGRATOR,
+                                                          "dt_s": c.dt_s},
             "segment_s": [c.start_s, c.start_s + c.duration_s],
             "cpu_targets": sorted({str(v) for v in np.unique(ds["cpu"].values)} - {""})}
     timing = {"wall_s": wall, "runs_executed": executed, "workers": n_workers or None, "batch": manifest["batch"],

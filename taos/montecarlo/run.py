@@ -39,6 +39,9 @@ RECORD_INTERVAL_S = 0.02
 #: measured cost of one RK4 step of a flight run in the lockstep kernel, for sizing batches [s]
 #: (CPU time under load, benchmarks/RESULTS.md issue 26: 0.11 s per 200,000-step run)
 STEP_COST_S = 5.5e-7
+#: the same for one ETDRK4 step (``integrator = "etdrk4"``; benchmarks/RESULTS.md, mcexp: 0.025 CPU-s a
+#: 40,000-step run in-process, load 1-4)
+EXP_STEP_COST_S = 6.5e-7
 STOP_FRACTION = 0.98
 #: the largest fundamental of a signal bounded by its peak: a square wave's, 4/pi (1 % margin)
 FUNDAMENTAL_BOUND = 4 / math.pi * 1.01
@@ -75,7 +78,8 @@ class FlightRuns:
 
     @property
     def run_cost_s(self) -> float:
-        return STEP_COST_S * self.campaign.duration_s / self.campaign.dt_s
+        step = EXP_STEP_COST_S if self.campaign.integrator == "etdrk4" else STEP_COST_S
+        return step * self.campaign.duration_s / self.campaign.dt_s
 
     @property
     def gimbal_range_deg(self) -> float:
@@ -104,7 +108,7 @@ class FlightRuns:
         # numbers are its own, whatever else is in the batch
         flown = simulate_ascents(runs, axis=c.axis, start_s=c.start_s, end_s=c.start_s + c.duration_s, dt_s=c.dt_s,
                                  record_interval_s=max(RECORD_INTERVAL_S, c.dt_s),
-                                 friction_follows_thrust=c.friction_follows_thrust)
+                                 friction_follows_thrust=c.friction_follows_thrust, integrator=c.integrator)
         for i, h in zip(rows, flown):
             if isinstance(h, (SimulationUnstable, InputError, ValueError, ArithmeticError)):
                 self._failed(out, i, h)

@@ -394,6 +394,62 @@ def _rates_lanes(Z, ip, ix, mx, H, fidl, fp, AVP, V, C, S, U, TF, DZ, DX):
     _rows(ip, ix, mx, V, 0, n, DX, 0)
 
 
+@njit(cache=True, inline="always")
+def lanes_by_slot(head):
+    """The lanes' packed limit heads (n_seg, R, N_HEAD) by slot, (n_seg, N_HEAD, R): contiguous
+    across lanes (vector loads)."""
+    nseg, nl, nh = head.shape
+    H = np.empty((nseg, nh, nl))
+    for s in range(nseg):
+        for j in range(nh):
+            for q in range(nl):
+                H[s, j, q] = head[s, q, j]
+    return H
+
+
+@njit(cache=True, inline="always")
+def lanes_jump(X, jdst, jsrc, jcoef, kick, seg):
+    """The state jumps at the start of segment ``seg`` (:func:`integrate_segments_lanes`)."""
+    n, nl = X.shape
+    for j in range(jdst.shape[0]):
+        for q in range(nl):
+            X[jdst[j], q] += jcoef[seg, j, q] * X[jsrc[j], q]
+    for i in range(n):
+        for q in range(nl):
+            X[i, q] += kick[seg, i, q]
+
+
+@njit(cache=True, inline="always")
+def lanes_record(X, Z, TF, U, x_out, aux_out, rec):
+    """Record ``rec``: the states, T_f [N m], z [rad] and u [rad] of every lane."""
+    n, nl = X.shape
+    for i in range(n):
+        for q in range(nl):
+            x_out[rec, i, q] = X[i, q]
+    for q in range(nl):
+        aux_out[rec, AUX_TF, q] = TF[q]
+        aux_out[rec, AUX_Z, q] = Z[q]
+        aux_out[rec, AUX_U, q] = U[q]
+
+
+@njit(cache=True, inline="always")
+def lanes_failed(X, Z, OK, status, step):
+    """Mark ``step`` in ``status`` for every lane whose state has just become non-finite;
+    returns how many did. x * 0 is 0 for a finite x and NaN otherwise: one vector pass finds them."""
+    n, nl = X.shape
+    for q in range(nl):
+        OK[q] = Z[q] * 0.0
+    for i in range(n):
+        for q in range(nl):
+            OK[q] += X[i, q] * 0.0
+    dead = 0
+    for q in range(nl):
+        if status[q] < 0 and not OK[q] == 0.0:
+            status[q] = step
+            dead += 1
+    return dead
+
+
 @njit(cache=True, error_model="numpy")  # x / 0 -> inf or NaN (the selects discard them), no exception
 def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc, jcoef, kick, x0, z0, r, dt,
                              rec_every, x_out, aux_out, status):
@@ -454,11 +510,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
     S = np.empty((2, nl))
     OK = np.empty(nl)
     # the lanes' limit heads and avionics packs by slot (contiguous across lanes: vector loads)
-    H = np.empty((nseg, head.shape[2], nl))
-    for s in range(nseg):
-        for j in range(head.shape[2]):
-            for q in range(nl):
-                H[s, j, q] = head[s, q, j]
+    H = lanes_by_slot(head)
     AVP = np.ascontiguousarray(avp.T)
     status[:] = -1
     alive = nl
@@ -470,12 +522,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
     h2 = 0.5 * dt
     for k in range(nsteps + 1):
         if seg < nseg and k == bounds[seg]:
-            for j in range(jdst.shape[0]):
-                for q in range(nl):
-                    X[jdst[j], q] += jcoef[seg, j, q] * X[jsrc[j], q]
-            for i in range(n):
-                for q in range(nl):
-                    X[i, q] += kick[seg, i, q]
+            lanes_jump(X, jdst, jsrc, jcoef, kick, seg)
             M = mx[seg]
             L = H[seg]
             F = fp[seg]
@@ -495,13 +542,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
         # the derivative at the step start (K1), with T_f and u there for the record
         _rates_lanes(Z, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D1, K1)
         if k % rec_every == 0:
-            for i in range(n):
-                for q in range(nl):
-                    x_out[rec, i, q] = X[i, q]
-            for q in range(nl):
-                aux_out[rec, AUX_TF, q] = TF[q]
-                aux_out[rec, AUX_Z, q] = Z[q]
-                aux_out[rec, AUX_U, q] = U[q]
+            lanes_record(X, Z, TF, U, x_out, aux_out, rec)
             rec += 1
         if k == nsteps:
             break
@@ -534,16 +575,7 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
                 X[i, q] += dt * (K1[i, q] + 2.0 * K2[i, q] + 2.0 * K3[i, q] + K4[i, q]) / 6.0
         for q in range(nl):
             Z[q] = Z[q] + dt * (D1[q] + 2.0 * D2[q] + 2.0 * D3[q] + D4[q]) / 6.0
-        # x * 0 is 0 for a finite x and NaN otherwise: one vector pass finds the non-finite lanes
-        for q in range(nl):
-            OK[q] = Z[q] * 0.0
-        for i in range(n):
-            for q in range(nl):
-                OK[q] += X[i, q] * 0.0
-        for q in range(nl):
-            if status[q] < 0 and not OK[q] == 0.0:
-                status[q] = k + 1
-                alive -= 1
+        alive -= lanes_failed(X, Z, OK, status, k + 1)
         if alive == 0:
             break
     return alive
