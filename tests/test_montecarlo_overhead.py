@@ -1,5 +1,5 @@
 """The Monte Carlo run's work outside the kernel, made cheaper without changing a bit (issue 44
-point 4): the turbulence recursion as one filter call, the segment flights interpolated at
+point 4): the turbulence recursion as one compiled call (no scipy.signal in a worker), the segment flights interpolated at
 once, a model's base variant loaded once a process. Each against the previous way of computing
 it, written out here, and a small campaign's store against the same campaign flown the previous
 way."""
@@ -78,7 +78,7 @@ def ascent():
 
 
 @pytest.mark.parametrize("seed,scale", [(1, 1.0), (20221116, 1.7), (5, 0.0)])
-def test_turbulence_filter_call_gives_the_loops_bits(ascent, seed, scale):
+def test_turbulence_kernel_gives_the_loops_bits(ascent, seed, scale):
     asc = dataclasses.replace(ascent, wind=dataclasses.replace(ascent.wind, scale=scale))
     t = 120.0 + np.arange(200_001) * 1e-3
     got = wind_speed(asc, t, np.random.default_rng(seed), 1e-3)

@@ -407,10 +407,9 @@ def wind_speed(ascent: Ascent, t_s: np.ndarray, rng: np.random.Generator, dt_s: 
     turb[0] = w.turbulence_intensity_m_s * xi[0]
     s = w.turbulence_intensity_m_s * math.sqrt(1 - phi * phi)
     if tc.size > 1:  # exact discretisation of the first-order (Ornstein-Uhlenbeck) process,
-        # turb[k] = phi turb[k-1] + s xi[k], as one filter call: y = s x + z, z = 0 x + phi y
-        # (direct form II transposed) is that recursion operation for operation, the same bits
-        from scipy.signal import lfilter
-        turb[1:] = lfilter([s, 0.0], [1.0, -phi], xi[1:], zi=[phi * turb[0]])[0]
+        # turb[k] = phi turb[k-1] + s xi[k] (taos.flight._turbulence)
+        from taos.flight._turbulence import ou_recursion
+        ou_recursion(turb, float(phi), float(s), xi)
     return w.scale * (steady + gust + np.interp(t, tc, turb))
 
 
