@@ -19,17 +19,27 @@ from typing import TYPE_CHECKING, Any
 from ..bounds import MAX_VIEW_FPS, MAX_VIEW_SCALE   # the view's argument bounds
 from ..errors import InputError
 from ..results import atomic_write
-from .base import BaseVisualizer
-from .geometry import EngineDrawing, geometry_for_run
-from .kinematics import ViewerFrames, viewer_frames
-from .meshcat_backend import MeshcatVisualizer, OfflineWindow, legend_html, live_visualizer
 
 if TYPE_CHECKING:
+    from .geometry import EngineDrawing
     from ..planar.simulate import TimeHistory
     from ..taos3d.simulate import TaosTimeHistory
 
 __all__ = ["BaseVisualizer", "EngineDrawing", "MeshcatVisualizer", "OfflineWindow", "ViewerFrames",
            "load_run", "offline_html", "serve", "viewer_frames", "write_html"]
+
+#: the drawing side's names, imported on first use (PEP 562): trimesh and meshcat cost about
+#: 0.5 s, which a refused run file (load_run) or a bad argument need not pay
+_LAZY = {"BaseVisualizer": ".base", "EngineDrawing": ".geometry", "geometry_for_run": ".geometry",
+         "ViewerFrames": ".kinematics", "viewer_frames": ".kinematics", "MeshcatVisualizer": ".meshcat_backend",
+         "OfflineWindow": ".meshcat_backend", "legend_html": ".meshcat_backend", "live_visualizer": ".meshcat_backend"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+        return getattr(importlib.import_module(_LAZY[name], __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 
@@ -90,6 +100,10 @@ def offline_html(th, *, angle_scale: float = 1.0, deflection_scale: float | None
     :mod:`taos.viewer.kinematics`); ``fps`` is the keyframe rate [1/s];
     ``paused_at_s`` opens the page paused at that time [s] (else it plays; ``?t=`` in the URL
     also selects a time)."""
+    from .geometry import geometry_for_run
+    from .kinematics import viewer_frames
+    from .meshcat_backend import MeshcatVisualizer, OfflineWindow, legend_html
+
     fr = viewer_frames(th, geometry, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps,
                        gimbal_scale=gimbal_scale)
     v = MeshcatVisualizer(geometry or geometry_for_run(th),
@@ -116,6 +130,10 @@ def serve(th: TimeHistory | TaosTimeHistory, *, angle_scale: float = 1.0, deflec
 
     Calls ``on_ready(url)`` once the scene is loaded; returns 0 after shutting the server down."""
     check_view_args(th, angle_scale, deflection_scale, fps, gimbal_scale)
+    from .geometry import geometry_for_run
+    from .kinematics import viewer_frames
+    from .meshcat_backend import live_visualizer
+
     fr = viewer_frames(th, angle_scale=angle_scale, deflection_scale=deflection_scale, fps=fps,
                        gimbal_scale=gimbal_scale)
     vis, proc = live_visualizer(geometry_for_run(th))
