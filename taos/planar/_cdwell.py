@@ -26,7 +26,7 @@ stale or foreign library is never loaded: it is rebuilt. Building (:func:`build`
 (the translator reads the kernels through their dispatchers), writes the C, runs the compiler
 into a temporary file and renames it into place (a concurrent build or a kill leaves no half
 library); the manifest beside it records the entries' argument kinds, the compiler's version
-and the SHA-256 of the generated C. ``taos warmup`` builds the built-in laws' libraries; a
+and the SHA-256 of the generated C. ``python -m taos.cli.warmup`` (run by ``make``) builds the built-in laws' libraries; a
 command that finds none builds its own law's on first use (about a second), so the first run
 works too.
 
