@@ -208,6 +208,15 @@ def _rates(x, z, u, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, dx, dz)
     _csr(mp, mx, mv, W, dx, nl)
 
 
+
+@njit(cache=True, fastmath=_FM)
+def _rates_stage(x, z, u, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, dx, dz):
+    """:func:`_rates` (same arguments) as one compiled function that :func:`integrate`'s four RK4
+    stages call out of line: inlined at each stage, the kernel's cold compile typed and lowered
+    four copies (benchmarks/RESULTS.md, compile2: the warm-up's masv step and the kernel's speed
+    before and after); compiled with :func:`integrate`'s fast-math flags, the same bits."""
+    _rates(x, z, u, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, dx, dz)
+
 @njit(cache=True)
 def _all_finite(x, z):
     """True if every entry of ``x`` and ``z`` is finite (compiled without fast-math, so the
@@ -262,7 +271,7 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0
             u0[k] = c0[amap[k]]
             um[k] = cm[amap[k]]
             u1[k] = c1[amap[k]]
-        _rates(x, z, u0, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k1, d1)
+        _rates_stage(x, z, u0, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k1, d1)
         if s % rec_every == 0:
             for i in range(n):
                 x_out[rec, i] = x[i]
@@ -278,17 +287,17 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0
             xt[i] = x[i] + h * k1[i]
         for k in range(na):
             zt[k] = z[k] + h * d1[k]
-        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k2, d2)
+        _rates_stage(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k2, d2)
         for i in range(n):
             xt[i] = x[i] + h * k2[i]
         for k in range(na):
             zt[k] = z[k] + h * d2[k]
-        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k3, d3)
+        _rates_stage(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k3, d3)
         for i in range(n):
             xt[i] = x[i] + dt * k3[i]
         for k in range(na):
             zt[k] = z[k] + dt * d3[k]
-        _rates(xt, zt, u1, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k4, d4)
+        _rates_stage(xt, zt, u1, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k4, d4)
         for i in range(n):
             x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
         for k in range(na):
