@@ -1,5 +1,5 @@
 """The RK4 lane kernels' records, bit for bit, and their kernel CPU time (branch compile2: the
-stage evaluation called out of line).
+four stages through one inlined copy of their rates).
 
     PYTHONPATH=$PWD NUMBA_NUM_THREADS=1 .venv/bin/python benchmarks/rk4_stage_bits.py --save OUT.npz [--compare REF.npz]
 
