@@ -264,7 +264,8 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0
             u1[k] = c1[amap[k]]
         # the four stages through ONE inlined copy of _rates: inlined at each stage, the kernel's
         # cold compile typed and lowered four copies; called out of line (one compiled function),
-        # its arguments cost 2 % of the kernel's run, this loop 3 % less (benchmarks/RESULTS.md, compile2); same bits
+        # its arguments cost 2 % of the kernel's run, this loop 3 % less than the four copies
+        # (benchmarks/RESULTS.md, compile2); the same bits
         for st in range(4):
             if st == 0:
                 for i in range(n):
