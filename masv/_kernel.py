@@ -239,8 +239,8 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0
     na = z0.shape[0]
     nl = m * na
     x, z = x0.copy(), z0.copy()
-    k1, k2, k3, k4, xt = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    d1, d2, d3, d4, zt = np.empty(na), np.empty(na), np.empty(na), np.empty(na), np.empty(na)
+    K, D = np.empty((4, n)), np.empty((4, na))   # the stages' dx/dt and dz/dt
+    xt, zt = np.empty(n), np.empty(na)
     nc = r.shape[1]
     u0, um, u1 = np.empty(na), np.empty(na), np.empty(na)
     c0, cm, c1 = np.empty(nc), np.empty(nc), np.empty(nc)
@@ -262,37 +262,41 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0
             u0[k] = c0[amap[k]]
             um[k] = cm[amap[k]]
             u1[k] = c1[amap[k]]
-        _rates(x, z, u0, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k1, d1)
-        if s % rec_every == 0:
-            for i in range(n):
-                x_out[rec, i] = x[i]
-            for k in range(2 * na):
-                v_out[rec, k] = W[nl + k]
-            for k in range(na):
-                z_out[rec, k] = z[k]
-            rec += 1
+        # the four stages through ONE inlined copy of _rates: inlined at each stage, the kernel's
+        # cold compile typed and lowered four copies; called out of line (one compiled function),
+        # its arguments cost 2 % of the kernel's run, this loop 3 % less than the four copies
+        # (benchmarks/RESULTS.md, compile2); the same bits
+        for st in range(4):
+            if st == 0:
+                for i in range(n):
+                    xt[i] = x[i]
+                for k in range(na):
+                    zt[k] = z[k]
+            else:
+                c = dt if st == 3 else 0.5 * dt
+                for i in range(n):
+                    xt[i] = x[i] + c * K[st - 1, i]
+                for k in range(na):
+                    zt[k] = z[k] + c * D[st - 1, k]
+            _rates(xt, zt, u0 if st == 0 else (u1 if st == 3 else um), ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0,
+                   m, aux, K[st], D[st])
+            if st == 0:
+                if s % rec_every == 0:
+                    for i in range(n):
+                        x_out[rec, i] = x[i]
+                    for k in range(2 * na):
+                        v_out[rec, k] = W[nl + k]
+                    for k in range(na):
+                        z_out[rec, k] = z[k]
+                    rec += 1
+                if s == nsteps:
+                    break
         if s == nsteps:
             break
-        h = 0.5 * dt
         for i in range(n):
-            xt[i] = x[i] + h * k1[i]
+            x[i] += dt * (K[0, i] + 2.0 * K[1, i] + 2.0 * K[2, i] + K[3, i]) / 6.0
         for k in range(na):
-            zt[k] = z[k] + h * d1[k]
-        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k2, d2)
-        for i in range(n):
-            xt[i] = x[i] + h * k2[i]
-        for k in range(na):
-            zt[k] = z[k] + h * d2[k]
-        _rates(xt, zt, um, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k3, d3)
-        for i in range(n):
-            xt[i] = x[i] + dt * k3[i]
-        for k in range(na):
-            zt[k] = z[k] + dt * d3[k]
-        _rates(xt, zt, u1, ml, mp, mx, mv, ql, rl, H, fidl, fp, W, ws0, m, aux, k4, d4)
-        for i in range(n):
-            x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
-        for k in range(na):
-            z[k] += dt * (d1[k] + 2.0 * d2[k] + 2.0 * d3[k] + d4[k]) / 6.0
+            z[k] += dt * (D[0, k] + 2.0 * D[1, k] + 2.0 * D[2, k] + D[3, k]) / 6.0
         if not _all_finite(x, z):
             return s + 1
     return -1

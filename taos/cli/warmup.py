@@ -197,12 +197,14 @@ STEPS: tuple[Step, ...] = (
     Step("lco confirmation", "planar", _lco_confirm, 0.1),
     Step("friction laws", "friction", _friction, 4.7),
     Step("C dwells", "cdwell", _c_dwells, 6.0),
-    # (+ 6.5 s: the ETDRK4 lanes, benchmarks/RESULTS.md mcexp)
-    Step("ascent lanes", "lanes", _ascent_lanes, 22.8),
+    # (+ 6.5 s: the ETDRK4 lanes, benchmarks/RESULTS.md mcexp; - 8.6 s: the RK4 lanes' four stages
+    # through one inlined copy of their rates, compile2)
+    Step("ascent lanes", "lanes", _ascent_lanes, 14.2),
     Step("3-D model", "3d", _taos_model, 8.9),
     Step("3-D simulate", "3d", _simulate_taos, 7.8),
     Step("3-D frequency response", "3d", _taos_freqresp, 2.3),
-    Step("masv simulate", "masv", _masv_simulate, 9.9),
+    # (- 6.4 s: the four RK4 stages through one inlined copy of their rates, benchmarks/RESULTS.md compile2)
+    Step("masv simulate", "masv", _masv_simulate, 3.5),
 )
 
 

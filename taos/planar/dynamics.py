@@ -500,8 +500,8 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
     nr = r.shape[2]
     X = x0.copy()
     Z = z0.copy()
-    K1, K2, K3, K4 = np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl))
-    D1, D2, D3, D4 = np.empty(nl), np.empty(nl), np.empty(nl), np.empty(nl)
+    K = np.empty((4, n, nl))   # the stages' derivatives k1..k4 [x/s] and dz/dt [rad/s]
+    D = np.empty((4, nl))
     ZT = np.empty(nl)
     U, TF = np.empty(nl), np.empty(nl)
     R0, RM, R1 = np.empty((nr, nl)), np.empty((nr, nl)), np.empty((nr, nl))
@@ -535,46 +535,45 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
         for j in range(nr):
             for q in range(nl):
                 RM[j, q] = 0.5 * (R0[j, q] + R1[j, q])
-                V[n + j, q] = R0[j, q]
-        for i in range(n):
-            for q in range(nl):
-                V[i, q] = X[i, q]
-        # the derivative at the step start (K1), with T_f and u there for the record
-        _rates_lanes(Z, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D1, K1)
-        if k % rec_every == 0:
-            lanes_record(X, Z, TF, U, x_out, aux_out, rec)
-            rec += 1
+        # the four stages through ONE inlined copy of _rates_lanes: inlined at each stage, the
+        # kernel's cold compile typed and lowered four copies; called out of line (one compiled
+        # function), its ~130 scalar arguments (arrays pass as their fields) cost 6 % of the
+        # kernel's run at 32 lanes (benchmarks/RESULTS.md, compile2); the same bits either way
+        for st in range(4):
+            if st == 0:   # the derivative at the step start (k1), with T_f and u there for the record
+                for j in range(nr):
+                    for q in range(nl):
+                        V[n + j, q] = R0[j, q]
+                for i in range(n):
+                    for q in range(nl):
+                        V[i, q] = X[i, q]
+                for q in range(nl):
+                    ZT[q] = Z[q]
+            else:
+                if st == 1 or st == 3:
+                    for j in range(nr):
+                        for q in range(nl):
+                            V[n + j, q] = RM[j, q] if st == 1 else R1[j, q]
+                c = dt if st == 3 else h2
+                for i in range(n):
+                    for q in range(nl):
+                        V[i, q] = X[i, q] + c * K[st - 1, i, q]
+                for q in range(nl):
+                    ZT[q] = Z[q] + c * D[st - 1, q]
+            _rates_lanes(ZT, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D[st], K[st])
+            if st == 0:
+                if k % rec_every == 0:
+                    lanes_record(X, Z, TF, U, x_out, aux_out, rec)
+                    rec += 1
+                if k == nsteps:
+                    break
         if k == nsteps:
             break
-        for j in range(nr):
-            for q in range(nl):
-                V[n + j, q] = RM[j, q]
         for i in range(n):
             for q in range(nl):
-                V[i, q] = X[i, q] + h2 * K1[i, q]
+                X[i, q] += dt * (K[0, i, q] + 2.0 * K[1, i, q] + 2.0 * K[2, i, q] + K[3, i, q]) / 6.0
         for q in range(nl):
-            ZT[q] = Z[q] + h2 * D1[q]
-        _rates_lanes(ZT, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D2, K2)
-        for i in range(n):
-            for q in range(nl):
-                V[i, q] = X[i, q] + h2 * K2[i, q]
-        for q in range(nl):
-            ZT[q] = Z[q] + h2 * D2[q]
-        _rates_lanes(ZT, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D3, K3)
-        for j in range(nr):
-            for q in range(nl):
-                V[n + j, q] = R1[j, q]
-        for i in range(n):
-            for q in range(nl):
-                V[i, q] = X[i, q] + dt * K3[i, q]
-        for q in range(nl):
-            ZT[q] = Z[q] + dt * D3[q]
-        _rates_lanes(ZT, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D4, K4)
-        for i in range(n):
-            for q in range(nl):
-                X[i, q] += dt * (K1[i, q] + 2.0 * K2[i, q] + 2.0 * K3[i, q] + K4[i, q]) / 6.0
-        for q in range(nl):
-            Z[q] = Z[q] + dt * (D1[q] + 2.0 * D2[q] + 2.0 * D3[q] + D4[q]) / 6.0
+            Z[q] = Z[q] + dt * (D[0, q] + 2.0 * D[1, q] + 2.0 * D[2, q] + D[3, q]) / 6.0
         alive -= lanes_failed(X, Z, OK, status, k + 1)
         if alive == 0:
             break
