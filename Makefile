@@ -127,8 +127,8 @@ test: $(PYC) $(WARM) browser $(DOCS_STAMP)
 
 # The fast loop while developing: every test except those marked slow (the end-to-end runs: the
 # Green Run report, Monte Carlo campaigns, the installed wheel, time-domain limit cycles, the
-# live viewer), on two processes (pytest-xdist), without the documentation build. Under 3 minutes
-# on 2 cores once the kernel cache is warm (after a source change the warm-up adds about one).
+# live viewer), on two processes (pytest-xdist), without the documentation build. About 5 minutes
+# on 2 cores once the kernel cache is warm (after a kernel-file change the warm-up adds about 30 s).
 check: $(PYC) $(WARM) browser
 	@$(PYTEST) -n 2 --dist worksteal -m "not slow" tests; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "pytest: no tests collected"; rc=0; fi; exit $$rc
