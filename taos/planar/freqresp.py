@@ -297,11 +297,10 @@ def sine_dwell_points(model: TvcModel, amplitudes_rad, freq_hz, axis: str = "pit
         if method == "settle":
             from ._cdwell import dwell_kernels
 
-            ks = dwell_kernels(model)
-        else:
-            from ._expplan import NUMBA as ks_shoot
-        npc = exp_steps_per_cycle(args, model, plant.inertia_kgm2, A, F, dt_max_s, min_steps_per_cycle,
-                                  ks or ks_shoot)
+            ks = plan_ks = dwell_kernels(model)
+        else:   # the shooting runs on numba's kernels, its step plan too
+            from ._expplan import NUMBA as plan_ks
+        npc = exp_steps_per_cycle(args, model, plant.inertia_kgm2, A, F, dt_max_s, min_steps_per_cycle, plan_ks)
     else:
         npc = np.maximum(np.ceil(1.0 / (F * dt_max_s)), min_steps_per_cycle).astype(np.int64)
     nbud = np.maximum(settle_cycles, np.ceil(ts * F)).astype(np.int64)
