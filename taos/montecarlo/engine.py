@@ -216,8 +216,13 @@ def connect(workers: int, scheduler: str | None, timeout_s: float = CONNECT_TIME
     import dask
     from dask.distributed import Client, LocalCluster
     if scheduler is None:
+        # silence_logs: the level of the "distributed" stream handlers, here and in each worker
+        # process (Dask's default prints a worker's errors): CRITICAL, as _quiet_dask_logs, so a
+        # worker whose scheduler closes first (SIGTERM or Ctrl-C mid-campaign) does not print
+        # "Failed to communicate with scheduler during heartbeat" and its traceback beside the
+        # campaign's one line; what goes wrong on a worker reaches the campaign as an exception
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
-                               silence_logs=logging.ERROR)
+                               silence_logs=logging.CRITICAL)
         client = Client(cluster)
         _checked(client, cluster)
         return client, cluster
