@@ -86,13 +86,20 @@ def _dwell(**kw) -> None:
 
 
 def _c_dwells() -> None:
-    """The C dwell libraries of the built-in laws (:mod:`taos.planar._cdwell`; none without a C
-    compiler): built where the cache has none, so a dwell command starts without numba."""
+    """The C dwell library of the built-in laws (:mod:`taos.planar._cdwell`; none without a C
+    compiler): one library for every law (one compile of the code they share), built where the
+    cache has none, so a dwell command starts without numba; if it cannot be built, each law's
+    own (the failure then remembered per law)."""
     from taos.friction._builtin import modules
     from taos.planar import _cdwell
 
     if _cdwell.compiler() is None:
         return
+    try:
+        _cdwell.warm()
+        return
+    except _cdwell.CUnavailable:
+        pass
     for law in modules():
         _cdwell.load(law, retry=True)
 
