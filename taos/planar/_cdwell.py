@@ -106,26 +106,26 @@ def law_module(law: str) -> str:
 
 def cache_key(law: str, cc: str) -> str:
     """SHA-256 naming the library of ``law`` built by ``cc`` on this machine (module docstring)."""
-    h = hashlib.sha256()
-    for rel in SOURCES + (law_module(law),):
-        h.update(rel.encode() + b"\0" + (ROOT / rel).read_bytes() + b"\0")
-    exe = Path(shutil.which(cc) or cc).resolve()
-    st = exe.stat()
-    for part in (law, str(exe), str(st.st_size), str(st.st_mtime_ns), " ".join(CFLAGS), platform.machine(), _cpu(),
-                 "%d.%d" % sys.version_info[:2]):
-        h.update(part.encode() + b"\0")
-    return h.hexdigest()[:32]
+    return _key((law,), law, cc)
 
 
 def cache_key_all(cc: str) -> str:
-    """SHA-256 naming the library of every built-in law (:func:`build_all`) built by ``cc``: the
-    laws' names and each law's :func:`cache_key` (its sources, the compiler, the flags, the
-    machine)."""
+    """SHA-256 naming the library of every built-in law (:func:`build_all`) built by ``cc``: as
+    :func:`cache_key`, over every law's name and module."""
     from ..friction._builtin import modules
 
-    h = hashlib.sha256(b"all\0")
-    for law in sorted(modules()):
-        h.update(law.encode() + b"\0" + cache_key(law, cc).encode() + b"\0")
+    return _key(tuple(sorted(modules())), "all", cc)
+
+
+def _key(laws: tuple[str, ...], name: str, cc: str) -> str:
+    h = hashlib.sha256()
+    for rel in SOURCES + tuple(dict.fromkeys(law_module(law) for law in laws)):
+        h.update(rel.encode() + b"\0" + (ROOT / rel).read_bytes() + b"\0")
+    exe = Path(shutil.which(cc) or cc).resolve()
+    st = exe.stat()
+    for part in (name, *(laws if len(laws) > 1 else ()), str(exe), str(st.st_size), str(st.st_mtime_ns),
+                 " ".join(CFLAGS), platform.machine(), _cpu(), "%d.%d" % sys.version_info[:2]):
+        h.update(part.encode() + b"\0")
     return h.hexdigest()[:32]
 
 
