@@ -26,10 +26,11 @@ that callee too, so the steps sharing such callees form one group and a group is
   ``planar._expstep`` (``etdrk4_step``, ``_nonlin``, ``sine_steps_exp``);
 * ``3d``: the 3-D model's kernels share ``taos3d.dynamics`` (with its pieces ``taos3d._rhs``,
   ``taos3d._commands``, ``taos3d._so3``) and ``taos3d._bearing``;
-* ``friction``: every built-in law's C callbacks, the lane forms included (``friction.registry.load_all``);
-* ``cdwell``: not numba's: the dwell kernels translated to C and compiled once per built-in law
-  (:mod:`taos.planar._cdwell`, its own cache), which ``taos freqresp``'s dwells load instead of
-  numba's; building one imports the law's C callbacks (the same key as ``friction``'s).
+* ``friction``: every built-in law's C callbacks, the lane forms included (``friction.registry.load_all``),
+  and the C dwells (not numba's: the dwell kernels translated to C and compiled into one library
+  for every built-in law, :mod:`taos.planar._cdwell`, its own cache, which ``taos freqresp``'s
+  dwells load instead of numba's): building it imports every law's C callbacks, the friction
+  step's kernels, so both steps stay in one share and the callbacks compile once.
 * ``masv``: masv's lane kernel (``masv._kernel.integrate``, one compile for any number of engines
   and laws), whose inlined limits come from ``planar.saturation``.
 
@@ -86,13 +87,20 @@ def _dwell(**kw) -> None:
 
 
 def _c_dwells() -> None:
-    """The C dwell libraries of the built-in laws (:mod:`taos.planar._cdwell`; none without a C
-    compiler): built where the cache has none, so a dwell command starts without numba."""
+    """The C dwell library of the built-in laws (:mod:`taos.planar._cdwell`; none without a C
+    compiler): one library for every law (one compile of the code they share), built where the
+    cache has none, so a dwell command starts without numba; if it cannot be built, each law's
+    own (the failure then remembered per law)."""
     from taos.friction._builtin import modules
     from taos.planar import _cdwell
 
     if _cdwell.compiler() is None:
         return
+    try:
+        _cdwell.warm()
+        return
+    except _cdwell.CUnavailable:
+        pass
     for law in modules():
         _cdwell.load(law, retry=True)
 
@@ -188,15 +196,17 @@ class Step:
 
 STEPS: tuple[Step, ...] = (
     # the planar steps' costs: the previous quiet-machine figures times each step's measured
-    # after/before ratio (issue 44 point 1, benchmarks/RESULTS.md "planar kernels' cold compile")
-    Step("simulate", "planar", _simulate, 7.6),
+    # after/before ratio (issue 44 point 1, benchmarks/RESULTS.md "planar kernels' cold compile"),
+    # and since for simulate, dwell rk4, shoot (the RK4 step's stages through one copy of its
+    # rates) and the C dwells (one library for every law): benchmarks/RESULTS.md "stage4"
+    Step("simulate", "planar", _simulate, 6.4),
     Step("simulate exponential", "planar", _simulate_exp, 7.0),
     Step("dwell exponential", "planar", _dwell, 6.6),
-    Step("dwell rk4", "planar", lambda: _dwell(integrator="rk4"), 4.7),
-    Step("shoot", "planar", _shoot, 14.4),
+    Step("dwell rk4", "planar", lambda: _dwell(integrator="rk4"), 3.9),
+    Step("shoot", "planar", _shoot, 12.8),
     Step("lco confirmation", "planar", _lco_confirm, 0.1),
     Step("friction laws", "friction", _friction, 4.7),
-    Step("C dwells", "cdwell", _c_dwells, 6.0),
+    Step("C dwells", "friction", _c_dwells, 4.9),
     # (+ 6.5 s: the ETDRK4 lanes, benchmarks/RESULTS.md mcexp; - 8.6 s: the RK4 lanes' four stages
     # through one inlined copy of their rates, compile2)
     Step("ascent lanes", "lanes", _ascent_lanes, 14.2),

@@ -120,24 +120,42 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
     step start).
 
     Compiled once, not inlined: :func:`integrate_samples`, :func:`sine_steps` and the shooting
-    periods (:mod:`taos.planar.steady`) call this one compiled step (inlined, each caller paid
-    for typing and lowering four copies of :func:`_rates` again). :func:`_rates` stays inlined
-    here: called out of line, its ~110 scalar arguments (arrays pass as their fields) cost 30 %
-    of the warm step."""
+    periods (:mod:`taos.planar.steady`) call this one step. :func:`_rates` stays inlined (called
+    out of line, its ~110 scalar arguments cost 30 % of the warm step), ONCE: the four stages are
+    a loop choosing the stage's state, input, coefficient and derivative array, as
+    :func:`integrate_segments_lanes` (inlined at each stage, numba typed and LLVM optimised four
+    copies). Each stage's arithmetic is the classical step's, operation for operation; z's
+    increment is summed in the order the four-copy step's compile gave it (the same bits:
+    benchmarks/planar_step_bits.py, benchmarks/RESULTS.md "stage4")."""
     n = x.shape[0]
-    dz1, tf, u = _rates(x, z, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k1)
-    for i in range(n):
-        xt[i] = x[i] + 0.5 * dt * k1[i]
-    dz2, _, _ = _rates(xt, z + 0.5 * dt * dz1, rm, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k2)
-    for i in range(n):
-        xt[i] = x[i] + 0.5 * dt * k2[i]
-    dz3, _, _ = _rates(xt, z + 0.5 * dt * dz2, rm, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k3)
-    for i in range(n):
-        xt[i] = x[i] + dt * k3[i]
-    dz4, _, _ = _rates(xt, z + dt * dz3, r1, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k4)
+    h2 = 0.5 * dt
+    dz1, dz2, dz3, dzs, tf, u = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    xs, zs, rs, ks = x, z, r0, k1   # stage 1: the derivative at the step start (k1), T_f and u there
+    for st in range(4):
+        if st > 0:  # stages 2-4: x + c k_prev, z + c dz_prev at the middle (c = dt/2) or end (c = dt)
+            c, kp, dzp, ks, rs = h2, k1, dz1, k2, rm
+            if st == 2:
+                kp, dzp, ks = k2, dz2, k3
+            elif st == 3:
+                c, kp, dzp, ks, rs = dt, k3, dz3, k4, r1
+            for i in range(n):
+                xt[i] = x[i] + c * kp[i]
+            xs, zs = xt, z + c * dzp
+        dz, tfs, us = _rates(xs, zs, rs, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, ks)
+        if st == 0:
+            dz1, tf, u = dz, tfs, us
+        elif st == 1:
+            dz2 = dz
+        elif st == 2:
+            dz3 = dz
+            dzs = 2.0 * (dz3 + dz2) + dz1
+        else:
+            dzs = dzs + dz
     for i in range(n):
         x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
-    z = z + dt * (dz1 + 2.0 * dz2 + 2.0 * dz3 + dz4) / 6.0
+    # z's increment (dz1 + 2 dz2 + 2 dz3 + dz4) dt / 6 [rad] as (2 (dz3 + dz2) + dz1) + dz4: the order
+    # LLVM's reassociation ("reassoc") gave the four-copy step; the loop's phis would get another
+    z = z + dt * dzs / 6.0
     return z, tf, u
 
 
