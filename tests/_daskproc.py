@@ -76,3 +76,28 @@ def communicate(p, timeout: float) -> tuple[str, str]:
     p.stdout.close()
     p.stderr.close()
     return got["stdout"], got["stderr"]
+
+
+def wait_stored(count, status_dir, n: int, running=lambda: True, timeout_s: float = 240.0,
+                poll_s: float = 0.05, recount_s: float = 1.0) -> int:
+    """Until ``count()`` (the runs or points a store holds) reaches ``n``, ``running()`` turns
+    false or ``timeout_s`` s pass; returns the last count. Polled every ``poll_s`` s, as the
+    tests did, but ``count()`` (opening the store: ~10 ms of CPU) is called only when the
+    modification time of ``status_dir`` (the store's ``status`` array folder: every batch write
+    replaces its chunk file there, Zarr's atomic rename) changed, or ``recount_s`` s after the
+    last count (a change within one tick of the file system's clock)."""
+    import time
+
+    deadline = time.monotonic() + timeout_s
+    seen, last_t, done = None, -float("inf"), 0
+    while True:
+        try:
+            stamp = os.stat(status_dir).st_mtime_ns
+        except OSError:
+            stamp = None
+        now = time.monotonic()
+        if stamp != seen or now - last_t >= recount_s:
+            seen, last_t, done = stamp, now, count()
+        if done >= n or not running() or now > deadline:
+            return done
+        time.sleep(poll_s)

@@ -235,9 +235,7 @@ def test_killing_a_worker_loses_no_run(isolated, reference, tmp_path):
         th.start()
         # (not this process's default client: the campaign's own client, in the thread, is)
         with Client(addr, timeout="10s", set_as_default=False) as c:
-            deadline = time.time() + 180
-            while _stored(out) < 4 and time.time() < deadline:
-                time.sleep(0.05)
+            _daskproc.wait_stored(lambda: _stored(out), out / "campaign.zarr" / "status", 4, timeout_s=180)
             who = {w: i["name"] for w, i in c.scheduler_info(n_workers=-1)["workers"].items()}
             running = [t for w, ts in c.processing().items() if who.get(w) == "victim" for t in ts]
             victim.kill()
@@ -260,9 +258,8 @@ def test_killed_client_resumes_to_the_same_store(isolated, reference, tmp_path):
     out = tmp_path / "resume"
     p = _forkserver.popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
                            "--batch", "2", "--out", str(out), "--no-progress"], ROOT)
-    deadline = time.time() + 180
-    while _stored(out) < 5 and time.time() < deadline and p.poll() is None:
-        time.sleep(0.05)
+    _daskproc.wait_stored(lambda: _stored(out), out / "campaign.zarr" / "status", 5, lambda: p.poll() is None,
+                          timeout_s=180)
     p.kill()
     p.wait()
     done = _stored(out)

@@ -373,9 +373,7 @@ def test_a_worker_running_other_taos_code_is_refused_naming_both(tmp_path, capsy
 
 def _when_stored(path: Path, n: int, then, timeout_s: float = 120) -> threading.Thread:
     def go():
-        deadline = time.time() + timeout_s
-        while _stored(path) < n and time.time() < deadline:
-            time.sleep(0.05)
+        _daskproc.wait_stored(lambda: _stored(path), path / "status", n, timeout_s=timeout_s)
         then()
     th = threading.Thread(target=go, daemon=True)
     th.start()
@@ -456,9 +454,8 @@ def test_scheduler_loss_is_one_line_with_the_runs_kept_and_the_resume_line(tmp_p
     try:
         p = _forkserver.popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", "10", "--scheduler", addr,
                                "--batch", "2", "--connect-timeout", "3", "--out", str(out), "--no-progress"], ROOT)
-        deadline = time.time() + 240
-        while _stored(out / "campaign.zarr") < 4 and time.time() < deadline and p.poll() is None:
-            time.sleep(0.05)
+        _daskproc.wait_stored(lambda: _stored(out / "campaign.zarr"), out / "campaign.zarr" / "status", 4,
+                              lambda: p.poll() is None)
         sched.kill()
         _, err = _daskproc.communicate(p, 120)
     finally:
@@ -485,9 +482,8 @@ def test_sigterm_says_how_many_runs_are_kept_and_how_to_resume(tmp_path):
     out = tmp_path / "mc"
     p = _forkserver.popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", "8", "--workers", "1", "--batch", "2",
                            "--out", str(out), "--no-progress"], ROOT)
-    deadline = time.time() + 240
-    while _stored(out / "campaign.zarr") < 2 and time.time() < deadline and p.poll() is None:
-        time.sleep(0.05)
+    _daskproc.wait_stored(lambda: _stored(out / "campaign.zarr"), out / "campaign.zarr" / "status", 2,
+                          lambda: p.poll() is None)
     p.send_signal(signal.SIGTERM)
     _, err = _daskproc.communicate(p, 120)
     assert p.returncode == 143, err

@@ -13,7 +13,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 import tomllib
 from pathlib import Path
 
@@ -176,9 +175,8 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
     exe = Path(sys.executable).parent / "taos"
     out = tmp_path / "run"
     p = _forkserver.popen([str(exe), *map(str, args), "--out", str(out)], ROOT)
-    t0 = time.monotonic()
-    while _store_done(out / "sweep.zarr") < 3 and p.poll() is None and time.monotonic() - t0 < 240:
-        time.sleep(0.05)
+    _daskproc.wait_stored(lambda: _store_done(out / "sweep.zarr"), out / "sweep.zarr" / "status", 3,
+                          lambda: p.poll() is None)
     p.send_signal(signal.SIGINT)
     _, err = _daskproc.communicate(p, 120)
     assert p.returncode == 130 and "Traceback" not in err, err

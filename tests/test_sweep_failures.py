@@ -11,9 +11,7 @@ import json
 import re
 import shlex
 import signal
-import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -48,9 +46,7 @@ def _start(args, out: Path, *extra):
 
 def _wait_stored(p, spath: Path, n: int) -> None:
     """Until the store holds ``n`` points (polled, never a guess of the batches' timing)."""
-    deadline = time.time() + 240
-    while _stored(spath) < n and time.time() < deadline and p.poll() is None:
-        time.sleep(0.05)
+    _daskproc.wait_stored(lambda: _stored(spath), spath / "status", n, lambda: p.poll() is None)
     assert p.poll() is None, "the run ended before the store held its first points"
 
 
