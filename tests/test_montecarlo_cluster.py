@@ -22,6 +22,7 @@ from taos.montecarlo import Design, Ishigami, load_campaign, open_store, run_cam
 from taos.montecarlo import sensitivity as sens
 from taos.montecarlo import store
 
+from tests import _daskproc, _forkserver
 from tests.test_montecarlo import ROOT, SHORT, copy_inputs, stats
 
 pytestmark = pytest.mark.slow
@@ -56,17 +57,16 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def start_worker(tmp: Path, addr: str, deny: list[Path], name: str | None = None) -> subprocess.Popen:
+def start_worker(tmp: Path, addr: str, deny: list[Path], name: str | None = None):
     """A one-thread worker process (no nanny) of the scheduler at ``addr``, run in ``tmp/cwd``,
-    that cannot open anything under ``deny``."""
+    that cannot open anything under ``deny`` (``dask worker``, :mod:`tests._daskproc`)."""
     cwd = tmp / "cwd"
     cwd.mkdir(exist_ok=True)
     (tmp / "deny_preload.py").write_text(DENY)
-    env = dict(os.environ, TAOS_TEST_DENY=os.pathsep.join(str(d.resolve()) for d in deny))
-    return subprocess.Popen([str(BIN / "dask"), "worker", addr, "--nthreads", "1", "--nworkers", "1",
-                             "--no-dashboard", "--no-nanny", "--host", "127.0.0.1",
-                             "--preload", str(tmp / "deny_preload.py"), *(["--name", name] if name else [])],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=cwd)
+    env = {"TAOS_TEST_DENY": os.pathsep.join(str(d.resolve()) for d in deny)}
+    return _daskproc.start("worker", [addr, "--nthreads", "1", "--nworkers", "1", "--no-dashboard", "--no-nanny",
+                                      "--host", "127.0.0.1", "--preload", str(tmp / "deny_preload.py"),
+                                      *(["--name", name] if name else [])], cwd=cwd, env=env)
 
 
 def wait_for_workers(addr: str, n: int, procs) -> None:
@@ -90,8 +90,7 @@ def start_cluster(tmp: Path, deny: list[Path], n: int = 2):
     run in ``tmp/cwd`` and cannot open anything under ``deny``."""
     port = _free_port()
     addr = f"tcp://127.0.0.1:{port}"
-    sched = subprocess.Popen([str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port),
-                              "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    sched = _daskproc.start("scheduler", ["--host", "127.0.0.1", "--port", str(port), "--no-dashboard"])
     workers = [start_worker(tmp, addr, deny) for _ in range(n)]
     wait_for_workers(addr, n, [sched, *workers])
     return addr, sched, workers
@@ -236,9 +235,7 @@ def test_killing_a_worker_loses_no_run(isolated, reference, tmp_path):
         th.start()
         # (not this process's default client: the campaign's own client, in the thread, is)
         with Client(addr, timeout="10s", set_as_default=False) as c:
-            deadline = time.time() + 180
-            while _stored(out) < 4 and time.time() < deadline:
-                time.sleep(0.05)
+            _daskproc.wait_stored(lambda: _stored(out), out / "campaign.zarr" / "status", 4, timeout_s=180)
             who = {w: i["name"] for w, i in c.scheduler_info(n_workers=-1)["workers"].items()}
             running = [t for w, ts in c.processing().items() if who.get(w) == "victim" for t in ts]
             victim.kill()
@@ -259,12 +256,10 @@ def test_killed_client_resumes_to_the_same_store(isolated, reference, tmp_path):
     after SIGTERM, :func:`stop_cluster`.)"""
     addr, _, _ = isolated
     out = tmp_path / "resume"
-    p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
-                          "--batch", "2", "--out", str(out), "--no-progress"],
-                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.time() + 180
-    while _stored(out) < 5 and time.time() < deadline and p.poll() is None:
-        time.sleep(0.05)
+    p = _forkserver.popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", str(RUNS), "--scheduler", addr,
+                           "--batch", "2", "--out", str(out), "--no-progress"], ROOT)
+    _daskproc.wait_stored(lambda: _stored(out), out / "campaign.zarr" / "status", 5, lambda: p.poll() is None,
+                          timeout_s=180)
     p.kill()
     p.wait()
     done = _stored(out)

@@ -33,6 +33,7 @@ from taos.montecarlo import sensitivity as sens
 from taos.montecarlo.run import FLAGS, SCALARS
 from taos.montecarlo.stats import spearman, spearman_exact_p, summarise
 
+from tests import _daskproc, _forkserver
 from tests.test_montecarlo import ROOT, SHORT
 
 BIN = Path(sys.executable).parent
@@ -81,15 +82,19 @@ def _stop(procs) -> None:
 
 
 def _scheduler(tmp: Path, env=None, workers: int = 1, scheduler_file: Path | None = None):
-    """A scheduler and one-thread workers (no nanny) as processes on loopback."""
+    """A scheduler and one-thread workers (no nanny) as processes on loopback (``dask scheduler``
+    and ``dask worker``: :mod:`tests._daskproc`; workers with their own ``env``, which a worker's
+    interpreter reads at its start, e.g. ``PYTHONPATH``, as new processes of that environment)."""
     port = _free_port()
     addr = f"tcp://127.0.0.1:{port}"
-    cmd = [str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"]
-    sched = subprocess.Popen(cmd + (["--scheduler-file", str(scheduler_file)] if scheduler_file else []),
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    ws = [subprocess.Popen([str(BIN / "dask"), "worker", addr, "--nthreads", "1", "--no-dashboard", "--no-nanny",
-                            "--host", "127.0.0.1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                           env=env or dict(os.environ), cwd=tmp) for _ in range(workers)]
+    sched = _daskproc.start("scheduler", ["--host", "127.0.0.1", "--port", str(port), "--no-dashboard",
+                                          *(["--scheduler-file", str(scheduler_file)] if scheduler_file else [])])
+    wargs = [addr, "--nthreads", "1", "--no-dashboard", "--no-nanny", "--host", "127.0.0.1"]
+    if env is None:
+        ws = [_daskproc.start("worker", wargs, cwd=tmp) for _ in range(workers)]
+    else:
+        ws = [subprocess.Popen([str(BIN / "dask"), "worker", *wargs], stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL, env=env, cwd=tmp) for _ in range(workers)]
     from dask.distributed import Client
     deadline = time.time() + 90
     while True:
@@ -368,9 +373,7 @@ def test_a_worker_running_other_taos_code_is_refused_naming_both(tmp_path, capsy
 
 def _when_stored(path: Path, n: int, then, timeout_s: float = 120) -> threading.Thread:
     def go():
-        deadline = time.time() + timeout_s
-        while _stored(path) < n and time.time() < deadline:
-            time.sleep(0.05)
+        _daskproc.wait_stored(lambda: _stored(path), path / "status", n, timeout_s=timeout_s)
         then()
     th = threading.Thread(target=go, daemon=True)
     th.start()
@@ -415,7 +418,8 @@ def test_a_batch_that_kills_its_workers_stops_the_campaign_with_the_runs_kept(tm
     from dask.distributed import LocalCluster
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
     p, flag = tmp_path / "s.zarr", tmp_path / "kill"
-    try:
+    env = dict(os.environ)   # (the nanny sets its workers' OMP_NUM_THREADS, ... here: put back below, so
+    try:                     # that the fork server's commands after this test need no new zygote)
         with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
             with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
                 _when_stored(p, 4, flag.touch)   # from the 3rd stored batch on, every batch kills its worker
@@ -424,6 +428,8 @@ def test_a_batch_that_kills_its_workers_stops_the_campaign_with_the_runs_kept(tm
                                scheduler=cluster.scheduler_address, batch=2)
     finally:
         cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
+        os.environ.clear()
+        os.environ.update(env)
     assert "workers died running the batch at run" in str(e.value) and "\n" not in str(e.value)
     st = store.status(p)   # (a batch finished but not yet fetched when its worker died is lost with it)
     assert 4 <= (st == store.STATUS["ok"]).sum() < 24
@@ -446,14 +452,12 @@ def test_scheduler_loss_is_one_line_with_the_runs_kept_and_the_resume_line(tmp_p
     addr, sched, ws = _scheduler(tmp_path, workers=1)
     out = tmp_path / "mc"
     try:
-        p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", "10", "--scheduler", addr,
-                              "--batch", "2", "--connect-timeout", "3", "--out", str(out), "--no-progress"],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        deadline = time.time() + 240
-        while _stored(out / "campaign.zarr") < 4 and time.time() < deadline and p.poll() is None:
-            time.sleep(0.05)
+        p = _forkserver.popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", "10", "--scheduler", addr,
+                               "--batch", "2", "--connect-timeout", "3", "--out", str(out), "--no-progress"], ROOT)
+        _daskproc.wait_stored(lambda: _stored(out / "campaign.zarr"), out / "campaign.zarr" / "status", 4,
+                              lambda: p.poll() is None)
         sched.kill()
-        _, err = p.communicate(timeout=120)
+        _, err = _daskproc.communicate(p, 120)
     finally:
         _stop([*ws, sched])
     assert p.returncode == 2, err
@@ -476,13 +480,12 @@ def test_sigterm_says_how_many_runs_are_kept_and_how_to_resume(tmp_path):
     many runs the store keeps and the resume command (not "no partial output written"); the
     resume command finishes the campaign."""
     out = tmp_path / "mc"
-    p = subprocess.Popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", "8", "--workers", "1", "--batch", "2",
-                          "--out", str(out), "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.time() + 240
-    while _stored(out / "campaign.zarr") < 2 and time.time() < deadline and p.poll() is None:
-        time.sleep(0.05)
+    p = _forkserver.popen([str(BIN / "taos"), "montecarlo", str(SHORT), "--runs", "8", "--workers", "1", "--batch", "2",
+                           "--out", str(out), "--no-progress"], ROOT)
+    _daskproc.wait_stored(lambda: _stored(out / "campaign.zarr"), out / "campaign.zarr" / "status", 2,
+                          lambda: p.poll() is None)
     p.send_signal(signal.SIGTERM)
-    _, err = p.communicate(timeout=120)
+    _, err = _daskproc.communicate(p, 120)
     assert p.returncode == 143, err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("taos: terminated (signal 15); "), err

@@ -13,14 +13,14 @@ import os
 import signal
 import subprocess
 import sys
-import time
 import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.conftest import MODELS, inline_actuator_set, run_cli
+from tests import _daskproc, _forkserver
+from tests.conftest import MODELS, ROOT, inline_actuator_set, run_cli
 from tests.inprocess import taos_json
 
 AMBIENT = MODELS / "rs25_ambient.toml"
@@ -174,13 +174,11 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path):
             "phase_margin_deg,lab_peaking_db,load_mode_hz", "--batch", "1"]
     exe = Path(sys.executable).parent / "taos"
     out = tmp_path / "run"
-    p = subprocess.Popen([str(exe), *map(str, args), "--out", str(out)], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
-    t0 = time.monotonic()
-    while _store_done(out / "sweep.zarr") < 3 and p.poll() is None and time.monotonic() - t0 < 240:
-        time.sleep(0.05)
+    p = _forkserver.popen([str(exe), *map(str, args), "--out", str(out)], ROOT)
+    _daskproc.wait_stored(lambda: _store_done(out / "sweep.zarr"), out / "sweep.zarr" / "status", 3,
+                          lambda: p.poll() is None)
     p.send_signal(signal.SIGINT)
-    _, err = p.communicate(timeout=120)
+    _, err = _daskproc.communicate(p, 120)
     assert p.returncode == 130 and "Traceback" not in err, err
     done = _store_done(out / "sweep.zarr")
     assert 3 <= done < 24
@@ -230,7 +228,6 @@ def test_ctrl_c_inside_a_store_write_exits_with_one_line_and_a_readable_store(tm
     from a write the interpreter's exit cut short), the store still readable, and the cut batch
     still pending, so a resume runs it again."""
     from taos.montecarlo import store
-    from tests import _forkserver
 
     path = tmp_path / "s.zarr"
     r = _forkserver.run([sys.executable, "-c", _CUT_WRITE, path], tmp_path, timeout=120)

@@ -11,9 +11,7 @@ import json
 import re
 import shlex
 import signal
-import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +20,7 @@ import pytest
 from taos.cli import main
 from taos.montecarlo import store
 
+from tests import _daskproc, _forkserver
 from tests.conftest import MODELS, ROOT, run_cli
 from tests.test_montecarlo_failures import _free_port, _scheduler, _stop, _stored
 
@@ -40,15 +39,14 @@ N_LCO = 4
 
 
 def _start(args, out: Path, *extra):
-    return subprocess.Popen([str(BIN / "taos"), *args, *extra, "--out", str(out)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    """``taos ARGS EXTRA --out OUT`` started (``Popen``'s text pipes; the fork server's child
+    where it can: :func:`tests._forkserver.popen`)."""
+    return _forkserver.popen([str(BIN / "taos"), *map(str, args), *map(str, extra), "--out", str(out)], ROOT)
 
 
 def _wait_stored(p, spath: Path, n: int) -> None:
     """Until the store holds ``n`` points (polled, never a guess of the batches' timing)."""
-    deadline = time.time() + 240
-    while _stored(spath) < n and time.time() < deadline and p.poll() is None:
-        time.sleep(0.05)
+    _daskproc.wait_stored(lambda: _stored(spath), spath / "status", n, lambda: p.poll() is None)
     assert p.poll() is None, "the run ended before the store held its first points"
 
 
@@ -94,12 +92,12 @@ def test_sweep_sigterm_keeps_the_store_and_its_resume_line_finishes_it(tmp_path,
     p = _start(SWEEP, out)
     _wait_stored(p, out / "sweep.zarr", 2)
     p.send_signal(signal.SIGTERM)
-    _, err = p.communicate(timeout=120)
+    _, err = _daskproc.communicate(p, 120)
     assert p.returncode == 143, err
     line = _kept_line(err, "taos: terminated (signal 15); ", out / "sweep.zarr", "points", N_SWEEP)
     done = _stored(out / "sweep.zarr")
     argv = _resume_line_json(line, "sweep", tmp_path / "resumed.json")
-    r = subprocess.run(argv, capture_output=True, text=True, cwd=ROOT)
+    r = _forkserver.run(argv, ROOT, 600)
     assert r.returncode == 0, r.stderr
     assert json.loads((tmp_path / "resumed.json").read_text())["timing"]["points_executed"] == N_SWEEP - done
     _same_store(out / "sweep.zarr", fresh_sweep, ("phase_margin_deg", "lab_peaking_db", "load_mode_hz"))
@@ -119,12 +117,12 @@ def test_lco_map_sigterm_keeps_the_store_and_its_resume_line_finishes_it(tmp_pat
     p = _start(LCO, out, "--workers", "1")
     _wait_stored(p, out / "map.zarr", 1)
     p.send_signal(signal.SIGTERM)
-    _, err = p.communicate(timeout=120)
+    _, err = _daskproc.communicate(p, 120)
     assert p.returncode == 143, err
     line = _kept_line(err, "taos: terminated (signal 15); ", out / "map.zarr", "points", N_LCO)
     argv = _resume_argv(line, "lco")
     assert argv[argv.index("--out") + 1] == str(out) and argv[argv.index("--workers") + 1] == "1"
-    r = subprocess.run([str(BIN / "taos"), *argv[1:]], capture_output=True, text=True, cwd=ROOT)
+    r = _forkserver.run([str(BIN / "taos"), *argv[1:]], ROOT, 600)
     assert r.returncode == 0, r.stderr
     assert _stored(out / "map.zarr") == N_LCO
     fresh = tmp_path / "fresh"
@@ -145,7 +143,7 @@ def test_sweep_scheduler_loss_is_one_line_with_the_points_kept_and_the_resume_li
         p = _start(SWEEP, out, "--scheduler", addr, "--connect-timeout", "3")
         _wait_stored(p, out / "sweep.zarr", 3)
         sched.kill()
-        _, err = p.communicate(timeout=120)
+        _, err = _daskproc.communicate(p, 120)
     finally:
         _stop([*ws, sched])
     assert p.returncode == 2, err
@@ -154,7 +152,7 @@ def test_sweep_scheduler_loss_is_one_line_with_the_points_kept_and_the_resume_li
     argv = _resume_argv(line, "sweep")
     assert argv[argv.index("--scheduler") + 1] == addr
     del argv[argv.index("--scheduler"):argv.index("--scheduler") + 2]   # this process instead (not bound)
-    r = subprocess.run([str(BIN / "taos"), *argv[1:]], capture_output=True, text=True, cwd=ROOT)
+    r = _forkserver.run([str(BIN / "taos"), *argv[1:]], ROOT, 600)
     assert r.returncode == 0, r.stderr
     _same_store(out / "sweep.zarr", fresh_sweep, ("phase_margin_deg", "lab_peaking_db", "load_mode_hz"))
 
