@@ -391,6 +391,8 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
         times the start value). The result reports them and flags any value that ends on one.
     """
     check_fit_args(**{k: v for k, v in locals().items() if k not in ("problem", "problems")})   # before any work
+    if problems is not None and not isinstance(problems, dict):
+        raise InputError("argument", "problems", "None or a dict kept between fits", got=repr(problems)[:40])
     t0 = time.perf_counter()
     data = tuple(data)
     free = tuple(free)
