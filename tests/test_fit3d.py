@@ -14,7 +14,6 @@ import pytest
 from taos.errors import InputError
 from tests._records3d import IN_LBF, LBF_PER_IN, ROOT, write_record3d
 from tests.conftest import run_cli
-from tests.inprocess import taos_main
 
 HOT = ROOT / "models" / "rs25_hotfire.toml"
 TRUE_KL, TRUE_TC = 180000.0 * LBF_PER_IN, 100000.0 * IN_LBF
@@ -101,9 +100,9 @@ def test_cli_fit_engine_taos(record, tmp_path):
     from taos.taos3d import taos_model
 
     j, m = tmp_path / "fit.json", tmp_path / "fit.toml"
-    # the fit's files in this process (tests.inprocess); the refusal below through the console script
-    assert taos_main("fit", record[0], "--engine", "taos", "--model", HOT, "--free", "load_stiffness,coulomb_torque",
-                     "--start", "load_stiffness=150000 lbf/in", "--json", j, "--out-model", m) == 0
+    r = run_cli("fit", record[0], "--engine", "taos", "--model", HOT, "--free", "load_stiffness,coulomb_torque",
+                "--start", "load_stiffness=150000 lbf/in", "--json", j, "--out-model", m, timeout=600)
+    assert r.returncode == 0, r.stderr
     d = json.loads(j.read_text())
     for k in ("engine", "parameters", "adequacy", "identifiable", "global_stage", "runs_3d", "provenance", "solver",
               "line_load_stiffness_N_per_m", "fitted_model_file"):
@@ -123,8 +122,9 @@ def test_cli_fit_engine_taos(record, tmp_path):
 @pytest.mark.slow
 def test_cli_compare_engine_taos(hot3d, record, tmp_path):
     out = tmp_path / "cmp"
-    assert taos_main("compare", "--engine", "taos", HOT, HOT, "--data", record[0], record[0], "--labels", "a,b",
-                     "--free", "load_stiffness,coulomb_torque", "--out", out) == 0   # in this process: its files
+    r = run_cli("compare", "--engine", "taos", HOT, HOT, "--data", record[0], record[0], "--labels", "a,b",
+                "--free", "load_stiffness,coulomb_torque", "--out", out, timeout=900)
+    assert r.returncode == 0, r.stderr
     d = json.loads((out / "comparison.json").read_text())
     assert (out / "figure11.png").stat().st_size > 10000 and (out / "table.txt").is_file()
     assert d["engine"] == "taos" and len(d["conditions"]) == 2
