@@ -398,10 +398,13 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
     free = tuple(free)
     m0 = _apply(model, list((start or {}).keys()), list((start or {}).values()))
     axes, f, A, hx, he, wx, we = _stack_points(data, use_engine, min_coherence, sigma_floor)
-    key = (m0.sha256, free, repr(bounds), str(axes.dtype), axes.tobytes(), f.tobytes(), A.tobytes())
-    prob = problem or (problems or {}).get(key) or FitProblem(m0, free, axes, f, A, bounds)
-    if problems is not None and problem is None:
-        problems.setdefault(key, prob)
+    prob = problem
+    if prob is None and problems is not None:   # the caller's problems, by content and point layout
+        key = (m0.sha256, free, repr(bounds), str(axes.dtype), axes.tobytes(), f.tobytes(), A.tobytes())
+        if key not in problems:
+            problems[key] = FitProblem(m0, free, axes, f, A, bounds)
+        prob = problems[key]
+    prob = prob or FitProblem(m0, free, axes, f, A, bounds)
     P = _pack(hx, he, wx, we)
     npar = len(free)
     grid = grid_search(prob, hx, he, wx, we, keep=max(1, starts)) if global_stage else None
