@@ -46,6 +46,16 @@ def dahl():
     return _Dahl()
 
 
+@pytest.fixture(scope="module")
+def soft_confirmed(dahl):
+    """The soft loop's start on the predicted cycle and its confirmation (the reference of both
+    confirmation tests below: the same run on the same inputs, made once for the module)."""
+    fl, m, plant, df, pred = dahl["soft"]
+    c = pred.stable_cycle
+    s = periodic_start(plant, m, df, c.amplitude_rad, c.freq_hz, "predicted cycle")
+    return s, confirm(plant, m, s)
+
+
 def test_start_is_the_harmonic_balance_state_of_the_whole_loop(dahl):
     """The start solves the plant's linear block for the avionics and friction fundamentals that
     give the describing function's engine and piston phasors; the FCS command it then carries,
@@ -62,7 +72,7 @@ def test_start_is_the_harmonic_balance_state_of_the_whole_loop(dahl):
 
 
 @pytest.mark.slow
-def test_confirmation_from_the_predicted_cycle_agrees_with_the_run_from_rest(dahl):
+def test_confirmation_from_the_predicted_cycle_agrees_with_the_run_from_rest(dahl, soft_confirmed):
     """Soft: the run started on the predicted cycle settles within 2 % in command and engine
     amplitude and 1 % in frequency of the 300 s run from rest (achieved 0.4 %, 0.5 %, 0.1 %) in
     at most a third of its simulated time; its first cycle is already within 5 % of its last (a
@@ -72,13 +82,13 @@ def test_confirmation_from_the_predicted_cycle_agrees_with_the_run_from_rest(dah
         fl, m, plant, df, pred = dahl[name]
         c = pred.stable_cycle
         if name == "soft":
-            s = periodic_start(plant, m, df, c.amplitude_rad, c.freq_hz, "predicted cycle")
+            s, r = soft_confirmed
         else:
             from taos.flight.lco_verdict import nearest_margin
             assert c is None
             near = nearest_margin(pred)
             s = periodic_start(plant, m, df, near.amplitude_rad, near.freq_hz, "nearest margin")
-        r = confirm(plant, m, s)
+            r = confirm(plant, m, s)
         ref = measure_oscillation(simulate_flight(fl, m, 300.0), 120.0)
         print(name, r.outcome, r.simulated_s, np.degrees(r.cycle_amplitudes_rad), ref)
         assert r.lco == ref.lco == (name == "soft")
@@ -94,13 +104,13 @@ def test_confirmation_from_the_predicted_cycle_agrees_with_the_run_from_rest(dah
 
 
 @pytest.mark.slow
-def test_the_confirmation_decides_rather_than_echoes_its_start(dahl):
+def test_the_confirmation_decides_rather_than_echoes_its_start(dahl, soft_confirmed):
     """Started at a quarter of the soft cycle the motion grows into the cycle (the settled
     amplitude is the cycle's, 2 %, not the start's); started at 0.3 deg in the stiff loop, which
     has no cycle, it decays and is reported so."""
     fl, m, plant, df, pred = dahl["soft"]
     c = pred.stable_cycle
-    ref = confirm(plant, m, periodic_start(plant, m, df, c.amplitude_rad, c.freq_hz, "predicted cycle"))
+    ref = soft_confirmed[1]   # the run started on the predicted cycle
     low = confirm(plant, m, periodic_start(plant, m, df, 0.25 * c.amplitude_rad, c.freq_hz, "probe"))
     print(np.degrees(low.cycle_amplitudes_rad))
     assert low.lco and low.outcome == "sustained"

@@ -14,7 +14,8 @@ import pytest
 from taos.identify.series import weighted_line
 
 from . import _records
-from .conftest import MODELS, run_cli
+from .conftest import MODELS
+from .inprocess import taos_main
 
 
 def test_weighted_line_matches_numpy_weighted_polyfit():
@@ -37,8 +38,9 @@ def test_series_recovers_the_known_drift_of_K_L_friction_and_notch(tmp_path):
     recs = _records.series_records(tmp_path)           # newest first: the test dates must order them
     out = tmp_path / "series"
     js = tmp_path / "series.json"
-    r = run_cli("compare", "--model", MODELS / "rs25_hotfire.toml", "--records", *recs, "--out", out, "--json", js)
-    assert r.returncode == 0, r.stderr
+    # the command's files, made in this process (tests.inprocess)
+    assert taos_main("compare", "--model", MODELS / "rs25_hotfire.toml", "--records", *recs, "--out", out,
+                     "--json", js) == 0
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "responses_overlay.png", "series.json", "series_table.txt", "trend.png"]
     d = json.loads(js.read_text())

@@ -355,7 +355,7 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
                            sigma_floor: float = 1e-3, correct: bool | None = None, max_corrections: int = 6,
                            correction_tol: float = 1e-4, absolute_sigma: bool = False,
                            problem: FitProblem | None = None, bounds: dict | None = None,
-                           global_stage: bool = True) -> FitResult:
+                           global_stage: bool = True, problems: dict | None = None) -> FitResult:
     """Fit ``free`` parameters of ``model`` to measured responses (module docstring).
 
     Parameters
@@ -381,18 +381,30 @@ def fit_frequency_response(model: TvcModel, data: Sequence[MeasuredResponse], fr
         model's exact response).
     problem : FitProblem, optional
         A built problem to reuse (same model, free set and points).
+    problems : dict, optional
+        Built problems kept by the caller between fits (e.g. a series of records of one
+        profile): the problem of this fit's model, free set, bounds and point layout is taken
+        from it when there, else built and stored (the same problem either way).
     bounds : dict name -> (lower, upper) SI, optional
         Bounds of free parameters (default: the physical ranges of
         :mod:`taos.identify.physbounds`, else :data:`taos.identify.surrogate.PARAMETERS`' lo/hi
         times the start value). The result reports them and flags any value that ends on one.
     """
-    check_fit_args(**{k: v for k, v in locals().items() if k != "problem"})   # every argument, before any work
+    check_fit_args(**{k: v for k, v in locals().items() if k not in ("problem", "problems")})   # before any work
+    if problems is not None and not isinstance(problems, dict):
+        raise InputError("argument", "problems", "None or a dict kept between fits", got=repr(problems)[:40])
     t0 = time.perf_counter()
     data = tuple(data)
     free = tuple(free)
     m0 = _apply(model, list((start or {}).keys()), list((start or {}).values()))
     axes, f, A, hx, he, wx, we = _stack_points(data, use_engine, min_coherence, sigma_floor)
-    prob = problem or FitProblem(m0, free, axes, f, A, bounds)
+    prob = problem
+    if prob is None and problems is not None:   # the caller's problems, by content and point layout
+        key = (m0.sha256, free, repr(bounds), str(axes.dtype), axes.tobytes(), f.tobytes(), A.tobytes())
+        if key not in problems:
+            problems[key] = FitProblem(m0, free, axes, f, A, bounds)
+        prob = problems[key]
+    prob = prob or FitProblem(m0, free, axes, f, A, bounds)
     P = _pack(hx, he, wx, we)
     npar = len(free)
     grid = grid_search(prob, hx, he, wx, we, keep=max(1, starts)) if global_stage else None

@@ -61,6 +61,7 @@ class Fit3dResult:
     @classmethod
     def build(cls, tm0, params, p0, x, r, J, lo_si, hi_si, basis, replays, ev, gs, *, absolute_sigma, refuse,
               max_rel_se, max_corr, wall_s, nfev, fd_step, local_starts=1):
+        from taos.errors import SimulationUnstable
         from taos.identify.params3d import REPLAY_DT_S, Unidentifiable
 
         n, m = len(params), r.size
@@ -96,24 +97,34 @@ class Fit3dResult:
             unid = tuple(names)
         reason = "; ".join(why)
         srcs = tuple(rp.data.source for rp in replays)
-        if refuse and why:
-            raise Unidentifiable(", ".join(srcs)[:120], "--free",
+
+        def result():
+            """The fit at ``values``: the fitted model and its responses at the records' points."""
+            from taos.taos3d import with_values
+            tm_fit = with_values(tm0, variant_values(tm0, params, values))
+            fitted = tuple(resp for rp in replays for resp in rp.simulate(tm_fit))
+            data = tuple(resp for rp in replays for resp in rp.responses)
+            return cls(taos=tm_fit, initial=tm0, params=tuple(params), values=values, start_values=p0,
+                       std_errors=values * se_x, correlation=corr, cost=cost, n_residuals=m, sigma2=sigma2, data=data,
+                       fitted=fitted, lower_si=lo_si, upper_si=hi_si, bound_basis=tuple(basis), unidentified=unid,
+                       unidentified_reason=reason, global_search=gs, runs=ev.runs, failed_runs=ev.failures, nfev=nfev,
+                       wall_s=wall_s, absolute_sigma=absolute_sigma, sources=srcs,
+                       solver={"engine": "taos", "replay_dt_max_s": REPLAY_DT_S, "local": "scipy least_squares trf",
+                               "jacobian": f"forward differences in ln p, step {fd_step:g}, runs on threads",
+                               "rcond_JtJ": rcond, "max_rel_se": max_rel_se, "max_corr": max_corr,
+                               "local_starts": int(local_starts),
+                               "integrator": "rk4, trapezoidal bearing torque + BDF2 bearing substeps"})
+
+        if refuse and why:   # refused, with the fit itself for whoever asks (Unidentifiable.result)
+            err = Unidentifiable(", ".join(srcs)[:120], "--free",
                                  "parameters the record identifies (drop or hold the others, or add records)",
                                  got=reason[:400])
-        from taos.taos3d import with_values
-        tm_fit = with_values(tm0, variant_values(tm0, params, values))
-        fitted = tuple(resp for rp in replays for resp in rp.simulate(tm_fit))
-        data = tuple(resp for rp in replays for resp in rp.responses)
-        return cls(taos=tm_fit, initial=tm0, params=tuple(params), values=values, start_values=p0,
-                   std_errors=values * se_x, correlation=corr, cost=cost, n_residuals=m, sigma2=sigma2, data=data,
-                   fitted=fitted, lower_si=lo_si, upper_si=hi_si, bound_basis=tuple(basis), unidentified=unid,
-                   unidentified_reason=reason, global_search=gs, runs=ev.runs, failed_runs=ev.failures, nfev=nfev,
-                   wall_s=wall_s, absolute_sigma=absolute_sigma, sources=srcs,
-                   solver={"engine": "taos", "replay_dt_max_s": REPLAY_DT_S, "local": "scipy least_squares trf",
-                           "jacobian": f"forward differences in ln p, step {fd_step:g}, runs on threads",
-                           "rcond_JtJ": rcond, "max_rel_se": max_rel_se, "max_corr": max_corr,
-                           "local_starts": int(local_starts),
-                           "integrator": "rk4, trapezoidal bearing torque + BDF2 bearing substeps"})
+            try:
+                err.result = result()
+            except (InputError, SimulationUnstable):   # the refusal stands without it
+                pass
+            raise err
+        return result()
 
     # -- derived -----------------------------------------------------------------------
     @property

@@ -52,7 +52,10 @@ REPLAY_DT_S = 4e-4
 
 class Unidentifiable(InputError):
     """The record does not identify some free parameters (:func:`taos.identify.fit3d.fit_taos`
-    refuses)."""
+    refuses). ``result``: the fit refused, the :class:`~taos.identify.fit3d_result.Fit3dResult`
+    ``refuse=False`` returns (its flags say why), or None."""
+
+    result = None
 
 
 @dataclass(frozen=True)

@@ -237,9 +237,9 @@ def fit_series(model: TvcModel, records: Sequence, free: Sequence[str] = DEFAULT
     if progress:
         from tqdm import tqdm
         it = tqdm(idx, desc="fitting records", unit="record")
-    recs = {}
+    recs, problems = {}, {}   # records of one profile share their fit's problem (built once)
     for i in it:
-        fit = fit_frequency_response(model, responses[i], list(free), starts=starts)
+        fit = fit_frequency_response(model, responses[i], list(free), starts=starts, problems=problems)
         q = {**parameter_estimates(fit), **notch_estimates(fit)}
         recs[i] = q, fit
     out = tuple(SeriesRecord(labels[i], datas[i].source, dates[k], xs[k], tuple(responses[i]), recs[i][1], recs[i][0])
