@@ -75,6 +75,11 @@ ALLOWED_ENV = frozenset({"PYTEST_CURRENT_TEST", "TAOS_TEST_NO_FORKSERVER"})
 #: import ``scipy.special`` and its filters, are left out); the plotting modules (matplotlib reads
 #: ``MPLBACKEND``/``MPLCONFIGDIR``, guarded as the environment; ``taos.plotting`` selects the Agg
 #: backend, as it does in a new process before anything is drawn): ~0.6 CPU-s of each plotting command
+#: Not preloaded (measured 2 Dec 2026, ``make test`` runs 7 zygotes: 2 workers, a restart each, 3
+#: of other environments): scipy.signal/.optimize/.ndimage, trimesh and taos.fem import
+#: scipy.special, whose warnings filters a new process has only once it imports them (a child
+#: would start with them), zarr adds a filter, xarray an atexit callback; pinocchio adds none of
+#: these but would cost each zygote 0.09 CPU-s to save a 3-D command 0.07 (0.48 -> 0.41 CPU-s)
 PRELOAD = ("numpy", "scipy.linalg", "numba", "pint", "h5py", "tomlkit",
            "taos.model", "taos.units", "taos.planar.freqresp", "taos.planar.simulate", "taos.results",
            "matplotlib.pyplot", "taos.plotting.bode", "taos.plotting.timehist", "taos.plotting.interactive")
@@ -485,15 +490,20 @@ def _end_main() -> None:
     _zygote = None
 
 
+def end_side() -> None:
+    """End the zygote of another environment (:func:`side_zygote`), if any."""
+    global _side
+    if _side is not None and _side.pid == os.getpid():
+        _side.z.close()
+    _side = None
+
+
 def shutdown(final: bool = True) -> None:
     """End this process's zygotes (``final``: at pytest's session end, which appends :data:`STATS`
     to the file ``$TAOS_TEST_FORKSERVER_STATS`` if set). A zygote whose caller ends without this
     ends by itself, its control socket closed."""
-    global _side
     _end_main()
-    if _side is not None and _side.pid == os.getpid():
-        _side.z.close()
-    _side = None
+    end_side()
     STATS.pop("child_cpu_s", None)   # the ended zygotes' children now count in this process's RUSAGE_CHILDREN
     if final and STATS and os.environ.get("TAOS_TEST_FORKSERVER_STATS"):
         with open(os.environ["TAOS_TEST_FORKSERVER_STATS"], "a") as f:

@@ -3,7 +3,8 @@ processes: for each command the same exit status, standard output, standard erro
 written; the same process state when a command starts (signal handlers, open descriptors,
 threads, warnings filters, standard streams, ``sys.path``, environment, umask, process group);
 a crash, an uncaught exception, ``sys.exit(text)`` and a timeout reported as ``subprocess.run``
-reports them; and what it refuses to run."""
+reports them; and what it refuses to run. Likewise ``python -c`` and ``python -m`` children and a
+command with its own environment (a zygote started with it)."""
 
 from __future__ import annotations
 
@@ -210,8 +211,8 @@ def test_a_command_with_its_own_environment_runs_in_a_zygote_of_that_environment
     assert _forkserver._side.z is side and _forkserver.STATS["side zygotes"] == starts + 1
     assert _forkserver.zygote(TAOS) is zygote and "TAOS_TEST_SIDE" not in zygote.env
     assert _forkserver._zygote_for([exe], tmp_path, dict(os.environ)) == (zygote, None)   # the own environment
-    _forkserver.shutdown(final=False)
-    assert side.proc.returncode == 0 and _forkserver._side is None
+    _forkserver.end_side()   # (the test process's own zygote goes on)
+    assert side.proc.returncode == 0 and _forkserver._side is None and zygote.alive()
 
 
 @pytest.mark.parametrize("mode", ["script", "python -c", "python -m"])
