@@ -20,7 +20,8 @@ child per command. The child does what the console script does in a new process:
 * the zygote's own objects frozen (``gc.freeze``) before it forks: the child's collections and
   its exit skip them (without it the exit of a child costs ~0.6 CPU-s more than a new process's).
 
-The caller (:func:`run`) gets a :class:`subprocess.CompletedProcess` as ``subprocess.run(...,
+The caller's side (the zygote process, :class:`tests._forkserver_io.Child`) is in
+``tests/_forkserver_io.py``. The caller (:func:`run`) gets a :class:`subprocess.CompletedProcess` as ``subprocess.run(...,
 capture_output=True, text=True, timeout=...)`` gives: exit status (``-N`` for a signal), the two
 texts decoded as ``subprocess`` decodes them, :class:`subprocess.TimeoutExpired` (the child
 killed, the output so far attached) on a timeout; an exception in the caller kills the child.
@@ -30,7 +31,18 @@ text=True)`` gives (pid, streams, poll, wait, signals) for a test that talks to 
 ``python -c CODE ARGS`` with the zygote's interpreter runs the same way (the zygote of the
 ``taos`` script beside that interpreter): ``sys.argv = ['-c', *ARGS]``, ``sys.path[0] = ''``, the
 code compiled as ``<string>`` in a ``__main__`` without ``__file__``, the interpreter's own signal
-handlers (a console script's start-up handlers are not installed).
+handlers (a console script's start-up handlers are not installed). ``python -m MODULE ARGS``
+likewise: ``sys.argv = ['-m', *ARGS]``, ``sys.path[0]`` the working folder, the interpreter's
+``__main__``, then ``runpy._run_module_as_main(MODULE)`` as the interpreter calls it (argv[0] the
+module's file, runpy's frames in a traceback); for a module of ``taos`` or ``masv`` first the
+start-up handlers that importing ``taos`` installs while ``sys.argv[0]`` is ``'-m'`` (masv imports
+taos). Only a module of those packages not imported by the zygote, or a plain module ``NAME.py``
+of the working folder not imported by it either (:func:`module_refused`), and never from a folder
+holding another ``taos``/``masv`` than the zygote's (:func:`folder_refused`; ``-c`` too).
+
+A command with its own environment (``run(..., env=...)``, e.g. a plug-in's folder on
+``PYTHONPATH``) runs in a zygote started with that environment (:func:`side_zygote`: one at a
+time, kept while the following commands have the same environment).
 
 The child's environment is the caller's: a key outside :data:`ALLOWED_ENV` that differs from
 the zygote's start (the preloaded modules read some at import: ``OMP_NUM_THREADS``, ``NUMBA_*``;
@@ -63,6 +75,11 @@ ALLOWED_ENV = frozenset({"PYTEST_CURRENT_TEST", "TAOS_TEST_NO_FORKSERVER"})
 #: import ``scipy.special`` and its filters, are left out); the plotting modules (matplotlib reads
 #: ``MPLBACKEND``/``MPLCONFIGDIR``, guarded as the environment; ``taos.plotting`` selects the Agg
 #: backend, as it does in a new process before anything is drawn): ~0.6 CPU-s of each plotting command
+#: Not preloaded (measured 2 Dec 2026, ``make test`` runs 7 zygotes: 2 workers, a restart each, 3
+#: of other environments): scipy.signal/.optimize/.ndimage, trimesh and taos.fem import
+#: scipy.special, whose warnings filters a new process has only once it imports them (a child
+#: would start with them), zarr adds a filter, xarray an atexit callback; pinocchio adds none of
+#: these but would cost each zygote 0.09 CPU-s to save a 3-D command 0.07 (0.48 -> 0.41 CPU-s)
 PRELOAD = ("numpy", "scipy.linalg", "numba", "pint", "h5py", "tomlkit",
            "taos.model", "taos.units", "taos.planar.freqresp", "taos.planar.simulate", "taos.results",
            "matplotlib.pyplot", "taos.plotting.bode", "taos.plotting.timehist", "taos.plotting.interactive")
@@ -91,6 +108,23 @@ def _preload() -> None:
         cpu_target.target_context.refresh()
     except Exception:
         pass
+
+
+def _ready(ctl_fd: int) -> None:
+    """Tell the caller the imports are done: the folders of the ``taos`` and ``masv`` packages
+    imported and the names in ``sys.modules``, whether each is a package (what ``python -m``
+    would find here)."""
+    import json
+
+    pkgs = {m: os.path.realpath(os.path.dirname(sys.modules[m].__file__)) for m in ("taos", "masv")
+            if getattr(sys.modules.get(m), "__file__", None)}
+    mods = {k: hasattr(m, "__path__") for k, m in list(sys.modules.items())}   # name -> a package
+    for names in (mods, None):
+        try:
+            os.write(ctl_fd, json.dumps({"packages": pkgs, "modules": names}).encode())
+            return
+        except OSError:   # too long a message: then python -m runs as a real process
+            pass
 
 
 def _serve(ctl_fd: int, base_signals: dict) -> dict:
@@ -188,12 +222,17 @@ def _child(req: dict) -> dict:
     import types
 
     main = types.ModuleType("__main__")
-    if _code_mode(req["argv"]):   # python -c CODE ARGS: argv ['-c', ARGS], sys.path[0] '' (the cwd)
-        sys.argv = ["-c", *req["argv"][3:]]
-        sys.path[0] = ""
-        source, script = req["argv"][2], "<string>"
+    mode, module = _mode(req["argv"]), None
+    if mode:   # python -c CODE ARGS: argv ['-c', ARGS], sys.path[0] '' (the cwd); -m MODULE: '-m', the cwd
+        sys.argv = [req["argv"][1], *req["argv"][3:]]
+        sys.path[0] = "" if mode == "c" else os.getcwd()
         main.__dict__.update(__package__=None, __spec__=None, __loader__=importlib.machinery.BuiltinImporter,
                              __builtins__=builtins, __annotations__={})
+        source, script = (req["argv"][2], "<string>") if mode == "c" else (None, None)
+        module = req["argv"][2] if mode == "m" else None
+        if module and module.partition(".")[0] in ("taos", "masv"):
+            import taos   # what its import does in a new process while sys.argv[0] is '-m' (masv imports taos)
+            taos._startup_signals()
     else:
         script = req["argv"][0]
         sys.argv = list(req["argv"])
@@ -219,6 +258,8 @@ def _child(req: dict) -> dict:
         _default(etype, value, tb)
 
     sys.excepthook = excepthook
+    if module:   # runpy, as the interpreter runs -m (it takes sys.modules['__main__'] as the globals)
+        return {"module": module}
     return {"code": compile(source, script, "exec"), "globals": main.__dict__}
 
 
@@ -226,209 +267,11 @@ def _child(req: dict) -> dict:
 # the caller (the test process)
 # --------------------------------------------------------------------------------------------
 
-class _NotStarted(Exception):
-    """The zygote is gone before it forked the command's child (the caller runs a real process)."""
 
-
-class _Zygote:
-    """One zygote process and its control socket; :meth:`run` is ``subprocess.run`` through it."""
-
-    def __init__(self, script: str):
-        import socket
-        import subprocess
-
-        self.script = script
-        self.interpreter = _interpreter(script)
-        self.env = dict(os.environ)
-        self.cwd = os.getcwd()
-        self.ctl, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
-        self.proc = subprocess.Popen([self.interpreter, os.path.abspath(__file__), str(theirs.fileno()), script],
-                                     pass_fds=[theirs.fileno()], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-        theirs.close()
-        os.set_blocking(self.proc.stdout.fileno(), False)
-        self.log = b""
-
-    def alive(self) -> bool:
-        self._drain()
-        return self.proc.poll() is None
-
-    def _drain(self) -> None:
-        try:
-            while chunk := self.proc.stdout.read(65536):
-                self.log += chunk
-        except (OSError, ValueError):
-            pass
-
-    def close(self) -> None:
-        self.ctl.close()
-        try:
-            self.proc.wait(timeout=10)
-        except Exception:
-            self.proc.kill()
-            self.proc.wait()
-        self._drain()
-        self.proc.stdout.close()
-
-    def _start(self, argv: list[str], cwd):
-        """Fork ``argv``'s child in ``cwd``: (control socket, stdout and stderr read ends, pid)."""
-        import json
-        import socket
-
-        umask = os.umask(0o022)
-        os.umask(umask)
-        req = {"argv": argv, "cwd": os.path.abspath(cwd), "umask": umask,
-               "env": {k: os.environ[k] for k in ALLOWED_ENV if k in os.environ}}
-        mine, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
-        out_r, out_w = os.pipe()
-        err_r, err_w = os.pipe()
-        first = b""
-        try:
-            socket.send_fds(self.ctl, [json.dumps(req).encode()], [theirs.fileno(), 0, out_w, err_w])
-            first = mine.recv(4096)
-        except OSError:
-            pass
-        finally:
-            for f in (out_w, err_w):
-                os.close(f)
-            theirs.close()
-            if not first:
-                for f in (out_r, err_r):
-                    os.close(f)
-                mine.close()
-        if not first:
-            raise _NotStarted("the fork server did not start the command")
-        return mine, out_r, err_r, json.loads(first)["pid"]
-
-    def popen(self, argv: list[str], cwd) -> "Child":
-        """``subprocess.Popen(argv, cwd=cwd, stdout=PIPE, stderr=PIPE, text=True)``."""
-        return Child(argv, *self._start(argv, cwd))
-
-    def run(self, argv: list[str], cwd, timeout: float):
-        """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)``."""
-        import io
-        import json
-        import selectors
-        import socket
-        import subprocess
-        import time
-
-        mine, out_r, err_r, _ = self._start(argv, cwd)
-        endtime = None if timeout is None else time.monotonic() + timeout
-        chunks = {out_r: [], err_r: []}
-        done = False
-        try:
-            with selectors.PollSelector() as sel:
-                for f in chunks:
-                    sel.register(f, selectors.EVENT_READ)
-                while sel.get_map():
-                    left = None if endtime is None else endtime - time.monotonic()
-                    if left is not None and left < 0:
-                        so_far = [b"".join(chunks[f]) if chunks[f] else None for f in (out_r, err_r)]
-                        raise subprocess.TimeoutExpired(argv, timeout, output=so_far[0], stderr=so_far[1])
-                    for key, _ in sel.select(left):
-                        data = os.read(key.fd, 32768)
-                        if not data:
-                            sel.unregister(key.fd)
-                        chunks[key.fd].append(data)
-            if endtime is not None:
-                mine.settimeout(max(endtime - time.monotonic(), 0.0))
-            try:
-                status = mine.recv(4096)
-            except socket.timeout:
-                raise subprocess.TimeoutExpired(argv, timeout) from None
-            if not status:
-                raise ChildProcessError("the fork server ended")
-            done = True
-        except subprocess.TimeoutExpired:
-            mine.settimeout(None)
-            mine.send(b"kill")
-            mine.recv(4096)   # its status, once reaped
-            raise
-        finally:
-            if not done:
-                mine.close()   # the zygote kills the child when this end closes
-            for f in chunks:
-                os.close(f)
-        mine.close()
-        status = json.loads(status)
-        rc = status["returncode"]
-        STATS["child_cpu_s"] = STATS.get("child_cpu_s", 0.0) + status["cpu_s"]
-        STATS["forked_cpu_s"] = STATS.get("forked_cpu_s", 0.0) + status["cpu_s"]
-        probe = io.TextIOWrapper(io.BytesIO())   # what subprocess.Popen(text=True) decodes with
-        text = [b"".join(chunks[f]).decode(probe.encoding, probe.errors).replace("\r\n", "\n").replace("\r", "\n")
-                for f in (out_r, err_r)]
-        return subprocess.CompletedProcess(argv, rc, text[0], text[1])
-
-
-class Child:
-    """A child forked by the zygote as :class:`subprocess.Popen` (``stdout=PIPE, stderr=PIPE,
-    text=True``) presents its process: ``args``, ``pid``, ``stdout`` and ``stderr`` (text streams,
-    decoded as ``Popen`` decodes them), ``returncode``, :meth:`poll`, :meth:`wait` (its timeout
-    raising :class:`subprocess.TimeoutExpired`), :meth:`send_signal`, :meth:`terminate`,
-    :meth:`kill`. The zygote reaps the child and reports its status on the control socket; a
-    signal is sent only while that status has not come (the pid is still the child's)."""
-
-    def __init__(self, args, ctl, out_r: int, err_r: int, pid: int):
-        self.args, self.pid, self.returncode, self._ctl = args, pid, None, ctl
-        self.stdout = open(out_r, "r")   # locale encoding, universal newlines: Popen's text mode
-        self.stderr = open(err_r, "r")
-
-    def _status(self, msg: bytes) -> int:
-        import json
-
-        if not msg:
-            raise ChildProcessError("the fork server ended")
-        st = json.loads(msg)
-        self.returncode = st["returncode"]
-        STATS["child_cpu_s"] = STATS.get("child_cpu_s", 0.0) + st["cpu_s"]
-        STATS["forked_cpu_s"] = STATS.get("forked_cpu_s", 0.0) + st["cpu_s"]
-        self._ctl.close()
-        return self.returncode
-
-    def poll(self) -> int | None:
-        import socket
-
-        if self.returncode is None:
-            try:
-                msg = self._ctl.recv(4096, socket.MSG_DONTWAIT)
-            except (BlockingIOError, socket.timeout):
-                return None
-            self._status(msg)
-        return self.returncode
-
-    def wait(self, timeout: float | None = None) -> int:
-        import socket
-        import subprocess
-
-        if self.returncode is None:
-            self._ctl.settimeout(timeout)
-            try:
-                msg = self._ctl.recv(4096)
-            except socket.timeout:
-                raise subprocess.TimeoutExpired(self.args, timeout) from None
-            finally:
-                self._ctl.settimeout(None)
-            self._status(msg)
-        return self.returncode
-
-    def send_signal(self, sig: int) -> None:
-        if self.poll() is None:
-            os.kill(self.pid, sig)
-
-    def terminate(self) -> None:
-        self.send_signal(15)
-
-    def kill(self) -> None:
-        self.send_signal(9)
-
-    def __del__(self):
-        if self.returncode is None:   # the zygote kills a child whose control socket closes
-            self._ctl.close()
-
-
-def _code_mode(argv: list[str]) -> bool:
-    """``argv`` is ``[python, "-c", code, *args]``."""
-    return len(argv) >= 3 and argv[1] == "-c"
+def _mode(argv: list[str]) -> str | None:
+    """``"c"`` for ``[python, "-c", code, *args]``, ``"m"`` for ``[python, "-m", module, *args]``,
+    None for a script."""
+    return argv[1][1] if len(argv) >= 3 and argv[1] in ("-c", "-m") else None
 
 
 def _interpreter(script: str) -> str | None:
@@ -444,10 +287,11 @@ def _interpreter(script: str) -> str | None:
     return path if ok else None
 
 
-_zygote: _Zygote | None | bool = None   # False: it could not start
+_zygote = None   # this process's zygote (a tests._forkserver_io._Zygote); False: it could not start
+_side = None     # the zygote of another environment (:func:`run`'s ``env``), the last one asked for
 _pid = None
 #: this process's count of forked commands ("forked") and of real processes, by reason, and the
-#: forked children's CPU seconds ("child_cpu_s": the running zygote's, which waits for them, not
+#: forked children's CPU seconds ("child_cpu_s": the running zygotes', which wait for them, not
 #: this process; ``benchmarks/pytest_cpu.py`` adds them to each test's figure; "forked_cpu_s": all)
 STATS: dict[str, float] = {}
 
@@ -468,6 +312,43 @@ def eligible(script: str, cwd) -> str | None:
     return None
 
 
+def folder_refused(cwd, info: dict | None) -> str | None:
+    """Why ``python -c``/``-m`` in ``cwd`` must be a real process: the folder (``sys.path[0]``)
+    has a ``taos`` or ``masv`` other than the one the zygote imported (a new process would import
+    that one); None: it has none, or the same."""
+    if info is None:
+        return "the fork server is gone"
+    for top, where in info["packages"].items():
+        for p in (os.path.join(cwd, top), os.path.join(cwd, top + ".py")):
+            if os.path.exists(p) and os.path.realpath(p) != where:
+                return f"another {top} in the working folder"
+    return None
+
+
+def module_refused(name: str, cwd, info: dict | None) -> str | None:
+    """Why ``python -m name`` in ``cwd`` must be a real process, given the zygote's
+    :meth:`~tests._forkserver_io._Zygote.info` (None: the zygote may run it; the folder checked
+    by :func:`folder_refused`): a module of ``taos`` or ``masv`` not imported by the zygote
+    (runpy would warn), or a plain module ``name.py`` of the folder, which a new process runs
+    first, that is no built-in or frozen module nor one the zygote has imported (runpy would
+    run that one)."""
+    import _imp
+
+    top = name.partition(".")[0]
+    if info is None or info["modules"] is None:
+        return "the fork server is gone" if info is None else "python -m: the fork server's modules unknown"
+    mods = info["modules"]
+    if top in ("taos", "masv"):
+        run = name + ".__main__" if mods.get(name) else name   # a package runs its __main__
+        # imported here already: runpy would warn (a new process imports only its parent packages)
+        return f"python -m {name}: {run} imported by the fork server" if run in mods else None
+    plain = ("." not in name and name.isidentifier() and os.path.isfile(os.path.join(cwd, name + ".py"))
+             and not os.path.exists(os.path.join(cwd, name)))
+    if plain and name not in sys.builtin_module_names and not _imp.is_frozen(name) and name not in mods:
+        return None
+    return f"python -m {name}: not a module of taos/masv nor a plain module of the working folder"
+
+
 def env_change() -> list[str]:
     """The environment keys (outside :data:`ALLOWED_ENV`) in which this process's environment now
     differs from its zygote's start: a zygote restart (the preloaded modules read some of them at
@@ -475,17 +356,24 @@ def env_change() -> list[str]:
     its workers' ``OMP_NUM_THREADS``, ``MALLOC_TRIM_THRESHOLD_``, ``PYTHONHASHSEED`` here."""
     if not (_zygote and _pid == os.getpid()):
         return []
-    old, new = _zygote.env, os.environ
+    return _differ(_zygote.env, os.environ)
+
+
+def _differ(old, new) -> list[str]:
     return sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k) and k not in ALLOWED_ENV)
 
 
 #: zygote restarts allowed per process after an environment change (then: real processes)
 MAX_RESTARTS = 4
+#: zygotes of other environments (``env``) started per process (then: real processes)
+MAX_SIDE = 6
 
 
-def zygote(script: str) -> _Zygote | None:
+def zygote(script: str):
     """This process's zygote (started on first use, preloading for the console script
     ``script``; it runs any Python script with the same interpreter), or ``None`` if it is gone."""
+    from tests._forkserver_io import _Zygote
+
     global _zygote, _pid
     if _zygote is None or _pid != os.getpid():
         _pid = os.getpid()
@@ -496,76 +384,127 @@ def zygote(script: str) -> _Zygote | None:
     return _zygote if _zygote and _zygote.alive() else None
 
 
-def _zygote_for(argv: list[str], cwd):
-    """(this process's zygote for ``argv``, None) or (None, why ``argv`` must be a real process).
-    ``python -c CODE ARGS`` (:func:`_code_mode`) runs in the zygote of the ``taos`` script beside
-    that Python, when that Python is the zygote's interpreter."""
-    code = _code_mode(argv)
-    script = os.path.join(os.path.dirname(argv[0]), "taos") if code else argv[0]
+def side_zygote(script: str, env: dict):
+    """The zygote started with the environment ``env`` (a test's own, e.g. a plug-in's folder on
+    ``PYTHONPATH``): one at a time, started anew when ``env`` differs from the last one's outside
+    :data:`ALLOWED_ENV` (at most :data:`MAX_SIDE` per process), or ``None``."""
+    from tests._forkserver_io import _Zygote
+
+    global _side
+    if _side is not None and (_side.pid != os.getpid() or _differ(_side.z.env, env) or not _side.z.alive()):
+        if _side.pid == os.getpid():
+            _side.z.close()
+        _side = None
+    if _side is None:
+        if STATS.get("side zygotes", 0) >= MAX_SIDE or not _interpreter(script):
+            return None
+        STATS["side zygotes"] = STATS.get("side zygotes", 0) + 1
+        try:
+            _side = _Side(_Zygote(script, env), os.getpid())
+        except OSError:
+            return None
+    return _side.z
+
+
+class _Side:
+    def __init__(self, z, pid):
+        self.z, self.pid = z, pid
+
+
+def _zygote_for(argv: list[str], cwd, env: dict | None = None):
+    """(the zygote for ``argv``, None) or (None, why ``argv`` must be a real process).
+    ``python -c CODE ARGS`` and ``python -m MODULE ARGS`` (:func:`_mode`) run in the zygote of the
+    ``taos`` script beside that Python, when that Python is the zygote's interpreter. ``env``
+    (the command's environment, default this process's) outside :data:`ALLOWED_ENV` other than
+    this process's: a zygote started with it (:func:`side_zygote`)."""
+    mode = _mode(argv)
+    script = os.path.join(os.path.dirname(argv[0]), "taos") if mode else argv[0]
     why, z = eligible(script, cwd), None
     interp = _interpreter(script) if why is None else None
     if why is None and interp is None:
         why = "not a Python console script"
-    if why is None and code and os.path.realpath(argv[0]) != os.path.realpath(interp):
+    if why is None and mode and os.path.realpath(argv[0]) != os.path.realpath(interp):
         why = "another interpreter"
-    if why is None and (keys := env_change()):
+    side = env is not None and _differ(os.environ, env)
+    if why is None and not side and (keys := env_change()):
         if STATS.get("restarts", 0) >= MAX_RESTARTS:
             why = "environment differs from the fork server's (restarts used up)"
         else:   # a new zygote for the new environment, as a new process would see it
             STATS["restarts"] = STATS.get("restarts", 0) + 1
             STATS["restarted for " + ", ".join(keys)] = STATS.get("restarted for " + ", ".join(keys), 0) + 1
-            shutdown(final=False)
-    if why is None and ((z := zygote(script)) is None or z.interpreter != interp):
+            _end_main()
+    if why is None and ((z := side_zygote(script, env) if side else zygote(script)) is None or z.interpreter != interp):
         why = "the fork server is gone" if z is None else "another interpreter"
+    if why is None and os.path.exists(os.path.join(z.cwd, _NUMBA_CONFIG)):
+        why = f"{_NUMBA_CONFIG} in the working folder"
+    if why is None and mode:
+        why = folder_refused(cwd, z.info()) or (module_refused(argv[2], cwd, z.info()) if mode == "m" else None)
     return (z, None) if why is None else (None, why)
 
 
-def run(argv: list[str], cwd, timeout: float = 300):
-    """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)`` through
-    this process's zygote (a console script, or ``python -c CODE ARGS``), or a real process when
-    :func:`eligible` refuses or the zygote is gone."""
+def run(argv: list[str], cwd, timeout: float = 300, env: dict | None = None):
+    """``subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout, env=env)``
+    through a zygote (a console script, ``python -c CODE ARGS`` or ``python -m MODULE ARGS``), or
+    a real process when :func:`eligible` or :func:`module_refused` refuses or the zygote is gone."""
     import subprocess
 
+    from tests._forkserver_io import _NotStarted
+
     argv = [str(a) for a in argv]
-    z, why = _zygote_for(argv, cwd)
+    z, why = _zygote_for(argv, cwd, env)
     if z is not None:
         try:
-            result = z.run(argv, cwd, timeout)
+            result = z.run(argv, cwd, timeout, env)
             STATS["forked"] = STATS.get("forked", 0) + 1
             return result
         except _NotStarted:
             why = "the fork server is gone"
     STATS[why] = STATS.get(why, 0) + 1
-    return subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout)
+    return subprocess.run(argv, capture_output=True, text=True, cwd=cwd, timeout=timeout, env=env)
 
 
-def popen(argv: list[str], cwd):
-    """``subprocess.Popen(argv, cwd=cwd, stdout=PIPE, stderr=PIPE, text=True)`` through this
-    process's zygote (a :class:`Child`), or a real process as :func:`run` decides."""
+def popen(argv: list[str], cwd, env: dict | None = None):
+    """``subprocess.Popen(argv, cwd=cwd, stdout=PIPE, stderr=PIPE, text=True, env=env)`` through a
+    zygote (a :class:`tests._forkserver_io.Child`), or a real process as :func:`run` decides."""
     import subprocess
 
+    from tests._forkserver_io import _NotStarted
+
     argv = [str(a) for a in argv]
-    z, why = _zygote_for(argv, cwd)
+    z, why = _zygote_for(argv, cwd, env)
     if z is not None:
         try:
-            child = z.popen(argv, cwd)
+            child = z.popen(argv, cwd, env)
             STATS["forked"] = STATS.get("forked", 0) + 1
             return child
         except _NotStarted:
             why = "the fork server is gone"
     STATS[why] = STATS.get(why, 0) + 1
-    return subprocess.Popen(argv, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(argv, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
 
 
-def shutdown(final: bool = True) -> None:
-    """End this process's zygote (``final``: at pytest's session end, which appends :data:`STATS`
-    to the file ``$TAOS_TEST_FORKSERVER_STATS`` if set). A zygote whose caller ends without this
-    ends by itself, its control socket closed."""
+def _end_main() -> None:
     global _zygote
     if _zygote and _pid == os.getpid():
         _zygote.close()
     _zygote = None
-    STATS.pop("child_cpu_s", None)   # the ended zygote's children now count in this process's RUSAGE_CHILDREN
+
+
+def end_side() -> None:
+    """End the zygote of another environment (:func:`side_zygote`), if any."""
+    global _side
+    if _side is not None and _side.pid == os.getpid():
+        _side.z.close()
+    _side = None
+
+
+def shutdown(final: bool = True) -> None:
+    """End this process's zygotes (``final``: at pytest's session end, which appends :data:`STATS`
+    to the file ``$TAOS_TEST_FORKSERVER_STATS`` if set). A zygote whose caller ends without this
+    ends by itself, its control socket closed."""
+    _end_main()
+    end_side()
+    STATS.pop("child_cpu_s", None)   # the ended zygotes' children now count in this process's RUSAGE_CHILDREN
     if final and STATS and os.environ.get("TAOS_TEST_FORKSERVER_STATS"):
         with open(os.environ["TAOS_TEST_FORKSERVER_STATS"], "a") as f:
             f.write(f"{os.getpid()} {STATS}\n")
@@ -586,6 +525,10 @@ if __name__ == "__main__":
 
     _gc.collect()
     _gc.freeze()   # the children's collections (and their exit's) skip the zygote's objects: ~0.6 CPU-s less each
+    _ready(_ctl_fd)
     _run = _child(_serve(_ctl_fd, _base))
     del _ctl_fd, _script, _signal, _base, _gc
-    exec(_run["code"], _run["globals"])
+    if "module" in _run:
+        __import__("runpy")._run_module_as_main(_run["module"], True)
+    else:
+        exec(_run["code"], _run["globals"])

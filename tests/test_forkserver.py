@@ -3,7 +3,8 @@ processes: for each command the same exit status, standard output, standard erro
 written; the same process state when a command starts (signal handlers, open descriptors,
 threads, warnings filters, standard streams, ``sys.path``, environment, umask, process group);
 a crash, an uncaught exception, ``sys.exit(text)`` and a timeout reported as ``subprocess.run``
-reports them; and what it refuses to run."""
+reports them; and what it refuses to run. Likewise ``python -c`` and ``python -m`` children and a
+command with its own environment (a zygote started with it)."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from tests import _forkserver
+from tests import _forkserver, _forkserver_io
 from tests.conftest import MODELS
 
 TAOS = str(Path(sys.executable).parent / "taos")
@@ -140,7 +141,81 @@ def test_python_c_starts_in_the_state_of_a_new_python_c(zygote, tmp_path):
     assert z is zygote and why is None
 
 
-@pytest.mark.parametrize("mode", ["script", "python -c"])
+def test_python_m_starts_in_the_state_of_a_new_python_m(zygote, tmp_path):
+    """``python -m MODULE ARGS`` of a plain module of the working folder: argv ``[its file,
+    ARGS]``, ``sys.path[0]`` the folder, runpy's ``__main__`` (``__file__``, its loader), the
+    interpreter's own signal handlers (the module is no ``taos`` command line)."""
+    (tmp_path / "probe_m.py").write_text(PROBE)
+    argv = [sys.executable, "-m", "probe_m", "x"]
+    a, b = zygote.run(argv, tmp_path, 300), subprocess.run(argv, capture_output=True, text=True, cwd=tmp_path)
+    same(a, b)
+    state = json.loads(a.stdout)
+    assert state["argv"] == [str(tmp_path / "probe_m.py"), "x"] and state["path"][0] == str(tmp_path)
+    assert state["main"][:2] == ["__main__", str(tmp_path / "probe_m.py")]
+    assert not any("_startup_signals" in h for h in state["signals"].values())
+    assert state["threads"] == ["MainThread"]
+    assert _forkserver._zygote_for(argv, tmp_path) == (zygote, None)
+
+
+@pytest.mark.parametrize("args", [
+    ["taos", "--help"],
+    ["taos", "info", "nope.toml"],                  # refused: exit 2 and one line
+    ["taos", "freqresp", MODELS / "rs25_ambient.toml", "--linear", "--freq-hz", "0.5,7", "--json", "out.json"],
+    ["masv.cli", "coupling", "nope.toml"],
+], ids=["help", "refused", "freqresp-json", "masv-cli"])
+def test_python_m_of_the_package_through_the_fork_server_is_the_real_process(zygote, tmp_path, args):
+    """``python -m taos``/``python -m masv.cli``: the start-up handlers installed as importing
+    taos installs them under ``-m`` (one line, the program named ``taos``), the same output."""
+    cwd = folders(tmp_path)
+    argv = [sys.executable, "-m", *map(str, args)]
+    assert _forkserver._zygote_for(argv, cwd[0]) == (zygote, None)
+    a, b = both(zygote, argv, cwd)
+    same(a, b)
+    assert files(cwd[0]) == files(cwd[1])
+    assert a.returncode == (0 if args[-1] in ("--help", "out.json") else 2)
+
+
+def test_python_m_the_fork_server_refuses(zygote, tmp_path):
+    """A module a new process would find elsewhere, or that runpy would find imported already."""
+    z = zygote
+    assert _forkserver.module_refused("taos", tmp_path, z.info()) is None
+    assert "imported" in _forkserver.module_refused("taos.model", tmp_path, z.info())   # runpy would warn
+    assert _forkserver.module_refused("nothere", tmp_path, z.info())                   # no nothere.py
+    (tmp_path / "os.py").write_text("print('mine')\n")                                 # frozen: never this file
+    (tmp_path / "json.py").write_text("print('mine')\n")
+    assert _forkserver.module_refused("os", tmp_path, z.info())
+    assert ("json" in z.info()["modules"]) == bool(_forkserver.module_refused("json", tmp_path, z.info()))
+    assert _forkserver.folder_refused(tmp_path, z.info()) is None
+    assert _forkserver.folder_refused(os.path.dirname(z.info()["packages"]["taos"]), z.info()) is None
+    (tmp_path / "taos").mkdir()                                                         # another taos first
+    assert "another taos" in _forkserver.folder_refused(tmp_path, z.info())
+    z2, why = _forkserver._zygote_for([sys.executable, "-c", "pass"], tmp_path)
+    assert z2 is None and "another taos" in why
+
+
+def test_a_command_with_its_own_environment_runs_in_a_zygote_of_that_environment(zygote, tmp_path):
+    """``run(..., env=E)``/``popen``: a zygote started with E (kept for the next command with E,
+    the test process's own zygote untouched), the child as a new process with E starts."""
+    exe = script(tmp_path / "bin", PROBE)
+    env = {**os.environ, "TAOS_TEST_SIDE": "1", "PYTEST_CURRENT_TEST": "side"}
+    starts = _forkserver.STATS.get("side zygotes", 0)
+    a = _forkserver.run([exe, "x"], tmp_path, env=env)
+    same(a, subprocess.run([exe, "x"], capture_output=True, text=True, cwd=tmp_path, env=env, timeout=300))
+    assert json.loads(a.stdout)["env"]["TAOS_TEST_SIDE"] == "1"
+    side = _forkserver._side.z
+    argv = [sys.executable, "-c", "import os; print(os.environ['PYTEST_CURRENT_TEST'], os.environ['TAOS_TEST_SIDE'])"]
+    p = _forkserver.popen(argv, tmp_path, env={**env, "PYTEST_CURRENT_TEST": "again"})
+    assert isinstance(p, _forkserver_io.Child) and p.wait(60) == 0 and p.stdout.read() == "again 1\n"
+    p.stdout.close()
+    p.stderr.close()
+    assert _forkserver._side.z is side and _forkserver.STATS["side zygotes"] == starts + 1
+    assert _forkserver.zygote(TAOS) is zygote and "TAOS_TEST_SIDE" not in zygote.env
+    assert _forkserver._zygote_for([exe], tmp_path, dict(os.environ)) == (zygote, None)   # the own environment
+    _forkserver.end_side()   # (the test process's own zygote goes on)
+    assert side.proc.returncode == 0 and _forkserver._side is None and zygote.alive()
+
+
+@pytest.mark.parametrize("mode", ["script", "python -c", "python -m"])
 @pytest.mark.parametrize("body, code", [
     ("import os\nos.abort()\n", -6),
     ("import os, signal\nos.kill(os.getpid(), signal.SIGKILL)\n", -9),
@@ -150,6 +225,9 @@ def test_python_c_starts_in_the_state_of_a_new_python_c(zygote, tmp_path):
 ], ids=["abort", "killed", "exit-text", "traceback", "exit-7"])
 def test_a_crash_is_reported_as_subprocess_run_reports_it(zygote, tmp_path, body, code, mode):
     argv = [script(tmp_path / "bin", body)] if mode == "script" else [sys.executable, "-c", body]
+    if mode == "python -m":   # a traceback through runpy's frames, as the interpreter's
+        (tmp_path / "crash_m.py").write_text(body)
+        argv = [sys.executable, "-m", "crash_m"]
     a, b = both(zygote, argv, (tmp_path, tmp_path))
     same(a, b)
     assert a.returncode == code
@@ -198,7 +276,7 @@ def test_a_forked_child_behaves_as_subprocess_popen(zygote, tmp_path, sig, code)
         p.stderr.close()
     assert got[0] == got[1]
     assert got[0][:3] == ("started ['a']\n", f"Command '{argv}' timed out after 0.2 seconds", code)
-    assert isinstance(zygote.popen([sys.executable, "-c", "pass"], tmp_path), _forkserver.Child)
+    assert isinstance(zygote.popen([sys.executable, "-c", "pass"], tmp_path), _forkserver_io.Child)
 
 
 def test_what_the_fork_server_refuses_runs_as_a_real_process(monkeypatch, tmp_path):
@@ -237,7 +315,7 @@ def test_a_changed_environment_restarts_the_fork_server(zygote, monkeypatch, tmp
 
 
 def test_the_fork_server_ends_with_its_caller_and_leaves_no_child(tmp_path):
-    z = _forkserver._Zygote(TAOS)
+    z = _forkserver_io._Zygote(TAOS)
     exe = script(tmp_path / "bin", "print('ok')\n")
     assert z.run([exe], tmp_path, 300).stdout == "ok\n"
     z.close()

@@ -31,6 +31,7 @@ import pytest
 
 import taos
 
+from . import _forkserver
 from .conftest import ROOT
 
 pytestmark = pytest.mark.slow
@@ -179,8 +180,14 @@ def copy(tmp_path_factory):
 
 
 def _run(copy: Path, *argv, extra_path: str = "") -> subprocess.CompletedProcess:
+    """``python ARGV`` in the copy with the copy (and ``extra_path``) on PYTHONPATH, as a new
+    process: forked from a fork server started with that environment (the copy's commands share
+    it: :func:`tests._forkserver.run`, ``env``), a real process for the one run with ``extra_path``."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (str(copy), extra_path) if p))
-    r = subprocess.run([sys.executable, *argv], capture_output=True, text=True, cwd=copy, env=env, timeout=900)
+    if not extra_path:
+        r = _forkserver.run([sys.executable, *argv], copy, timeout=900, env=env)
+    else:
+        r = subprocess.run([sys.executable, *argv], capture_output=True, text=True, cwd=copy, env=env, timeout=900)
     assert r.returncode == 0, r.stderr[-3000:]
     return r
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import subprocess
+import os
 import sys
 from pathlib import Path
 
@@ -17,6 +17,8 @@ from masv.config import load_config
 from masv.structure import NODE_NAMES, load_modes
 from masv.synthetic import synthetic_structure
 from taos.errors import InputError
+
+from . import _forkserver
 
 ROOT = Path(__file__).resolve().parents[1]
 RIGID = ROOT / "models" / "masv" / "core_stage_rigid.toml"
@@ -108,7 +110,8 @@ def test_cli_freqresp_json_contract(capsys):
 def test_cli_bad_input_exits_2_with_one_line(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text(RIGID.read_text().replace('low = "0.5 Hz"', 'low = "fast"'))
-    r = subprocess.run([sys.executable, "-m", "masv.cli", "coupling", str(bad)], capture_output=True, text=True)
+    # python -m masv.cli as a new process (forked from the test process's fork server, tests/_forkserver.py)
+    r = _forkserver.run([sys.executable, "-m", "masv.cli", "coupling", str(bad)], os.getcwd(), timeout=None)
     assert r.returncode == 2
     assert r.stderr.strip().count("\n") == 0 and "band.low" in r.stderr
 

@@ -57,12 +57,6 @@ def temporaries(folder: Path) -> list[Path]:
     return [p for p in folder.iterdir() if p.name.endswith(".tmp")]
 
 
-def env():
-    e = dict(os.environ)
-    e["PYTHONPATH"] = str(ROOT) + os.pathsep + e.get("PYTHONPATH", "")
-    return e
-
-
 # -- foreign files ----------------------------------------------------------------------------
 
 @pytest.mark.slow
@@ -311,8 +305,9 @@ def test_viewer_server_ends_when_its_parent_is_killed(tmp_path):
 
     h5 = tmp_path / "run.h5"
     simulate(load_model(AMBIENT), load_profile(STEP)).to_hdf5(h5)
-    proc = subprocess.Popen([sys.executable, "-m", "taos", "view", str(h5)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=env())
+    # python -m taos as a new process, forked from the test process's fork server (Popen-like; the
+    # package the fork server imported, as run_cli's commands: no checkout prepended to PYTHONPATH)
+    proc = _forkserver.popen([sys.executable, "-m", "taos", "view", str(h5)], tmp_path)
     try:
         t_end, ok = time.time() + 60, False
         while time.time() < t_end and not ok:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import pytest
 
+from . import _forkserver
 from .conftest import MODELS, ROOT
 from .inprocess import taos_json, taos_main
 
@@ -130,10 +131,15 @@ def plugin_path(tmp_path_factory):
     return target
 
 
-def taos_with(path: Path, *args) -> subprocess.CompletedProcess:
+def taos_with(path: Path, *args, fork: bool = True) -> subprocess.CompletedProcess:
+    """``taos ARGS`` as a new process with ``path`` first on PYTHONPATH: forked from a fork server
+    started with that environment (:func:`tests._forkserver.run`, ``env``: the plug-in fixture's
+    commands share one), or (``fork=False``, a folder used by one test alone) a real process."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(path), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
-    exe = Path(sys.executable).parent / "taos"
-    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
+    argv = [str(Path(sys.executable).parent / "taos"), *map(str, args)]
+    if fork:
+        return _forkserver.run(argv, ROOT, timeout=600, env=env)
+    return subprocess.run(argv, capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
 
 
 def test_the_installed_plugin_is_listed_and_used_by_info(plugin_path):
@@ -180,11 +186,11 @@ def test_a_broken_plugin_stops_with_one_line_naming_it(tmp_path):
     whl = _wheel(tmp_path, "taos_broken_plugin", {"taos_broken_plugin/__init__.py": "raise ImportError('missing dep')\n"},
                  "[taos.friction_laws]\nbroken-law = taos_broken_plugin:entry\n")
     target = _install(whl, tmp_path / "site")
-    r = taos_with(target, "info", MODELS / "rs25_hotfire.toml", "--friction", "broken-law")
+    r = taos_with(target, "info", MODELS / "rs25_hotfire.toml", "--friction", "broken-law", fork=False)
     assert r.returncode == 2, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "taos_broken_plugin" in r.stderr and "missing dep" in r.stderr
     # a broken plug-in does not touch models using other laws
-    r = taos_with(target, "info", MODELS / "rs25_hotfire.toml")
+    r = taos_with(target, "info", MODELS / "rs25_hotfire.toml", fork=False)
     assert r.returncode == 0, r.stderr
 
 

@@ -24,6 +24,7 @@ from taos.planar.simulate import TimeHistory
 from taos.viewer import EngineDrawing, load_run, offline_html, viewer_frames
 from taos.viewer.kinematics import AXES
 
+from . import _forkserver
 from .conftest import MODELS
 
 CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking",
@@ -223,8 +224,8 @@ def test_live_view_serves_on_loopback_renders_and_stops_on_sigint(tmp_path):
     h5 = tmp_path / "run.h5"
     big_motion_run().to_hdf5(h5)
     exe = Path(sys.executable).parent / "taos"
-    proc = subprocess.Popen([str(exe), "view", str(h5)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=tmp_path)
+    # the command as a new process, forked from the test process's fork server (Popen-like)
+    proc = _forkserver.popen([str(exe), "view", str(h5)], tmp_path)
     try:
         url, lines, t_end = None, [], time.time() + 40
         while url is None and time.time() < t_end:
