@@ -100,6 +100,8 @@ def run_law(law: str, duration: float | None, spent: dict) -> dict:
 
 
 def main() -> None:
+    from rk4_stage_bits import save_compare   # (this folder: the script's own)
+
     from taos.friction._builtin import modules
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -116,14 +118,7 @@ def main() -> None:
     print(f"laws: {', '.join(laws)}")
     print("CPU s: " + ", ".join(f"{k} {v:.2f}" for k, v in spent.items()))
     print(f"load {load0:.2f} -> {os.getloadavg()[0]:.2f}")
-    np.savez(a.save, **res)
-    if a.compare:
-        ref = np.load(a.compare)
-        bad = sorted(set(ref.files) ^ set(res))
-        bad += [k for k in ref.files if k in res and not (ref[k].dtype == res[k].dtype and ref[k].shape == res[k].shape
-                                                           and ref[k].tobytes() == res[k].tobytes())]
-        print(f"{len(res)} arrays against {a.compare}: " + ("all bit-identical" if not bad else f"DIFFER: {bad}"))
-        sys.exit(1 if bad else 0)
+    save_compare(res, a.save, a.compare)
 
 
 if __name__ == "__main__":

@@ -85,6 +85,19 @@ def masv(repeat: int) -> tuple[dict, float]:
     return res, best
 
 
+def save_compare(res: dict, save: str, compare: str | None) -> None:
+    """Keep the arrays ``res`` in ``save`` (.npz); with ``compare`` (a reference .npz), report
+    whether every array equals the reference's bit for bit and exit 1 if not."""
+    np.savez(save, **res)
+    if compare:
+        ref = np.load(compare)
+        bad = sorted(set(ref.files) ^ set(res))
+        bad += [k for k in ref.files if k in res and not (ref[k].dtype == res[k].dtype and ref[k].shape == res[k].shape
+                                                           and ref[k].tobytes() == res[k].tobytes())]
+        print(f"{len(res)} arrays against {compare}: " + ("all bit-identical" if not bad else f"DIFFER: {bad}"))
+        sys.exit(1 if bad else 0)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--save", required=True)
@@ -100,14 +113,7 @@ def main() -> None:
     print(f"masv kernel, core_stage 5 s at 4e-4 s: {t2:.3f} s CPU, best of {a.repeat}")
     print(f"load {load0:.2f} -> {os.getloadavg()[0]:.2f}")
     res = {**r1, **r2}
-    np.savez(a.save, **res)
-    if a.compare:
-        ref = np.load(a.compare)
-        bad = sorted(set(ref.files) ^ set(res))
-        bad += [k for k in ref.files if k in res and not (ref[k].dtype == res[k].dtype and ref[k].shape == res[k].shape
-                                                           and ref[k].tobytes() == res[k].tobytes())]
-        print(f"{len(res)} arrays against {a.compare}: " + ("all bit-identical" if not bad else f"DIFFER: {bad}"))
-        sys.exit(1 if bad else 0)
+    save_compare(res, a.save, a.compare)
 
 
 if __name__ == "__main__":
