@@ -194,3 +194,34 @@ def test_the_command_output_matches_and_names_its_kernels(cache, tmp_path):
         for k in ("piston", "engine"):
             d.pop(k)
     assert c == n
+
+
+def test_a_build_prunes_libraries_unused_for_30_days_and_nothing_else(tmp_path, monkeypatch):
+    """The cache does not grow with every kernel change: a build removes the libraries (all
+    their files) whose newest file is older than PRUNE_AFTER_S, and killed builds' folders as
+    old; a recently used library, the one just built and files not of this module stay. A load
+    marks the manifest it used, so a library in use is never the oldest."""
+    import time
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setattr(_cdwell, "_LOADED", {})
+    folder = _cdwell.cache_dir()
+    folder.mkdir(parents=True)
+    old = time.time() - _cdwell.PRUNE_AFTER_S - 86400.0
+    stale, fresh = "a" * 32, "b" * 32
+    for k in (stale, fresh):
+        for ext in ("so", "json", "failed"):
+            (folder / f"{k}.{ext}").write_text(k)
+    (folder / "notes.txt").write_text("not ours")
+    (folder / ".build-killed").mkdir()
+    for f in [*folder.glob(f"{stale}.*"), folder / "notes.txt", folder / ".build-killed", folder / f"{fresh}.so"]:
+        os.utime(f, (old, old))   # the fresh library: its .so old, its manifest used recently
+    key = _cdwell.cache_key("none", _cdwell.compiler())
+    _cdwell.build("none", folder)
+    left = sorted(p.name for p in folder.iterdir())
+    assert left == sorted(["notes.txt", f"{fresh}.so", f"{fresh}.json", f"{fresh}.failed", f"{key}.so", f"{key}.json"])
+    # a load marks its manifest: made old, loaded, it is recent again
+    os.utime(folder / f"{key}.json", (old, old))
+    assert _cdwell.load("none").name == "c"
+    assert time.time() - (folder / f"{key}.json").stat().st_mtime < 60
+    assert _cdwell.prune(folder, keep="none of these") == []   # nothing older than 30 days is left

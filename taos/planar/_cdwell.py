@@ -36,6 +36,12 @@ CPU time. :func:`load` uses a law's own library when there is one, else that sha
 of each function is the same text in both, compiled with the same flags (IEEE arithmetic, no
 contraction): the same numbers either way.
 
+Every load marks the library's manifest as used (its modification time); each build then removes
+the libraries of this cache not used for :data:`PRUNE_AFTER_S` (:func:`prune`: those of a source,
+compiler or machine no longer current), so the cache does not grow with every change of the
+kernels. Only this module's own files are touched (``KEY.so``, ``KEY.json``, ``KEY.failed`` with
+a 32-digit key, and its ``.build-*`` folders).
+
 When numba runs instead (:func:`dwell_kernels` returns :data:`taos.planar._expplan.NUMBA`): the
 environment sets ``TAOS_KERNELS=numba``; the law is not a built-in one (a plug-in or a law
 registered at run time: its kernel may not be translatable); no C compiler (``$CC``, ``cc``,
@@ -71,6 +77,8 @@ SOURCES = ("planar/_expstep.py", "planar/_expplan.py", "planar/dynamics.py", "pl
            "friction/_laws.py", "cosim/_ccode.py", "cosim/_ccode_func.py",
            "cosim/_ccode_stmt.py", "planar/_cdwell.py")
 ROOT = Path(__file__).resolve().parents[1]
+#: a library not loaded for this long [s] (30 days) is removed by the next build (module docstring)
+PRUNE_AFTER_S = 30 * 86400.0
 _LOCK = threading.Lock()
 _LOADED: dict[str, "CKernels"] = {}
 
@@ -229,7 +237,47 @@ def _compile(cc: str, key: str, name: str, src: str, manifest: dict, folder: Pat
         (Path(tmp) / "m.json").write_text(json.dumps(manifest, indent=1))
         os.replace(so, folder / f"{key}.so")
         os.replace(Path(tmp) / "m.json", folder / f"{key}.json")   # written last: the library is complete
+    prune(folder, keep=key)
     return folder / f"{key}.so"
+
+
+def prune(folder: Path, keep: str, max_age_s: float = PRUNE_AFTER_S, now: float | None = None) -> list[str]:
+    """Remove from ``folder`` every library (``KEY.so``, ``KEY.json``, ``KEY.failed``) other than
+    ``keep`` whose newest file is older than ``max_age_s`` [s] at ``now`` [s, Unix time; default:
+    the clock], and this module's ``.build-*`` folders as old (a killed build's); returns the keys
+    removed. A load marks its manifest (:func:`_mark_used`), so a library in use stays; nothing
+    else in ``folder`` is touched; a file another process removes first is skipped."""
+    import re
+    import time
+
+    now = time.time() if now is None else now
+    ages: dict[str, float] = {}
+    try:
+        names = list(folder.iterdir())
+    except OSError:
+        return []
+    for f in names:
+        m = re.fullmatch(r"([0-9a-f]{32})\.(so|json|failed)", f.name)
+        try:
+            if m and m.group(1) != keep:
+                ages[m.group(1)] = max(ages.get(m.group(1), -float("inf")), f.stat().st_mtime)
+            elif f.name.startswith(".build-") and f.is_dir() and now - f.stat().st_mtime > max_age_s:
+                shutil.rmtree(f, ignore_errors=True)
+        except OSError:
+            continue
+    gone = sorted(k for k, t in ages.items() if now - t > max_age_s)
+    for k in gone:
+        for ext in ("json", "so", "failed"):   # the manifest first: a half-removed library is not loaded
+            (folder / f"{k}.{ext}").unlink(missing_ok=True)
+    return gone
+
+
+def _mark_used(manifest: Path) -> None:
+    """Mark the library of ``manifest`` as used now (its modification time; :func:`prune`)."""
+    try:
+        os.utime(manifest)
+    except OSError:   # a read-only cache: the library is used all the same
+        pass
 
 
 class CKernels:
@@ -329,6 +377,7 @@ def load(law: str, retry: bool = False) -> CKernels:
                 if attempt or not man.is_file():
                     build(law, folder)
                 ks = CKernels(so, json.loads(man.read_text()))
+                _mark_used(man)
                 break
             except CUnavailable as e:
                 _write_failure(failed, str(e))
@@ -346,9 +395,11 @@ def _from_all(folder: Path, cc: str, law: str) -> CKernels | None:
     ``folder``, or None (none there, or not loadable: the law's own library is built instead)."""
     key = cache_key_all(cc)
     try:
-        return CKernels(folder / f"{key}.so", json.loads((folder / f"{key}.json").read_text()), law)
+        ks = CKernels(folder / f"{key}.so", json.loads((folder / f"{key}.json").read_text()), law)
     except (OSError, ValueError, KeyError, AttributeError):
         return None
+    _mark_used(folder / f"{key}.json")
+    return ks
 
 
 def warm() -> None:
