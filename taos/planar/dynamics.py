@@ -87,7 +87,7 @@ def _rates(x, z, r, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, dx):
         for j in range(nr):
             s += Br[i, j] * r[j]
         dx[i] = s
-    _lim.apply(lim, x, u, dx)  # actuator/gimbal limits (taos.planar.saturation); no-op when none
+    _lim.apply_inlined(lim, x, u, dx)  # actuator/gimbal limits (taos.planar.saturation); no-op when none
     return dz, tf, u
 
 
@@ -115,40 +115,63 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
     at the step start.
 
     ``x`` (n,) [x] (in place), ``z`` [rad]; ``r0``, ``rm``, ``r1`` (n_r,) [r] the external input
-    at the step's start, middle and end; ``dt`` [s]; plant arrays, ``fid``, ``fp``, ``avp``:
-    module docstring; ``k1``..``k4``, ``xt`` (n,) scratch (k1 receives the derivative at the
-    step start).
+    at the step's start, middle and end (``r0`` is the stages' input buffer: it holds ``r1`` on
+    return, so callers fill all three before every step, as they do); ``dt`` [s]; plant arrays,
+    ``fid``, ``fp``, ``avp``: module docstring; ``k1``..``k4``, ``xt`` (n,) scratch (k1 receives
+    the derivative at the step start).
 
     Compiled once, not inlined: :func:`integrate_samples`, :func:`sine_steps` and the shooting
     periods (:mod:`taos.planar.steady`) call this one step. :func:`_rates` stays inlined (called
     out of line, its ~110 scalar arguments cost 30 % of the warm step), ONCE: the four stages are
-    a loop choosing the stage's state, input, coefficient and derivative array, as
-    :func:`integrate_segments_lanes` (inlined at each stage, numba typed and LLVM optimised four
-    copies). Each stage's arithmetic is the classical step's, operation for operation; z's
-    increment is summed in the order the four-copy step's compile gave it (the same bits:
-    benchmarks/planar_step_bits.py, benchmarks/RESULTS.md "stage4")."""
+    a loop, as :func:`integrate_segments_lanes` (inlined at each stage, numba typed and LLVM
+    optimised four copies). The loop passes the same arrays to every stage: the stage's state is
+    written into ``xt``, its input into ``r0`` and its derivative into ``k4`` (copied to
+    ``k1``..``k3``). An array variable chosen per stage instead (``ks = k2``, ...) costs numba an
+    atomic reference-count increment and decrement per stage and array (its ``NRT_incref`` and
+    ``NRT_decref``, which its reference-count pruning leaves in a loop with calls), about 10 % of
+    the step (benchmarks/RESULTS.md "nrt"). Each stage's arithmetic is the classical step's,
+    operation for operation; z's increment is summed in the order the four-copy step's compile
+    gave it (the same bits: benchmarks/planar_step_bits.py, benchmarks/RESULTS.md "stage4", "nrt")."""
     n = x.shape[0]
+    nr = r0.shape[0]
     h2 = 0.5 * dt
     dz1, dz2, dz3, dzs, tf, u = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    xs, zs, rs, ks = x, z, r0, k1   # stage 1: the derivative at the step start (k1), T_f and u there
     for st in range(4):
-        if st > 0:  # stages 2-4: x + c k_prev, z + c dz_prev at the middle (c = dt/2) or end (c = dt)
-            c, kp, dzp, ks, rs = h2, k1, dz1, k2, rm
-            if st == 2:
-                kp, dzp, ks = k2, dz2, k3
-            elif st == 3:
-                c, kp, dzp, ks, rs = dt, k3, dz3, k4, r1
+        # the stage's state into xt and its input into r0 (stage 1: r0 itself)
+        if st == 0:
             for i in range(n):
-                xt[i] = x[i] + c * kp[i]
-            xs, zs = xt, z + c * dzp
-        dz, tfs, us = _rates(xs, zs, rs, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, ks)
+                xt[i] = x[i]
+            zs = z
+        elif st == 1:
+            for i in range(n):
+                xt[i] = x[i] + h2 * k1[i]
+            zs = z + h2 * dz1
+            for j in range(nr):
+                r0[j] = rm[j]
+        elif st == 2:
+            for i in range(n):
+                xt[i] = x[i] + h2 * k2[i]
+            zs = z + h2 * dz2
+        else:
+            for i in range(n):
+                xt[i] = x[i] + dt * k3[i]
+            zs = z + dt * dz3
+            for j in range(nr):
+                r0[j] = r1[j]
+        dz, tfs, us = _rates(xt, zs, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k4)
         if st == 0:
             dz1, tf, u = dz, tfs, us
+            for i in range(n):
+                k1[i] = k4[i]
         elif st == 1:
             dz2 = dz
+            for i in range(n):
+                k2[i] = k4[i]
         elif st == 2:
             dz3 = dz
             dzs = 2.0 * (dz3 + dz2) + dz1
+            for i in range(n):
+                k3[i] = k4[i]
         else:
             dzs = dzs + dz
     for i in range(n):

@@ -126,7 +126,7 @@ def stop_torque(th, om, th_max, k_s, c_s):
     return -sg * max(0.0, k_s * pen + c_s * sg * om)
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, inline="always")
 def apply_valve_pressure(lim, x, off, u, dx):
     """Add the rate-limit and pressure-limit corrections to ``dx[off:off+m]`` for the state
     ``x[off:off+m]`` and post-avionics command ``u`` [rad]; no-op for an empty ``lim``.
@@ -205,7 +205,10 @@ def pressure_flow_correction(lim, q, p):
 def apply(lim, x, u, dx):
     """All limits on a planar plant's whole state (valve, pressure, hard stop): ``lim`` packed
     over the whole state (m = n), ``x`` the state, ``u`` the post-avionics command [rad],
-    ``dx`` the derivative corrected in place (as :func:`apply_valve_pressure` with off = 0)."""
+    ``dx`` the derivative corrected in place (as :func:`apply_valve_pressure` with off = 0).
+
+    :data:`apply_inlined` is the same function inlined where it is called (the RK4 rates of
+    :mod:`taos.planar.dynamics`, four calls a step)."""
     if lim.shape[0] == 0:
         return
     # int(0): a run-time zero, not the literal 0 (a literal argument of a jitted call compiles a
@@ -218,6 +221,13 @@ def apply(lim, x, u, dx):
         if t != 0.0:
             _axpy(lim, ROW_STOP_IN, m, t, dx, 0)
 
+
+#: :func:`apply` inlined (numba ``inline="always"``) into the planar RK4 step's rates, called four
+#: times a step: called out of line, each of its array arguments costs numba an atomic
+#: reference-count increment and decrement a call, about 15 % of the step (benchmarks/RESULTS.md
+#: "nrt"). The same Python function (its ``py_func``), so the same arithmetic, bit for bit; the
+#: exponential kernels, which call it once a step, keep the out-of-line :func:`apply`.
+apply_inlined = njit(fastmath=_FM, inline="always")(apply.py_func)
 
 # -- the same laws across lanes (many plants in lockstep: taos.planar.dynamics._rates_lanes) ----
 # Each is the scalar law above written as one element-wise loop over the lanes, the branches as
