@@ -104,8 +104,7 @@ def _finite(x, z):
 def work_buffers(n, nr):
     """Scratch of one RK4 integration: the stages k1..k4 and the trial state (n,), the input
     at the step start, middle and end (nr,); ``n`` states, ``nr`` external inputs."""
-    return (np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
-            np.empty(nr), np.empty(nr), np.empty(nr))
+    return np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(nr), np.empty(nr), np.empty(nr)
 
 
 @njit(cache=True, fastmath=_FM)
@@ -114,50 +113,31 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
     """Advance (x, z) by one classical RK4 step in place; return (z_new [rad], T_f [N m], u [rad])
     at the step start.
 
-    ``x`` (n,) [x] (in place), ``z`` [rad]; ``r0``, ``rm``, ``r1`` (n_r,) [r] the external input
-    at the step's start, middle and end (``r0`` is the stages' input buffer: it holds ``r1`` on
-    return, so callers fill all three before every step, as they do); ``dt`` [s]; plant arrays,
-    ``fid``, ``fp``, ``avp``: module docstring; ``k1``..``k4``, ``xt`` (n,) scratch (k1 receives
-    the derivative at the step start).
+    ``x`` (n,) [x] (in place), ``z`` [rad]; ``r0``, ``rm``, ``r1`` (n_r,) [r] the input at the step's
+    start, middle and end (``r0`` holds ``r1`` on return: callers fill all three every step);
+    ``dt`` [s]; plant arrays, ``fid``, ``fp``, ``avp``: module docstring; ``k1``..``k4``, ``xt``
+    (n,) scratch (k1 receives the derivative at the step start).
 
     Compiled once, not inlined: :func:`integrate_samples`, :func:`sine_steps` and the shooting
-    periods (:mod:`taos.planar.steady`) call this one step. :func:`_rates` stays inlined (called
-    out of line, its ~110 scalar arguments cost 30 % of the warm step), ONCE: the four stages are
-    a loop, as :func:`integrate_segments_lanes` (inlined at each stage, numba typed and LLVM
-    optimised four copies). The loop passes the same arrays to every stage: the stage's state is
-    written into ``xt``, its input into ``r0`` and its derivative into ``k4`` (copied to
-    ``k1``..``k3``). An array variable chosen per stage instead (``ks = k2``, ...) costs numba an
-    atomic reference-count increment and decrement per stage and array (its ``NRT_incref`` and
-    ``NRT_decref``, which its reference-count pruning leaves in a loop with calls), about 10 % of
-    the step (benchmarks/RESULTS.md "nrt"). Each stage's arithmetic is the classical step's,
-    operation for operation; z's increment is summed in the order the four-copy step's compile
-    gave it (the same bits: benchmarks/planar_step_bits.py, benchmarks/RESULTS.md "stage4", "nrt")."""
+    periods (:mod:`taos.planar.steady`) call this one step. :func:`_rates` is inlined (out of
+    line, its ~110 scalar arguments cost 30 % of the step) ONCE: the stages are a loop passing the
+    same arrays to every stage (state ``xt``, input ``r0``, derivative ``k4``, copied to k1..k3),
+    as an array chosen per stage (``ks = k2``) costs numba an atomic reference-count increment
+    and decrement per stage (RESULTS.md "nrt"). Each stage's arithmetic is the classical step's;
+    z's increment is summed in the order the four-copy step's compile gave it (the same bits:
+    benchmarks/planar_step_bits.py; RESULTS "stage4", "nrt")."""
     n = x.shape[0]
-    nr = r0.shape[0]
     h2 = 0.5 * dt
-    dz1, dz2, dz3, dzs, tf, u = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    dz, dz1, dz2, dzs, tf, u = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     for st in range(4):
-        # the stage's state into xt and its input into r0 (stage 1: r0 itself)
-        if st == 0:
-            for i in range(n):
-                xt[i] = x[i]
-            zs = z
-        elif st == 1:
-            for i in range(n):
-                xt[i] = x[i] + h2 * k1[i]
-            zs = z + h2 * dz1
-            for j in range(nr):
-                r0[j] = rm[j]
-        elif st == 2:
-            for i in range(n):
-                xt[i] = x[i] + h2 * k2[i]
-            zs = z + h2 * dz2
-        else:
-            for i in range(n):
-                xt[i] = x[i] + dt * k3[i]
-            zs = z + dt * dz3
-            for j in range(nr):
-                r0[j] = r1[j]
+        # stage 1 at (x, z, r0); 2-4 at x + c k_prev (in k4), z + c dz_prev, mid (c = dt/2) or end (dt)
+        c = dt if st == 3 else h2
+        for i in range(n):
+            xt[i] = x[i] if st == 0 else x[i] + c * k4[i]
+        zs = z if st == 0 else z + c * dz
+        if st == 1 or st == 3:
+            for j in range(r0.shape[0]):
+                r0[j] = rm[j] if st == 1 else r1[j]
         dz, tfs, us = _rates(xt, zs, r0, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp, k4)
         if st == 0:
             dz1, tf, u = dz, tfs, us
@@ -168,16 +148,15 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
             for i in range(n):
                 k2[i] = k4[i]
         elif st == 2:
-            dz3 = dz
-            dzs = 2.0 * (dz3 + dz2) + dz1
+            dzs = 2.0 * (dz + dz2) + dz1   # dz3 = dz
             for i in range(n):
                 k3[i] = k4[i]
         else:
             dzs = dzs + dz
     for i in range(n):
         x[i] += dt * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0
-    # z's increment (dz1 + 2 dz2 + 2 dz3 + dz4) dt / 6 [rad] as (2 (dz3 + dz2) + dz1) + dz4: the order
-    # LLVM's reassociation ("reassoc") gave the four-copy step; the loop's phis would get another
+    # z's increment (dz1 + 2 dz2 + 2 dz3 + dz4) dt / 6 [rad] as (2 (dz3 + dz2) + dz1) + dz4: the
+    # order LLVM's reassociation gave the four-copy step
     z = z + dt * dzs / 6.0
     return z, tf, u
 
