@@ -107,7 +107,7 @@ def work_buffers(n, nr):
     return np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(nr), np.empty(nr), np.empty(nr)
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, _nrt=False)
 def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp, avp,
               k1, k2, k3, k4, xt):
     """Advance (x, z) by one classical RK4 step in place; return (z_new [rad], T_f [N m], u [rad])
@@ -120,12 +120,13 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
 
     Compiled once, not inlined: :func:`integrate_samples`, :func:`sine_steps` and the shooting
     periods (:mod:`taos.planar.steady`) call this one step. :func:`_rates` is inlined (out of
-    line, its ~110 scalar arguments cost 30 % of the step) ONCE: the stages are a loop passing the
-    same arrays to every stage (state ``xt``, input ``r0``, derivative ``k4``, copied to k1..k3),
-    as an array chosen per stage (``ks = k2``) costs numba an atomic reference-count increment
-    and decrement per stage (RESULTS.md "nrt"). Each stage's arithmetic is the classical step's;
-    z's increment is summed in the order the four-copy step's compile gave it (the same bits:
-    benchmarks/planar_step_bits.py; RESULTS "stage4", "nrt")."""
+    line, its ~110 scalar arguments cost 30 % of the step) ONCE: the stages are a loop passing
+    the same arrays to every stage (state ``xt``, input ``r0``, derivative ``k4``, copied to
+    k1..k3). Compiled without numba's reference counting (``_nrt=False``; it allocates nothing):
+    an atomic increment and decrement for each array argument on every call, and for each array
+    an inlined callee binds per stage, were 60-70 % of the step (RESULTS.md "nrt"). Each stage's
+    arithmetic is the classical step's; z's increment is summed in the order the four-copy
+    step's compile gave it (the same bits: benchmarks/planar_step_bits.py; "stage4", "nrt")."""
     n = x.shape[0]
     h2 = 0.5 * dt
     dz, dz1, dz2, dzs, tf, u = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0

@@ -224,9 +224,9 @@ def apply(lim, x, u, dx):
 
 #: :func:`apply` inlined (numba ``inline="always"``) into the planar RK4 step's rates, called four
 #: times a step: called out of line, each of its array arguments costs numba an atomic
-#: reference-count increment and decrement a call, about 15 % of the step (benchmarks/RESULTS.md
-#: "nrt"). The same Python function (its ``py_func``), so the same arithmetic, bit for bit; the
-#: exponential kernels, which call it once a step, keep the out-of-line :func:`apply`.
+#: reference-count increment and decrement a call (benchmarks/RESULTS.md "nrt"). The same Python
+#: function (its ``py_func``), so the same arithmetic, bit for bit; the exponential kernels, which
+#: call it once a step, keep the out-of-line :func:`apply`.
 apply_inlined = njit(fastmath=_FM, inline="always")(apply.py_func)
 
 # -- the same laws across lanes (many plants in lockstep: taos.planar.dynamics._rates_lanes) ----
