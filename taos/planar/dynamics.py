@@ -124,9 +124,8 @@ def _rk4_step(x, z, r0, rm, r1, dt, A, Br, bc, bf, cc, dc, cw, ca, lim, fid, fp,
     the same arrays to every stage (state ``xt``, input ``r0``, derivative ``k4``, copied to
     k1..k3). Compiled without numba's reference counting (``_nrt=False``; it allocates nothing):
     an atomic increment and decrement for each array argument on every call, and for each array
-    an inlined callee binds per stage, were 60-70 % of the step (RESULTS.md "nrt"). Each stage's
-    arithmetic is the classical step's; z's increment is summed in the order the four-copy
-    step's compile gave it (the same bits: benchmarks/planar_step_bits.py; "stage4", "nrt")."""
+    an inlined callee binds per stage, were 60-70 % of the step (RESULTS.md "nrt"). Same bits as
+    the classical step's four copies (benchmarks/planar_step_bits.py; RESULTS "stage4", "nrt")."""
     n = x.shape[0]
     h2 = 0.5 * dt
     dz, dz1, dz2, dzs, tf, u = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
