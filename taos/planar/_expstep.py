@@ -142,10 +142,13 @@ def etd_coefficients(A: np.ndarray, h: float):
     return _xc.etd_coefficients(A, h, expm_small)
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, _nrt=False)
 def _matvec_add(M, v, out, scale):
     """out += scale * M v. (Not inlined, as :func:`_nonlin`: compiled once per process and cache;
-    LLVM still inlines it into its callers when it links them, so the warm step is unchanged.)"""
+    LLVM still inlines it into its callers when it links them, so the warm step is unchanged.)
+    This function, :func:`_stair`, :func:`_nonlin` and :func:`etdrk4_step`, called every step and
+    allocating nothing, are compiled without numba's reference counting (``_nrt=False``): an
+    atomic increment and decrement per array argument and call (benchmarks/RESULTS.md "nrt")."""
     n = out.shape[0]
     for i in range(n):
         s = 0.0
@@ -176,7 +179,7 @@ def _g_at(G, D, H, M, tau, out, scale):
         out[k] += scale * (h00 * G[i, k] + h10 * d * D[i, k] + h01 * G[i + 1, k] + h11 * d * D[i + 1, k])
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, _nrt=False)
 def _stair(G, D, H, M, cmax, w, ph0, ph1, avp, out):
     """out = the staircase's response over one half step (module docstring, part 2): the
     command c = cmax sin(phase) [rad] from phase ``ph0`` to ``ph1`` [rad] (one monotone
@@ -221,7 +224,7 @@ def _stair(G, D, H, M, cmax, w, ph0, ph1, avp, out):
     return u
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, _nrt=False)
 def _nonlin(x, z, r, u, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, N):
     """N(x, z, t) of the module docstring into ``N`` (n,) [x/s]; returns dz/dt [rad/s]. ``r``
     the external input [r], ``u`` the avionics output [rad]; with ``stair`` false the command
@@ -246,7 +249,7 @@ def _nonlin(x, z, r, u, stair, A, Br, bc, bf, cw, ca, lim, fid, fp, N):
     return dz
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, _nrt=False)
 def etdrk4_step(x, z, r0, rm, r1, u0, um, u1, stair, g1, g2, A, Br, bc, bf, cw, ca, lim, fid, fp, E, E2, P2, F1, F2,
                 F3, dt, Nu, Na, Nb, Nc, a, b, c, xn, tmp):
     """One ETDRK4 step of length ``dt`` [s] (module docstring, part 3) in place on ``x`` (n,)
