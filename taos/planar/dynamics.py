@@ -166,41 +166,32 @@ def integrate_samples(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0, 
                       rec_every, y_out, aux_out):
     """Integrate over the input samples ``r`` taken every ``dt``.
 
-    Parameters
-    ----------
-    A, Br, bc, bf, cc, dc, cw, ca, lim
-        The plant (module docstring: shapes and units).
-    Cy : (n_y, n) float64
-        Recorded outputs [y per x].
-    fid, fp, avp
-        The friction law's ``rates`` kernel and packed parameters, the packed avionics
-        (module docstring).
-    x0 : (n,) float64
-        Initial state [x] (not modified).
-    z0 : float
-        Initial friction state [rad].
-    r : (n_steps + 1, n_r) float64
-        External input samples [r], linearly interpolated between samples.
-    dt : float
-        Step [s].
-    rec_every : int
-        Record every that many steps.
-    y_out : (n_steps // rec_every + 1, n_y) float64
-        Receives Cy x.
-    aux_out : (n_steps // rec_every + 1, N_AUX) float64
-        Receives (T_f [N m], z [rad], u [rad]) (columns ``AUX_*``).
+    Parameters: ``A, Br, bc, bf, cc, dc, cw, ca, lim`` the plant, ``fid, fp, avp`` the friction
+    law's ``rates`` kernel and packed parameters and the packed avionics (module docstring:
+    shapes and units); ``Cy`` (n_y, n) the recorded outputs [y per x]; ``x0`` (n,) the initial
+    state [x] (not modified), ``z0`` the initial friction state [rad]; ``r`` (n_steps + 1, n_r)
+    the external input samples [r], linearly interpolated between samples; ``dt`` the step [s];
+    ``rec_every`` record every that many steps; ``y_out`` (n_steps // rec_every + 1, n_y)
+    receives Cy x, ``aux_out`` (n_steps // rec_every + 1, N_AUX) receives (T_f [N m], z [rad],
+    u [rad]) (columns ``AUX_*``).
 
     Returns -1 on success or the index of the step whose state became non-finite.
 
     Runs without the GIL: independent calls in threads of one process run on all cores, each
     with the same numbers as alone (:mod:`taos.planar._parallel`).
     """
-    n = x0.shape[0]
-    x = x0.copy()
-    z = z0
+    return _sample_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x0.copy(), z0, r, dt, rec_every,
+                         y_out, aux_out, *work_buffers(x0.shape[0], r.shape[1]))
+
+
+@njit(cache=True, fastmath=_FM, _nrt=False)
+def _sample_steps(A, Br, bc, bf, cc, dc, cw, ca, lim, Cy, fid, fp, avp, x, z, r, dt, rec_every, y_out, aux_out,
+                  k1, k2, k3, k4, xt, r0, rm, r1):
+    """The steps of :func:`integrate_samples` from ``x`` (advanced in place) and ``z``, with its
+    scratch (:func:`work_buffers`); compiled without numba's reference counting (as :func:`_rk4_step`)."""
+    n = x.shape[0]
     nsteps = r.shape[0] - 1
     nr = r.shape[1]
-    k1, k2, k3, k4, xt, r0, rm, r1 = work_buffers(n, nr)
     rec = 0
     for k in range(nsteps + 1):
         k1n = min(k + 1, nsteps)
