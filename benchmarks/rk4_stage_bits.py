@@ -5,7 +5,9 @@ four stages through one inlined copy of their rates).
 
 Runs (1) a 32-run batch of the soft case of models/montecarlo/post_separation.toml through the
 RK4 lanes at 1 ms (:func:`taos.planar.dynamics.integrate_segments_lanes`, as
-``integrator = "rk4"``) and (2) masv simulate (:func:`masv._kernel.integrate`) on
+``integrator = "rk4"``), (2) the same batch through the ETDRK4 lanes at the campaign's 5 ms
+(:func:`taos.planar._explanes.integrate_segments_lanes_exp`, the Monte Carlo default; added on
+branch lanesnrt) and (3) masv simulate (:func:`masv._kernel.integrate`) on
 models/masv/core_stage.toml over the first 5 s of the Green Run two-axis profile; keeps every
 array the kernels write (records, statuses) and the batch's stored outputs in ``--save``, and
 with ``--compare`` reports whether each equals the reference file's bit for bit (exit 1 if not).
@@ -40,26 +42,30 @@ def _capture(mod, name, outs, spent, idx):
     return lambda: setattr(mod, name, orig)
 
 
-def lanes(runs: int, repeat: int) -> tuple[dict, float]:
+def lanes(runs: int, repeat: int, exp: bool = False) -> tuple[dict, float]:
+    import taos.planar._explanes as xl
     import taos.planar.dynamics as dyn
     from taos.montecarlo import load_campaign
     from taos.montecarlo.executor import flight_runs, montecarlo_design
     c = load_campaign("post_separation")
     kind, _ = flight_runs(c, "soft", None)
-    kind = replace(kind, campaign=replace(c, integrator="rk4", dt_s=1e-3))
+    if not exp:
+        kind = replace(kind, campaign=replace(c, integrator="rk4", dt_s=1e-3))
+    mod, name, idx, tag = ((xl, "integrate_segments_lanes_exp", (19, 20, 21), "exp") if exp
+                           else (dyn, "integrate_segments_lanes", (17, 18, 19), "lanes"))
     d = montecarlo_design(c, runs + 1)
     kind.run_batch(d.names, d.factors[:2], d.seeds[:2])   # load the compiled kernel
     best, res = float("inf"), {}
     for _ in range(repeat):
         outs, spent = [], []
-        undo = _capture(dyn, "integrate_segments_lanes", outs, spent, (17, 18, 19))
+        undo = _capture(mod, name, outs, spent, idx)
         try:
             got = kind.run_batch(d.names, d.factors[1:], d.seeds[1:])
         finally:
             undo()
         best = min(best, sum(spent))
-        res = {f"lanes_call{i}_{j}": a for i, o in enumerate(outs) for j, a in enumerate(o)}
-        res.update({f"lanes_batch_{k}": np.asarray(v) for k, v in got.items() if k != "error"})
+        res = {f"{tag}_call{i}_{j}": a for i, o in enumerate(outs) for j, a in enumerate(o)}
+        res.update({f"{tag}_batch_{k}": np.asarray(v) for k, v in got.items() if k != "error"})
     return res, best
 
 
@@ -107,12 +113,15 @@ def main() -> None:
     a = ap.parse_args()
     load0 = os.getloadavg()[0]
     r1, t1 = lanes(a.runs, a.repeat)
+    r3, t3 = lanes(a.runs, a.repeat, exp=True)
     r2, t2 = masv(a.repeat)
     print(f"RK4 lanes kernel, {a.runs} runs x 200 s at 1 ms: {t1:.3f} s CPU ({t1 / a.runs * 1e3:.1f} ms a run), "
           f"best of {a.repeat}")
+    print(f"ETDRK4 lanes kernel, {a.runs} runs x 200 s at 5 ms: {t3:.3f} s CPU ({t3 / a.runs * 1e3:.1f} ms a run), "
+          f"best of {a.repeat}")
     print(f"masv kernel, core_stage 5 s at 4e-4 s: {t2:.3f} s CPU, best of {a.repeat}")
     print(f"load {load0:.2f} -> {os.getloadavg()[0]:.2f}")
-    res = {**r1, **r2}
+    res = {**r1, **r3, **r2}
     save_compare(res, a.save, a.compare)
 
 

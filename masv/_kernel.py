@@ -237,7 +237,6 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0
     Returns -1, or the step at which the state became non-finite."""
     n = x0.shape[0]
     na = z0.shape[0]
-    nl = m * na
     x, z = x0.copy(), z0.copy()
     K, D = np.empty((4, n)), np.empty((4, na))   # the stages' dx/dt and dz/dt
     xt, zt = np.empty(n), np.empty(na)
@@ -246,6 +245,24 @@ def integrate(ml, mp, mx, mv, ql, rl, H, m, nw, ws0, fidl, fp, avp, amap, x0, z0
     c0, cm, c1 = np.empty(nc), np.empty(nc), np.empty(nc)
     W = np.zeros(nw)
     aux = np.empty(len(R_ROWS) * na)
+    return _steps(ml, mp, mx, mv, ql, rl, H, m, ws0, fidl, fp, avp, amap, r, dt, rec_every, x_out, v_out, z_out,
+                  x, z, K, D, xt, zt, u0, um, u1, c0, cm, c1, W, aux)
+
+
+@njit(cache=True, fastmath=_FM, nogil=True, _nrt=False)
+def _steps(ml, mp, mx, mv, ql, rl, H, m, ws0, fidl, fp, avp, amap, r, dt, rec_every, x_out, v_out, z_out,
+           x, z, K, D, xt, zt, u0, um, u1, c0, cm, c1, W, aux):
+    """The steps of :func:`integrate` (its arguments; ``x`` (n_x,) [x], ``z`` (n_a,) [rad] the
+    states, advanced in place; the rest its scratch); returns as it. Compiled without numba's
+    reference counting (``_nrt=False``; nothing is allocated here, the caller holds every array):
+    every array bound per stage (the operators' rows out of their tuples, ``H[k]``, the slices of
+    ``aux`` and ``W``, the parameters of the inlined rates) cost an atomic ``NRT_incref`` and
+    ``NRT_decref`` that numba's pruning left in the loop, a third of the run
+    (benchmarks/RESULTS.md, lanesnrt)."""
+    n = x.shape[0]
+    na = z.shape[0]
+    nl = m * na
+    nc = r.shape[1]
     nsteps = r.shape[0] - 1
     for j in range(nc):
         c1[j] = _av.apply(r[0, j], avp[j])

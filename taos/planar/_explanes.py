@@ -57,12 +57,14 @@ def _block_cols(M, V, OUT, nb, cols, scale):
                 OUT[i, q] += scale * M[i, j, q] * V[j, q]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _n_lanes(Z, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D, N):
     """N(x) of every lane (:func:`taos.planar.dynamics._rates_lanes` on N's matrix): one compiled
     copy the four stages call out of line (inlined four times, the kernel's cold compile took
     16.4 s instead of 6.5 s, for the same run time within the noise: the call's arguments are
-    amortised over the lanes; the same bits)."""
+    amortised over the lanes; the same bits). Without numba's reference counting, as
+    :func:`_exp_steps` (each array argument and callee parameter cost an atomic increment and
+    decrement a call)."""
     _dy._rates_lanes(Z, ip, ix, M, L, fidl, F, AVP, V, C, S, U, TF, D, N)
 
 
@@ -92,11 +94,8 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
         Receives -1 or the half-step sample at whose step that lane's state became non-finite.
     """
     n, nl = x0.shape
-    nseg = bounds.shape[0] - 1
-    nsamp = r.shape[1] - 1
     nr = r.shape[2]
-    X = x0.copy()
-    Z = z0.copy()
+    X, Z = x0.copy(), z0.copy()
     NU, NA, NB, NC = np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl))
     XA, XB, XC, T = np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl)), np.empty((n, nl))
     D1, D2, D3, D4 = np.empty(nl), np.empty(nl), np.empty(nl), np.empty(nl)
@@ -121,23 +120,33 @@ def integrate_segments_lanes_exp(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, 
         if ip[i + 1] > ip[i]:
             cols[cnt] = i
             cnt += 1
+    return _exp_steps(ip, ix, mx, H, fidl, fp, AVP, bounds, jdst, jsrc, jcoef, kick, r, h, nb, co, rec_every, x_out,
+                      aux_out, status, cols, X, Z, NU, NA, NB, NC, XA, XB, XC, T, D1, D2, D3, D4, ZA, ZB, ZC, U, TF, V, C,
+                      S, OK)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _exp_steps(ip, ix, mx, H, fidl, fp, AVP, bounds, jdst, jsrc, jcoef, kick, r, h, nb, co, rec_every, x_out,
+               aux_out, status, cols, X, Z, NU, NA, NB, NC, XA, XB, XC, T, D1, D2, D3, D4, ZA, ZB, ZC, U, TF, V, C,
+               S, OK):
+    """The steps of :func:`integrate_segments_lanes_exp` (its arguments, ``H``, ``AVP`` by slot,
+    ``cols`` (m,) int64 the block rows N reaches; ``X`` (n, R) [x], ``Z`` (R,) [rad] the states,
+    advanced in place; the rest its scratch); returns the lanes still finite. Without numba's
+    reference counting (``_nrt=False``; no allocation here), as
+    :func:`taos.planar.dynamics._lanes_steps`: every array bound per step (``CO[1]``, ...) or by
+    an inlined callee cost an atomic ``NRT_incref`` and ``NRT_decref`` (benchmarks/RESULTS.md,
+    lanesnrt)."""
+    n, nl = X.shape
+    nseg, nsamp, nr = bounds.shape[0] - 1, r.shape[1] - 1, r.shape[2]
     status[:] = -1
-    alive = nl
-    rec = 0
-    seg = 0
-    M = mx[0]
-    L = H[0]
-    F = fp[0]
-    CO = co[0]
+    alive, rec, seg = nl, 0, 0
+    M, L, F, CO = mx[0], H[0], fp[0], co[0]
     h2 = 0.5 * h
     h6 = h / 6.0
     for p in range(0, nsamp + 1, 2):
         if seg < nseg and p == bounds[seg]:
             _dy.lanes_jump(X, jdst, jsrc, jcoef, kick, seg)
-            M = mx[seg]
-            L = H[seg]
-            F = fp[seg]
-            CO = co[seg]
+            M, L, F, CO = mx[seg], H[seg], fp[seg], co[seg]
             seg += 1
         pm = min(p + 1, nsamp)
         p1 = min(p + 2, nsamp)

@@ -506,37 +506,38 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
     No fast-math: a lane's numbers are the same for any R and any position among the lanes.
     """
     n, nl = x0.shape
-    nseg = bounds.shape[0] - 1
-    nsteps = r.shape[1] - 1
     nr = r.shape[2]
-    X = x0.copy()
-    Z = z0.copy()
-    K = np.empty((4, n, nl))   # the stages' derivatives k1..k4 [x/s] and dz/dt [rad/s]
-    D = np.empty((4, nl))
-    ZT = np.empty(nl)
-    U, TF = np.empty(nl), np.empty(nl)
+    X, Z = x0.copy(), z0.copy()
+    K, D = np.empty((4, n, nl)), np.empty((4, nl))   # the stages' derivatives k1..k4 [x/s] and dz/dt [rad/s]
+    ZT, U, TF = np.empty(nl), np.empty(nl), np.empty(nl)
     R0, RM, R1 = np.empty((nr, nl)), np.empty((nr, nl)), np.empty((nr, nl))
     V = np.zeros((n + nr + 5, nl))  # rows 0..n-1: the stage's state, then its inputs (_rates_lanes)
-    C = np.empty((8, nl))
-    S = np.empty((2, nl))
-    OK = np.empty(nl)
+    C, S, OK = np.empty((8, nl)), np.empty((2, nl)), np.empty(nl)
     # the lanes' limit heads and avionics packs by slot (contiguous across lanes: vector loads)
     H = lanes_by_slot(head)
     AVP = np.ascontiguousarray(avp.T)
+    return _lanes_steps(ip, ix, mx, H, fidl, fp, AVP, bounds, jdst, jsrc, jcoef, kick, r, dt, rec_every, x_out, aux_out,
+                        status, X, Z, K, D, ZT, U, TF, R0, RM, R1, V, C, S, OK)
+
+
+@njit(cache=True, _nrt=False)
+def _lanes_steps(ip, ix, mx, H, fidl, fp, AVP, bounds, jdst, jsrc, jcoef, kick, r, dt, rec_every, x_out, aux_out,
+                 status, X, Z, K, D, ZT, U, TF, R0, RM, R1, V, C, S, OK):
+    """The steps of :func:`integrate_segments_lanes` (its arguments, ``H``, ``AVP`` by slot; ``X``
+    (n, R) [x], ``Z`` (R,) [rad] the states, advanced in place; the rest its scratch); returns
+    the lanes still finite. Without numba's reference counting (``_nrt=False``; no allocation
+    here): every array an inlined callee binds per stage cost an atomic ``NRT_incref`` and
+    ``NRT_decref`` its pruning left in the loop, 22 % of the run (benchmarks/RESULTS.md, lanesnrt)."""
+    n, nl = X.shape
+    nseg, nsteps, nr = bounds.shape[0] - 1, r.shape[1] - 1, r.shape[2]
     status[:] = -1
-    alive = nl
-    rec = 0
-    seg = 0
-    M = mx[0]
-    L = H[0]
-    F = fp[0]
+    alive, rec, seg = nl, 0, 0
+    M, L, F = mx[0], H[0], fp[0]
     h2 = 0.5 * dt
     for k in range(nsteps + 1):
         if seg < nseg and k == bounds[seg]:
             lanes_jump(X, jdst, jsrc, jcoef, kick, seg)
-            M = mx[seg]
-            L = H[seg]
-            F = fp[seg]
+            M, L, F = mx[seg], H[seg], fp[seg]
             seg += 1
         k1n = min(k + 1, nsteps)
         for j in range(nr):
@@ -546,10 +547,8 @@ def integrate_segments_lanes(ip, ix, mx, head, fidl, fp, avp, bounds, jdst, jsrc
         for j in range(nr):
             for q in range(nl):
                 RM[j, q] = 0.5 * (R0[j, q] + R1[j, q])
-        # the four stages through ONE inlined copy of _rates_lanes: inlined at each stage, the
-        # kernel's cold compile typed and lowered four copies; called out of line (one compiled
-        # function), its ~130 scalar arguments (arrays pass as their fields) cost 6 % of the
-        # kernel's run at 32 lanes (benchmarks/RESULTS.md, compile2); the same bits either way
+        # the four stages through ONE inlined copy of _rates_lanes (not four: the cold compile; not
+        # out of line: its ~130 scalar arguments, 6 % of the run; benchmarks/RESULTS.md, compile2)
         for st in range(4):
             if st == 0:   # the derivative at the step start (k1), with T_f and u there for the record
                 for j in range(nr):
