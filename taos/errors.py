@@ -493,9 +493,13 @@ def run_cli(parser: "argparse.ArgumentParser", argv: list[str] | None,
     except Exception as e:  # a bug: still one line unless --debug
         if debug:
             traceback.print_exc()
-        msg = " ".join(str(e).split())[:300]
-        print(f"{parser.prog}: internal error: {type(e).__name__}: {msg} (rerun with --debug for the traceback)",
-              file=sys.stderr)
+        # unless raised while the interrupt this handler raised unwound (a C extension's import
+        # turns a KeyboardInterrupt in its initialisation into "ImportError: initialization
+        # failed", the interrupt itself lost): then the interrupt (handler.received) is reported alone
+        if not handler.raised:
+            msg = " ".join(str(e).split())[:300]
+            print(f"{parser.prog}: internal error: {type(e).__name__}: {msg} (rerun with --debug for the traceback)",
+                  file=sys.stderr)
         rc = 1
     finally:
         handler.closing = True   # from here a signal is recorded, never raised
