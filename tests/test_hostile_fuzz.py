@@ -295,17 +295,22 @@ sys.exit(run_cli(ap, []))
 """
 
 
+def _ends_with_the_signals_line(script: str, signum: int) -> None:
+    """Run ``script`` (a ``run_cli`` command that signals itself with ``signum``, its argument):
+    it exits 128 + signum with the signal's one line, nothing else."""
+    r = subprocess.run([sys.executable, "-c", script, str(int(signum))], capture_output=True,
+                       text=True, env=_env(), timeout=120)
+    want = ("taos: interrupted (Ctrl-C); no partial output written" if signum == signal.SIGINT
+            else f"taos: terminated (signal {int(signum)}); no partial output written")
+    assert r.returncode == 128 + signum and r.stderr.splitlines() == [want], r.stderr
+
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_second_signal_inside_the_unraisable_hook_is_not_a_traceback(signum):
     """Issue 40: an interrupt swallowed by a callback reaches ``sys.unraisablehook``, which
     delivers it again; a second signal landing while the hook starts that delivery (made to land
     exactly there, not by timing) is recorded, never raised inside the hook ("Exception ignored in
     sys.unraisablehook" and a traceback); the run still stops in ordinary code with one line."""
-    r = subprocess.run([sys.executable, "-c", _SIGNAL_IN_HOOK, str(int(signum))], capture_output=True,
-                       text=True, env=_env(), timeout=120)
-    want = ("taos: interrupted (Ctrl-C); no partial output written" if signum == signal.SIGINT
-            else f"taos: terminated (signal {int(signum)}); no partial output written")
-    assert r.returncode == 128 + signum and r.stderr.splitlines() == [want], r.stderr
+    _ends_with_the_signals_line(_SIGNAL_IN_HOOK, signum)
 
 
 _INTERRUPT_TURNED_IMPORT_ERROR = """
@@ -333,11 +338,7 @@ def test_an_interrupt_turned_into_another_error_is_the_interrupt_alone(signum):
     interrupt lost; seen once as test_a_signal_at_any_moment's Ctrl-C at 0.6 s, an "internal
     error" line beside the interrupt's, 2 Dec 2026): an error raised while the interrupt unwinds
     is the interrupt, one line and its status (made to happen here, not by timing)."""
-    r = subprocess.run([sys.executable, "-c", _INTERRUPT_TURNED_IMPORT_ERROR, str(int(signum))], capture_output=True,
-                       text=True, env=_env(), timeout=120)
-    want = ("taos: interrupted (Ctrl-C); no partial output written" if signum == signal.SIGINT
-            else f"taos: terminated (signal {int(signum)}); no partial output written")
-    assert r.returncode == 128 + signum and r.stderr.splitlines() == [want], r.stderr
+    _ends_with_the_signals_line(_INTERRUPT_TURNED_IMPORT_ERROR, signum)
 
 _IGNORED_INT = """
 import argparse, os, signal, sys
