@@ -273,5 +273,13 @@ def main(argv: list[str] | None = None) -> int:
     return run(build_parser(), argv, check=check_arguments)
 
 
+def console() -> None:
+    """The installed ``masv`` script: :func:`main`, then the interpreter's exit without its
+    release of the loaded modules (:func:`taos.cli._exit.exit_process`)."""
+    from taos.cli._exit import exit_process
+
+    exit_process(main())
+
+
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    console()

@@ -1,17 +1,11 @@
-"""``python -m taos``: the ``taos`` command line."""
+"""``python -m taos``: the ``taos`` command line (:func:`taos.cli.console`).
 
-import os
-import sys
+The exit is :func:`taos.cli._exit.exit_process`'s ``os._exit(status)``, which also gives an
+interrupted run its documented status: under ``python -m`` the interpreter's own exit had ended
+such a run with the signal (-2) instead of 130 (seen 7 runs in 8 on a quiet machine; most likely
+CPython's "unhandled keyboard interrupt" flag, set inside a library call and checked at exit).
+"""
 
-from taos.cli import main
+from taos.cli import console
 
-rc = main()
-if rc in (130, 143):
-    # Interrupted: run_cli has printed its one line and written nothing. Under ``python -m`` the
-    # interpreter still ended such a run with the signal (-2) instead of 130 (seen 7 runs in 8 on
-    # a quiet machine; most likely CPython's "unhandled keyboard interrupt" flag, set inside a
-    # library call and checked at exit, not pinned down); so exit with the documented status.
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(rc)
-sys.exit(rc)
+console()

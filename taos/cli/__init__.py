@@ -88,5 +88,14 @@ def main(argv: list[str] | None = None) -> int:
     return run(parser, argv, check=check_arguments)
 
 
+def console() -> None:
+    """The installed ``taos`` script (and ``python -m taos``): :func:`main`, then the
+    interpreter's exit without its release of the loaded modules
+    (:func:`taos.cli._exit.exit_process`; about 0.1 CPU-s less a command)."""
+    from taos.cli._exit import exit_process
+
+    exit_process(main())
+
+
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    console()
