@@ -17,7 +17,8 @@ One command, default parts ``peer,soft`` (add ``--with-big`` for the 100,000-run
    run and stage, the lockstep kernel's friction before the laws' lane form, issue 44 point 4):
    its CPU seconds per run, kernel share, and whether its results equal the lane form's bit for
    bit; then the lane form timed again, in the same warm state, for the comparison (the first
-   timed batch pays a first-batch cost the later ones do not). Run from the project root with ``PYTHONPATH=.`` (it imports the reference from tests/).
+   timed batch pays a first-batch cost the later ones do not). Run from the project root with
+   ``PYTHONPATH=.`` (it imports the reference from tests/).
 2. The soft campaign, ``--runs`` runs on a LocalCluster of 2 workers, end to end (cluster start-up
    included), as ``taos montecarlo post_separation --runs N --case soft`` runs it; its LCO
    fraction. With ``--previous TREE`` (a checkout of the previous code, e.g. ``git worktree add
